@@ -1,0 +1,63 @@
+"""DRT's render settings, stored in the .blend as `scene.drt`."""
+import bpy
+from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
+
+SAMPLER_ITEMS = [
+    ("jittered", "Jittered", "Stratified jittered samples with Cook's ray-id chaining across "
+     "dimensions (correlated multi-jittering)"),
+    ("sobol", "Sobol", "Owen-scrambled Sobol quasi-Monte Carlo points"),
+    ("random", "Random", "Independent uniform random samples (a baseline)"),
+]
+INTEGRATOR_ITEMS = [
+    ("path", "Path Tracing", "Kajiya path tracing: full global illumination with next-event "
+     "estimation and multiple importance sampling"),
+]
+FILTER_ITEMS = [
+    ("BLACKMAN_HARRIS", "Blackman-Harris", "Blackman-Harris filter, as Cycles"),
+    ("BOX", "Box", "Box filter"),
+]
+
+
+class DRTRenderSettings(bpy.types.PropertyGroup):
+    samples: IntProperty(name="Samples", description="Samples per pixel",
+                         default=64, min=1, max=1 << 24, soft_max=4096)
+    seed: IntProperty(name="Seed", description="Seed of every random number of the render; "
+                      "different seeds give independent images", default=0, min=0)
+    sampler: EnumProperty(name="Sampler", items=SAMPLER_ITEMS, default="jittered")
+    integrator: EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="path")
+    max_bounces: IntProperty(name="Total", description="Maximum number of bounces",
+                             default=12, min=0, max=1024)
+    diffuse_bounces: IntProperty(name="Diffuse", default=4, min=0, max=1024)
+    glossy_bounces: IntProperty(name="Glossy", default=4, min=0, max=1024)
+    transmission_bounces: IntProperty(name="Transmission", default=12, min=0, max=1024)
+    transparent_bounces: IntProperty(name="Transparent", default=8, min=0, max=1024)
+    clamp_direct: FloatProperty(name="Direct Light", description="Clamp direct light "
+                                "samples to this value (0 disables)", default=0.0, min=0.0)
+    clamp_indirect: FloatProperty(name="Indirect Light", description="Clamp indirect light "
+                                  "samples to this value (0 disables)", default=10.0, min=0.0)
+    filter_type: EnumProperty(name="Filter", items=FILTER_ITEMS, default="BLACKMAN_HARRIS")
+    filter_width: FloatProperty(name="Width", description="Pixel filter width in pixels",
+                                default=1.5, min=0.01, max=10.0, subtype="PIXEL")
+    threads: IntProperty(name="Threads", description="Worker threads (0 = all cores)",
+                         default=0, min=0, max=256)
+
+    def to_engine_settings(self):
+        from .engine_link import engine
+        return engine.RenderSettings(
+            samples=self.samples, seed=self.seed, sampler=self.sampler,
+            integrator=self.integrator, max_bounces=self.max_bounces,
+            diffuse_bounces=self.diffuse_bounces, glossy_bounces=self.glossy_bounces,
+            transmission_bounces=self.transmission_bounces,
+            transparent_bounces=self.transparent_bounces, clamp_direct=self.clamp_direct,
+            clamp_indirect=self.clamp_indirect, filter_type=self.filter_type,
+            filter_width=self.filter_width, threads=self.threads)
+
+
+def register():
+    bpy.utils.register_class(DRTRenderSettings)
+    bpy.types.Scene.drt = PointerProperty(type=DRTRenderSettings)
+
+
+def unregister():
+    del bpy.types.Scene.drt
+    bpy.utils.unregister_class(DRTRenderSettings)

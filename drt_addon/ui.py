@@ -1,0 +1,87 @@
+"""Render Properties panels for DRT, and DRT added to Blender's own Camera, Light,
+Material and World panels (the way Cycles' add-on does), so users edit the usual fields."""
+import bpy
+
+ENGINE = "DRT"
+
+
+class DRTPanel:
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "render"
+    COMPAT_ENGINES = {ENGINE}
+
+    @classmethod
+    def poll(cls, context):
+        return context.engine in cls.COMPAT_ENGINES
+
+
+class DRT_PT_sampling(DRTPanel, bpy.types.Panel):
+    bl_label = "Sampling"
+
+    def draw(self, context):
+        s = context.scene.drt
+        col = self.layout.column()
+        col.use_property_split = True
+        col.prop(s, "samples")
+        col.prop(s, "sampler")
+        col.prop(s, "seed")
+        col.prop(s, "integrator")
+        col.prop(s, "threads")
+
+
+class DRT_PT_light_paths(DRTPanel, bpy.types.Panel):
+    bl_label = "Light Paths"
+
+    def draw(self, context):
+        s = context.scene.drt
+        col = self.layout.column(align=True)
+        col.use_property_split = True
+        for name in ("max_bounces", "diffuse_bounces", "glossy_bounces",
+                     "transmission_bounces", "transparent_bounces"):
+            col.prop(s, name)
+        col = self.layout.column(align=True)
+        col.use_property_split = True
+        col.prop(s, "clamp_direct")
+        col.prop(s, "clamp_indirect")
+
+
+class DRT_PT_film(DRTPanel, bpy.types.Panel):
+    bl_label = "Film"
+
+    def draw(self, context):
+        s = context.scene.drt
+        col = self.layout.column()
+        col.use_property_split = True
+        col.prop(s, "filter_type")
+        col.prop(s, "filter_width")
+
+
+CLASSES = (DRT_PT_sampling, DRT_PT_light_paths, DRT_PT_film)
+
+# Blender's own panels that also make sense for DRT (beyond those Cycles already shares).
+_EXTRA_PANELS = ("DATA_PT_light", "DATA_PT_spot", "DATA_PT_area", "DATA_PT_sunlight")
+
+
+def _builtin_panels():
+    for name in dir(bpy.types):
+        cls = getattr(bpy.types, name, None)
+        engines = getattr(cls, "COMPAT_ENGINES", None)
+        if not isinstance(engines, set) or not getattr(cls, "__module__", "").startswith("bl_ui"):
+            continue
+        if "CYCLES" in engines or name in _EXTRA_PANELS:
+            yield cls
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    for panel in _builtin_panels():
+        panel.COMPAT_ENGINES.add(ENGINE)
+
+
+def unregister():
+    for panel in _builtin_panels():
+        panel.COMPAT_ENGINES.discard(ENGINE)
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

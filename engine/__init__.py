@@ -1,0 +1,13 @@
+"""DRT's tracer: distribution ray tracing and path tracing on NumPy and Embree.
+
+Never imports bpy. The input is an `engine.scene.Scene`, the output an `engine.film.Film`.
+"""
+from .film import Film
+from .render import RenderContext, RenderStats, render
+from .scene import (AreaLight, Camera, Material, PointLight, Scene, SunLight, TriangleMesh,
+                    World)
+from .settings import RenderSettings
+
+__all__ = ["AreaLight", "Camera", "Film", "Material", "PointLight", "RenderContext",
+           "RenderSettings", "RenderStats", "Scene", "SunLight", "TriangleMesh", "World",
+           "render"]

@@ -1,0 +1,1 @@
+"""Reflection models, all in the local shading frame (normal = +Z)."""

@@ -1,0 +1,174 @@
+"""Kajiya's path tracer, wavefront style, with next-event estimation and MIS.
+
+A batch of paths advances one bounce at a time. At each surface vertex:
+  1. emission seen by the incoming ray (area and sphere lights are hit analytically,
+     weighted against light sampling by the power heuristic);
+  2. next-event estimation: one light picked in proportion to its power, one point on it,
+     one shadow ray, weighted against BSDF sampling by the power heuristic;
+  3. BSDF sampling over the lobes whose bounce budget (Cycles' diffuse, glossy,
+     transmission and total limits) is not used up; Russian roulette after three bounces.
+Where no lobe may continue, light sampling takes the whole weight (no MIS), so direct
+light stays unbiased with zero bounces.
+
+Radiance sums are float64: a path's throughput is a product of many factors and the
+film sums millions of them.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..bsdf.lobes import TRANSMISSION
+from ..bsdf.principled import PrincipledBSDF
+from ..sampling import dimensions as D
+from ..surface import offset_origin
+from ..warp import to_local, to_world
+
+ROULETTE_START = 3
+
+
+def power_heuristic(a, b):
+    a2, b2 = a * a, b * b
+    with np.errstate(invalid="ignore", over="ignore"):
+        w = np.where(np.isinf(a), 1.0, a2 / np.where(a2 + b2 > 0, a2 + b2, 1.0))
+    return np.where(np.isinf(b) & ~np.isinf(a), 0.0, w)
+
+
+def _clamp(values, limit):
+    if limit <= 0:
+        return values
+    m = values.max(axis=1, keepdims=True)
+    return np.where(m > limit, values * (limit / np.maximum(m, 1e-300)), values)
+
+
+class PathIntegrator:
+    def __init__(self, ctx):
+        self.ctx = ctx                       # engine.render.RenderContext
+        s = ctx.settings
+        self.limits = np.array([s.diffuse_bounces, s.glossy_bounces, s.transmission_bounces])
+        self.max_bounces = s.max_bounces
+
+    def radiance(self, pixel, index, origins, dirs, tmax):
+        """Radiance along camera rays; pixel/index give each path's sampler coordinates."""
+        ctx = self.ctx
+        sampler, lights, mats, s = ctx.sampler, ctx.lights, ctx.materials, ctx.settings
+        n = len(pixel)
+        L = np.zeros((n, 3))
+        # Per-path state, indexed by path id; `path` lists the live ones.
+        beta = np.ones((n, 3))
+        counts = np.zeros((n, 3), dtype=np.int64)
+        path = np.arange(n)
+        o, d, tm = origins, dirs, tmax
+        prev_pdf = np.full(n, np.inf)        # camera rays count as specular: MIS weight 1
+        prev_pos = o
+
+        def add(rows, contrib, depth, direct=False):
+            # Cycles' clamps: direct light at the first hit, indirect beyond it;
+            # what the camera sees directly is never clamped.
+            limit = s.clamp_direct if direct else (s.clamp_indirect if depth > 0 else 0.0)
+            L[rows] += _clamp(contrib, limit)   # rows are unique: one entry per path
+
+        for depth in range(self.max_bounces + 1):
+            if path.size == 0:
+                break
+            px, ix = pixel[path], index[path]
+            b = beta[path]
+            hits = ctx.accel.intersect(o, d, tm)
+            t_geom = np.where(hits.hit, hits.t, tm)
+            alive = np.ones(path.size, dtype=bool)
+
+            # 1a. area and sphere lights in front of the geometry
+            if len(lights):
+                t_l, k_l, le = lights.hit_surfaces(o, d, t_geom)
+                on_light = k_l >= 0
+                if depth == 0:
+                    on_light &= ctx.light_visible_camera[np.maximum(k_l, 0)]
+                if on_light.any():
+                    sel = np.nonzero(on_light)[0]
+                    light_pdf = lights.pdf(k_l[sel], prev_pos[sel], d[sel], t_l[sel])
+                    w = power_heuristic(prev_pdf[sel], light_pdf)
+                    add(path[sel], b[sel] * le[sel] * w[:, None], depth)
+                    alive[sel] = False
+            # 1b. escaped rays: world background and sun discs
+            escaped = alive & ~hits.hit
+            if escaped.any():
+                sel = np.nonzero(escaped)[0]
+                env = np.broadcast_to(ctx.world_radiance, (sel.size, 3)).copy()
+                for k, sun in lights.suns():
+                    w = power_heuristic(prev_pdf[sel],
+                                        sun.pdf(None, d[sel], None) * lights.select_pdf[k])
+                    env += sun.escaped(d[sel]) * w[:, None]
+                add(path[sel], b[sel] * env, depth)
+                alive[sel] = False
+            live = np.nonzero(alive)[0]
+            if live.size == 0:
+                break
+
+            # The surfaces hit
+            si = ctx.surfaces.build(hits, live, d)
+            ns, ng = si.shading_normal, si.geometric_normal
+            wo = to_local(-d[live], ns)
+            rows = path[live]
+            b_live = b[live]
+            px_l, ix_l = px[live], ix[live]
+            # 1c. emissive surfaces (two-sided, like Cycles' Emission shader)
+            if mats.any_emission:
+                em = mats.emission[si.material]
+                if em.any():
+                    add(rows, b_live * em, depth)
+
+            bsdf = PrincipledBSDF.from_materials(mats, si.material)
+            c_live = counts[rows]
+            allowed = (c_live < self.limits[None, :]) & (depth < self.max_bounces)
+
+            # 2. next-event estimation
+            if len(lights):
+                u_pick = sampler.get_1d(D.bounce_dim(depth, D.LIGHT_PICK), px_l, ix_l)
+                u_pt = sampler.get_2d(D.bounce_dim(depth, D.LIGHT_POINT), px_l, ix_l)
+                ls, _, delta = lights.sample(si.position, u_pick, u_pt)
+                wi_local = to_local(ls.wi, ns)
+                f = bsdf.eval_f(wo, wi_local)
+                ok = ((ls.pdf > 0) & (ls.radiance.max(1) > 0) & (f.max(1) > 0)
+                      & ((ls.wi * ng).sum(1) > 0))
+                if ok.any():
+                    sel = np.nonzero(ok)[0]
+                    org = offset_origin(si.position[sel], ng[sel], si.scale[sel], ls.wi[sel])
+                    dist = ls.dist[sel]
+                    # stop short of the light by the same relative margin as the origin
+                    far = np.where(np.isfinite(dist), dist * (1.0 - 2e-5), ctx.scene_radius * 4.0)
+                    vis = ~ctx.accel.occluded(org, ls.wi[sel], np.maximum(far, 0.0))
+                    if vis.any():
+                        sv = sel[vis]
+                        bsdf_pdf = bsdf.pdf(wo, wi_local, allowed)[sv]
+                        w = np.where(delta[sv], 1.0, power_heuristic(ls.pdf[sv], bsdf_pdf))
+                        contrib = (b_live[sv] * f[sv] * np.abs(wi_local[sv, 2:3])
+                                   * ls.radiance[sv] * (w / ls.pdf[sv])[:, None])
+                        add(rows[sv], contrib, depth, direct=depth == 0)
+
+            # 3. continue by BSDF sampling
+            u_lobe = sampler.get_1d(D.bounce_dim(depth, D.BSDF_LOBE), px_l, ix_l)
+            u_dir = sampler.get_2d(D.bounce_dim(depth, D.BSDF_DIR), px_l, ix_l)
+            bs = bsdf.sample(wo, u_lobe, u_dir, allowed)
+            wi_world = to_world(bs.wi, ns)
+            # reflection leaves on the geometric normal's side, refraction through it
+            side = (wi_world * ng).sum(1)
+            cont = bs.valid & allowed.any(1) & np.where(bs.kind == TRANSMISSION, side < 0, side > 0)
+            new_beta = b_live * bs.weight
+            if depth + 1 >= ROULETTE_START:
+                u_rr = sampler.get_1d(D.bounce_dim(depth, D.ROULETTE), px_l, ix_l)
+                q = np.clip(new_beta.max(1), 0.0, 0.95)
+                survive = u_rr < q
+                new_beta = new_beta / np.where(survive, np.maximum(q, 1e-300), 1.0)[:, None]
+                cont &= survive
+            cont &= new_beta.max(1) > 0
+            keep = np.nonzero(cont)[0]
+            if keep.size == 0:
+                break
+            path = rows[keep]
+            beta[path] = new_beta[keep]
+            counts[path, bs.kind[keep]] += 1
+            d = wi_world[keep]
+            o = offset_origin(si.position[keep], ng[keep], si.scale[keep], d)
+            tm = np.full(keep.size, np.inf)
+            prev_pos = si.position[keep]
+            prev_pdf = np.where(bs.delta[keep], np.inf, bs.pdf[keep])
+        return L

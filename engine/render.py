@@ -1,0 +1,172 @@
+"""The render driver: turns a Scene and RenderSettings into a Film.
+
+Work is split into units of (a block of pixels) x (a range of sample indices), each at
+most `settings.chunk_paths` paths, so memory is bounded by the chunk size, never by
+samples x pixels. Units run on a thread pool: Embree and most NumPy kernels release the
+GIL, so threads use every core. Samples go in passes (progressive rendering): after each
+pass the caller's `progress` callback sees the film, and `cancelled` is polled between
+units, so a cancel returns within one unit's time and leaves a valid partial film (each
+pixel is the mean of the samples it got).
+
+Any sample range [sample_start, sample_end) renders on its own and the films of disjoint
+ranges merge exactly (`Film.merge`): every random number is a function of (seed, pixel,
+sample index, dimension), see `engine.sampling`.
+"""
+from __future__ import annotations
+
+import os
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .accel import Accelerator
+from .bsdf.principled import MaterialTable
+from .camera import CameraModel
+from .film import Film
+from .integrators.path import PathIntegrator
+from .lights import LightSet
+from .pixel_filter import PixelFilter
+from .sampling import dimensions as D
+from .sampling import make_sampler
+from .scene import Scene
+from .settings import RenderSettings
+from .surface import SurfaceBuilder
+
+
+@dataclass
+class RenderStats:
+    samples_done: int = 0
+    paths: int = 0
+    nonfinite_samples: int = 0
+    seconds: float = 0.0
+    cancelled: bool = False
+
+    def paths_per_second(self) -> float:
+        return self.paths / self.seconds if self.seconds > 0 else 0.0
+
+
+class RenderContext:
+    """Everything a render needs, built once per scene (the acceleration structure is the
+    expensive part)."""
+
+    def __init__(self, scene: Scene, settings: RenderSettings):
+        settings.validate()
+        self.scene, self.settings = scene, settings
+        self.camera = CameraModel(scene.camera, scene.width, scene.height, scene.pixel_aspect)
+        self.filter = PixelFilter(settings.filter_type, settings.filter_width)
+        self.sampler = make_sampler(settings.sampler, settings.seed, settings.samples)
+        self.accel = Accelerator(scene.meshes, threads=1)
+        self.surfaces = SurfaceBuilder(self.accel, scene.meshes)
+        self.materials = MaterialTable(scene.materials)
+        self.scene_radius = _scene_radius(scene, self.accel)
+        self.lights = LightSet(scene.lights, self.scene_radius)
+        self.light_visible_camera = np.array(
+            [getattr(m, "visible_camera", True) for m in self.lights.models] or [True])
+        self.world_radiance = np.asarray(scene.world.color, dtype=np.float64)[:3]
+        self.integrator = PathIntegrator(self)
+
+    def close(self):
+        self.accel.close()
+
+
+def _scene_radius(scene: Scene, accel: Accelerator) -> float:
+    pts = [accel.positions] if len(accel.positions) else []
+    for l in scene.lights:
+        if hasattr(l, "position"):
+            pts.append(np.asarray(l.position, dtype=np.float64)[None])
+        elif hasattr(l, "matrix"):
+            pts.append(np.asarray(l.matrix, dtype=np.float64)[None, :3, 3])
+    pts.append(np.asarray(scene.camera.matrix, dtype=np.float64)[None, :3, 3])
+    allp = np.concatenate(pts)
+    lo, hi = allp.min(0), allp.max(0)
+    return float(max(np.linalg.norm(hi - lo) * 0.5, 1e-6))
+
+
+def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sample_end: int):
+    """Radiance of samples [sample_start, sample_end) of each pixel in `pixels`.
+    Returns (pixel ids, radiance (n, 3) float64)."""
+    k = sample_end - sample_start
+    pixel = np.repeat(pixels.astype(np.int64), k)
+    index = np.tile(np.arange(sample_start, sample_end, dtype=np.int64), len(pixels))
+    w = ctx.scene.width
+    u_pix = ctx.sampler.get_2d(D.PIXEL, pixel, index)
+    offset = ctx.filter.sample(u_pix)
+    film_xy = np.stack([pixel % w + 0.5 + offset[:, 0], pixel // w + 0.5 + offset[:, 1]], axis=1)
+    lens_u = ctx.sampler.get_2d(D.LENS, pixel, index) if ctx.camera.has_lens else None
+    rays = ctx.camera.generate(film_xy, lens_u)
+    radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax)
+    return pixel, radiance
+
+
+def plan_passes(total: int, first: int = 1, growth: float = 2.0, largest: int = 64):
+    """Sample counts per progressive pass: 1, 2, 4, ... up to `largest` per pass."""
+    passes, size, done = [], first, 0
+    while done < total:
+        size = min(size, total - done)
+        passes.append((done, done + size))
+        done += size
+        size = min(int(size * growth) or 1, largest)
+    return passes
+
+
+def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
+           sample_end: int | None = None, progress=None, cancelled=None,
+           context: RenderContext | None = None):
+    """Render samples [sample_start, sample_end) (default: all of settings.samples).
+
+    progress(film, stats, fraction) is called after every pass; cancelled() is polled
+    between work units. Returns (film, stats)."""
+    ctx = context or RenderContext(scene, settings)
+    sample_end = settings.samples if sample_end is None else sample_end
+    if not (0 <= sample_start < sample_end):
+        raise ValueError(f"empty or negative sample range [{sample_start}, {sample_end})")
+    film = Film(scene.width, scene.height)
+    stats = RenderStats()
+    n_pixels = scene.width * scene.height
+    threads = settings.threads or min(os.cpu_count() or 1, 8)
+    lock = threading.Lock()
+    t0 = time.perf_counter()
+    total = sample_end - sample_start
+    stop = threading.Event()
+
+    def run(pixels, a, b):
+        if stop.is_set():
+            return 0
+        pix, rad = render_unit(ctx, pixels, a, b)
+        bad = ~np.isfinite(rad).all(axis=1)
+        if bad.any():
+            rad[bad] = 0.0
+        with lock:
+            film.add(pix, rad)
+            stats.paths += len(pix)
+            stats.nonfinite_samples += int(bad.sum())
+        return len(pix)
+
+    try:
+        with ThreadPoolExecutor(threads) as pool:
+            for a, b in plan_passes(total):
+                a, b = a + sample_start, b + sample_start
+                per_unit = max(1, settings.chunk_paths // (b - a))
+                futures = []
+                for start in range(0, n_pixels, per_unit):
+                    pixels = np.arange(start, min(start + per_unit, n_pixels))
+                    futures.append(pool.submit(run, pixels, a, b))
+                for f in futures:
+                    if cancelled is not None and not stop.is_set() and cancelled():
+                        stop.set()
+                    f.result()
+                if stop.is_set():
+                    stats.cancelled = True
+                    break
+                stats.samples_done = b - sample_start
+                stats.seconds = time.perf_counter() - t0
+                if progress is not None:
+                    progress(film, stats, stats.samples_done / total)
+    finally:
+        if context is None:
+            ctx.close()
+    stats.seconds = time.perf_counter() - t0
+    return film, stats

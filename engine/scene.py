@@ -1,0 +1,173 @@
+"""The scene description: the whole contract between the Blender exporter and the tracer.
+
+Plain NumPy arrays and small dataclasses, nothing else, so the tracer is tested without
+Blender and the exporter is tested without tracing. Units and conventions follow Blender:
+metres, right-handed world with +Z up, cameras looking down their local -Z with +Y up,
+colours in scene-linear Rec.709, light strengths in Blender's watts (converted to radiance
+in `engine.lights`, which is the only place that knows Cycles' unit conventions).
+
+Precision: geometry is stored in float64 so that the exporter never loses bits; the
+acceleration structure rounds to float32 (Embree's only format) and hit points are rebuilt
+in float64 from barycentrics (see `engine.surface`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+
+@dataclass
+class Material:
+    """The part of a Principled BSDF the tracer understands, with Blender's meanings.
+
+    roughness maps to GGX alpha = roughness**2 as in Cycles. `emission` is radiance
+    (colour times strength), no extra 1/pi.
+    """
+    name: str = "default"
+    base_color: tuple = (0.8, 0.8, 0.8)
+    metallic: float = 0.0
+    roughness: float = 0.5
+    ior: float = 1.5
+    transmission: float = 0.0
+    specular_ior_level: float = 0.5
+    emission: tuple = (0.0, 0.0, 0.0)
+    alpha: float = 1.0
+
+    def is_emissive(self) -> bool:
+        return max(self.emission) > 0.0
+
+
+@dataclass
+class TriangleMesh:
+    """One evaluated mesh in world space (instances are expanded by the exporter).
+
+    positions: (V, 3) float64 vertex positions.
+    triangles: (T, 3) int32 vertex indices.
+    material_indices: (T,) int32 indices into `Scene.materials`.
+    corner_normals: optional (T, 3, 3) float32 shading normals per triangle corner
+        (Blender's split normals); None means flat shading.
+    uvs: optional (T, 3, 2) float32 texture coordinates per corner.
+    """
+    name: str
+    positions: np.ndarray
+    triangles: np.ndarray
+    material_indices: np.ndarray
+    corner_normals: Optional[np.ndarray] = None
+    uvs: Optional[np.ndarray] = None
+
+    def __post_init__(self):
+        self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)
+        self.triangles = np.ascontiguousarray(self.triangles, dtype=np.int32).reshape(-1, 3)
+        self.material_indices = np.ascontiguousarray(
+            self.material_indices, dtype=np.int32).reshape(-1)
+        if self.material_indices.size == 1 and len(self.triangles) != 1:
+            self.material_indices = np.full(len(self.triangles), self.material_indices[0], np.int32)
+        if len(self.material_indices) != len(self.triangles):
+            raise ValueError(f"mesh {self.name!r}: {len(self.material_indices)} material indices "
+                             f"for {len(self.triangles)} triangles")
+        if len(self.triangles) and (self.triangles.min() < 0
+                                    or self.triangles.max() >= len(self.positions)):
+            raise ValueError(f"mesh {self.name!r}: triangle index out of range")
+
+
+@dataclass
+class PointLight:
+    """A point light, or a sphere light when radius > 0. strength: RGB watts (Blender's
+    colour x power x 2**exposure). Spot lights add a cone: spot_size is the full cone
+    angle in radians, spot_blend Blender's 0..1 blend, `direction` the light's -Z axis."""
+    position: tuple
+    strength: tuple
+    radius: float = 0.0
+    spot_size: Optional[float] = None
+    spot_blend: float = 0.0
+    direction: tuple = (0.0, 0.0, -1.0)
+    name: str = "point"
+
+
+@dataclass
+class SunLight:
+    """A distant light. strength: RGB irradiance in W/m^2 at normal incidence; direction
+    is where the light travels (the lamp's -Z); angle the full angular diameter, radians."""
+    direction: tuple
+    strength: tuple
+    angle: float = 0.0
+    name: str = "sun"
+
+
+@dataclass
+class AreaLight:
+    """A one-sided area light emitting along its local -Z.
+
+    matrix: 4x4 light-to-world transform (scale allowed), shape one of 'SQUARE',
+    'RECTANGLE', 'DISK', 'ELLIPSE'; size_x/size_y in local units; strength RGB watts;
+    normalize as Blender's `normalize` (radiance divided by the area when True)."""
+    matrix: np.ndarray
+    strength: tuple
+    shape: str = "SQUARE"
+    size_x: float = 1.0
+    size_y: float = 1.0
+    normalize: bool = True
+    visible_camera: bool = True
+    name: str = "area"
+
+
+@dataclass
+class Camera:
+    """A Blender camera reduced to what rays need.
+
+    matrix: 4x4 camera-to-world (scale is removed by the camera model).
+    kind: 'PERSP' or 'ORTHO'. For PERSP, `fov_x`/`fov_y` are implied by
+    sensor_width/sensor_height/lens/sensor_fit like Blender; for ORTHO, ortho_scale is
+    the extent along the fitted axis. shift_x/shift_y are in units of the fitted
+    extent, as in Blender. aperture_radius in metres (0 = pinhole), focus_distance in
+    metres, blades 0 for a round aperture.
+    """
+    matrix: np.ndarray
+    kind: str = "PERSP"
+    lens: float = 50.0
+    sensor_width: float = 36.0
+    sensor_height: float = 24.0
+    sensor_fit: str = "AUTO"
+    ortho_scale: float = 6.0
+    shift_x: float = 0.0
+    shift_y: float = 0.0
+    clip_start: float = 0.1
+    clip_end: float = 1000.0
+    aperture_radius: float = 0.0
+    focus_distance: float = 10.0
+    blades: int = 0
+    blade_rotation: float = 0.0
+    aperture_ratio: float = 1.0
+
+
+@dataclass
+class World:
+    """Uniform background radiance (colour x strength)."""
+    color: tuple = (0.0, 0.0, 0.0)
+
+
+@dataclass
+class Scene:
+    camera: Camera
+    width: int
+    height: int
+    meshes: list = field(default_factory=list)
+    materials: list = field(default_factory=lambda: [Material()])
+    lights: list = field(default_factory=list)
+    world: World = field(default_factory=World)
+    pixel_aspect: float = 1.0
+
+    def __post_init__(self):
+        if self.width < 1 or self.height < 1:
+            raise ValueError(f"resolution must be positive, got {self.width}x{self.height}")
+        if not self.materials:
+            self.materials = [Material()]
+        for m in self.meshes:
+            if len(m.material_indices) and m.material_indices.max() >= len(self.materials):
+                raise ValueError(f"mesh {m.name!r} uses a material index beyond the "
+                                 f"{len(self.materials)} materials")
+
+    def triangle_count(self) -> int:
+        return int(sum(len(m.triangles) for m in self.meshes))

@@ -1,0 +1,54 @@
+"""Render settings, with Cycles' defaults where Cycles has the same setting."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+SAMPLERS = ("jittered", "sobol", "random")
+INTEGRATORS = ("path",)
+
+
+@dataclass
+class RenderSettings:
+    samples: int = 64
+    seed: int = 0
+    sampler: str = "jittered"
+    integrator: str = "path"
+    # Light paths (Cycles' defaults)
+    max_bounces: int = 12
+    diffuse_bounces: int = 4
+    glossy_bounces: int = 4
+    transmission_bounces: int = 12
+    transparent_bounces: int = 8
+    clamp_direct: float = 0.0         # 0 = off, as in Cycles
+    clamp_indirect: float = 10.0
+    # Film
+    filter_type: str = "BLACKMAN_HARRIS"
+    filter_width: float = 1.5
+    # Execution: paths per work unit bounds memory (about 1 KB of state per path).
+    chunk_paths: int = 1 << 16
+    threads: int = 0                   # 0 = all cores
+
+    def validate(self) -> "RenderSettings":
+        problems = []
+        if not isinstance(self.samples, int) or self.samples < 1 or self.samples > 1 << 24:
+            problems.append(f"samples must be an integer in 1..16777216, got {self.samples!r}")
+        if self.sampler not in SAMPLERS:
+            problems.append(f"sampler must be one of {SAMPLERS}, got {self.sampler!r}")
+        if self.integrator not in INTEGRATORS:
+            problems.append(f"integrator must be one of {INTEGRATORS}, got {self.integrator!r}")
+        for name in ("max_bounces", "diffuse_bounces", "glossy_bounces",
+                     "transmission_bounces", "transparent_bounces"):
+            v = getattr(self, name)
+            if not isinstance(v, int) or v < 0 or v > 1024:
+                problems.append(f"{name} must be an integer in 0..1024, got {v!r}")
+        for name in ("clamp_direct", "clamp_indirect"):
+            v = getattr(self, name)
+            if not (v >= 0) or v == float("inf"):
+                problems.append(f"{name} must be a finite number >= 0 (0 = off), got {v!r}")
+        if not (0 < self.filter_width <= 100):
+            problems.append(f"filter_width must be in (0, 100] pixels, got {self.filter_width!r}")
+        if self.chunk_paths < 256:
+            problems.append("chunk_paths must be at least 256")
+        if problems:
+            raise ValueError("; ".join(problems))
+        return self
