@@ -1,8 +1,9 @@
 """The headless batch renderer on the bpy module.
 
     python -m drt_addon render SCENE.blend -o OUT.png [--samples N] [--seed S] [--frame F]
+    python -m drt_addon package [-o DIR]   (build the extension zip; see docs/install.md)
 
-Exit codes: 0 success, 2 bad arguments, 3 file missing or not a .blend, 4 render failed.
+Exit codes: 0 success, 2 bad arguments, 3 file missing or not a .blend, 4 render or package failed.
 Errors go to stderr as one line; no traceback reaches the user.
 """
 from __future__ import annotations
@@ -27,7 +28,7 @@ class CliError(Exception):
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
-        raise CliError(EXIT_USAGE, f"{self.prog}: error: {message}")
+        raise CliError(EXIT_USAGE, f"drt: error: {message} (see '{self.prog} --help')")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -44,6 +45,9 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--frame", type=int, help="frame to render (default: the current frame)")
     r.add_argument("--engine", default="DRT", choices=("DRT", "CYCLES"),
                    help="render engine (CYCLES for reference images)")
+    pk = sub.add_parser("package", help="build and validate the Blender extension zip "
+                                        "(downloads the pinned embreex wheels into wheels/)")
+    pk.add_argument("-o", "--output-dir", help="folder for the zip (default: build/)")
     return p
 
 
@@ -61,8 +65,25 @@ def check_blend(path: str) -> None:
         raise CliError(EXIT_FILE, f"drt: error: {path} is not a .blend file")
 
 
+def run_package(args) -> int:
+    from . import packaging
+    if args.output_dir and os.path.exists(args.output_dir) and not os.path.isdir(args.output_dir):
+        raise CliError(EXIT_USAGE, f"drt: error: {args.output_dir} is not a folder")
+    try:
+        zip_path = packaging.package(args.output_dir)
+    except packaging.PackagingError as e:
+        raise CliError(EXIT_RENDER, f"drt: error: package failed: {e}") from None
+    except Exception as e:
+        raise CliError(EXIT_RENDER, f"drt: error: package failed: {type(e).__name__}: {e}") \
+            from None
+    print(zip_path)
+    return EXIT_OK
+
+
 def run(argv) -> int:
     args = build_parser().parse_args(argv)
+    if args.command == "package":
+        return run_package(args)
     ext = os.path.splitext(args.output)[1].lower()
     if ext not in FORMATS:
         raise CliError(EXIT_USAGE, f"drt: error: unsupported output extension {ext or '(none)'!r};"
@@ -73,8 +94,11 @@ def run(argv) -> int:
         raise CliError(EXIT_USAGE, "drt: error: --seed must be >= 0")
     check_blend(args.blend)
     out_dir = os.path.dirname(os.path.abspath(args.output))
-    if not os.path.isdir(out_dir):
-        raise CliError(EXIT_USAGE, f"drt: error: output folder does not exist: {out_dir}")
+    try:
+        os.makedirs(out_dir, exist_ok=True)      # like Blender's own output paths
+    except OSError as e:
+        raise CliError(EXIT_USAGE, f"drt: error: cannot create the output folder {out_dir}: "
+                                   f"{e.strerror}") from None
 
     import bpy
 

@@ -59,8 +59,11 @@ class DRT_PT_film(DRTPanel, bpy.types.Panel):
 
 CLASSES = (DRT_PT_sampling, DRT_PT_light_paths, DRT_PT_film)
 
-# Blender's own panels that also make sense for DRT (beyond those Cycles already shares).
-_EXTRA_PANELS = ("DATA_PT_light", "DATA_PT_spot", "DATA_PT_area", "DATA_PT_sunlight")
+# Blender's generic panels for what Cycles draws in panels of its own add-on: depth of
+# field, light type/colour/power, spot shape, the material slots and node surfaces.
+_EXTRA_PANELS = ("DATA_PT_camera_dof", "DATA_PT_camera_dof_aperture", "DATA_PT_light",
+                 "DATA_PT_spot", "EEVEE_MATERIAL_PT_context_material",
+                 "EEVEE_MATERIAL_PT_surface", "EEVEE_WORLD_PT_surface")
 
 
 def _builtin_panels():

@@ -29,7 +29,8 @@ def reset():
 def principled(name, color, roughness=0.5, specular=0.5, metallic=0.0, emission=None,
                strength=0.0):
     mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        mat.use_nodes = True
     bsdf = mat.node_tree.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (*color, 1.0)
     bsdf.inputs["Roughness"].default_value = roughness
@@ -90,7 +91,8 @@ def render_defaults(scene, size=(256, 256), samples=64):
     if hasattr(scene, "drt"):
         scene.drt.samples = samples
     world = bpy.data.worlds.new("World")
-    world.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        world.use_nodes = True
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (0, 0, 0, 1)
     scene.world = world
 

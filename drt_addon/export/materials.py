@@ -6,8 +6,17 @@ back to a sensible approximation and is reported once per material.
 """
 from __future__ import annotations
 
+import bpy
+
 from ..engine_link import engine
 from .errors import Reporter
+
+
+def uses_nodes(datablock) -> bool:
+    """Blender 5 always uses the node tree (use_nodes is deprecated); 4.x has the toggle."""
+    if datablock.node_tree is None:
+        return False
+    return bpy.app.version >= (5, 0, 0) or datablock.use_nodes
 
 
 def _output_node(tree):
@@ -54,7 +63,7 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
     name = mat.name
     fallback = engine.Material(name, tuple(mat.diffuse_color[:3]), metallic=float(mat.metallic),
                                roughness=float(mat.roughness), specular_ior_level=0.5)
-    if not mat.use_nodes or mat.node_tree is None:
+    if not uses_nodes(mat):
         return fallback
     out = _output_node(mat.node_tree)
     if out is None:

@@ -3,12 +3,13 @@ from __future__ import annotations
 
 from ..engine_link import engine
 from .errors import Reporter
+from .materials import uses_nodes
 
 
 def export_world(world, reporter: Reporter) -> "engine.World":
     if world is None:
         return engine.World((0.0, 0.0, 0.0))
-    if not world.use_nodes or world.node_tree is None:
+    if not uses_nodes(world):
         return engine.World(tuple(world.color[:3]))
     tree = world.node_tree
     out = next((n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputWorld"

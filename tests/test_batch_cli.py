@@ -1,0 +1,89 @@
+"""The batch renderer's exit codes, each one, with a single clear line on stderr."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from conftest import ROOT, SAMPLES_DIR
+
+CORNELL = os.path.join(SAMPLES_DIR, "cornell_box.blend")
+
+
+def drt(*args, timeout=300):
+    return subprocess.run([sys.executable, "-m", "drt_addon", *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+def assert_one_clear_error_line(proc):
+    lines = [l for l in proc.stderr.splitlines() if l.strip()]
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].startswith("drt: error:"), proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+def test_success_writes_the_image(tmp_path):
+    out = tmp_path / "cornell.png"
+    proc = drt("render", CORNELL, "-o", str(out), "--samples", "2", "--seed", "3", "--frame", "1")
+    assert proc.returncode == 0, proc.stderr
+    assert out.exists()
+    assert f"wrote {out}" in proc.stdout
+    from PIL import Image
+    img = np.asarray(Image.open(out)).astype(float)
+    assert img.shape[:2] == (256, 256)
+    assert img.std() > 10
+
+
+@pytest.mark.parametrize("args", [
+    (),                                             # no command
+    ("render",),                                    # no file
+    ("render", CORNELL),                            # no output
+    ("render", CORNELL, "-o", "x.png", "--samples", "zero"),
+    ("render", CORNELL, "-o", "x.png", "--samples", "0"),
+    ("render", CORNELL, "-o", "x.png", "--seed", "-1"),
+    ("render", CORNELL, "-o", "x.bmpx"),           # unknown output format
+    ("render", CORNELL, "-o", "/dev/null/cannot/x.png"),   # folder cannot be created
+    ("paint", CORNELL),
+])
+def test_bad_arguments_exit_2(args):
+    proc = drt(*args)
+    assert proc.returncode == 2, (proc.returncode, proc.stderr)
+    assert_one_clear_error_line(proc)
+
+
+def test_missing_file_exits_3(tmp_path):
+    proc = drt("render", str(tmp_path / "missing.blend"), "-o", str(tmp_path / "x.png"))
+    assert proc.returncode == 3
+    assert_one_clear_error_line(proc)
+    assert "not found" in proc.stderr
+
+
+def test_not_a_blend_file_exits_3(tmp_path):
+    fake = tmp_path / "fake.blend"
+    fake.write_text("this is not a blend file\n")
+    proc = drt("render", str(fake), "-o", str(tmp_path / "x.png"))
+    assert proc.returncode == 3
+    assert_one_clear_error_line(proc)
+    assert "not a .blend" in proc.stderr
+
+
+def test_truncated_blend_exits_3(tmp_path):
+    broken = tmp_path / "broken.blend"
+    broken.write_bytes(open(CORNELL, "rb").read()[:4000])
+    proc = drt("render", str(broken), "-o", str(tmp_path / "x.png"))
+    assert proc.returncode == 3, proc.stderr
+    assert_one_clear_error_line(proc)
+
+
+def test_render_failure_exits_4(tmp_path):
+    # A valid .blend whose scene has no camera cannot be rendered.
+    blend = tmp_path / "no_camera.blend"
+    script = ("import bpy; bpy.ops.wm.read_factory_settings(use_empty=True); "
+              f"bpy.ops.wm.save_as_mainfile(filepath={str(blend)!r})")
+    subprocess.run([sys.executable, "-c", script], check=True, capture_output=True)
+    proc = drt("render", str(blend), "-o", str(tmp_path / "x.png"))
+    assert proc.returncode == 4, proc.stderr
+    assert_one_clear_error_line(proc)
+    assert "camera" in proc.stderr
+    assert not (tmp_path / "x.png").exists()
