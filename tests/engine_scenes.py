@@ -61,3 +61,54 @@ def cornell_box(width=64, height=64, light_kind="area") -> Scene:
         lights = [PointLight((0, 0, 1.8), (60.0, 60.0, 60.0))]
     cam = Camera(look_at((0, -3.9, 1.0), (0, 0, 1.0)), lens=35.0)
     return Scene(cam, width, height, meshes, mats, lights, World((0, 0, 0)))
+
+
+def uv_sphere(center, radius, n_theta=24, n_phi=48, name="sphere", material=0) -> TriangleMesh:
+    """A closed triangulated sphere."""
+    c = np.asarray(center, dtype=np.float64)
+    th = np.linspace(0, np.pi, n_theta + 1)[1:-1]
+    ph = np.linspace(0, 2 * np.pi, n_phi, endpoint=False)
+    T, P = np.meshgrid(th, ph, indexing="ij")
+    ring = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], -1).reshape(-1, 3)
+    pts = np.concatenate([[[0, 0, 1]], ring, [[0, 0, -1]]]) * radius + c
+    tris = []
+    for j in range(n_phi):                                  # caps
+        j1 = (j + 1) % n_phi
+        tris.append([0, 1 + j, 1 + j1])
+        last = 1 + (n_theta - 2) * n_phi
+        tris.append([len(pts) - 1, last + j1, last + j])
+    for i in range(n_theta - 2):                            # bands
+        for j in range(n_phi):
+            j1 = (j + 1) % n_phi
+            a, b = 1 + i * n_phi + j, 1 + i * n_phi + j1
+            c2, d = a + n_phi, b + n_phi
+            tris += [[a, c2, b], [b, c2, d]]
+    tris = np.array(tris)
+    return TriangleMesh(name, pts, tris, np.full(len(tris), material))
+
+
+def scaled(scene: Scene, s: float) -> Scene:
+    """The same scene with every length multiplied by s (light powers by s^2, so every
+    radiance, and hence the image, stays the same)."""
+    import copy
+    out = copy.deepcopy(scene)
+    for m in out.meshes:
+        m.positions = m.positions * s
+    for l in out.lights:
+        if isinstance(l, AreaLight):
+            l.matrix = l.matrix.copy()
+            l.matrix[:3, 3] *= s
+            l.size_x *= s
+            l.size_y *= s
+            l.strength = tuple(np.asarray(l.strength) * s * s)
+        elif isinstance(l, PointLight):
+            l.position = tuple(np.asarray(l.position) * s)
+            l.radius *= s
+            l.strength = tuple(np.asarray(l.strength) * s * s)
+    out.camera.matrix = out.camera.matrix.copy()
+    out.camera.matrix[:3, 3] *= s
+    out.camera.clip_start *= s
+    out.camera.clip_end *= s
+    out.camera.focus_distance *= s
+    out.camera.aperture_radius *= s
+    return out
