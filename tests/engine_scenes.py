@@ -39,8 +39,9 @@ def box(lo, hi, name="box", material=0) -> TriangleMesh:
     return TriangleMesh(name, p, t, np.full(len(t), material))
 
 
-def cornell_box(width=64, height=64, light_kind="area") -> Scene:
-    """A unit-ish Cornell box (2 m cube centred on x=0,y=0, floor z=0) with one light."""
+def cornell_box(width=64, height=64, light_kind="area", light_size=0.5) -> Scene:
+    """A unit-ish Cornell box (2 m cube centred on x=0,y=0, floor z=0) with one light
+    (its radiance kept the same whatever its size)."""
     mats = [Material("white", (0.73, 0.73, 0.73), specular_ior_level=0.0),
             Material("red", (0.65, 0.05, 0.05), specular_ior_level=0.0),
             Material("green", (0.12, 0.45, 0.15), specular_ior_level=0.0)]
@@ -56,7 +57,8 @@ def cornell_box(width=64, height=64, light_kind="area") -> Scene:
     if light_kind == "area":
         m = np.eye(4)
         m[:3, 3] = (0, 0, 1.98)
-        lights = [AreaLight(m, (60.0, 60.0, 60.0), "SQUARE", 0.5, 0.5)]
+        power = 60.0 * (light_size / 0.5) ** 2
+        lights = [AreaLight(m, (power,) * 3, "SQUARE", light_size, light_size)]
     else:
         lights = [PointLight((0, 0, 1.8), (60.0, 60.0, 60.0))]
     cam = Camera(look_at((0, -3.9, 1.0), (0, 0, 1.0)), lens=35.0)
