@@ -11,6 +11,10 @@ SAMPLER_ITEMS = [
 INTEGRATOR_ITEMS = [
     ("path", "Path Tracing", "Kajiya path tracing: full global illumination with next-event "
      "estimation and multiple importance sampling"),
+    ("distribution", "Distribution", "Cook 1984: soft shadows, blurry reflection and "
+     "translucency, depth of field and motion blur, but no diffuse interreflection"),
+    ("whitted", "Whitted", "Whitted 1980: hard shadows and mirror reflection/refraction "
+     "only (the baseline)"),
 ]
 FILTER_ITEMS = [
     ("BLACKMAN_HARRIS", "Blackman-Harris", "Blackman-Harris filter, as Cycles"),

@@ -26,7 +26,7 @@ from .accel import Accelerator
 from .bsdf.principled import MaterialTable
 from .camera import CameraModel
 from .film import Film
-from .integrators.path import PathIntegrator
+from .integrators import make_integrator
 from .lights import LightSet
 from .pixel_filter import PixelFilter
 from .sampling import dimensions as D
@@ -66,7 +66,7 @@ class RenderContext:
         self.light_visible_camera = np.array(
             [getattr(m, "visible_camera", True) for m in self.lights.models] or [True])
         self.world_radiance = np.asarray(scene.world.color, dtype=np.float64)[:3]
-        self.integrator = PathIntegrator(self)
+        self.integrator = make_integrator(settings.integrator, self)
 
     def close(self):
         self.accel.close()

@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 SAMPLERS = ("jittered", "sobol", "random")
-INTEGRATORS = ("path",)
+INTEGRATORS = ("path", "distribution", "whitted")
 
 
 @dataclass

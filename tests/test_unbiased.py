@@ -77,3 +77,15 @@ def test_the_z_test_detects_a_five_percent_bias(path_reference):
     rate, pooled = judge(test, ref)
     print(f"5% bias: {rate:.1%} within 3 sigma, pooled Z {pooled:+.2f}")
     assert not passes(rate, pooled)
+
+
+@pytest.mark.parametrize("integrator", ["distribution", "whitted"])
+def test_other_integrators_are_unbiased(integrator):
+    scene = low_variance_cornell()
+    ref, _ = render(scene, RenderSettings(samples=1024, sampler="sobol", seed=77,
+                                          integrator=integrator, clamp_indirect=0.0))
+    test, _ = render(scene, RenderSettings(samples=TEST_SPP // 2, sampler="jittered", seed=3,
+                                           integrator=integrator, clamp_indirect=0.0))
+    rate, pooled = judge(test, ref)
+    print(f"{integrator}: {rate:.1%} of pixel channels within 3 sigma, pooled Z {pooled:+.2f}")
+    assert passes(rate, pooled)

@@ -1,0 +1,21 @@
+"""Cook, Porter and Carpenter's distribution ray tracing (1984).
+
+Rays are distributed over the pixel (anti-aliasing), the lens (depth of field), the time
+(motion blur), the light's area (soft shadows) and the glossy and transmission lobes
+(blurry reflection and translucency), but light that reaches a surface by diffuse
+interreflection is not followed: a diffuse surface gets direct light only. That is the
+path tracer's loop with the diffuse bounce budget set to zero, which is exactly the
+estimator of the 1984 paper with importance sampling, stratification (Cook's ray-id
+chaining, see engine.sampling) and multiple importance sampling of lights and lobes.
+"""
+from __future__ import annotations
+
+from ..bsdf.lobes import DIFFUSE
+from .path import PathIntegrator
+
+
+class DistributionIntegrator(PathIntegrator):
+    def __init__(self, ctx):
+        super().__init__(ctx)
+        self.limits = self.limits.copy()
+        self.limits[DIFFUSE] = 0          # no diffuse interreflection
