@@ -76,7 +76,14 @@ class TriangleMesh:
 class PointLight:
     """A point light, or a sphere light when radius > 0. strength: RGB watts (Blender's
     colour x power x 2**exposure). Spot lights add a cone: spot_size is the full cone
-    angle in radians, spot_blend Blender's 0..1 blend, `direction` the light's -Z axis."""
+    angle in radians, spot_blend Blender's 0..1 blend, `direction` the light's -Z axis.
+
+    soft_falloff: Blender's `use_soft_falloff` (on by default). With radius > 0, Cycles
+    then does not render a sphere but a disc of the same radius and radiance
+    S / (4 pi^2 r^2), centred on the light and always facing the shaded point (sampled
+    uniformly by area); only the part above the point's horizon lights it. Far from the
+    light both give the intensity S / (4 pi); 1 m from a 0.3 m light the disc gives a
+    few percent less. False means a sphere (what `use_soft_falloff` off gives in Cycles)."""
     position: tuple
     strength: tuple
     radius: float = 0.0
@@ -84,6 +91,7 @@ class PointLight:
     spot_blend: float = 0.0
     direction: tuple = (0.0, 0.0, -1.0)
     name: str = "point"
+    soft_falloff: bool = False
 
 
 @dataclass

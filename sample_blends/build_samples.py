@@ -122,7 +122,148 @@ def cornell_box():
     return scene
 
 
-SCENES = {"cornell_box": cornell_box}
+# --- Light unit scenes: one light over a diffuse plane, direct light only -------------
+#
+# A grey Principled plane (Specular IOR Level 0, roughness 0.5: purely Lambertian in both
+# engines) fills the view of a camera 4 m above it, looking straight down; one light of
+# the type under test lights it, placed outside the camera's view (or invisible to
+# camera rays), so the image is the light's irradiance on the plane times albedo / pi.
+# Diffuse bounces are 0, so the image is direct light only. 48 x 48 pixels.
+
+LIGHT_PLANE_ALBEDO = (0.8, 0.8, 0.8)
+
+
+def _aim(obj, target):
+    """Point the object's -Z axis at `target` (Blender lights emit along -Z)."""
+    from mathutils import Vector
+    direction = Vector(target) - obj.location
+    obj.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+
+
+def _light_plane_scene(kind, location, target=(0.0, 0.0, 0.0), **props):
+    scene = reset()
+    grey = principled("Grey", LIGHT_PLANE_ALBEDO, roughness=0.5, specular=0.0)
+    quad("Plane", [(-4, -4, 0), (4, -4, 0), (4, 4, 0), (-4, 4, 0)], grey)
+    camera(scene, (0.0, 0.0, 4.0), (0.0, 0.0, 0.0), lens=50.0)
+    light = bpy.data.lights.new("Light", kind)
+    for key, value in props.items():
+        setattr(light, key, value)
+    obj = bpy.data.objects.new("Light", light)
+    obj.location = location
+    scene.collection.objects.link(obj)
+    _aim(obj, target)
+    render_defaults(scene, size=(48, 48), samples=256)
+    scene.cycles.diffuse_bounces = 0
+    scene.cycles.use_adaptive_sampling = False
+    if hasattr(scene, "drt"):
+        scene.drt.diffuse_bounces = 0
+    return scene
+
+
+def light_point():
+    """A point light of radius 0, 100 W, 1 m above the plane."""
+    return _light_plane_scene("POINT", (0.4, 0.3, 1.0), energy=100.0, shadow_soft_size=0.0)
+
+
+def light_point_radius():
+    """A point light of radius 0.3 m (Blender's default soft falloff), out of view."""
+    return _light_plane_scene("POINT", (1.9, 0.0, 1.0), energy=300.0, shadow_soft_size=0.3)
+
+
+def light_point_sphere():
+    """As light_point_radius, with soft falloff off: a true sphere light."""
+    return _light_plane_scene("POINT", (1.9, 0.0, 1.0), energy=300.0, shadow_soft_size=0.3,
+                              use_soft_falloff=False)
+
+
+def light_spot():
+    """A spot light, cone 60 degrees with blend 0.4, aimed off-centre so both the cone's
+    edge and its smooth blend cross the image."""
+    return _light_plane_scene("SPOT", (0.3, 0.0, 1.5), target=(0.5, 0.2, 0.0), energy=200.0,
+                              shadow_soft_size=0.0, spot_size=math.radians(60.0),
+                              spot_blend=0.4)
+
+
+def _sun(angle):
+    # 30 degrees off the vertical: the irradiance on the plane is 3 cos(30 deg).
+    target = (1.0 - 2.0 * math.tan(math.radians(30.0)), 0.0, 0.0)
+    return _light_plane_scene("SUN", (1.0, 0.0, 2.0), target=target, energy=3.0, angle=angle)
+
+
+def light_sun():
+    """A sun of strength 3 W/m^2, angle 0, 30 degrees off the vertical."""
+    return _sun(0.0)
+
+
+def light_sun_angle():
+    """As light_sun with an angular diameter of 10 degrees."""
+    return _sun(math.radians(10.0))
+
+
+def _area(shape, **props):
+    props.setdefault("energy", 150.0)
+    return _light_plane_scene("AREA", (1.9, 0.0, 0.9), target=(0.0, 0.0, 0.0), shape=shape,
+                              **props)
+
+
+def light_area_square():
+    """A 0.5 m square area light, out of view, aimed at the centre of the plane."""
+    return _area("SQUARE", size=0.5)
+
+
+def light_area_rectangle():
+    """A 0.8 x 0.3 m rectangular area light."""
+    return _area("RECTANGLE", size=0.8, size_y=0.3)
+
+
+def light_area_disk():
+    """A disk area light of 0.5 m diameter."""
+    return _area("DISK", size=0.5)
+
+
+def light_area_ellipse():
+    """An ellipse area light of 0.8 x 0.3 m."""
+    return _area("ELLIPSE", size=0.8, size_y=0.3)
+
+
+def light_area_unnormalized():
+    """A 0.5 m square area light with `normalize` off (power not divided by the area)."""
+    return _area("SQUARE", size=0.5, energy=10.0, normalize=False)
+
+
+def light_exposure_color():
+    """A point light with exposure 1.5 and an orange colour: S = colour x energy x 2^1.5."""
+    return _light_plane_scene("POINT", (0.4, 0.3, 1.0), energy=40.0, shadow_soft_size=0.0,
+                              exposure=1.5, color=(1.0, 0.55, 0.2))
+
+
+def light_point_unnormalized():
+    """A point light of radius 0 with `normalize` off (Blender 4.4+ has it on every light
+    type)."""
+    return _light_plane_scene("POINT", (0.4, 0.3, 1.0), energy=25.0, shadow_soft_size=0.0,
+                              normalize=False)
+
+
+def light_sun_angle_unnormalized():
+    """A 10 degree sun with `normalize` off: `energy` is then its radiance."""
+    target = (1.0 - 2.0 * math.tan(math.radians(30.0)), 0.0, 0.0)
+    return _light_plane_scene("SUN", (1.0, 0.0, 2.0), target=target, energy=100.0,
+                              angle=math.radians(10.0), normalize=False)
+
+
+def light_temperature():
+    """A point light coloured by a 3000 K blackbody temperature."""
+    return _light_plane_scene("POINT", (0.4, 0.3, 1.0), energy=100.0, shadow_soft_size=0.0,
+                              use_temperature=True, temperature=3000.0)
+
+
+LIGHT_SCENES = {f.__name__: f for f in (
+    light_point, light_point_radius, light_point_sphere, light_spot, light_sun,
+    light_sun_angle, light_area_square, light_area_rectangle, light_area_disk,
+    light_area_ellipse, light_area_unnormalized, light_exposure_color,
+    light_point_unnormalized, light_sun_angle_unnormalized, light_temperature)}
+
+SCENES = {"cornell_box": cornell_box, **LIGHT_SCENES}
 
 
 def main(argv=None):
@@ -136,7 +277,8 @@ def main(argv=None):
             p.error(f"unknown scene {name!r}")
         SCENES[name]()
         path = os.path.join(os.path.abspath(args.out_dir), f"{name}.blend")
-        bpy.ops.wm.save_as_mainfile(filepath=path, compress=False)
+        # The small light scenes are stored compressed (86 KB instead of 440 KB each).
+        bpy.ops.wm.save_as_mainfile(filepath=path, compress=name in LIGHT_SCENES)
         print(f"built {path}")
     return 0
 

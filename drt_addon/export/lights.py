@@ -1,5 +1,17 @@
-"""Blender lights to DRT lights, keeping Blender's units (see engine.lights)."""
+"""Blender lights to DRT lights, keeping Blender's units (see engine.lights).
+
+Checked against Cycles 5.0 renders (tests/test_lights_vs_cycles.py), per light type:
+- strength S = colour x blackbody colour (when `use_temperature`) x energy x 2^exposure;
+- `normalize` (on every light type since Blender 4.4): Cycles divides a point or spot
+  light's power by the area of its sphere (4 pi r^2, or 4 when r = 0) and a sun's by the
+  area of its disc (pi sin^2(angle / 2), or 1 when the angle is 0); with `normalize` off
+  it does not. DRT's point and sun lights always normalise, so with `normalize` off the
+  exporter multiplies the strength by that same area, which gives Cycles' radiance.
+  Area lights carry the flag to the engine.
+"""
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -8,34 +20,64 @@ from .errors import Reporter
 from .matrices import to_numpy
 
 
-def _strength(light) -> tuple:
+def light_strength(light) -> tuple:
+    """RGB strength S = colour x energy x 2^exposure (x blackbody colour)."""
     scale = float(light.energy) * 2.0 ** float(getattr(light, "exposure", 0.0))
-    return tuple(c * scale for c in light.color)
+    color = np.array(light.color[:3], dtype=np.float64)
+    if getattr(light, "use_temperature", False):
+        color = color * np.array(light.temperature_color[:3], dtype=np.float64)
+    return tuple(float(c) * scale for c in color)
+
+
+def _normalize(light) -> bool:
+    return bool(getattr(light, "normalize", True))
+
+
+def _point_area(radius: float) -> float:
+    """The area Cycles divides a point or spot light's power by when normalising."""
+    return 4.0 * math.pi * radius * radius if radius > 0.0 else 4.0
+
+
+def _sun_area(angle: float) -> float:
+    half = 0.5 * angle
+    return math.pi * math.sin(half) ** 2 if half > 0.0 else 1.0
+
+
+def _scaled(strength, factor):
+    return tuple(c * factor for c in strength)
 
 
 def export_light(obj, matrix_world, reporter: Reporter):
     light = obj.data
     m = to_numpy(matrix_world)
-    if getattr(light, "use_temperature", False):
-        reporter.warn(f"DRT: light {obj.name!r} uses a colour temperature, which DRT does not "
-                      f"model yet; using its colour", key=(obj.name, "temperature"))
-    strength = _strength(light)
+    strength = light_strength(light)
     direction = -m[:3, 2] / max(np.linalg.norm(m[:3, 2]), 1e-300)
-    if light.type == "POINT":
-        return engine.PointLight(tuple(m[:3, 3]), strength, radius=float(light.shadow_soft_size),
-                                 name=obj.name)
-    if light.type == "SPOT":
-        return engine.PointLight(tuple(m[:3, 3]), strength, radius=float(light.shadow_soft_size),
-                                 spot_size=float(light.spot_size),
-                                 spot_blend=float(light.spot_blend),
-                                 direction=tuple(direction), name=obj.name)
+    if not getattr(light, "use_shadow", True):
+        reporter.warn(f"DRT: light {obj.name!r} has shadows off, which DRT does not model; "
+                      "it casts shadows", key=(obj.name, "shadow"))
+    if light.type in ("POINT", "SPOT"):
+        radius = max(float(light.shadow_soft_size), 0.0)
+        if not _normalize(light):
+            strength = _scaled(strength, _point_area(radius))
+        kwargs = dict(radius=radius, soft_falloff=bool(getattr(light, "use_soft_falloff", False)),
+                      name=obj.name)
+        if light.type == "SPOT":
+            kwargs.update(spot_size=float(light.spot_size), spot_blend=float(light.spot_blend),
+                          direction=tuple(direction))
+        return engine.PointLight(tuple(m[:3, 3]), strength, **kwargs)
     if light.type == "SUN":
-        return engine.SunLight(tuple(direction), tuple(c for c in strength),
-                               angle=float(light.angle), name=obj.name)
+        angle = float(light.angle)
+        if not _normalize(light):
+            strength = _scaled(strength, _sun_area(angle))
+        return engine.SunLight(tuple(direction), strength, angle=angle, name=obj.name)
     if light.type == "AREA":
+        spread = float(getattr(light, "spread", math.pi))
+        if spread < math.pi - 1e-6:
+            reporter.warn(f"DRT: area light {obj.name!r} has a spread of "
+                          f"{math.degrees(spread):.0f} degrees; DRT emits over the full "
+                          "hemisphere (180 degrees)", key=(obj.name, "spread"))
         return engine.AreaLight(m, strength, shape=light.shape, size_x=float(light.size),
-                                size_y=float(light.size_y),
-                                normalize=bool(getattr(light, "normalize", True)),
+                                size_y=float(light.size_y), normalize=_normalize(light),
                                 visible_camera=bool(getattr(obj, "visible_camera", True)),
                                 name=obj.name)
     reporter.warn(f"DRT: light {obj.name!r} of type {light.type} is not supported; skipped")
