@@ -2,17 +2,42 @@
 
 Units (Blender's, checked against Cycles 5.0, see ../shared/notes/blender-facts.md):
 - Point: strength S (W) gives intensity S / (4 pi) W/sr. With radius r > 0 it is a
-  sphere of radiance S / (4 pi^2 r^2), which is the same intensity seen from afar.
+  sphere of radiance S / (4 pi^2 r^2), which is the same intensity seen from afar (or,
+  with `soft_falloff`, a disc of that radius and radiance facing the shaded point).
 - Spot: a point light times Blender's smoothstep cone falloff, not renormalised.
 - Sun: strength is irradiance (W/m^2) at normal incidence; with an angular diameter a > 0
   it is a uniform cone of half-angle a/2 and radiance E / (pi sin^2(a/2)).
 - Area: one-sided along the light's -Z, radiance S / (pi A) with A the world-space area
   (pi/4 x size product for disks and ellipses); `normalize` off drops the 1/A.
+- Emissive triangles (engine.mesh_lights): radiance = the material's emission, two-sided.
 
-Each light samples a direction from a shading point with a pdf in solid angle (area
-lights by area, converted; sphere lights by the cone they subtend), and area, sphere and
-sun lights can also be hit by BSDF-sampled rays, which multiple importance sampling
-needs: `intersect` and `pdf` give what those rays see.
+Every light model has
+  sample(p, u) -> LightSample(wi, dist, radiance, pdf, delta): one direction per shading
+      point p from u in [0,1)^2, through a continuous map of u (stratification survives),
+      pdf in solid angle at p;
+  intersect(o, d) -> (t, radiance): what a BSDF-sampled ray sees (inf where it misses);
+  pdf(p, wi, t): the solid-angle pdf with which sample(p, .) produces wi (t = distance of
+      the light along wi). It is a deterministic function of (p, wi): whatever strategy
+      sample() chose for p (solid angle or area), pdf() chooses the same, so the power
+      heuristic weights of multiple importance sampling sum to one.
+
+Strategies (all pdfs in solid angle, omega = solid angle subtended, A = area):
+- sphere light outside the sphere: the uniform cone it subtends, pdf 1 / (2 pi (1 - cos
+  theta_max)) with sin^2 theta_max = r^2 / d^2 (1 - cos computed without cancellation so
+  a 1e-6 m light 1e4 m away keeps its precision); inside: uniform sphere, 1 / (4 pi).
+- sun disc: uniform cone, 1 / (2 pi (1 - cos(a/2))), 1 - cos(x) = 2 sin^2(x/2).
+- rectangle and square area lights: uniform in the spherical rectangle they subtend,
+  pdf 1 / omega (Urena, Fajardo, King 2013, "An Area-Preserving Parametrization for
+  Spherical Rectangles", EGSR), rewritten here in a cancellation-free form (see
+  `SphericalRectangle`). Fallback to uniform area sampling, pdf d^2 / (A |cos theta_l|),
+  when (rule `_use_solid_angle`):
+    omega < SOLID_ANGLE_MIN           (far or edge-on light: area sampling is then as good
+                                       and the spherical inversion loses digits),
+    |z| < IN_PLANE_REL x (edge sum)   (p almost in the light's plane: omega -> 0 or 2 pi),
+    the edges are not perpendicular   (a sheared transform makes a parallelogram).
+- disk and ellipse area lights: uniform area sampling (Shirley-Chiu concentric map), as
+  Cycles does for ellipses.
+- point light with soft_falloff and r > 0: uniform area sampling of the facing disc.
 """
 from __future__ import annotations
 
@@ -21,9 +46,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from .scene import AreaLight, PointLight, SunLight
-from .warp import concentric_disk, one_minus_cos, orthonormal_basis, uniform_cone, uniform_sphere
+from .warp import concentric_disk, orthonormal_basis, uniform_sphere
 
 INF = np.inf
+TWO_PI = 2.0 * np.pi
+
+# Spherical rectangle sampling is used above this solid angle (steradians) ...
+SOLID_ANGLE_MIN = 1e-4
+# ... and when the point is farther from the light's plane than this fraction of the
+# rectangle's edge sum (closer, the spherical rectangle degenerates to 0 or 2 pi).
+IN_PLANE_REL = 1e-7
 
 
 def luminance(rgb) -> float:
@@ -36,16 +68,39 @@ def _smoothstep01(x):
     return x * x * (3.0 - 2.0 * x)
 
 
+def cone_from_one_minus_cos(u, one_minus_cos_max):
+    """Uniform directions in the cone about +Z whose half-angle theta_max is given by
+    1 - cos(theta_max) (so tiny cones keep full precision); pdf 1 / (2 pi (1 - cos
+    theta_max)). Continuous in u: 1 - cos theta = u0 (1 - cos theta_max), phi = 2 pi u1."""
+    om = np.asarray(one_minus_cos_max, dtype=np.float64)
+    omz = u[..., 0] * om
+    sin_t = np.sqrt(np.maximum(0.0, omz * (2.0 - omz)))
+    phi = TWO_PI * u[..., 1]
+    return np.stack([sin_t * np.cos(phi), sin_t * np.sin(phi), 1.0 - omz], axis=-1)
+
+
+def _safe_unit(v):
+    n = np.linalg.norm(v, axis=-1)
+    ok = n > 0
+    out = np.where(ok[:, None], v / np.where(ok, n, 1.0)[:, None], np.array([0.0, 0.0, 1.0]))
+    return out, n
+
+
 @dataclass
 class LightSample:
     wi: np.ndarray        # (n, 3) unit direction towards the light
     dist: np.ndarray      # (n,) distance to the sampled point (inf for the sun)
     radiance: np.ndarray  # (n, 3) radiance arriving along -wi (0 where it cannot)
-    pdf: np.ndarray       # (n,) solid-angle pdf (1 for delta lights)
+    pdf: np.ndarray       # (n,) solid-angle pdf (1 for delta lights; 0 = no sample)
     delta: bool           # a point or a zero-angle sun: no MIS, BSDF rays never hit it
+    # (n,) how far before `dist` a shadow ray must stop so as not to hit the light
+    # itself (emissive triangles are scene geometry); None = no such need
+    margin: np.ndarray | None = None
 
 
 class PointLightModel:
+    """Point, spot, sphere (radius > 0) and soft-falloff disc lights."""
+
     def __init__(self, light: PointLight):
         self.position = np.asarray(light.position, dtype=np.float64)
         self.strength = np.asarray(light.strength, dtype=np.float64)
@@ -55,11 +110,15 @@ class PointLightModel:
         if self.is_spot:
             d = np.asarray(light.direction, dtype=np.float64)
             self.axis = d / np.linalg.norm(d)
-            self.cos_half = float(np.cos(0.5 * min(float(light.spot_size), np.pi)))
-            self.smooth = max(float(light.spot_blend), 0.0) * (1.0 - self.cos_half)
+            self.cos_half = float(np.cos(0.5 * min(max(float(light.spot_size), 0.0), np.pi)))
+            self.smooth = min(max(float(light.spot_blend), 0.0), 1.0) * (1.0 - self.cos_half)
+        self.delta = not (self.radius > 0.0)
+        self.disc = (not self.delta) and bool(getattr(light, "soft_falloff", False))
         self.sphere_radiance = (self.strength / (4.0 * np.pi ** 2 * self.radius ** 2)
-                                if self.radius > 0 else None)
-        self.delta = self.radius == 0.0
+                                if not self.delta else None)
+        if not self.delta and not np.all(np.isfinite(self.sphere_radiance)):
+            self.delta = True                         # r so small r^2 underflows: a point
+            self.disc = False
         self.visible = not self.delta
 
     def power(self, scene_radius):
@@ -70,45 +129,62 @@ class PointLightModel:
 
     def _spot(self, dir_from_light):
         if not self.is_spot:
-            return 1.0
+            return np.ones(len(dir_from_light))
         c = dir_from_light @ self.axis
         if self.smooth > 0.0:
             return _smoothstep01((c - self.cos_half) / self.smooth)
         return (c > self.cos_half).astype(np.float64)
 
+    def _cone(self, d2):
+        """1 - cos(theta_max) of the cone subtended by the sphere, cancellation-free."""
+        sin2 = np.minimum(self.radius ** 2 / np.maximum(d2, 1e-300), 1.0)
+        return sin2 / (1.0 + np.sqrt(1.0 - sin2))
+
     def sample(self, p, u):
         to = self.position - p
         d2 = (to * to).sum(1)
-        dist_c = np.sqrt(d2)
+        axis, dist_c = _safe_unit(to)
         n = len(p)
+        away = -axis                                     # from the light towards p
         if self.delta:
-            wi = to / np.maximum(dist_c, 1e-300)[:, None]
-            rad = self.intensity[None, :] / np.maximum(d2, 1e-300)[:, None]
-            rad = rad * np.atleast_1d(self._spot(-wi))[:, None] if self.is_spot else rad
-            return LightSample(wi, dist_c, rad, np.ones(n), True)
+            ok = d2 > 0
+            rad = self.intensity[None, :] / np.where(ok, d2, 1.0)[:, None]
+            rad = rad * (self._spot(away) * ok)[:, None]
+            return LightSample(axis, dist_c, rad, ok.astype(np.float64), True)
+        if self.disc:
+            return self._sample_disc(p, u, axis, dist_c, away)
         r = self.radius
-        inside = dist_c <= r
-        # Uniform cone of directions subtended by the sphere.
-        sin2 = np.minimum((r * r) / np.maximum(d2, 1e-300), 1.0)
-        cos_max = np.sqrt(np.maximum(0.0, 1.0 - sin2))
-        axis = to / np.maximum(dist_c, 1e-300)[:, None]
-        local = uniform_cone(u, cos_max)
+        inside = d2 <= r * r
+        om = self._cone(d2)
+        local = cone_from_one_minus_cos(u, om)
         t, b = orthonormal_basis(axis)
         wi = local[:, :1] * t + local[:, 1:2] * b + local[:, 2:3] * axis
-        # Distance to the near side of the sphere along wi.
+        # Distance to the near side of the sphere along wi: proj - sqrt(r^2 - d^2 sin^2).
+        omz = u[:, 0] * om
+        sin2 = omz * (2.0 - omz)
         proj = dist_c * local[:, 2]
-        disc = np.maximum(r * r - (d2 - proj * proj), 0.0)
-        dist = proj - np.sqrt(disc)
-        pdf = 1.0 / (2.0 * np.pi * np.maximum(one_minus_cos(cos_max), 1e-300))
+        dist = proj - np.sqrt(np.maximum(r * r - d2 * sin2, 0.0))
+        pdf = 1.0 / (TWO_PI * np.maximum(om, 1e-300))
         if inside.any():                                 # inside the sphere: uniform sphere
             wi_in = uniform_sphere(u[inside])
             wi[inside] = wi_in
             pdf[inside] = 1.0 / (4.0 * np.pi)
             dist[inside] = self._exit_distance(p[inside], wi_in)
-        rad = np.broadcast_to(self.sphere_radiance, (n, 3)).copy()
-        if self.is_spot:
-            rad *= np.atleast_1d(self._spot(-axis))[:, None]
+        rad = np.broadcast_to(self.sphere_radiance, (n, 3)) * self._spot(away)[:, None]
         return LightSample(wi, np.maximum(dist, 0.0), rad, pdf, False)
+
+    def _sample_disc(self, p, u, axis, dist_c, away):
+        """Uniform point on the disc of radius r through the centre, facing p."""
+        t, b = orthonormal_basis(axis)
+        st = concentric_disk(u) * self.radius
+        q = self.position + st[:, :1] * t + st[:, 1:2] * b
+        wi, dist = _safe_unit(q - p)
+        cos_l = np.abs((wi * axis).sum(1))
+        area = np.pi * self.radius ** 2
+        ok = (dist > 0) & (cos_l > 0) & (dist_c > 0)
+        pdf = np.where(ok, dist * dist / (area * np.where(ok, cos_l, 1.0)), 0.0)
+        rad = self.sphere_radiance[None, :] * (self._spot(away) * ok)[:, None]
+        return LightSample(wi, dist, rad, pdf, False)
 
     def _exit_distance(self, p, d):
         oc = p - self.position
@@ -117,10 +193,20 @@ class PointLightModel:
         return -b + np.sqrt(np.maximum(b * b - c, 0.0))
 
     def intersect(self, o, d):
-        """Distance to the sphere along each ray (inf if missed) and its radiance."""
+        """Distance to the sphere (or facing disc) along each ray (inf if missed) and
+        its radiance."""
         n = len(o)
         if self.delta:
-            return np.full(n, INF), None
+            return np.full(n, INF), np.zeros((n, 3))
+        axis, dist_c = _safe_unit(self.position - o)
+        rad = np.broadcast_to(self.sphere_radiance, (n, 3)) * self._spot(-axis)[:, None]
+        if self.disc:
+            den = (d * axis).sum(1)
+            front = (den > 0) & (dist_c > 0)
+            t = np.where(front, dist_c / np.where(front, den, 1.0), INF)
+            q = o + d * np.where(front, t, 0.0)[:, None] - self.position
+            inside = (q * q).sum(1) <= self.radius ** 2
+            return np.where(front & inside, t, INF), rad
         oc = o - self.position
         b = (oc * d).sum(1)
         c = (oc * oc).sum(1) - self.radius ** 2
@@ -129,19 +215,20 @@ class PointLightModel:
         sq = np.sqrt(np.maximum(disc, 0.0))
         t0, t1 = -b - sq, -b + sq
         t = np.where(t0 > 0, t0, np.where(t1 > 0, t1, INF))
-        t = np.where(ok, t, INF)
-        rad = np.broadcast_to(self.sphere_radiance, (n, 3)).copy()
-        if self.is_spot:
-            rad *= np.atleast_1d(self._spot(-((self.position - o) / np.maximum(
-                np.linalg.norm(self.position - o, axis=1), 1e-300)[:, None])))[:, None]
-        return t, rad
+        return np.where(ok, t, INF), rad
 
     def pdf(self, p, wi, t):
         to = self.position - p
         d2 = (to * to).sum(1)
-        sin2 = np.minimum(self.radius ** 2 / np.maximum(d2, 1e-300), 1.0)
-        cos_max = np.sqrt(np.maximum(0.0, 1.0 - sin2))
-        pdf = 1.0 / (2.0 * np.pi * np.maximum(one_minus_cos(cos_max), 1e-300))
+        if self.delta:
+            return np.zeros(len(p))
+        if self.disc:
+            axis, dist_c = _safe_unit(to)
+            cos_l = np.abs((wi * axis).sum(1))
+            ok = (cos_l > 0) & (dist_c > 0)
+            area = np.pi * self.radius ** 2
+            return np.where(ok, t * t / (area * np.where(ok, cos_l, 1.0)), 0.0)
+        pdf = 1.0 / (TWO_PI * np.maximum(self._cone(d2), 1e-300))
         return np.where(d2 <= self.radius ** 2, 1.0 / (4.0 * np.pi), pdf)
 
 
@@ -151,12 +238,14 @@ class SunLightModel:
         self.to_light = -d / np.linalg.norm(d)
         self.irradiance = np.asarray(light.strength, dtype=np.float64)
         half = 0.5 * min(max(float(light.angle), 0.0), np.pi)
-        self.delta = half < 1e-7
+        self.one_minus = 2.0 * np.sin(0.5 * half) ** 2          # 1 - cos(half), exactly
+        sin2_half = np.sin(half) ** 2
+        # Below ~1e-7 rad the disc is a delta (and sin^2 would lose the radiance's digits).
+        self.delta = half < 1e-7 or not sin2_half > 0
         self.visible = not self.delta
         if not self.delta:
             self.cos_max = float(np.cos(half))
-            self.one_minus = float(one_minus_cos(self.cos_max))
-            self.radiance = self.irradiance / (np.pi * np.sin(half) ** 2)
+            self.radiance = self.irradiance / (np.pi * sin2_half)
             self.t, self.b = orthonormal_basis(self.to_light[None, :])
 
     def power(self, scene_radius):
@@ -168,22 +257,123 @@ class SunLightModel:
             wi = np.broadcast_to(self.to_light, (n, 3)).copy()
             rad = np.broadcast_to(self.irradiance, (n, 3)).copy()
             return LightSample(wi, np.full(n, INF), rad, np.ones(n), True)
-        local = uniform_cone(u, self.cos_max)
+        local = cone_from_one_minus_cos(u, self.one_minus)
         wi = local[:, :1] * self.t + local[:, 1:2] * self.b + local[:, 2:3] * self.to_light
-        pdf = np.full(n, 1.0 / (2.0 * np.pi * self.one_minus))
+        pdf = np.full(n, 1.0 / (TWO_PI * self.one_minus))
         rad = np.broadcast_to(self.radiance, (n, 3)).copy()
         return LightSample(wi, np.full(n, INF), rad, pdf, False)
+
+    def _inside(self, d):
+        # 1 - cos(angle to the sun's centre) >= 0 compared without cancellation
+        diff = d - self.to_light
+        return 0.5 * (diff * diff).sum(1) <= self.one_minus
 
     def escaped(self, d):
         """Radiance seen along escaping rays d (zero outside the sun's disc)."""
         n = len(d)
         if self.delta:
             return np.zeros((n, 3))
-        inside = (d @ self.to_light) >= self.cos_max
-        return np.where(inside[:, None], self.radiance[None, :], 0.0)
+        return np.where(self._inside(d)[:, None], self.radiance[None, :], 0.0)
 
     def pdf(self, p, wi, t):
-        return np.full(len(wi), 1.0 / (2.0 * np.pi * self.one_minus))
+        if self.delta:
+            return np.zeros(len(wi))
+        return np.where(self._inside(wi), 1.0 / (TWO_PI * self.one_minus), 0.0)
+
+
+class SphericalRectangle:
+    """The spherical rectangle a rectangle subtends from points p (Urena et al. 2013).
+
+    Local frame: x, y along the rectangle's edges (lengths lx, ly) from its corner c,
+    z = x cross y; with (x0, y0, z') = (c - p) in that frame, the rectangle is
+    [x0, x1] x [y0, y1] at height z' (x1 = x0 + lx, y1 = y0 + ly); z = |z'|.
+
+    Solid angle omega = g0 + g1 + g2 + g3 - 2 pi with the interior angles g_i at the
+    corners, here as atan2(|n_i x n_j|, -n_i . n_j) of the edge-plane normals, which
+    simplifies to  g = atan2(z |v|, s x y)  at a corner v = (x, y, z) with the sign s
+    alternating (+, -, +, -) over (x1, y0), (x1, y1), (x0, y1), (x0, y0): exact even
+    when z -> 0 or omega -> 0 (acos of a dot product would lose half the digits).
+
+    Sampling u -> (xu, yv) (the paper's eqs. with cancellation-free rewrites):
+      k = 2 pi - g2 - g3,  au = u0 omega + k,
+      N = cos(au) b0 - b1,  D = sin(au),  b0 = -y0 / sqrt(y0^2 + z^2),
+      b1 = y1 / sqrt(y1^2 + z^2),  1 - b0^2 = z^2 / (y0^2 + z^2),
+      xu = sign(N) z D / sqrt(N^2 - (1 - b0^2) D^2)   [= -cu z0 / sqrt(1 - cu^2) of the
+           paper with cu = sign(fu) / sqrt(fu^2 + b0^2), fu = N / D; no division by D]
+      dd = sqrt(xu^2 + z^2), h_i = y_i / sqrt(dd^2 + y_i^2), hv = h0 + u1 (h1 - h0),
+      yv = hv dd / sqrt((1 - hv)(1 + hv)),  with 1 -+ hv interpolated from 1 -+ h_i, each
+      computed without cancellation.
+    Both steps are continuous and monotonic in u; the result is uniform in solid angle.
+    """
+
+    def __init__(self, p, corner, xh, yh, zh, lx, ly):
+        d = corner - p
+        self.x0 = d @ xh
+        self.y0 = d @ yh
+        self.z_signed = d @ zh
+        self.z = np.abs(self.z_signed)
+        self.x1 = self.x0 + lx
+        self.y1 = self.y0 + ly
+        self.frame = (xh, yh, zh)                   # unit x, y, z axes of the rectangle
+        z2 = self.z * self.z
+
+        def g(x, y, s):
+            return np.arctan2(self.z * np.sqrt(x * x + y * y + z2), s * x * y)
+
+        g0 = g(self.x1, self.y0, 1.0)
+        g1 = g(self.x1, self.y1, -1.0)
+        g2 = g(self.x0, self.y1, 1.0)
+        g3 = g(self.x0, self.y0, -1.0)
+        self.k = TWO_PI - g2 - g3
+        self.solid_angle = np.maximum(g0 + g1 - self.k, 0.0)
+
+    def take(self, mask) -> "SphericalRectangle":
+        """The same spherical rectangles for the points p[mask] only."""
+        out = SphericalRectangle.__new__(SphericalRectangle)
+        for name, value in vars(self).items():
+            setattr(out, name, value[mask] if isinstance(value, np.ndarray)
+                    and value.ndim == 1 else value)
+        return out
+
+    def sample(self, u):
+        """Offsets (n, 3) from p to uniformly distributed points on the rectangle."""
+        x0, x1, y0, y1, z = self.x0, self.x1, self.y0, self.y1, self.z
+        z2 = z * z
+        r00 = np.sqrt(y0 * y0 + z2)
+        r01 = np.sqrt(y1 * y1 + z2)
+        b0 = -y0 / np.where(r00 > 0, r00, 1.0)
+        b1 = y1 / np.where(r01 > 0, r01, 1.0)
+        b0c2 = z2 / np.where(r00 > 0, r00 * r00, 1.0)      # 1 - b0^2
+        au = u[:, 0] * self.solid_angle + self.k
+        num = np.cos(au) * b0 - b1
+        den = np.sin(au)
+        den2 = num * num - b0c2 * den * den
+        ok = den2 > 0
+        xu = np.sign(num) * z * den / np.sqrt(np.where(ok, den2, 1.0))
+        xu = np.where(ok, xu, np.where(u[:, 0] < 0.5, x0, x1))
+        xu = np.clip(xu, x0, x1)
+        dd2 = xu * xu + z2
+
+        def one_minus_plus(y):
+            r = np.sqrt(dd2 + y * y)
+            rs = np.where(r > 0, r, 1.0)
+            pos = y >= 0
+            small = dd2 / (rs * (rs + np.abs(y)))           # 1 - |h|, exactly
+            large = (rs + np.abs(y)) / rs                    # 1 + |h|
+            return np.where(pos, small, large), np.where(pos, large, small)
+
+        om0, op0 = one_minus_plus(y0)
+        om1, op1 = one_minus_plus(y1)
+        v = u[:, 1]
+        om = (1.0 - v) * om0 + v * om1                       # 1 - hv
+        op = (1.0 - v) * op0 + v * op1                       # 1 + hv
+        hv = 0.5 * (op - om)
+        prod = om * op
+        yv = np.where(prod > 0, hv * np.sqrt(dd2) / np.sqrt(np.where(prod > 0, prod, 1.0)),
+                      np.where(hv > 0, y1, y0))
+        yv = np.clip(yv, y0, y1)
+        xh, yh, zh = self.frame
+        return xu[:, None] * xh + yv[:, None] * yh + self.z_signed[:, None] * zh
 
 
 class AreaLightModel:
@@ -215,23 +405,46 @@ class AreaLightModel:
         self.visible_camera = bool(light.visible_camera)
         # Inverse of [ax ay normal] maps world offsets to (s, t, z) with s,t in [-1, 1].
         self.inv = np.linalg.inv(np.stack([self.ax, self.ay, self.normal], axis=1))
+        # Spherical rectangle frame (rectangles with perpendicular edges only).
+        lx, ly = 2.0 * np.linalg.norm(self.ax), 2.0 * np.linalg.norm(self.ay)
+        self.xh, self.yh = self.ax / (0.5 * lx), self.ay / (0.5 * ly)
+        self.solid_angle_ok = (not self.round) and abs(self.xh @ self.yh) < 1e-9
+        self.lx, self.ly = lx, ly
+        self.zh = np.cross(self.xh, self.yh)
+        self.corner = self.center - self.ax - self.ay
 
     def power(self, scene_radius):
         return luminance(self.radiance) * np.pi * self.area
 
+    def _spherical(self, p):
+        """(SphericalRectangle or None, mask of points that use it): the rule of the
+        module docstring, a function of p only."""
+        if not self.solid_angle_ok:
+            return None, np.zeros(len(p), dtype=bool)
+        sr = SphericalRectangle(p, self.corner, self.xh, self.yh, self.zh, self.lx, self.ly)
+        use = (sr.solid_angle >= SOLID_ANGLE_MIN) & (sr.z > IN_PLANE_REL * (self.lx + self.ly))
+        return sr, use
+
+    def _emitting_side(self, p):
+        return (self.center - p) @ self.normal > 0          # p below the light's -Z face
+
     def sample(self, p, u):
+        n = len(p)
         if self.round:
             st = concentric_disk(u)
         else:
             st = 2.0 * u - 1.0
-        q = self.center + st[:, :1] * self.ax + st[:, 1:2] * self.ay
-        to = q - p
-        d2 = (to * to).sum(1)
-        dist = np.sqrt(d2)
-        wi = to / np.maximum(dist, 1e-300)[:, None]
+        offset = self.center - p + st[:, :1] * self.ax + st[:, 1:2] * self.ay
+        sr, use = self._spherical(p)
+        if use.any():
+            offset[use] = sr.take(use).sample(u[use])
+        wi, dist = _safe_unit(offset)
         cos_l = wi @ self.normal                      # > 0 when p is on the emitting (-Z) side
-        ok = (cos_l > 0) & (dist > 0)
-        pdf = np.where(ok, d2 / (self.area * np.maximum(cos_l, 1e-300)), 0.0)
+        ok = (cos_l > 0) & (dist > 0) & self._emitting_side(p)
+        area_pdf = dist * dist / (self.area * np.where(ok, cos_l, 1.0))
+        pdf = np.where(use, 1.0 / np.where(use, sr.solid_angle, 1.0) if sr is not None else 0.0,
+                       area_pdf)
+        pdf = np.where(ok, pdf, 0.0)
         rad = np.where(ok[:, None], self.radiance[None, :], 0.0)
         return LightSample(wi, dist, rad, pdf, False)
 
@@ -252,8 +465,15 @@ class AreaLightModel:
         return t, rad
 
     def pdf(self, p, wi, t):
+        """Solid-angle pdf of sample(p, .) producing wi, the light being hit at distance
+        t (assumed: the caller found the hit with intersect)."""
         cos_l = np.abs(wi @ self.normal)
-        return t * t / (self.area * np.maximum(cos_l, 1e-300))
+        ok = (cos_l > 0) & np.isfinite(t)
+        out = np.where(ok, t * t / (self.area * np.where(ok, cos_l, 1.0)), 0.0)
+        sr, use = self._spherical(p)
+        if sr is not None:
+            out = np.where(use & ok, 1.0 / np.where(use, sr.solid_angle, 1.0), out)
+        return out
 
 
 def make_light(light):
@@ -267,29 +487,41 @@ def make_light(light):
 
 
 class LightSet:
-    """All lights of a scene, one picked per shading point in proportion to its power."""
+    """All lights of a scene: the lamps (`models`) followed by the emissive triangles
+    (`mesh`, an engine.mesh_lights.EmissiveTriangles, may be None), as one list of
+    entries. Next-event estimation picks one entry per shading point with probability
+    proportional to its estimated power (luminance of radiance x pi x area for area
+    lights and triangles, of strength for points, of irradiance x pi R^2 for suns):
+    `select_pdf`, over len(self) entries; entry k >= n_lamps is triangle k - n_lamps."""
 
-    def __init__(self, lights, scene_radius: float):
+    def __init__(self, lights, scene_radius: float, mesh_lights=None):
         self.models = [make_light(l) for l in lights]
         power = np.array([max(m.power(scene_radius), 0.0) for m in self.models], dtype=np.float64)
+        power = np.where(np.isfinite(power), power, 0.0)
         keep = power > 0
         self.models = [m for m, k in zip(self.models, keep) if k]
-        power = power[keep]
-        self.select_pdf = power / power.sum() if len(power) else power
+        self.n_lamps = len(self.models)
+        self.mesh = mesh_lights if mesh_lights is not None and len(mesh_lights) else None
+        mesh_power = self.mesh.power if self.mesh is not None else np.zeros(0)
+        power = np.concatenate([power[keep], mesh_power])
+        total = power.sum()
+        self.select_pdf = power / total if total > 0 else power
         self.cdf = np.cumsum(self.select_pdf)
         if len(self.cdf):
             self.cdf[-1] = 1.0
 
     def __len__(self):
-        return len(self.models)
+        return len(self.select_pdf)
 
     def sample(self, p, u_pick, u_point):
         """Pick one light per point and sample it. Returns (LightSample with pdf
-        including the pick probability, light index, delta mask)."""
+        including the pick probability, entry index, delta mask)."""
         n = len(p)
-        idx = np.searchsorted(self.cdf, u_pick, side="right").clip(0, len(self.models) - 1)
+        idx = np.searchsorted(self.cdf, u_pick, side="right").clip(0, len(self) - 1)
         wi = np.zeros((n, 3))
+        wi[:, 2] = 1.0
         dist = np.zeros(n)
+        margin = np.zeros(n)
         rad = np.zeros((n, 3))
         pdf = np.zeros(n)
         delta = np.zeros(n, dtype=bool)
@@ -301,11 +533,19 @@ class LightSet:
             wi[sel], dist[sel], rad[sel] = s.wi, s.dist, s.radiance
             pdf[sel] = s.pdf * self.select_pdf[k]
             delta[sel] = s.delta
-        return LightSample(wi, dist, rad, pdf, False), idx, delta
+        if self.mesh is not None:
+            sel = np.nonzero(idx >= self.n_lamps)[0]
+            if sel.size:
+                s = self.mesh.sample(p[sel], idx[sel] - self.n_lamps, u_point[sel])
+                wi[sel], dist[sel], rad[sel] = s.wi, s.dist, s.radiance
+                pdf[sel] = s.pdf * self.select_pdf[idx[sel]]
+                margin[sel] = s.margin
+        return LightSample(wi, dist, rad, pdf, False, margin), idx, delta
 
     def hit_surfaces(self, o, d, tmax):
-        """The nearest area or sphere light along each ray before tmax:
-        (t, light index or -1, radiance)."""
+        """The nearest area or sphere lamp along each ray before tmax:
+        (t, lamp index or -1, radiance). Emissive triangles are scene geometry: the
+        integrator finds them with the ordinary ray cast."""
         n = len(o)
         best_t = np.asarray(tmax, dtype=np.float64).copy()
         best_i = np.full(n, -1, dtype=np.int64)
@@ -323,13 +563,25 @@ class LightSet:
 
     def pdf(self, k_index, p, wi, t):
         """Solid-angle pdf, pick probability included, of sampling direction wi from p
-        towards light k_index[i] (hit at distance t)."""
+        towards lamp k_index[i] (hit at distance t)."""
         out = np.zeros(len(p))
         for k, model in enumerate(self.models):
             sel = np.nonzero(k_index == k)[0]
             if sel.size:
                 out[sel] = model.pdf(p[sel], wi[sel], t[sel]) * self.select_pdf[k]
         return out
+
+    def mesh_pdf(self, prim, p, q):
+        """Solid-angle pdf, pick probability included, with which next-event estimation
+        from points p samples the points q on global triangles `prim` (0 for triangles
+        that are not lights)."""
+        if self.mesh is None:
+            return np.zeros(len(p))
+        entry = self.mesh.entry_of(prim)
+        is_light = entry >= 0
+        sel = np.maximum(entry, 0)
+        pdf = self.mesh.pdf_area_to_solid_angle(sel, p, q)
+        return np.where(is_light, pdf * self.select_pdf[self.n_lamps + sel], 0.0)
 
     def suns(self):
         return [(k, m) for k, m in enumerate(self.models)

@@ -28,6 +28,7 @@ from .camera import CameraModel
 from .film import Film
 from .integrators import make_integrator
 from .lights import LightSet
+from .mesh_lights import EmissiveTriangles
 from .pixel_filter import PixelFilter
 from .sampling import dimensions as D
 from .sampling import make_sampler
@@ -58,11 +59,13 @@ class RenderContext:
         self.camera = CameraModel(scene.camera, scene.width, scene.height, scene.pixel_aspect)
         self.filter = PixelFilter(settings.filter_type, settings.filter_width)
         self.sampler = make_sampler(settings.sampler, settings.seed, settings.samples)
-        self.accel = Accelerator(scene.meshes, threads=1)
+        self.has_motion = scene.has_motion()
+        self.accel = Accelerator(scene.meshes, threads=1, time_enabled=self.has_motion)
         self.surfaces = SurfaceBuilder(self.accel, scene.meshes)
         self.materials = MaterialTable(scene.materials)
         self.scene_radius = _scene_radius(scene, self.accel)
-        self.lights = LightSet(scene.lights, self.scene_radius)
+        self.lights = LightSet(scene.lights, self.scene_radius,
+                               mesh_lights=EmissiveTriangles.from_scene(scene, self.accel))
         self.light_visible_camera = np.array(
             [getattr(m, "visible_camera", True) for m in self.lights.models] or [True])
         self.world_radiance = np.asarray(scene.world.color, dtype=np.float64)[:3]
@@ -96,8 +99,12 @@ def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sampl
     offset = ctx.filter.sample(u_pix)
     film_xy = np.stack([pixel % w + 0.5 + offset[:, 0], pixel // w + 0.5 + offset[:, 1]], axis=1)
     lens_u = ctx.sampler.get_2d(D.LENS, pixel, index) if ctx.camera.has_lens else None
-    rays = ctx.camera.generate(film_xy, lens_u)
-    radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax)
+    # The time dimension exists only when something moves within an open shutter.
+    time = ctx.scene.shutter.sample(ctx.sampler.get_1d(D.TIME, pixel, index)) \
+        if ctx.has_motion else None
+    rays = ctx.camera.generate(film_xy, lens_u, time)
+    radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
+                                       **({} if time is None else {"time": time}))
     return pixel, radiance
 
 

@@ -1,14 +1,25 @@
 """Kajiya's path tracer, wavefront style, with next-event estimation and MIS.
 
 A batch of paths advances one bounce at a time. At each surface vertex:
-  1. emission seen by the incoming ray (area and sphere lights are hit analytically,
-     weighted against light sampling by the power heuristic);
-  2. next-event estimation: one light picked in proportion to its power, one point on it,
-     one shadow ray, weighted against BSDF sampling by the power heuristic;
+  1. emission seen by the incoming ray: area and sphere lamps (hit analytically), sun
+     discs (escaped rays) and emissive triangles (hit by the ray cast), each weighted
+     against light sampling by the power heuristic with the pdf light sampling would have
+     had for that direction (`LightSet.pdf`, `LightSet.mesh_pdf`); camera rays and
+     specular bounces (pdf = inf) see emission with weight 1;
+  2. next-event estimation: one light entry (lamp or emissive triangle) picked in
+     proportion to its power, one point on it, one shadow ray, weighted against BSDF
+     sampling by the power heuristic;
   3. BSDF sampling over the lobes whose bounce budget (Cycles' diffuse, glossy,
      transmission and total limits) is not used up; Russian roulette after three bounces.
 Where no lobe may continue, light sampling takes the whole weight (no MIS), so direct
 light stays unbiased with zero bounces.
+
+`mis_mode` (a test and debug hook, not a user setting) selects the weights of those two
+estimators of direct light: 'mis' (default) the power heuristic; 'light' light sampling
+only (BSDF-sampled rays that hit a light light sampling could have produced add nothing);
+'bsdf' BSDF sampling only (next-event estimation is kept only for delta lights and for
+directions the BSDF cannot sample, e.g. when no bounce is left). All three are unbiased
+and must agree in expectation (tests/test_light_transport.py).
 
 Radiance sums are float64: a path's throughput is a product of many factors and the
 film sums millions of them.
@@ -24,6 +35,7 @@ from ..surface import offset_origin
 from ..warp import to_local, to_world
 
 ROULETTE_START = 3
+MIS_MODES = ("mis", "light", "bsdf")
 
 
 def power_heuristic(a, b):
@@ -46,6 +58,30 @@ class PathIntegrator:
         s = ctx.settings
         self.limits = np.array([s.diffuse_bounces, s.glossy_bounces, s.transmission_bounces])
         self.max_bounces = s.max_bounces
+        self.mis_mode = "mis"                # test/debug hook, see the module docstring
+
+    def _hit_weight(self, prev_pdf, light_pdf):
+        """Weight of emission found by a BSDF-sampled ray (pdf prev_pdf, inf after a
+        camera ray or a specular bounce) that light sampling reaches with light_pdf."""
+        mode = self.mis_mode
+        if mode == "mis":
+            return power_heuristic(prev_pdf, light_pdf)
+        if mode == "light":
+            return np.where(np.isinf(prev_pdf) | ~(light_pdf > 0), 1.0, 0.0)
+        if mode == "bsdf":
+            return np.ones(len(prev_pdf))
+        raise ValueError(f"mis_mode must be one of {MIS_MODES}, got {mode!r}")
+
+    def _nee_weight(self, light_pdf, bsdf_pdf, delta):
+        """Weight of a light sample that the BSDF would have sampled with bsdf_pdf."""
+        mode = self.mis_mode
+        if mode == "mis":
+            return np.where(delta, 1.0, power_heuristic(light_pdf, bsdf_pdf))
+        if mode == "light":
+            return np.ones(len(light_pdf))
+        if mode == "bsdf":
+            return np.where(delta | ~(bsdf_pdf > 0), 1.0, 0.0)
+        raise ValueError(f"mis_mode must be one of {MIS_MODES}, got {mode!r}")
 
     def radiance(self, pixel, index, origins, dirs, tmax):
         """Radiance along camera rays; pixel/index give each path's sampler coordinates."""
@@ -85,7 +121,7 @@ class PathIntegrator:
                 if on_light.any():
                     sel = np.nonzero(on_light)[0]
                     light_pdf = lights.pdf(k_l[sel], prev_pos[sel], d[sel], t_l[sel])
-                    w = power_heuristic(prev_pdf[sel], light_pdf)
+                    w = self._hit_weight(prev_pdf[sel], light_pdf)
                     add(path[sel], b[sel] * le[sel] * w[:, None], depth)
                     alive[sel] = False
             # 1b. escaped rays: world background and sun discs
@@ -94,8 +130,8 @@ class PathIntegrator:
                 sel = np.nonzero(escaped)[0]
                 env = np.broadcast_to(ctx.world_radiance, (sel.size, 3)).copy()
                 for k, sun in lights.suns():
-                    w = power_heuristic(prev_pdf[sel],
-                                        sun.pdf(None, d[sel], None) * lights.select_pdf[k])
+                    w = self._hit_weight(prev_pdf[sel],
+                                         sun.pdf(None, d[sel], None) * lights.select_pdf[k])
                     env += sun.escaped(d[sel]) * w[:, None]
                 add(path[sel], b[sel] * env, depth)
                 alive[sel] = False
@@ -110,11 +146,17 @@ class PathIntegrator:
             rows = path[live]
             b_live = b[live]
             px_l, ix_l = px[live], ix[live]
-            # 1c. emissive surfaces (two-sided, like Cycles' Emission shader)
+            # 1c. emissive surfaces (two-sided, like Cycles' Emission shader), weighted
+            # against next-event estimation of the emissive triangle that was hit
             if mats.any_emission:
                 em = mats.emission[si.material]
-                if em.any():
-                    add(rows, b_live * em, depth)
+                glow = np.nonzero((em != 0).any(axis=1))[0]
+                if glow.size:
+                    g_live = live[glow]
+                    light_pdf = lights.mesh_pdf(hits.prim[g_live], prev_pos[g_live],
+                                                si.position[glow])
+                    w = self._hit_weight(prev_pdf[g_live], light_pdf)
+                    add(rows[glow], b_live[glow] * em[glow] * w[:, None], depth)
 
             bsdf = PrincipledBSDF.from_materials(mats, si.material)
             c_live = counts[rows]
@@ -135,11 +177,13 @@ class PathIntegrator:
                     dist = ls.dist[sel]
                     # stop short of the light by the same relative margin as the origin
                     far = np.where(np.isfinite(dist), dist * (1.0 - 2e-5), ctx.scene_radius * 4.0)
+                    if ls.margin is not None:          # emissive triangles: skip the light itself
+                        far = np.minimum(far, dist - ls.margin[sel])
                     vis = ~ctx.accel.occluded(org, ls.wi[sel], np.maximum(far, 0.0))
                     if vis.any():
                         sv = sel[vis]
                         bsdf_pdf = bsdf.pdf(wo, wi_local, allowed)[sv]
-                        w = np.where(delta[sv], 1.0, power_heuristic(ls.pdf[sv], bsdf_pdf))
+                        w = self._nee_weight(ls.pdf[sv], bsdf_pdf, delta[sv])
                         contrib = (b_live[sv] * f[sv] * np.abs(wi_local[sv, 2:3])
                                    * ls.radiance[sv] * (w / ls.pdf[sv])[:, None])
                         add(rows[sv], contrib, depth, direct=depth == 0)

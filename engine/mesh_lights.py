@@ -1,0 +1,122 @@
+"""Emissive triangles as lights: soft shadows and low noise from emissive meshes.
+
+Every scene triangle whose material has an emission (radiance, colour x strength) of
+positive luminance and whose area is positive becomes a light entry of
+`engine.lights.LightSet`. Emission is two-sided, as Cycles' Emission closure:
+`emissive_simple_eval` returns 1 when |Ng . wi| > 0 (intern/cycles/kernel/closure/
+emissive.h), and Cycles' default "Auto" emission sampling light-samples such a material
+from front and back (EMISSION_SAMPLING_FRONT_BACK, scene/shader.cpp, when its constant
+emission estimate exceeds 0.5; dimmer ones are only found by BSDF rays there, here every
+emissive triangle is light-sampled, which changes noise, not the expected value).
+
+Selection (done by the LightSet, jointly with the lamps): triangle j is picked with
+probability proportional to its estimated power  P_j = luminance(L_j) x pi x A_j,  the
+power one side emits: a point in front of a two-sided triangle only ever receives one
+side's light, so this is the same estimate an equally bright one-sided area lamp gets.
+
+Sampling a point on triangle (v0, v1, v2) from u in [0,1)^2 uses Heitz's low-distortion
+map (E. Heitz, "A Low-Distortion Map Between Triangle and Square", 2019):
+    if u1 > u0: s = u0 / 2, t = u1 - s    else: t = u1 / 2, s = u0 - t
+    q = v0 + s (v1 - v0) + t (v2 - v0)
+which is piecewise linear with constant Jacobian, hence uniform in area (pdf 1/A), and
+continuous (both branches agree on u0 = u1), so stratified u stay stratified on the
+triangle. Converted to solid angle at p:  pdf = |q - p|^2 / (A |cos theta_q|),
+cos theta_q = n . (q - p) / |q - p|  (either side, emission being two-sided).
+
+A BSDF-sampled ray that hits an emissive triangle (global primitive id g, as Embree
+reports it) is weighted by multiple importance sampling against that same pdf times the
+triangle's pick probability: `entry_of(g)` maps g to its light entry.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .lights import LightSample, luminance
+from .surface import RELATIVE_OFFSET
+
+
+class EmissiveTriangles:
+    def __init__(self, v0, v1, v2, radiance, prim_ids, n_prims_total: int):
+        v0, v1, v2 = (np.asarray(v, dtype=np.float64).reshape(-1, 3) for v in (v0, v1, v2))
+        radiance = np.asarray(radiance, dtype=np.float64).reshape(-1, 3)
+        prim_ids = np.asarray(prim_ids, dtype=np.int64).reshape(-1)
+        e1, e2 = v1 - v0, v2 - v0
+        cr = np.cross(e1, e2)
+        norm = np.linalg.norm(cr, axis=1)
+        area = 0.5 * norm
+        power = luminance(np.maximum(radiance, 0.0)) * np.pi * area
+        keep = np.isfinite(power) & (power > 0) & (norm > 0)
+        self.v0, self.e1, self.e2 = v0[keep], e1[keep], e2[keep]
+        self.normal = cr[keep] / norm[keep, None]
+        self.area = area[keep]
+        self.radiance = radiance[keep]
+        self.power = power[keep]
+        self.prim = prim_ids[keep]
+        self.tri_scale = np.max(np.abs(np.stack([v0, v1, v2], 1)), axis=(1, 2))[keep] \
+            if len(v0) else np.zeros(0)
+        self.entry = np.full(max(int(n_prims_total), 1), -1, dtype=np.int64)
+        self.entry[self.prim] = np.arange(len(self.prim))
+
+    @classmethod
+    def from_scene(cls, scene, accel) -> "EmissiveTriangles":
+        """The emissive triangles of `scene`, with the global ids of `accel`
+        (engine.accel.Accelerator, which concatenates the meshes' triangles in order)."""
+        tri = accel.triangles
+        if not len(tri) or not scene.materials:
+            return cls(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
+                       np.zeros((0, 3)), np.zeros(0, np.int64), 0)
+        emission = np.array([tuple(m.emission[:3]) for m in scene.materials], dtype=np.float64)
+        mat = np.concatenate([m.material_indices for m in scene.meshes]).astype(np.int64)
+        emissive = np.nonzero(emission[mat].max(axis=1) > 0)[0]
+        p = accel.positions
+        t = tri[emissive]
+        return cls(p[t[:, 0]], p[t[:, 1]], p[t[:, 2]], emission[mat[emissive]], emissive,
+                   len(tri))
+
+    def __len__(self):
+        return len(self.area)
+
+    def entry_of(self, prim):
+        """Light entry (0..len-1) of global triangle ids, -1 for non-lights and misses."""
+        prim = np.asarray(prim, dtype=np.int64)
+        ok = (prim >= 0) & (prim < len(self.entry))
+        return np.where(ok, self.entry[np.where(ok, prim, 0)], -1)
+
+    @staticmethod
+    def square_to_triangle(u):
+        """Heitz's map: weights (s, t) of the edges v1 - v0 and v2 - v0, uniform in area."""
+        u0, u1 = u[:, 0], u[:, 1]
+        upper = u1 > u0
+        b1 = np.where(upper, 0.5 * u0, u0 - 0.5 * u1)
+        b2 = np.where(upper, u1 - 0.5 * u0, 0.5 * u1)
+        return b1, b2
+
+    def sample(self, p, tri, u) -> LightSample:
+        """A uniform point on triangle entries `tri` (one per shading point), as a
+        direction from p with its solid-angle pdf (pick probability NOT included)."""
+        b1, b2 = self.square_to_triangle(u)
+        q = self.v0[tri] + b1[:, None] * self.e1[tri] + b2[:, None] * self.e2[tri]
+        to = q - p
+        dist = np.linalg.norm(to, axis=1)
+        ok_d = dist > 0
+        wi = np.where(ok_d[:, None], to / np.where(ok_d, dist, 1.0)[:, None], (0.0, 0.0, 1.0))
+        cos_l = np.abs((wi * self.normal[tri]).sum(1))
+        ok = ok_d & (cos_l > 0)
+        pdf = np.where(ok, dist * dist / (self.area[tri] * np.where(ok, cos_l, 1.0)), 0.0)
+        rad = np.where(ok[:, None], self.radiance[tri], 0.0)
+        # Shadow rays stop before the plane offset from the triangle by the same relative
+        # amount as ray origins (engine.surface), measured along the ray: Embree rounds
+        # the triangle and the ray to float32, so the light must not occlude itself.
+        scale = np.maximum(np.max(np.abs(q), axis=1), self.tri_scale[tri])
+        margin = np.where(ok, RELATIVE_OFFSET * scale / np.where(ok, cos_l, 1.0), 0.0)
+        return LightSample(wi, dist, rad, pdf, False, margin)
+
+    def pdf_area_to_solid_angle(self, tri, p, q):
+        """Solid-angle pdf of sample(p, tri, .) producing the point q on triangle tri."""
+        to = q - p
+        d2 = (to * to).sum(1)
+        cos_abs_d = np.abs((to * self.normal[tri]).sum(1))     # |cos| x distance
+        ok = (cos_abs_d > 0) & (d2 > 0)
+        # d^2 / (A |cos|) = d^3 / (A |n . (q - p)|)
+        return np.where(ok, d2 * np.sqrt(d2) / (self.area[tri] * np.where(ok, cos_abs_d, 1.0)),
+                        0.0)
