@@ -429,15 +429,14 @@ class AreaLightModel:
         return (self.center - p) @ self.normal > 0          # p below the light's -Z face
 
     def sample(self, p, u):
-        n = len(p)
-        if self.round:
-            st = concentric_disk(u)
-        else:
-            st = 2.0 * u - 1.0
-        offset = self.center - p + st[:, :1] * self.ax + st[:, 1:2] * self.ay
         sr, use = self._spherical(p)
-        if use.any():
-            offset[use] = sr.take(use).sample(u[use])
+        if sr is not None and use.all():
+            offset = sr.sample(u)
+        else:
+            st = concentric_disk(u) if self.round else 2.0 * u - 1.0
+            offset = self.center - p + st[:, :1] * self.ax + st[:, 1:2] * self.ay
+            if use.any():
+                offset[use] = sr.take(use).sample(u[use])
         wi, dist = _safe_unit(offset)
         cos_l = wi @ self.normal                      # > 0 when p is on the emitting (-Z) side
         ok = (cos_l > 0) & (dist > 0) & self._emitting_side(p)

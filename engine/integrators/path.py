@@ -175,11 +175,18 @@ class PathIntegrator:
                     sel = np.nonzero(ok)[0]
                     org = offset_origin(si.position[sel], ng[sel], si.scale[sel], ls.wi[sel])
                     dist = ls.dist[sel]
-                    # stop short of the light by the same relative margin as the origin
-                    far = np.where(np.isfinite(dist), dist * (1.0 - 2e-5), ctx.scene_radius * 4.0)
-                    if ls.margin is not None:          # emissive triangles: skip the light itself
-                        far = np.minimum(far, dist - ls.margin[sel])
-                    vis = ~ctx.accel.occluded(org, ls.wi[sel], np.maximum(far, 0.0))
+                    finite = np.isfinite(dist)
+                    # the shadow ray runs from the offset origin to the sampled light point
+                    # and stops short of it by the same relative margin as the origin (and,
+                    # for emissive triangles, which are geometry, before the light itself)
+                    to = si.position[sel] + ls.wi[sel] * np.where(finite, dist, 0.0)[:, None] - org
+                    seg = np.linalg.norm(to, axis=1)
+                    sdir = np.where((finite & (seg > 0))[:, None],
+                                    to / np.where(seg > 0, seg, 1.0)[:, None], ls.wi[sel])
+                    far = np.where(finite, seg * (1.0 - 2e-5), ctx.scene_radius * 4.0)
+                    if ls.margin is not None:
+                        far = np.where(finite, np.minimum(far, seg - ls.margin[sel]), far)
+                    vis = ~ctx.accel.occluded(org, sdir, np.maximum(far, 0.0))
                     if vis.any():
                         sv = sel[vis]
                         bsdf_pdf = bsdf.pdf(wo, wi_local, allowed)[sv]
