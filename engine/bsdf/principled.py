@@ -1,21 +1,66 @@
 """Blender's Principled BSDF as a mixture of lobes, evaluated for a batch of points.
 
-Each point carries its own material parameters; a lobe is chosen per point with
-probability proportional to an estimate of its albedo, and the mixture pdf is the
-probability-weighted sum of the lobes' pdfs (used by multiple importance sampling).
+Composition (Blender 4.x manual, "Principled BSDF", and Cycles' layering; weights per
+point, every lobe in the local shading frame):
 
-`allowed` masks (n, 3) restrict sampling and the sampling pdf to the lobe kinds whose
-bounce budget is not exhausted (Cycles' diffuse/glossy/transmission limits), while
-`eval_f` always returns the whole BSDF: next-event estimation still sees every lobe.
+  metal         weight  m                   GGX reflection, Schlick Fresnel, F0 = base colour
+                                            (clamped to [0, 1])
+  transmission  weight  (1 - m) t           dielectric interface with the material IOR:
+                                            smooth (delta) if GGX alpha <= ~3e-4, else
+                                            rough GGX (Walter et al. 2007); reflection is
+                                            untinted, refraction tinted by sqrt(base colour)
+                                            per crossing (Cycles' choice: a round trip
+                                            through a closed object gives the base colour)
+  specular      weight  (1 - m)(1 - t)      GGX reflection with exact dielectric Fresnel of
+                                            an IOR adjusted by `specular_ior_level`:
+                                            F0' = F0(ior) * 2 level (0.5 = plain IOR, 0 =
+                                            no specular, 1 = twice F0), IOR' = IOR(F0')
+  diffuse       weight  (1 - m)(1 - t)      Lambert with the base colour, under the specular
+                        (1 - E_spec(wo))    layer: it gets only the energy the layer does not
+                                            reflect, E_spec(wo) being that layer's
+                                            directional albedo (Cycles' albedo scaling), so
+                                            diffuse + specular <= 1 for base colour <= 1.
+
+with m = metallic, t = transmission, GGX alpha = roughness^2 (clamped, see
+`microfacet.ALPHA_MIN`). The weights sum to 1, and each part conserves energy, so the
+whole does. E_spec is tabulated once per process (lazily, thread-safe) over
+(cos theta_o, roughness, F0^(1/4), side of eta; for eta < 1 the cos axis is
+aligned on the critical angle) by stratified visible-normal quadrature
+and interpolated trilinearly.
+
+Not modelled (Cycles has them): subsurface, sheen, coat, specular tint/F82 tint (with
+Blender's default white tint, Cycles' F82-tint metal reduces to Schlick), anisotropy,
+thin film, and multiple-scattering GGX energy compensation (Cycles' default
+"Multiscatter GGX"): rough metals and glass here are single-scattering, so slightly
+darker than Cycles at high roughness.
+
+Sampling: a lobe is chosen per point with probability proportional to an estimate of its
+albedo at wo; the mixture pdf is sum_i q_i pdf_i over the allowed lobes (the delta part
+of a smooth glass has no density and reports pdf = inf, delta = True). `allowed` masks
+(n, 3) over DIFFUSE/GLOSSY/TRANSMISSION restrict sampling and the sampling pdf to the lobe
+kinds whose bounce budget is not exhausted (Cycles' diffuse/glossy/transmission limits;
+glass reflection counts as GLOSSY, refraction as TRANSMISSION), while `eval_f` always
+returns the whole BSDF: next-event estimation still sees every lobe.
+
+Lobes whose weight is zero at every point of a batch are never evaluated or sampled
+(`active`), so a batch of plain diffuse materials costs what Lambert alone costs.
+
+Sides: the integrator flips the shading normal towards the incoming ray, so wo_z > 0.
+Whether the ray arrives from inside the object (a back face) matters only to the glass
+lobe: pass `front_facing` to `from_materials` (the relative IOR becomes 1/ior there).
+Without it every hit is taken as a front face.
 """
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass
 
 import numpy as np
 
-from . import lambert
+from . import dielectric, fresnel, lambert
+from . import microfacet as mf
 from .lobes import DIFFUSE, GLOSSY, TRANSMISSION
+from ..warp import cosine_hemisphere
 
 
 @dataclass
@@ -28,42 +73,421 @@ class BSDFSample:
     valid: np.ndarray     # (n,) bool
 
 
-class PrincipledBSDF:
-    """The lobes DRT models so far: Lambertian diffuse from the base colour."""
+# Lobe indices of the mixture
+L_DIFFUSE, L_SPECULAR, L_METAL, L_GLASS = 0, 1, 2, 3
+LOBE_NAMES = ("diffuse", "specular", "metal", "glass")
+# Lower bound of a present lobe's selection estimate, relative to its weight, so a lobe
+# that reflects little at this wo (black metal at normal incidence) can still be sampled.
+MIN_SELECTION = 0.02
 
-    def __init__(self, base_color: np.ndarray, metallic: np.ndarray, transmission: np.ndarray):
-        self.n = len(base_color)
-        diffuse_w = (1.0 - np.clip(metallic, 0, 1)) * (1.0 - np.clip(transmission, 0, 1))
-        self.diffuse_albedo = base_color * diffuse_w[:, None]
-        # lobe weights for selection, one column per kind
-        self.lobe_weight = np.zeros((self.n, 3))
-        self.lobe_weight[:, DIFFUSE] = np.maximum(self.diffuse_albedo.max(axis=1), 0.0)
+
+# --- directional albedo of the specular layer ------------------------------------------
+
+_TABLE_T = np.linspace(0.0, 1.0, 33)        # cos theta_o coordinate, see _mu_of_t
+_TABLE_R = np.linspace(0.01, 1.0, 17)       # roughness (alpha = r^2 >= ALPHA_MIN)
+_TABLE_S = np.linspace(0.0, 0.95 ** 0.5, 25)  # F0^(1/4) = sqrt(|eta - 1| / (eta + 1)):
+#                                             dense near eta = 1, where E is steep
+_TABLE_STRATA = 16                          # 16 x 16 stratified visible normals per entry
+_tables = [None, None]                      # eta >= 1, eta < 1; each built on first use
+_table_lock = threading.Lock()
+
+
+def _critical_cos(eta):
+    """cos of the critical angle for relative IOR eta < 1 (0 for eta >= 1)."""
+    return np.sqrt(np.clip(1.0 - np.asarray(eta, dtype=np.float64) ** 2, 0.0, 1.0))
+
+
+def _mu_of_t(t, c):
+    """The cos theta_o of table coordinate t in [0, 1]. For eta >= 1 (c = 0): t^2. For
+    eta < 1 the critical cosine c sits at t = 1/2 with nodes crowding towards it from
+    both sides (c sin^2(pi t) below, quadratic above), so that the steep edge of total
+    internal reflection is resolved even for small roughness."""
+    t = np.asarray(t, dtype=np.float64)
+    lo = c * np.sin(np.pi * np.minimum(t, 0.5)) ** 2
+    hi = c + (1.0 - c) * (2.0 * t - 1.0) ** 2
+    return np.where(c > 0, np.where(t <= 0.5, lo, hi), t * t)
+
+
+def _t_of_mu(mu, c):
+    mu = np.clip(np.asarray(mu, dtype=np.float64), 0.0, 1.0)
+    cs = np.where(c > 0, c, 1.0)
+    lo = np.arcsin(np.sqrt(np.clip(mu / cs, 0.0, 1.0))) / np.pi
+    hi = 0.5 + 0.5 * np.sqrt(np.clip((mu - c) / np.maximum(1.0 - c, 1e-300), 0.0, 1.0))
+    return np.where(c > 0, np.where(mu <= c, lo, hi), np.sqrt(mu))
+
+
+def _eta_of(x, side):
+    eta = (1.0 + x) / (1.0 - x)
+    return 1.0 / eta if side else eta
+
+
+def _build_specular_albedo_table(side):
+    """E[s, r, t] = integral of F D G2 / (4 cos_o) over the reflected hemisphere, by
+    midpoint quadrature of the visible-normal sampling weight F(wo.h) G2/G1, for
+    eta >= 1 (side 0) or eta < 1 (side 1)."""
+    k = _TABLE_STRATA
+    g = (np.arange(k) + 0.5) / k
+    u = np.stack(np.meshgrid(g, g, indexing="ij"), -1).reshape(-1, 2)  # (S, 2)
+    table = np.empty((len(_TABLE_S), len(_TABLE_R), len(_TABLE_T)))
+    cache = {}
+    for j, x in enumerate(_TABLE_S ** 2):
+        eta = _eta_of(x, side)
+        c = float(_critical_cos(eta))
+        if c not in cache:       # eta >= 1: one set of directions serves every eta
+            mu = np.maximum(_mu_of_t(_TABLE_T, c), 1e-6)
+            rr, tt = np.meshgrid(_TABLE_R, mu, indexing="ij")        # (R, T)
+            cos_o = np.repeat(tt.reshape(-1), len(u))
+            alpha = np.repeat(rr.reshape(-1) ** 2, len(u))
+            wo = np.stack([np.sqrt(np.maximum(0.0, 1.0 - cos_o ** 2)), np.zeros_like(cos_o),
+                           cos_o], -1)
+            wi, h, valid = mf.reflection_sample(wo, alpha, np.tile(u, (tt.size, 1)))
+            weight = np.where(valid, mf.G2_over_G1(wo, wi, alpha), 0.0)
+            cache = {c: (weight, np.clip((wo * h).sum(1), 0.0, 1.0), tt.shape)}
+        weight, cos_oh, shape = cache[c]
+        F = fresnel.dielectric(cos_oh, eta)
+        table[j] = (F * weight).reshape(-1, len(u)).mean(1).reshape(shape)
+    return np.clip(table, 0.0, 1.0)
+
+
+def _get_table(side):
+    if _tables[side] is None:
+        with _table_lock:
+            if _tables[side] is None:
+                _tables[side] = _build_specular_albedo_table(side)
+    return _tables[side]
+
+
+def _lerp_coords(grid, v):
+    f = (np.clip(v, grid[0], grid[-1]) - grid[0]) / (grid[1] - grid[0])
+    i0 = np.minimum(f.astype(np.int64), len(grid) - 2)
+    return i0, f - i0
+
+
+def specular_albedo(cos_o, alpha, eta) -> np.ndarray:
+    """Directional albedo (n,) of GGX reflection with exact dielectric Fresnel of
+    relative IOR `eta`, single scattering, interpolated from the tables."""
+    cos_o = np.asarray(cos_o, dtype=np.float64)
+    eta = np.broadcast_to(np.asarray(eta, dtype=np.float64), cos_o.shape)
+    alpha = np.broadcast_to(mf.clamp_alpha(alpha), cos_o.shape)
+    out = np.zeros(cos_o.shape)
+    for side in (0, 1):
+        sel = (eta < 1.0) if side else (eta >= 1.0)
+        if not sel.any():
+            continue
+        table = _get_table(side)
+        e = eta[sel]
+        x = np.abs(e - 1.0) / (e + 1.0)
+        i, fi = _lerp_coords(_TABLE_S, np.sqrt(x))
+        j, fj = _lerp_coords(_TABLE_R, np.sqrt(alpha[sel]))
+        # each eta node has its own cos axis, aligned on its critical angle: the same
+        # coordinate t is the same position relative to the critical angle in every node
+        k, fk = _lerp_coords(_TABLE_T, _t_of_mu(cos_o[sel], _critical_cos(e)))
+        acc = 0.0
+        for di, wi_ in ((0, 1.0 - fi), (1, fi)):
+            for dj, wj in ((0, 1.0 - fj), (1, fj)):
+                for dk, wk in ((0, 1.0 - fk), (1, fk)):
+                    acc = acc + wi_ * wj * wk * table[i + di, j + dj, k + dk]
+        out[sel] = acc
+    return out
+
+
+# --- the mixture -----------------------------------------------------------------------
+
+def _sub(a, rows):
+    return a if rows is None else a[rows]
+
+
+class PrincipledBSDF:
+    """Diffuse, dielectric specular, metal and glass lobes with Blender's weights."""
+
+    def __init__(self, base_color, metallic, transmission, roughness=None, ior=None,
+                 specular_ior_level=None, front_facing=None):
+        base_color = np.asarray(base_color, dtype=np.float64).reshape(-1, 3)
+        n = self.n = len(base_color)
+
+        def param(v, default):
+            if v is None:
+                return np.full(n, default, dtype=np.float64)
+            return np.broadcast_to(np.asarray(v, dtype=np.float64), (n,)).copy()
+
+        m = np.clip(param(metallic, 0.0), 0.0, 1.0)
+        t = np.clip(param(transmission, 0.0), 0.0, 1.0)
+        rough = np.clip(param(roughness, 0.5), 0.0, 1.0)
+        ior = np.maximum(param(ior, 1.5), 1e-5)
+        level = np.maximum(param(specular_ior_level, 0.5), 0.0)
+        front = (np.ones(n, bool) if front_facing is None
+                 else np.broadcast_to(np.asarray(front_facing, bool), (n,)))
+
+        self.base = np.maximum(base_color, 0.0)         # Cycles: diffuse is not clamped
+        self.base_clamped = np.minimum(self.base, 1.0)  # ... metal F0 and glass tint are
+        self.alpha = mf.clamp_alpha(rough * rough)
+        base_w = (1.0 - m) * (1.0 - t)
+        # specular layer: F0 scaled by 2 * level, IOR recomputed from it
+        f0 = fresnel.f0_from_ior(ior) * 2.0 * level
+        eta_s = fresnel.ior_from_f0(f0)
+        eta_s = np.where(ior < 1.0, 1.0 / eta_s, eta_s)
+        self.eta_spec = np.where(level == 0.5, ior, eta_s)
+        spec_on = (f0 > 0) & (np.abs(self.eta_spec - 1.0) > 1e-7)
+        self.eta_glass = np.where(front, ior, 1.0 / ior)
+        self.glass_smooth = dielectric.is_smooth(self.alpha, self.eta_glass)
+        self.tint_t = np.sqrt(self.base_clamped)
+        self.diffuse_color = self.base * base_w[:, None]
+        self.weight = np.stack([
+            np.where(self.diffuse_color.max(1) > 0, base_w, 0.0),   # diffuse (scalar part)
+            np.where(spec_on, base_w, 0.0),                         # specular
+            m,                                                      # metal
+            (1.0 - m) * t,                                          # glass
+        ], axis=1)
+        on = self.weight > 0
+        self.active = on.any(0)                  # lobes present anywhere in the batch
+        self._all_on = on.all(0)
+        self._rows_on = [np.nonzero(on[:, k])[0] for k in range(4)]
+        self._state_key = None
+        self._state = None
+        # the common case of a batch of plain diffuse surfaces takes Lambert's own path
+        self.diffuse_only = bool(self.active[L_DIFFUSE] and not self.active[1:].any())
 
     @classmethod
-    def from_materials(cls, table: "MaterialTable", index: np.ndarray) -> "PrincipledBSDF":
-        return cls(table.base_color[index], table.metallic[index], table.transmission[index])
+    def from_materials(cls, table: "MaterialTable", index: np.ndarray,
+                       front_facing=None) -> "PrincipledBSDF":
+        return cls(table.base_color[index], table.metallic[index], table.transmission[index],
+                   table.roughness[index], table.ior[index], table.specular_ior_level[index],
+                   front_facing)
 
-    def _selection(self, allowed):
-        w = self.lobe_weight if allowed is None else self.lobe_weight * allowed
+    @classmethod
+    def lambertian(cls, base_color) -> "PrincipledBSDF":
+        """A plain Lambertian BSDF (no specular layer): only the diffuse lobe is active,
+        and `diffuse_only` is set, so every call takes Lambert's own code path."""
+        n = len(base_color)
+        return cls(base_color, np.zeros(n), np.zeros(n), specular_ior_level=np.zeros(n))
+
+    # -- per-wo quantities ---------------------------------------------------------------
+    def _wo_state(self, wo):
+        """Albedo-dependent weights at wo: the diffuse colour under the specular layer and
+        the lobe selection estimates (n, 5): diffuse, specular, metal, glass reflection,
+        glass refraction. Cached for the last wo array seen (the integrator evaluates,
+        computes pdfs and samples with one wo)."""
+        if self._state_key is wo:
+            return self._state
+        n = self.n
+        cos_o = np.clip(wo[:, 2], 0.0, 1.0)
+        est = np.zeros((n, 5))
+        e_spec = np.zeros(n)
+        if self.active[L_SPECULAR]:
+            r = self._rows_on[L_SPECULAR]
+            e_spec[r] = specular_albedo(cos_o[r], self.alpha[r], self.eta_spec[r])
+            est[r, 1] = self.weight[r, L_SPECULAR] * e_spec[r]
+        diffuse = self.diffuse_color * (1.0 - e_spec)[:, None]
+        if self.active[L_DIFFUSE]:
+            est[:, 0] = diffuse.max(1)
+        if self.active[L_METAL]:
+            r = self._rows_on[L_METAL]
+            F = fresnel.schlick(self.base_clamped[r], cos_o[r]).max(1)
+            est[r, 2] = self.weight[r, L_METAL] * F
+        if self.active[L_GLASS]:
+            r = self._rows_on[L_GLASS]
+            eta = self.eta_glass[r]
+            F = fresnel.dielectric(wo[r, 2], eta)
+            eta_rel = np.where(wo[r, 2] < 0, 1.0 / eta, eta)
+            est[r, 3] = self.weight[r, L_GLASS] * F
+            est[r, 4] = (self.weight[r, L_GLASS] * (1.0 - F) * self.tint_t[r].max(1)
+                         / (eta_rel * eta_rel))
+        # floors so that every present lobe can be sampled
+        floor = MIN_SELECTION * self.weight
+        est[:, :3] = np.where(self.weight[:, :3] > 0, np.maximum(est[:, :3], floor[:, :3]), 0.0)
+        est[:, 3] = np.where(self.weight[:, 3] > 0, np.maximum(est[:, 3], 0.5 * floor[:, 3]), 0.0)
+        est[:, 4] = np.where(self.weight[:, 3] > 0, np.maximum(est[:, 4], 0.5 * floor[:, 3]), 0.0)
+        self._state_key, self._state = wo, (diffuse, est)
+        return self._state
+
+    def _selection(self, est, allowed):
+        """Lobe probabilities (n, 4) and the glass lobe's allow flags."""
+        if allowed is None:
+            allowed = np.ones((len(est), 3), bool)
+        allowed = np.asarray(allowed, bool)
+        a_g, a_t = allowed[:, GLOSSY], allowed[:, TRANSMISSION]
+        w = np.stack([est[:, 0] * allowed[:, DIFFUSE], est[:, 1] * a_g, est[:, 2] * a_g,
+                      est[:, 3] * a_g + est[:, 4] * a_t], axis=1)
         total = w.sum(1, keepdims=True)
-        return np.where(total > 0, w / np.where(total > 0, total, 1.0), 0.0)
+        q = np.where(total > 0, w / np.where(total > 0, total, 1.0), 0.0)
+        return q, a_g, a_t
+
+    def _lobe_rows(self, lobe, idx):
+        """Rows of lobe `lobe` within the subset idx: (global rows, local rows), None = all."""
+        if idx is None:
+            if self._all_on[lobe]:
+                return None, None
+            r = self._rows_on[lobe]
+            return r, r
+        loc = np.nonzero(self.weight[idx, lobe] > 0)[0]
+        if len(loc) == len(idx):
+            return idx, None
+        return idx[loc], loc
+
+    # -- evaluation ----------------------------------------------------------------------
+    def _eval(self, idx, wo, wi, diffuse):
+        f = np.zeros((len(wo), 3))
+        if self.active[L_DIFFUSE]:
+            g, loc = self._lobe_rows(L_DIFFUSE, idx)
+            if g is None or len(g):
+                val = lambert.eval_f(_sub(diffuse, g), _sub(wo, loc), _sub(wi, loc))
+                if loc is None:
+                    f += val
+                else:
+                    f[loc] += val
+        for lobe in (L_SPECULAR, L_METAL):
+            if not self.active[lobe]:
+                continue
+            g, loc = self._lobe_rows(lobe, idx)
+            if g is not None and not len(g):
+                continue
+            o, i = _sub(wo, loc), _sub(wi, loc)
+            base, h = mf.reflection_eval(o, i, _sub(self.alpha, g))
+            cos_oh = np.clip((o * h).sum(1), 0.0, 1.0)
+            if lobe == L_SPECULAR:
+                F = fresnel.dielectric(cos_oh, _sub(self.eta_spec, g))[:, None]
+            else:
+                F = fresnel.schlick(_sub(self.base_clamped, g), cos_oh)
+            val = F * (base * _sub(self.weight[:, lobe], g))[:, None]
+            if loc is None:
+                f += val
+            else:
+                f[loc] += val
+        if self.active[L_GLASS]:
+            g, loc = self._lobe_rows(L_GLASS, idx)
+            if g is None or len(g):
+                rough = ~_sub(self.glass_smooth, g)
+                if rough.any():
+                    rr = np.nonzero(rough)[0]
+                    gr = rr if g is None else g[rr]
+                    lr = rr if loc is None else loc[rr]
+                    f_r, f_t = dielectric.rough_eval(wo[lr], wi[lr], self.eta_glass[gr],
+                                                     self.alpha[gr])
+                    val = (f_r[:, None] + f_t[:, None] * self.tint_t[gr]) \
+                        * self.weight[gr, L_GLASS][:, None]
+                    f[lr] += val
+        return f
 
     def eval_f(self, wo, wi):
-        return lambert.eval_f(self.diffuse_albedo, wo, wi)
+        """The whole BSDF f(wo, wi) (n, 3) in 1/sr (delta parts excluded)."""
+        if self.diffuse_only:
+            return lambert.eval_f(self.diffuse_color, wo, wi)
+        diffuse, _ = self._wo_state(wo)
+        return self._eval(None, wo, wi, diffuse)
+
+    def _pdf(self, idx, wo, wi, q, a_g, a_t):
+        """Mixture pdf on the subset idx; q, a_g, a_t already restricted to it."""
+        p = np.zeros(len(wo))
+        if self.active[L_DIFFUSE]:
+            p += q[:, L_DIFFUSE] * lambert.pdf(wo, wi)
+        if self.active[L_SPECULAR] or self.active[L_METAL]:
+            q_refl = q[:, L_SPECULAR] + q[:, L_METAL]
+            r = np.nonzero(q_refl > 0)[0]
+            if len(r):
+                g = r if idx is None else idx[r]
+                p[r] += q_refl[r] * mf.reflection_pdf(wo[r], wi[r], self.alpha[g])
+        if self.active[L_GLASS]:
+            gl = q[:, L_GLASS] > 0
+            gl &= ~_sub(self.glass_smooth, idx)
+            r = np.nonzero(gl)[0]
+            if len(r):
+                g = r if idx is None else idx[r]
+                p[r] += q[r, L_GLASS] * dielectric.rough_pdf(
+                    wo[r], wi[r], self.eta_glass[g], self.alpha[g], a_g[r], a_t[r])
+        return p
 
     def pdf(self, wo, wi, allowed=None):
-        q = self._selection(allowed)
-        return q[:, DIFFUSE] * lambert.pdf(wo, wi)
+        """Mixture pdf (n,) in 1/sr of `sample` with the same `allowed` mask."""
+        if self.diffuse_only:
+            return np.where(self._diffuse_allowed(allowed), lambert.pdf(wo, wi), 0.0)
+        _, est = self._wo_state(wo)
+        q, a_g, a_t = self._selection(est, allowed)
+        return self._pdf(None, wo, wi, q, a_g, a_t)
+
+    # -- sampling ------------------------------------------------------------------------
+    def _diffuse_allowed(self, allowed):
+        on = self.weight[:, L_DIFFUSE] > 0
+        return on if allowed is None else on & np.asarray(allowed, bool)[:, DIFFUSE]
+
+    def _sample_diffuse_only(self, wo, u_dir, allowed):
+        wi = cosine_hemisphere(u_dir)
+        pdf = np.where(self._diffuse_allowed(allowed), lambert.pdf(wo, wi), 0.0)
+        ok = pdf > 0
+        # f |cos| / pdf of a Lambertian lobe is its albedo
+        weight = np.where(ok[:, None], self.diffuse_color, 0.0)
+        return BSDFSample(wi, weight, pdf, np.full(self.n, DIFFUSE, dtype=np.int64),
+                          np.zeros(self.n, bool), ok)
 
     def sample(self, wo, u_lobe, u_dir, allowed=None) -> BSDFSample:
-        q = self._selection(allowed)
-        kind = np.full(self.n, DIFFUSE, dtype=np.int64)
-        wi = lambert.sample(wo, u_dir)
-        pdf = self.pdf(wo, wi, allowed)
-        f = self.eval_f(wo, wi)
-        valid = (pdf > 0) & (q.sum(1) > 0) & (wo[:, 2] > 0)
-        weight = np.where(valid[:, None], f * np.abs(wi[:, 2:3]) / np.where(valid, pdf, 1.0)[:, None], 0.0)
-        return BSDFSample(wi, weight, pdf, kind, np.zeros(self.n, bool), valid)
+        """Choose a lobe with u_lobe (n,), a direction with u_dir (n, 2) (the rest of
+        u_lobe, rescaled, picks a glass reflection or refraction)."""
+        if self.diffuse_only:
+            return self._sample_diffuse_only(wo, u_dir, allowed)
+        n = self.n
+        diffuse, est = self._wo_state(wo)
+        q, a_g, a_t = self._selection(est, allowed)
+        cdf = np.cumsum(q, axis=1)
+        total = cdf[:, -1]
+        lobe = (u_lobe[:, None] >= cdf[:, :3]).sum(1)
+        lo = np.take_along_axis(np.concatenate([np.zeros((n, 1)), cdf], 1), lobe[:, None], 1)[:, 0]
+        q_sel = np.take_along_axis(q, np.minimum(lobe, 3)[:, None], 1)[:, 0]
+        u_re = np.clip((u_lobe - lo) / np.where(q_sel > 0, q_sel, 1.0), 0.0, 1.0 - 2.0 ** -53)
+
+        wi = np.zeros((n, 3))
+        wi[:, 2] = 1.0
+        kind = np.full(n, DIFFUSE, dtype=np.int64)
+        delta = np.zeros(n, bool)
+        ok = (total > 0) & (q_sel > 0)
+        weight = np.zeros((n, 3))
+        pdf = np.zeros(n)
+
+        r = np.nonzero(ok & (lobe == L_DIFFUSE))[0]
+        if len(r):
+            wi[r] = cosine_hemisphere(u_dir[r])
+            ok[r] &= wo[r, 2] > 0
+        r = np.nonzero(ok & ((lobe == L_SPECULAR) | (lobe == L_METAL)))[0]
+        if len(r):
+            w, _, v = mf.reflection_sample(wo[r], self.alpha[r], u_dir[r])
+            wi[r] = w
+            kind[r] = GLOSSY
+            ok[r] &= v
+        r = np.nonzero(ok & (lobe == L_GLASS))[0]
+        if len(r):
+            smooth = self.glass_smooth[r]
+            rs, rr = r[smooth], r[~smooth]
+            if len(rs):
+                w, ws, refr, v = dielectric.smooth_sample(
+                    wo[rs], self.eta_glass[rs], u_re[rs], a_g[rs], a_t[rs])
+                wi[rs] = w
+                kind[rs] = np.where(refr, TRANSMISSION, GLOSSY)
+                ok[rs] &= v
+                delta[rs] = True
+                tint = np.where(refr[:, None], self.tint_t[rs], 1.0)
+                weight[rs] = tint * (ws * self.weight[rs, L_GLASS]
+                                     / np.where(v, q_sel[rs], 1.0))[:, None]
+                pdf[rs] = np.inf
+            if len(rr):
+                w, _, refr, v, _ = dielectric.rough_sample(
+                    wo[rr], self.eta_glass[rr], self.alpha[rr], u_re[rr], u_dir[rr],
+                    a_g[rr], a_t[rr])
+                wi[rr] = w
+                kind[rr] = np.where(refr, TRANSMISSION, GLOSSY)
+                ok[rr] &= v
+
+        # non-delta choices: one-sample mixture estimator f |cos| / sum_j q_j pdf_j
+        r = np.nonzero(ok & ~delta)[0]
+        if len(r):
+            f = self._eval(r, wo[r], wi[r], diffuse)
+            p = self._pdf(r, wo[r], wi[r], q[r], a_g[r], a_t[r])
+            good = (p > 0) & np.isfinite(p)
+            weight[r] = np.where(good[:, None],
+                                 f * (np.abs(wi[r, 2]) / np.where(good, p, 1.0))[:, None], 0.0)
+            pdf[r] = np.where(good, p, 0.0)
+            ok[r] &= good
+        weight[~ok] = 0.0
+        pdf[~ok] = 0.0
+        delta &= ok
+        return BSDFSample(wi, weight, pdf, kind, delta, ok)
 
 
 class MaterialTable:
@@ -78,9 +502,14 @@ class MaterialTable:
         self.specular_ior_level = np.array([m.specular_ior_level for m in materials], np.float64)
         self.emission = np.array([m.emission[:3] for m in materials], dtype=np.float64)
         self.alpha = np.array([m.alpha for m in materials], dtype=np.float64)
-        for name in ("base_color", "metallic", "roughness", "ior", "transmission", "emission"):
+        for name in ("base_color", "metallic", "roughness", "ior", "transmission",
+                     "specular_ior_level", "emission"):
             if not np.all(np.isfinite(getattr(self, name))):
                 bad = [m.name for m in materials
                        if not np.all(np.isfinite(np.asarray(getattr(m, name), dtype=float)))]
                 raise ValueError(f"material {bad[0]!r} has a non-finite {name}")
         self.any_emission = bool((self.emission > 0).any())
+        # Which lobes any material can produce (a scene of plain diffuse materials never
+        # touches the microfacet code; PrincipledBSDF also skips lobes per batch).
+        self.any_glossy = bool(((self.specular_ior_level > 0) | (self.metallic > 0)
+                                | (self.transmission > 0)).any())
