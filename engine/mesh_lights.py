@@ -58,15 +58,23 @@ class EmissiveTriangles:
         self.entry[self.prim] = np.arange(len(self.prim))
 
     @classmethod
-    def from_scene(cls, scene, accel) -> "EmissiveTriangles":
+    def from_scene(cls, scene, accel, emission=None) -> "EmissiveTriangles":
         """The emissive triangles of `scene`, with the global ids of `accel`
-        (engine.accel.Accelerator, which concatenates the meshes' triangles in order)."""
+        (engine.accel.Accelerator, which concatenates the meshes' triangles in order).
+        `emission`: (materials, 3) radiance table, by default the materials' `emission`;
+        the renderer passes the one its integrator adds at hits, so both agree."""
         tri = accel.triangles
         if not len(tri) or not scene.materials:
             return cls(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
                        np.zeros((0, 3)), np.zeros(0, np.int64), 0)
-        emission = np.array([tuple(m.emission[:3]) for m in scene.materials], dtype=np.float64)
-        mat = np.concatenate([m.material_indices for m in scene.meshes]).astype(np.int64)
+        if emission is None:
+            emission = [tuple(m.emission[:3]) for m in scene.materials]
+        emission = np.asarray(emission, dtype=np.float64).reshape(-1, 3)
+        # Only the static triangles (the accelerator's first `static_count` ids) are
+        # light-sampled: a moving emissive mesh is still seen, blurred, by camera and BSDF
+        # rays (with MIS weight 1), just not sampled directly.
+        static_meshes = accel.ordered_meshes[:len(accel.ordered_meshes) - len(accel.moving)]
+        mat = np.concatenate([m.material_indices for m in static_meshes]).astype(np.int64)
         emissive = np.nonzero(emission[mat].max(axis=1) > 0)[0]
         p = accel.positions
         t = tri[emissive]

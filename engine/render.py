@@ -65,7 +65,8 @@ class RenderContext:
         self.materials = MaterialTable(scene.materials)
         self.scene_radius = _scene_radius(scene, self.accel)
         self.lights = LightSet(scene.lights, self.scene_radius,
-                               mesh_lights=EmissiveTriangles.from_scene(scene, self.accel))
+                               mesh_lights=EmissiveTriangles.from_scene(
+                                   scene, self.accel, self.materials.emission))
         self.light_visible_camera = np.array(
             [getattr(m, "visible_camera", True) for m in self.lights.models] or [True])
         self.world_radiance = np.asarray(scene.world.color, dtype=np.float64)[:3]
@@ -104,7 +105,7 @@ def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sampl
         if ctx.has_motion else None
     rays = ctx.camera.generate(film_xy, lens_u, time)
     radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
-                                       **({} if time is None else {"time": time}))
+                                       time=time)
     return pixel, radiance
 
 
