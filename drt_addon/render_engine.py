@@ -1,18 +1,77 @@
-"""The RenderEngine Blender selects as 'DRT' (F12, `blender -b file.blend -E DRT -f 1`)."""
+"""The RenderEngine Blender selects as 'DRT' (F12, `blender -b file.blend -E DRT -f 1`).
+
+Render passes, declared in `update_render_passes` and written when enabled in the view
+layer (Properties > View Layer > Passes):
+- Depth (`use_pass_z`): distance along the camera's view axis to the first hit, as
+  Cycles' Z pass; 1e10 where nothing is hit.
+- Normal (`use_pass_normal`): world-space shading normal of the first hit.
+- Denoising Normal and Denoising Albedo (`view_layer.drt.use_pass_denoising_data`):
+  camera-space normal and diffuse albedo, the inputs of the compositor's Denoise node.
+- DRT Noise (`view_layer.drt.use_pass_noise`): per pixel and channel, the standard error
+  of the pixel's mean radiance (sqrt of engine.film.Film.variance_of_mean); inf where a
+  pixel has fewer than two samples.
+Depth, Normal and the denoising passes come from engine.aov (a first-hit query on the
+same camera samples), not from the path tracer.
+
+Border render (Render Region): only the border's pixels are traced; the result covers
+just that rectangle, which Blender places in the frame (or crops to, with Crop to Render
+Region).
+"""
 from __future__ import annotations
 
 import time
 import traceback
+from importlib import import_module
 
 import bpy
 import numpy as np
+from bpy.props import BoolProperty, PointerProperty
 
 from .engine_link import engine
-from .export import ExportError, Reporter, export_scene, render_size
+from .export import ExportError, Reporter, export_scene, render_region
 
-# What the last render did, for the batch renderer (Blender's operator says FINISHED even
-# when an engine reported an error).
-last_render = {"ok": None, "error": None, "warnings": [], "stats": None, "pixels": None}
+aov = import_module(engine.__name__ + ".aov")   # engine.aov, in either package layout
+
+# What the last render did, for the batch renderer and tests (Blender's operator says
+# FINISHED even when an engine reported an error). "scene" is the exported description,
+# "passes" the extra passes written (top-down float arrays by pass name).
+last_render = {"ok": None, "error": None, "warnings": [], "stats": None, "pixels": None,
+               "scene": None, "export_stats": None, "passes": {}, "region": None}
+
+
+class DRTViewLayerSettings(bpy.types.PropertyGroup):
+    use_pass_denoising_data: BoolProperty(
+        name="Denoising Data", default=False,
+        description="Write Denoising Normal and Denoising Albedo passes, the inputs of the "
+                    "compositor's Denoise node")
+    use_pass_noise: BoolProperty(
+        name="Noise Estimate", default=False,
+        description="Write the 'DRT Noise' pass: per pixel, the standard error of the mean "
+                    "radiance (how far the pixel may be from the converged value)")
+
+
+# (name, channels, channel ids, type) of each pass DRT can write, and when it is enabled.
+PASSES = {
+    "Depth": (1, "Z", "VALUE", lambda vl: vl.use_pass_z),
+    "Normal": (3, "XYZ", "VECTOR", lambda vl: vl.use_pass_normal),
+    "Denoising Normal": (3, "XYZ", "VECTOR", lambda vl: _drt_layer(vl, "use_pass_denoising_data")),
+    "Denoising Albedo": (3, "RGB", "COLOR", lambda vl: _drt_layer(vl, "use_pass_denoising_data")),
+    "DRT Noise": (3, "RGB", "COLOR", lambda vl: _drt_layer(vl, "use_pass_noise")),
+}
+
+
+def _drt_layer(view_layer, name) -> bool:
+    settings = getattr(view_layer, "drt", None)
+    return bool(getattr(settings, name, False))
+
+
+def enabled_passes(view_layer) -> list:
+    return [name for name, (*_, enabled) in PASSES.items() if enabled(view_layer)]
+
+
+def _bottom_up(image: np.ndarray) -> np.ndarray:
+    """(h, w[, c]) top-down image to Blender's flat bottom-up float32 buffer."""
+    return np.ascontiguousarray(image[::-1], dtype=np.float32).reshape(-1)
 
 
 def _rgba_bottom_up(image: np.ndarray) -> np.ndarray:
@@ -32,11 +91,28 @@ class DRTRenderEngine(bpy.types.RenderEngine):
     bl_use_shading_nodes_custom = False   # keep Cycles' shader nodes editable
     bl_use_eevee_viewport = True          # Material Preview and viewport use EEVEE
 
+    @classmethod
+    def register(cls):
+        bpy.utils.register_class(DRTViewLayerSettings)
+        bpy.types.ViewLayer.drt = PointerProperty(type=DRTViewLayerSettings)
+
+    @classmethod
+    def unregister(cls):
+        del bpy.types.ViewLayer.drt
+        bpy.utils.unregister_class(DRTViewLayerSettings)
+
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)  # required since Blender 4.4
 
+    def update_render_passes(self, scene=None, renderlayer=None):
+        self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+        for name in enabled_passes(renderlayer):
+            channels, chan_id, kind, _ = PASSES[name]
+            self.register_pass(scene, renderlayer, name, channels, chan_id, kind)
+
     def render(self, depsgraph):
-        last_render.update(ok=False, error=None, warnings=[], stats=None, pixels=None)
+        last_render.update(ok=False, error=None, warnings=[], stats=None, pixels=None,
+                           scene=None, export_stats=None, passes={}, region=None)
         try:
             self._render(depsgraph)
         except ExportError as e:
@@ -52,21 +128,26 @@ class DRTRenderEngine(bpy.types.RenderEngine):
 
     def _render(self, depsgraph):
         scene = depsgraph.scene
-        width, height = render_size(scene)
+        view_layer = depsgraph.view_layer
+        region = render_region(scene)
         reporter = Reporter(self.report)
         self.update_stats("", "DRT: exporting scene")
         t0 = time.perf_counter()
-        description = export_scene(depsgraph, reporter, size=(width, height))
+        export_stats = {}
+        description = export_scene(depsgraph, reporter, region=region, stats=export_stats)
         settings = scene.drt.to_engine_settings()
         try:
             settings.validate()
         except ValueError as e:
             raise ExportError(f"DRT: invalid render settings: {e}") from e
         export_seconds = time.perf_counter() - t0
+        last_render.update(scene=description, export_stats=export_stats, region=region)
         self.update_stats("", "DRT: building acceleration structure")
         ctx = engine.RenderContext(description, settings)
-        result = self.begin_result(0, 0, width, height)
-        combined = result.layers[0].passes["Combined"]
+        result = self.begin_result(0, 0, region.width, region.height, layer=view_layer.name)
+        layer = result.layers[0]
+        combined = layer.passes["Combined"]
+        image = None
         try:
             def progress(film, stats, fraction):
                 combined.rect.foreach_set(_rgba_bottom_up(film.mean()))
@@ -81,6 +162,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                                         cancelled=self.test_break)
             image = film.mean()
             combined.rect.foreach_set(_rgba_bottom_up(image))
+            if not stats.cancelled:
+                self._write_passes(layer, ctx, film, view_layer, description)
         finally:
             ctx.close()
             self.end_result(result)
@@ -90,3 +173,21 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         last_render.update(ok=not stats.cancelled, error="cancelled" if stats.cancelled else None,
                            warnings=reporter.warnings, stats=stats, pixels=image,
                            export_seconds=export_seconds)
+
+    def _write_passes(self, layer, ctx, film, view_layer, description):
+        wanted = [name for name in enabled_passes(view_layer)
+                  if layer.passes.get(name) is not None]
+        if not wanted:
+            return
+        images = {}
+        if any(n in wanted for n in ("Depth", "Normal", "Denoising Normal", "Denoising Albedo")):
+            self.update_stats("", "DRT: depth, normal and albedo passes")
+            first = aov.first_hit_passes(ctx)
+            images.update({"Depth": first.depth, "Normal": first.normal,
+                           "Denoising Albedo": first.albedo,
+                           "Denoising Normal": first.camera_normal(description.camera.matrix)})
+        if "DRT Noise" in wanted:
+            images["DRT Noise"] = np.sqrt(film.variance_of_mean())
+        for name in wanted:
+            layer.passes[name].rect.foreach_set(_bottom_up(images[name]))
+            last_render["passes"][name] = images[name]

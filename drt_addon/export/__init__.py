@@ -1,28 +1,59 @@
 """From Blender's evaluated depsgraph to DRT's scene description (engine.scene)."""
 from __future__ import annotations
 
+import time
+
 from ..engine_link import engine
-from .camera import export_camera
+from .camera import RenderRegion, export_camera, render_region, window_camera
 from .errors import ExportError, Reporter
 from .lights import export_light
 from .materials import export_material
-from .mesh import GEOMETRY_TYPES, export_mesh_instance
+from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
 from .world import export_world
 
-__all__ = ["ExportError", "Reporter", "export_scene", "render_size"]
+__all__ = ["ExportError", "RenderRegion", "Reporter", "export_scene", "render_region",
+           "render_size"]
 
 
 def render_size(scene):
-    r = scene.render
-    scale = r.resolution_percentage / 100.0
-    return max(1, int(r.resolution_x * scale)), max(1, int(r.resolution_y * scale))
+    """The full frame's size in pixels (resolution x percentage, Blender's integer maths)."""
+    region = render_region(scene)
+    return region.full_width, region.full_height
 
 
-def export_scene(depsgraph, reporter: Reporter | None = None, size=None) -> "engine.Scene":
+def _is_holdout(inst, obj, view_layer) -> bool:
+    """Holdout by the object's own flag or by a holdout collection (of the object, or of
+    the instancer for instanced geometry), as Cycles decides it."""
+    if getattr(obj, "is_holdout", False):
+        return True
+    owner = inst.parent if inst.is_instance and inst.parent is not None else obj
+    original = owner.original if owner.original is not None else owner
+    try:
+        return bool(original.holdout_get(view_layer=view_layer))
+    except (TypeError, RuntimeError, AttributeError):
+        return False
+
+
+def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
+                 region: RenderRegion | None = None, stats: dict | None = None
+                 ) -> "engine.Scene":
+    """The scene as DRT's description.
+
+    region: the pixels to render (default: Blender's render size and border, see
+    `render_region`); the Scene then has the region's size and a camera for just that
+    region. `size=(w, h)` renders the whole frame at that size instead. stats, if given,
+    receives counts of the export (mesh evaluations, reused instances, seconds)."""
+    t0 = time.perf_counter()
     reporter = reporter or Reporter()
     scene = depsgraph.scene
-    width, height = size or render_size(scene)
-    camera = export_camera(scene.camera, depsgraph)
+    if region is None:
+        if size is not None:
+            region = RenderRegion(size[0], size[1], 0, 0, size[0], size[1])
+        else:
+            region = render_region(scene)
+    aspect = scene.render.pixel_aspect_x / max(scene.render.pixel_aspect_y, 1e-9)
+    camera = window_camera(export_camera(scene.camera, depsgraph), region, aspect)
+    view_layer = depsgraph.view_layer
     materials, material_index = [], {}
 
     def material_id(mat):
@@ -32,20 +63,25 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None) -> "eng
             materials.append(export_material(mat, reporter))
         return material_index[key]
 
+    cache = MeshCache()
     meshes, lights = [], []
+    holdouts = 0
     for k, inst in enumerate(depsgraph.object_instances):
         obj = inst.object
         if obj.type in GEOMETRY_TYPES:
-            if inst.is_instance is False and not inst.show_self:
+            if not inst.is_instance and not inst.show_self:
                 continue
-            if getattr(obj, "is_holdout", False):
-                reporter.warn(f"DRT: holdout object {obj.name!r} is left out", key=(obj.name, "holdout"))
+            if _is_holdout(inst, obj, view_layer):
+                holdouts += 1
+                reporter.warn(f"DRT: holdout object {obj.name!r} is left out (DRT does not "
+                              "render holdouts yet)", key=(obj.name, "holdout"))
+                continue
+            local = cache.local(obj)
+            if local is None:
                 continue
             slots = [material_id(s.material) for s in obj.material_slots] or [material_id(None)]
-            mesh = export_mesh_instance(obj, inst.matrix_world.copy(), slots,
-                                        f"{obj.name}#{k}" if inst.is_instance else obj.name)
-            if mesh is not None:
-                meshes.append(mesh)
+            name = f"{obj.name}#{k}" if inst.is_instance else obj.name
+            meshes.append(instance_mesh(local, inst.matrix_world.copy(), slots, name))
         elif obj.type == "LIGHT":
             light = export_light(obj, inst.matrix_world.copy(), reporter)
             if light is not None:
@@ -53,6 +89,10 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None) -> "eng
     if not materials:
         materials.append(engine.Material())
     world = export_world(scene.world, reporter)
-    aspect = scene.render.pixel_aspect_x / max(scene.render.pixel_aspect_y, 1e-9)
-    return engine.Scene(camera, width, height, meshes, materials, lights, world,
+    if stats is not None:
+        stats.update(mesh_evaluations=cache.evaluations, mesh_reuses=cache.reuses,
+                     meshes=len(meshes), lights=len(lights), holdouts=holdouts,
+                     triangles=int(sum(len(m.triangles) for m in meshes)),
+                     seconds=time.perf_counter() - t0)
+    return engine.Scene(camera, region.width, region.height, meshes, materials, lights, world,
                         pixel_aspect=aspect)

@@ -1,5 +1,14 @@
-"""Evaluated Blender meshes to world-space triangle arrays, via foreach_get."""
+"""Evaluated Blender meshes to world-space triangle arrays, via foreach_get.
+
+Object-space arrays are read once per distinct evaluated geometry and reused for every
+instance of it within one export (`MeshCache`): linked duplicates without modifiers,
+collection instances and geometry-node instances share one evaluated mesh, so a forest of
+a thousand instanced trees costs one `to_mesh` and a thousand matrix products.
+"""
 from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 
@@ -8,6 +17,15 @@ from .errors import ExportError
 from .matrices import to_numpy
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT", "CURVES"}
+
+
+@dataclass
+class LocalMesh:
+    """One evaluated geometry in object space."""
+    positions: np.ndarray                  # (V, 3) float64
+    triangles: np.ndarray                  # (T, 3) int32
+    material: np.ndarray                   # (T,) int32 material slot index
+    normals: Optional[np.ndarray] = None   # (T, 3, 3) float32 split normals, None if all flat
 
 
 def mesh_arrays(mesh):
@@ -39,32 +57,98 @@ def _has_smooth_faces(mesh) -> bool:
     return bool(smooth.any())
 
 
-def export_mesh_instance(obj, matrix_world, material_slots, name) -> "engine.TriangleMesh | None":
-    """One evaluated object instance as a world-space TriangleMesh (None if empty).
+def _cache_key(obj):
+    """What identifies an evaluated geometry within one depsgraph.
 
-    material_slots: global material index per slot of this object."""
+    For meshes, the evaluated object's data is the evaluated mesh (modifiers applied): two
+    objects share it only when they share the mesh and neither has modifiers, so its
+    address is the key. Names are not: every evaluated mesh keeps its original's name.
+    Other types (curves, text, metaballs) keep their original data after evaluation, so
+    the evaluated object is part of the key."""
+    data = getattr(obj, "data", None)
+    if data is None:
+        return None
+    if obj.type == "MESH":
+        return ("MESH", data.as_pointer())
+    original = obj.original
+    return (obj.type, original.as_pointer() if original is not None else obj.as_pointer(),
+            data.as_pointer())
+
+
+class MeshCache:
+    """Object-space arrays per evaluated geometry, for the length of one export."""
+
+    def __init__(self):
+        self._local = {}
+        self.evaluations = 0      # to_mesh calls
+        self.reuses = 0           # instances served from the cache
+
+    def local(self, obj) -> Optional[LocalMesh]:
+        key = _cache_key(obj)
+        if key is not None and key in self._local:
+            self.reuses += 1
+            return self._local[key]
+        local = _evaluate(obj)
+        self.evaluations += 1
+        if key is not None:
+            self._local[key] = local
+        return local
+
+
+def _evaluate(obj) -> Optional[LocalMesh]:
     try:
         mesh = obj.to_mesh()
     except RuntimeError as e:
         raise ExportError(f"object {obj.name!r}: cannot evaluate its mesh ({e})") from e
-    if mesh is None:
-        return None
     try:
+        if mesh is None:
+            return None
         pos, tris, mat, normals = mesh_arrays(mesh)
     finally:
         obj.to_mesh_clear()
     if len(tris) == 0:
         return None
     if not np.all(np.isfinite(pos)):
-        raise ExportError(f"object {obj.name!r} has non-finite (NaN or Inf) vertex positions")
+        bad = int(np.count_nonzero(~np.isfinite(pos).all(axis=1)))
+        raise ExportError(f"object {obj.name!r} has {bad} vertices with non-finite (NaN or "
+                          "infinite) positions; fix or delete them to render")
+    if normals is not None and not np.all(np.isfinite(normals)):
+        normals = None                        # degenerate faces: fall back to flat shading
+    return LocalMesh(pos, tris, mat, normals)
+
+
+def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engine.TriangleMesh":
+    """A LocalMesh placed in the world by `matrix_world`.
+
+    material_slots: global material index per material slot of the instanced object."""
     m = to_numpy(matrix_world)
-    world = pos @ m[:3, :3].T + m[:3, 3]
+    m3 = m[:3, :3]
+    if not np.all(np.isfinite(m)):
+        raise ExportError(f"object {name!r} has a non-finite transform")
+    world = local.positions @ m3.T + m[:3, 3]
+    tris = local.triangles
+    normals = local.normals
+    det = float(np.linalg.det(m3))
     if normals is not None:
-        normal_matrix = np.linalg.inv(m[:3, :3]).T if abs(np.linalg.det(m[:3, :3])) > 1e-300 \
-            else m[:3, :3]
+        normal_matrix = np.linalg.inv(m3).T if abs(det) > 1e-300 else m3
         nw = normals.reshape(-1, 3).astype(np.float64) @ normal_matrix.T
         nw /= np.maximum(np.linalg.norm(nw, axis=1, keepdims=True), 1e-300)
         normals = nw.reshape(-1, 3, 3).astype(np.float32)
+    if det < 0:
+        # A mirroring transform flips the winding; swap two corners so that the geometric
+        # normal still points to the side Blender's normals point to.
+        tris = tris[:, [0, 2, 1]]
+        if normals is not None:
+            normals = normals[:, [0, 2, 1]]
     slots = np.asarray(material_slots if len(material_slots) else [0], dtype=np.int32)
-    global_mat = slots[np.clip(mat, 0, len(slots) - 1)]
+    global_mat = slots[np.clip(local.material, 0, len(slots) - 1)]
     return engine.TriangleMesh(name, world, tris, global_mat, corner_normals=normals)
+
+
+def export_mesh_instance(obj, matrix_world, material_slots, name,
+                         cache: Optional[MeshCache] = None) -> "engine.TriangleMesh | None":
+    """One evaluated object instance as a world-space TriangleMesh (None if empty)."""
+    local = (cache or MeshCache()).local(obj)
+    if local is None:
+        return None
+    return instance_mesh(local, matrix_world, material_slots, name)

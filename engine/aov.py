@@ -1,0 +1,121 @@
+"""First-hit render passes (AOVs): depth, normal and albedo of what each pixel sees.
+
+They are computed by a separate, cheap query on a RenderContext (camera rays and one
+intersection each, no shading), with Cycles' meanings:
+- depth: the hit's distance along the camera's view axis (camera-space z, Cycles'
+  `camera_z_depth`, which is what Blender's compositor expects of a Z pass), of the ray
+  through the pixel centre and the centre of the lens; DEPTH_MISS (Cycles' 1e10) where
+  that ray hits nothing;
+- normal: the world-space shading normal, turned towards the camera ray (Cycles flips
+  back faces the same way), averaged over the pixel's first `samples` camera samples
+  (the same sub-pixel, lens and time samples the radiance used); zero where a sample hit
+  nothing, so edge pixels are weighted by coverage as in Cycles;
+- albedo: the diffuse albedo of the Principled BSDF hit, base colour x (1 - metallic) x
+  (1 - transmission), averaged the same way (what Cycles writes to Denoising Albedo for
+  a rough surface).
+Emitting lights (area and sphere lights) are not surfaces here: rays see through them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from .camera import CameraModel
+from .sampling import dimensions as D
+
+DEPTH_MISS = 1.0e10
+AOV_SAMPLES = 16
+
+
+@dataclass
+class FirstHitPasses:
+    depth: np.ndarray            # (h, w) float64
+    normal: np.ndarray           # (h, w, 3) float64, world space
+    albedo: np.ndarray           # (h, w, 3) float64
+    samples: int                 # camera samples averaged per pixel
+
+    def camera_normal(self, camera_matrix) -> np.ndarray:
+        """The normal pass in camera space (x right, y up, z towards the viewer), as
+        Cycles writes Denoising Normal."""
+        m = np.asarray(camera_matrix, dtype=np.float64)[:3, :3]
+        rot = m / np.linalg.norm(m, axis=0)
+        return self.normal @ rot          # rows: n_world . column_i = (R^T n)_i
+
+
+def _intersect(ctx, o, d, tmax, time):
+    if time is None:
+        return ctx.accel.intersect(o, d, tmax)
+    return ctx.accel.intersect(o, d, tmax, time=time)
+
+
+def _build(ctx, hits, index, d, time):
+    if time is None:
+        return ctx.surfaces.build(hits, index, d)
+    return ctx.surfaces.build(hits, index, d, time=time)
+
+
+def _camera_samples(ctx, pixel, index):
+    """The camera rays of samples `index` of `pixel`, drawn exactly as the renderer draws
+    them (sub-pixel position through the pixel filter, lens, shutter time)."""
+    w = ctx.scene.width
+    u_pix = ctx.sampler.get_2d(D.PIXEL, pixel, index)
+    offset = ctx.filter.sample(u_pix)
+    film_xy = np.stack([pixel % w + 0.5 + offset[:, 0], pixel // w + 0.5 + offset[:, 1]], axis=1)
+    lens_u = ctx.sampler.get_2d(D.LENS, pixel, index) if ctx.camera.has_lens else None
+    time = None
+    if getattr(ctx, "has_motion", False):
+        time = ctx.scene.shutter.sample(ctx.sampler.get_1d(D.TIME, pixel, index))
+        return ctx.camera.generate(film_xy, lens_u, time), time
+    return ctx.camera.generate(film_xy, lens_u), None
+
+
+def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16) -> FirstHitPasses:
+    """Depth, normal and albedo passes for the scene of `ctx` (an engine.RenderContext)."""
+    scene = ctx.scene
+    width, height = scene.width, scene.height
+    n_pix = width * height
+    k = int(max(1, min(samples, ctx.settings.samples)))
+    mats = ctx.materials
+    diffuse = (mats.base_color * ((1.0 - np.clip(mats.metallic, 0.0, 1.0))
+                                  * (1.0 - np.clip(mats.transmission, 0.0, 1.0)))[:, None])
+
+    # Depth: the pinhole ray through each pixel centre (the lens centre for a thin lens).
+    pinhole = CameraModel(replace(scene.camera, aperture_radius=0.0), width, height,
+                          scene.pixel_aspect)
+    cam = np.asarray(scene.camera.matrix, dtype=np.float64)
+    view_axis = -cam[:3, 2] / np.linalg.norm(cam[:3, 2])
+    depth = np.full(n_pix, DEPTH_MISS)
+    for start in range(0, n_pix, chunk):
+        pix = np.arange(start, min(start + chunk, n_pix))
+        xy = np.stack([pix % width + 0.5, pix // width + 0.5], axis=1).astype(np.float64)
+        rays = pinhole.generate(xy)
+        hits = ctx.accel.intersect(rays.origins, rays.directions, rays.tmax)
+        hit = np.nonzero(hits.hit)[0]
+        if hit.size:
+            p = rays.origins[hit] + rays.directions[hit] * hits.t[hit, None]
+            depth[pix[hit]] = (p - cam[:3, 3]) @ view_axis
+
+    # Normal and albedo: the mean over the first k camera samples of each pixel.
+    normal = np.zeros((n_pix, 3))
+    albedo = np.zeros((n_pix, 3))
+    per_chunk = max(1, chunk // k)
+    for start in range(0, n_pix, per_chunk):
+        pixels = np.arange(start, min(start + per_chunk, n_pix), dtype=np.int64)
+        pixel = np.repeat(pixels, k)
+        index = np.tile(np.arange(k, dtype=np.int64), len(pixels))
+        rays, time = _camera_samples(ctx, pixel, index)
+        hits = _intersect(ctx, rays.origins, rays.directions, rays.tmax, time)
+        hit = np.nonzero(hits.hit)[0]
+        if hit.size == 0:
+            continue
+        si = _build(ctx, hits, hit, rays.directions, time)
+        for c in range(3):
+            normal[:, c] += np.bincount(pixel[hit], weights=si.shading_normal[:, c],
+                                        minlength=n_pix)
+            albedo[:, c] += np.bincount(pixel[hit], weights=diffuse[si.material, c],
+                                        minlength=n_pix)
+    normal /= k
+    albedo /= k
+    return FirstHitPasses(depth.reshape(height, width), normal.reshape(height, width, 3),
+                          albedo.reshape(height, width, 3), k)
