@@ -466,3 +466,22 @@ def test_dof_focus_object_sets_the_focus_distance(bpy_drt):
     assert s.camera.focus_distance == pytest.approx(expected, rel=1e-6)
     assert abs(expected - 1.0) > 5.0                      # not the ignored focus_distance
     assert s.camera.aperture_radius == pytest.approx(cam.data.lens * 1e-3 / 4.0)
+
+
+def test_light_export_warns_about_what_drt_ignores(bpy_drt):
+    bpy = bpy_drt
+    build_scene(bpy)
+    scene = bpy.context.scene
+    spot = bpy.data.objects.new("Spot", bpy.data.lights.new("Spot", "SPOT"))
+    spot.scale = (2.0, 1.0, 1.0)
+    area = bpy.data.lights.new("Area", "AREA")
+    area.spread = 0.5
+    area_obj = bpy.data.objects.new("Area", area)
+    for o in (spot, area_obj):
+        scene.collection.objects.link(o)
+    from drt_addon.export import Reporter, export_scene
+    reporter = Reporter()
+    s = export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
+    assert len(s.lights) == 3
+    assert any("'Spot'" in w and "elliptical" in w for w in reporter.warnings), reporter.warnings
+    assert any("'Area'" in w and "spread" in w for w in reporter.warnings), reporter.warnings

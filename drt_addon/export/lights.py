@@ -52,6 +52,10 @@ def export_light(obj, matrix_world, reporter: Reporter):
     m = to_numpy(matrix_world)
     strength = light_strength(light)
     direction = -m[:3, 2] / max(np.linalg.norm(m[:3, 2]), 1e-300)
+    if getattr(light, "use_nodes", False) and light.node_tree is not None:
+        reporter.warn(f"DRT: light {obj.name!r} uses a shader node tree, which DRT ignores; "
+                      "its colour and power are used as set on the light",
+                      key=(obj.name, "nodes"))
     if not getattr(light, "use_shadow", True):
         reporter.warn(f"DRT: light {obj.name!r} has shadows off, which DRT does not model; "
                       "it casts shadows", key=(obj.name, "shadow"))
@@ -62,6 +66,11 @@ def export_light(obj, matrix_world, reporter: Reporter):
         kwargs = dict(radius=radius, soft_falloff=bool(getattr(light, "use_soft_falloff", False)),
                       name=obj.name)
         if light.type == "SPOT":
+            sx, sy = np.linalg.norm(m[:3, 0]), np.linalg.norm(m[:3, 1])
+            if abs(sx - sy) > 1e-4 * max(sx, sy):
+                reporter.warn(f"DRT: spot light {obj.name!r} is scaled unevenly in X and Y; "
+                              "Cycles then makes its cone elliptical, DRT keeps it round",
+                              key=(obj.name, "spot scale"))
             kwargs.update(spot_size=float(light.spot_size), spot_blend=float(light.spot_blend),
                           direction=tuple(direction))
         return engine.PointLight(tuple(m[:3, 3]), strength, **kwargs)
