@@ -78,7 +78,11 @@ class CameraModel:
         return np.stack([ndc_x * self.half_x + self.shift[0],
                          ndc_y * self.half_y + self.shift[1]], axis=-1)
 
-    def generate(self, film_xy: np.ndarray, lens_u: np.ndarray | None = None) -> CameraRays:
+    def generate(self, film_xy: np.ndarray, lens_u: np.ndarray | None = None,
+                 time: np.ndarray | None = None) -> CameraRays:
+        """Rays through continuous raster positions; lens_u (n, 2) only with an aperture;
+        time (n,) shutter times only when the camera moves (its transform is then
+        interpolated per ray, see engine.motion)."""
         cam = self.camera
         p = self.plane_points(film_xy)
         n = len(p)
@@ -101,7 +105,13 @@ class CameraModel:
         cos_axis = -d_cam[:, 2]                           # > 0 for every camera ray
         t_near = cam.clip_start / cos_axis
         t_far = cam.clip_end / cos_axis
-        origins = o_cam @ self.rotation.T + self.position
-        dirs = d_cam @ self.rotation.T
+        if time is not None and cam.motion is not None:
+            m = cam.motion.at(time)
+            rot = m[:, :3, :3] / np.linalg.norm(m[:, :3, :3], axis=1, keepdims=True)
+            origins = np.einsum("nij,nj->ni", rot, o_cam) + m[:, :3, 3]
+            dirs = np.einsum("nij,nj->ni", rot, d_cam)
+        else:
+            origins = o_cam @ self.rotation.T + self.position
+            dirs = d_cam @ self.rotation.T
         origins = origins + dirs * t_near[:, None]
         return CameraRays(origins, dirs, t_far - t_near)

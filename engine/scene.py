@@ -49,6 +49,10 @@ class TriangleMesh:
     corner_normals: optional (T, 3, 3) float32 shading normals per triangle corner
         (Blender's split normals); None means flat shading.
     uvs: optional (T, 3, 2) float32 texture coordinates per corner.
+    motion: None for a static mesh (positions in world space); an
+        `engine.motion.RigidMotion` (positions then in OBJECT space, placed in the world by
+        the motion's transform at each ray's time); or an `engine.motion.DeformMotion`
+        (vertex positions over the shutter in world space; `positions` is ignored).
     """
     name: str
     positions: np.ndarray
@@ -56,6 +60,7 @@ class TriangleMesh:
     material_indices: np.ndarray
     corner_normals: Optional[np.ndarray] = None
     uvs: Optional[np.ndarray] = None
+    motion: Optional[object] = None
 
     def __post_init__(self):
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)
@@ -148,6 +153,7 @@ class Camera:
     blades: int = 0
     blade_rotation: float = 0.0
     aperture_ratio: float = 1.0
+    motion: Optional[object] = None      # engine.motion.RigidMotion of `matrix` over the shutter
 
 
 @dataclass
@@ -166,6 +172,7 @@ class Scene:
     lights: list = field(default_factory=list)
     world: World = field(default_factory=World)
     pixel_aspect: float = 1.0
+    shutter: Optional[object] = None     # engine.motion.Shutter; None = motion blur off
 
     def __post_init__(self):
         if self.width < 1 or self.height < 1:
@@ -177,5 +184,21 @@ class Scene:
                 raise ValueError(f"mesh {m.name!r} uses a material index beyond the "
                                  f"{len(self.materials)} materials")
 
+    def has_motion(self) -> bool:
+        """True only when motion blur is on and something actually moves: otherwise the
+        render takes the static path (no time dimension, no extra acceleration structures)."""
+        if self.shutter is None:
+            return False
+        moving = [m for m in self.meshes if m.motion is not None and not _is_static(m.motion)]
+        camera_moves = self.camera.motion is not None and not _is_static(self.camera.motion)
+        return bool(moving) or camera_moves
+
     def triangle_count(self) -> int:
         return int(sum(len(m.triangles) for m in self.meshes))
+
+
+def _is_static(motion) -> bool:
+    if hasattr(motion, "is_static"):
+        return motion.is_static()
+    p = motion.positions
+    return bool(np.all(np.abs(p - p[0]) == 0))

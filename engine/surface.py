@@ -34,57 +34,97 @@ class SurfaceHit:
 
 
 class SurfaceBuilder:
-    """Precomputes per-triangle data of an Accelerator's triangles."""
+    """Precomputes per-triangle data in the accelerator's global triangle order; for
+    moving objects it places the triangle at each ray's own time."""
 
-    def __init__(self, accel: Accelerator, meshes):
+    def __init__(self, accel: Accelerator, meshes=None):
         self.accel = accel
-        tri = accel.triangles
+        ordered = accel.ordered_meshes
+        tri = accel.triangles                      # static triangles, world space
         p = accel.positions
-        if len(tri):
-            self.v0, self.v1, self.v2 = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
-            n = np.cross(self.v1 - self.v0, self.v2 - self.v0)
-            length = np.linalg.norm(n, axis=1)
-            ok = length > 0
-            n[ok] /= length[ok, None]
-            n[~ok] = (0.0, 0.0, 1.0)                     # never hit by Embree anyway
-            self.normal = n
-            self.tri_scale = np.max(np.abs(np.stack([self.v0, self.v1, self.v2], 1)), axis=(1, 2))
-        self.material = np.concatenate([m.material_indices for m in meshes]).astype(np.int64) \
-            if meshes else np.zeros(0, np.int64)
-        has_normals = any(m.corner_normals is not None for m in meshes)
+        v0, v1, v2 = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
+        # Moving objects: object-space (rigid) or frame (deform) vertices as placeholders;
+        # their hits are rebuilt at the ray's time in build().
+        extra = [[], [], []]
+        for obj in accel.moving:
+            m = obj.mesh
+            base = m.positions if obj.rigid else obj.slice_positions[0]
+            for k in range(3):
+                extra[k].append(base[m.triangles[:, k]])
+        self.v0, self.v1, self.v2 = (np.concatenate([a] + e) if e else a
+                                     for a, e in zip((v0, v1, v2), extra))
+        self.normal = _unit_normals(self.v0, self.v1, self.v2)
+        self.tri_scale = np.max(np.abs(np.stack([self.v0, self.v1, self.v2], 1)), axis=(1, 2)) \
+            if len(self.v0) else np.zeros(0)
+        self.material = (np.concatenate([m.material_indices for m in ordered]).astype(np.int64)
+                         if ordered else np.zeros(0, np.int64))
         self.corner_normals = None
-        if has_normals:
-            parts = []
-            for m in meshes:
+        if any(m.corner_normals is not None for m in ordered):
+            parts, offset = [], 0
+            for m in ordered:
+                t = len(m.triangles)
                 if m.corner_normals is not None:
                     parts.append(np.asarray(m.corner_normals, np.float32).reshape(-1, 3, 3))
                 else:
-                    parts.append(None)
-            fill = []
-            offset = 0
-            for m, part in zip(meshes, parts):
-                if part is None:
-                    t = len(m.triangles)
                     flat = self.normal[offset:offset + t].astype(np.float32)
-                    part = np.repeat(flat[:, None, :], 3, axis=1)
-                fill.append(part)
-                offset += len(m.triangles)
-            self.corner_normals = np.concatenate(fill)
+                    parts.append(np.repeat(flat[:, None, :], 3, axis=1))
+                offset += t
+            self.corner_normals = np.concatenate(parts)
 
-    def build(self, hits: Hits, index: np.ndarray, ray_dirs: np.ndarray) -> SurfaceHit:
-        """Interactions for the rays `index` (which must all have hit)."""
+    def _moving_vertices(self, prim, time):
+        """World vertices, normal matrices (or None) of hit triangles at the rays' times."""
+        v0, v1, v2 = self.v0[prim].copy(), self.v1[prim].copy(), self.v2[prim].copy()
+        normal_m = None
+        for obj in self.accel.moving:
+            lo, hi = obj.prim_offset, obj.prim_offset + len(obj.mesh.triangles)
+            rows = np.nonzero((prim >= lo) & (prim < hi))[0]
+            if rows.size == 0:
+                continue
+            local = prim[rows] - lo
+            tri = obj.mesh.triangles[local]
+            if obj.rigid:
+                m = obj.mesh.motion.at(time[rows])
+                a, t = m[:, :3, :3], m[:, :3, 3]
+                for dst, k in ((v0, 0), (v1, 1), (v2, 2)):
+                    dst[rows] = np.einsum("nij,nj->ni", a, obj.mesh.positions[tri[:, k]]) + t
+                if normal_m is None:
+                    normal_m = np.broadcast_to(np.eye(3), (len(prim), 3, 3)).copy()
+                normal_m[rows] = np.transpose(np.linalg.inv(a), (0, 2, 1))
+            else:
+                sl = obj.mesh.motion.slice_of(time[rows])
+                for s in np.unique(sl):
+                    r = rows[sl == s]
+                    pos = obj.slice_positions[s]
+                    tr = tri[sl == s]
+                    v0[r], v1[r], v2[r] = pos[tr[:, 0]], pos[tr[:, 1]], pos[tr[:, 2]]
+        return v0, v1, v2, normal_m
+
+    def build(self, hits: Hits, index: np.ndarray, ray_dirs: np.ndarray,
+              time: np.ndarray | None = None) -> SurfaceHit:
+        """Interactions for the rays `index` (which must all have hit); `time` is the
+        per-ray shutter time of all rays (needed when the scene has moving objects)."""
         prim = hits.prim[index]
         u = hits.u[index][:, None]
         v = hits.v[index][:, None]
         w = 1.0 - u - v
-        pos = w * self.v0[prim] + u * self.v1[prim] + v * self.v2[prim]
-        ng = self.normal[prim]
+        normal_m = None
+        if self.accel.moving and (prim >= self.accel.static_count).any():
+            v0, v1, v2, normal_m = self._moving_vertices(prim, time[index])
+            ng = _unit_normals(v0, v1, v2)
+            tri_scale = np.max(np.abs(np.stack([v0, v1, v2], 1)), axis=(1, 2))
+        else:
+            v0, v1, v2 = self.v0[prim], self.v1[prim], self.v2[prim]
+            ng = self.normal[prim]
+            tri_scale = self.tri_scale[prim]
+        pos = w * v0 + u * v1 + v * v2
         d = ray_dirs[index]
         front = (ng * d).sum(1) < 0.0
         sign = np.where(front, 1.0, -1.0)[:, None]
         ng_f = ng * sign
         if self.corner_normals is not None:
             cn = self.corner_normals[prim].astype(np.float64)
+            if normal_m is not None:
+                cn = np.einsum("nij,nkj->nki", normal_m, cn)
             ns = w * cn[:, 0] + u * cn[:, 1] + v * cn[:, 2]
             length = np.linalg.norm(ns, axis=1, keepdims=True)
             ns = np.where(length > 1e-12, ns / np.maximum(length, 1e-300), ng)
@@ -95,8 +135,17 @@ class SurfaceBuilder:
             ns[bad] = ng_f[bad]
         else:
             ns = ng_f
-        scale = np.maximum(np.max(np.abs(pos), axis=1), self.tri_scale[prim])
+        scale = np.maximum(np.max(np.abs(pos), axis=1), tri_scale)
         return SurfaceHit(pos, ng_f, ns, front, self.material[prim], scale)
+
+
+def _unit_normals(v0, v1, v2):
+    n = np.cross(v1 - v0, v2 - v0)
+    length = np.linalg.norm(n, axis=1)
+    ok = length > 0
+    n[ok] /= length[ok, None]
+    n[~ok] = (0.0, 0.0, 1.0)                     # never hit by Embree anyway
+    return n
 
 
 def offset_origin(position: np.ndarray, normal: np.ndarray, scale: np.ndarray,

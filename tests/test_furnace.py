@@ -2,7 +2,9 @@
 
 Inside a closed surface of uniform albedo rho and uniform emitted radiance Le, the
 radiance is the same everywhere and in every direction: L = Le (1 + rho + rho^2 + ...)
-= Le / (1 - rho), or Le (1 - rho^(n+1)) / (1 - rho) with at most n bounces. That holds
+= Le / (1 - rho). With a bounce limit of n, Cycles' meaning is that direct light still
+reaches the last vertex (0 bounces = direct light only), so the series stops after
+rho^(n+1): L = Le (1 - rho^(n+2)) / (1 - rho). That holds
 for any closed shape, so the triangulated sphere is exact, and it exercises camera rays,
 emission, next-event estimation, BSDF sampling, MIS, bounce limits and Russian roulette
 at once.
@@ -29,7 +31,7 @@ def test_closed_sphere_path_traced_radiance_matches_closed_form(rho):
     settings = RenderSettings(samples=128, seed=1, max_bounces=bounces, diffuse_bounces=bounces,
                               clamp_indirect=0.0)
     film, _ = render(furnace(rho), settings)
-    expected = LE * (1 - rho ** (bounces + 1)) / (1 - rho)
+    expected = LE * (1 - rho ** (bounces + 2)) / (1 - rho)
     got = film.mean().mean()
     err = abs(got - expected) / expected
     print(f"rho={rho}: image mean {got:.5f}, closed form {expected:.5f}, error {err:.3%}")
@@ -42,7 +44,7 @@ def test_bounce_limit_truncates_the_series_exactly(bounces):
     settings = RenderSettings(samples=64, seed=2, max_bounces=bounces, diffuse_bounces=bounces,
                               clamp_indirect=0.0)
     film, _ = render(furnace(rho), settings)
-    expected = LE * (1 - rho ** (bounces + 1)) / (1 - rho)
+    expected = LE * (1 - rho ** (bounces + 2)) / (1 - rho)
     got = film.mean().mean()
     assert abs(got - expected) / expected < 0.01, (got, expected)
 
@@ -52,5 +54,5 @@ def test_diffuse_limit_applies_even_with_a_larger_total():
     settings = RenderSettings(samples=64, seed=3, max_bounces=12, diffuse_bounces=1,
                               clamp_indirect=0.0)
     film, _ = render(furnace(rho), settings)
-    expected = LE * (1 + rho)
+    expected = LE * (1 + rho + rho ** 2)
     assert abs(film.mean().mean() - expected) / expected < 0.01

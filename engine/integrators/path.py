@@ -83,8 +83,10 @@ class PathIntegrator:
             return np.where(delta | ~(bsdf_pdf > 0), 1.0, 0.0)
         raise ValueError(f"mis_mode must be one of {MIS_MODES}, got {mode!r}")
 
-    def radiance(self, pixel, index, origins, dirs, tmax):
-        """Radiance along camera rays; pixel/index give each path's sampler coordinates."""
+    def radiance(self, pixel, index, origins, dirs, tmax, time=None):
+        """Radiance along camera rays; pixel/index give each path's sampler coordinates,
+        time (or None when nothing moves) each path's shutter time, kept for all its
+        rays so that moving objects are where they were when the path was taken."""
         ctx = self.ctx
         sampler, lights, mats, s = ctx.sampler, ctx.lights, ctx.materials, ctx.settings
         n = len(pixel)
@@ -108,7 +110,8 @@ class PathIntegrator:
                 break
             px, ix = pixel[path], index[path]
             b = beta[path]
-            hits = ctx.accel.intersect(o, d, tm)
+            tp = None if time is None else time[path]
+            hits = ctx.accel.intersect(o, d, tm, tp)
             t_geom = np.where(hits.hit, hits.t, tm)
             alive = np.ones(path.size, dtype=bool)
 
@@ -140,7 +143,8 @@ class PathIntegrator:
                 break
 
             # The surfaces hit
-            si = ctx.surfaces.build(hits, live, d)
+            si = ctx.surfaces.build(hits, live, d, tp)
+            t_live = None if tp is None else tp[live]
             ns, ng = si.shading_normal, si.geometric_normal
             wo = to_local(-d[live], ns)
             rows = path[live]
@@ -158,7 +162,7 @@ class PathIntegrator:
                     w = self._hit_weight(prev_pdf[g_live], light_pdf)
                     add(rows[glow], b_live[glow] * em[glow] * w[:, None], depth)
 
-            bsdf = PrincipledBSDF.from_materials(mats, si.material)
+            bsdf = PrincipledBSDF.from_materials(mats, si.material, si.front_facing)
             c_live = counts[rows]
             allowed = (c_live < self.limits[None, :]) & (depth < self.max_bounces)
 
@@ -186,7 +190,8 @@ class PathIntegrator:
                     far = np.where(finite, seg * (1.0 - 2e-5), ctx.scene_radius * 4.0)
                     if ls.margin is not None:
                         far = np.where(finite, np.minimum(far, seg - ls.margin[sel]), far)
-                    vis = ~ctx.accel.occluded(org, sdir, np.maximum(far, 0.0))
+                    vis = ~ctx.accel.occluded(org, sdir, np.maximum(far, 0.0),
+                                              None if t_live is None else t_live[sel])
                     if vis.any():
                         sv = sel[vis]
                         bsdf_pdf = bsdf.pdf(wo, wi_local, allowed)[sv]

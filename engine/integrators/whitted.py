@@ -48,7 +48,7 @@ class WhittedIntegrator:
         self.ctx = ctx
         self.max_depth = ctx.settings.max_bounces
 
-    def _direct(self, si, diffuse_albedo):
+    def _direct(self, si, diffuse_albedo, time):
         """Sum over all lights of one deterministic shadow ray each (hard shadows)."""
         ctx = self.ctx
         n = len(si.position)
@@ -66,13 +66,14 @@ class WhittedIntegrator:
                                 ls.wi[sel])
             far = np.where(np.isfinite(ls.dist[sel]), ls.dist[sel] * (1.0 - 2e-5),
                            ctx.scene_radius * 4.0)
-            vis = ~ctx.accel.occluded(org, ls.wi[sel], np.maximum(far, 0.0))
+            vis = ~ctx.accel.occluded(org, ls.wi[sel], np.maximum(far, 0.0),
+                                      None if time is None else time[sel])
             sv = sel[vis]
             out[sv] += (diffuse_albedo[sv] * INV_PI * cos[sv, None] * ls.radiance[sv]
                         / ls.pdf[sv, None])
         return out
 
-    def radiance(self, pixel, index, origins, dirs, tmax):
+    def radiance(self, pixel, index, origins, dirs, tmax, time=None):
         ctx = self.ctx
         mats = ctx.materials
         n = len(pixel)
@@ -84,7 +85,8 @@ class WhittedIntegrator:
             if path.size == 0:
                 break
             b = beta[path]
-            hits = ctx.accel.intersect(o, d, tm)
+            tp = None if time is None else time[path]
+            hits = ctx.accel.intersect(o, d, tm, tp)
             t_geom = np.where(hits.hit, hits.t, tm)
             alive = np.ones(path.size, dtype=bool)
             if len(ctx.lights):
@@ -100,7 +102,7 @@ class WhittedIntegrator:
             live = np.nonzero(alive)[0]
             if live.size == 0:
                 break
-            si = ctx.surfaces.build(hits, live, d)
+            si = ctx.surfaces.build(hits, live, d, tp)
             rows = path[live]
             bl = b[live]
             m = si.material
@@ -117,7 +119,7 @@ class WhittedIntegrator:
             k_t = trans * (1.0 - f_d)
             k_d = base * (1 - metal) * (1 - trans) * (1.0 - np.minimum(f_d * spec, 1.0))
             if len(ctx.lights):
-                L[rows] += bl * self._direct(si, k_d)
+                L[rows] += bl * self._direct(si, k_d, None if tp is None else tp[live])
             if depth == self.max_depth:
                 break
             # Follow the mirror or the refracted ray (one branch of Whitted's tree).
