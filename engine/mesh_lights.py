@@ -26,6 +26,11 @@ cos theta_q = n . (q - p) / |q - p|  (either side, emission being two-sided).
 A BSDF-sampled ray that hits an emissive triangle (global primitive id g, as Embree
 reports it) is weighted by multiple importance sampling against that same pdf times the
 triangle's pick probability: `entry_of(g)` maps g to its light entry.
+
+Only static triangles are light entries. Emissive triangles of objects that move during
+the shutter (engine.accel traces them apart, after the static ones) are not sampled:
+BSDF-sampled rays still find them, with MIS weight 1 (their light pdf is 0), which is
+unbiased, only noisier.
 """
 from __future__ import annotations
 
@@ -60,7 +65,7 @@ class EmissiveTriangles:
     @classmethod
     def from_scene(cls, scene, accel, emission=None) -> "EmissiveTriangles":
         """The emissive triangles of `scene`, with the global ids of `accel`
-        (engine.accel.Accelerator, which concatenates the meshes' triangles in order).
+        (engine.accel.Accelerator: static triangles first, ids 0..len(accel.triangles)-1).
         `emission`: (materials, 3) radiance table, by default the materials' `emission`;
         the renderer passes the one its integrator adds at hits, so both agree."""
         tri = accel.triangles
@@ -73,7 +78,9 @@ class EmissiveTriangles:
         # Only the static triangles (the accelerator's first `static_count` ids) are
         # light-sampled: a moving emissive mesh is still seen, blurred, by camera and BSDF
         # rays (with MIS weight 1), just not sampled directly.
-        static_meshes = accel.ordered_meshes[:len(accel.ordered_meshes) - len(accel.moving)]
+        # (getattr: an accelerator without motion support has all meshes, in scene order)
+        ordered = list(getattr(accel, "ordered_meshes", scene.meshes))
+        static_meshes = ordered[:len(ordered) - len(getattr(accel, "moving", ()))]
         mat = np.concatenate([m.material_indices for m in static_meshes]).astype(np.int64)
         emissive = np.nonzero(emission[mat].max(axis=1) > 0)[0]
         p = accel.positions
