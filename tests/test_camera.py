@@ -99,3 +99,78 @@ def test_invalid_cameras_are_rejected_clearly():
         CameraModel(Camera(np.eye(4), clip_start=5, clip_end=1), 10, 10)
     with pytest.raises(ValueError, match="lens"):
         CameraModel(Camera(np.eye(4), lens=0.0), 10, 10)
+
+
+# --- chi-square goodness of fit: lens and filter sampling against their own pdfs ------
+from scipy import integrate, stats  # noqa: E402
+
+ALPHA = 0.01 / 6          # Bonferroni over the chi-square tests in this file
+
+
+def _inside_aperture(x, y, blades, rotation):
+    if blades < 3:
+        return x * x + y * y <= 1.0
+    # inside the regular polygon with corners at angles rotation + 2 pi k / blades
+    inside = np.ones(np.shape(x), dtype=bool)
+    for k in range(blades):
+        a0 = rotation + 2 * np.pi * k / blades
+        a1 = a0 + 2 * np.pi / blades
+        p0 = np.array([np.cos(a0), np.sin(a0)])
+        p1 = np.array([np.cos(a1), np.sin(a1)])
+        edge = p1 - p0
+        inside &= (edge[0] * (y - p0[1]) - edge[1] * (x - p0[0])) >= -1e-12
+    return inside
+
+
+@pytest.mark.parametrize("blades,rotation", [(0, 0.0), (5, 0.3), (6, 0.0), (3, 1.0)])
+def test_lens_sampling_chi_square(blades, rotation):
+    """Aperture samples are uniform over the disk or polygon: chi-square over a 16x16 grid,
+    expected counts from the cell's area inside the aperture (4096-point sub-grid)."""
+    n, cells, sub = 200_000, 16, 64
+    u = np.random.default_rng(10 + blades).random((n, 2))
+    p = sample_aperture(u, 1.0, blades, rotation)
+    counts, _, _ = np.histogram2d(p[:, 0], p[:, 1], bins=cells, range=[[-1, 1], [-1, 1]])
+    edges = np.linspace(-1, 1, cells + 1)
+    fine = (np.arange(cells * sub) + 0.5) / (cells * sub) * 2 - 1
+    X, Y = np.meshgrid(fine, fine, indexing="ij")
+    frac = _inside_aperture(X, Y, blades, rotation).reshape(cells, sub, cells, sub).mean(axis=(1, 3))
+    expected = n * frac / frac.sum()
+    keep = expected >= 5          # pool the rest into one cell
+    obs = np.append(counts[keep], counts[~keep].sum())
+    exp = np.append(expected[keep], expected[~keep].sum())
+    if exp[-1] == 0:
+        obs, exp = obs[:-1], exp[:-1]
+    p_value = stats.chisquare(obs, exp).pvalue
+    print(f"blades={blades}: chi-square p = {p_value:.3g}")
+    assert p_value > ALPHA
+    assert edges.size == cells + 1
+
+
+@pytest.mark.parametrize("kind,width", [("BLACKMAN_HARRIS", 1.5), ("BLACKMAN_HARRIS", 0.7),
+                                        ("BOX", 1.0)])
+def test_filter_importance_sampling_chi_square(kind, width):
+    f = PixelFilter(kind, width)
+    n, bins = 200_000, 40
+    x = f.sample(np.random.default_rng(3).random((n, 2)))[:, 0]
+    counts, edges = np.histogram(x, bins=bins, range=(-f.radius, f.radius))
+    expected = np.array([integrate.quad(f.pdf_1d, a, b)[0] for a, b in zip(edges[:-1], edges[1:])])
+    expected *= n / expected.sum()
+    keep = expected >= 5
+    obs = np.append(counts[keep], counts[~keep].sum())
+    exp = np.append(expected[keep], expected[~keep].sum())
+    if exp[-1] == 0:
+        obs, exp = obs[:-1], exp[:-1]
+    p_value = stats.chisquare(obs, exp).pvalue
+    print(f"{kind} {width}: chi-square p = {p_value:.3g}")
+    assert p_value > ALPHA
+
+
+def test_chi_square_harness_rejects_a_wrong_pdf():
+    """Negative control: samples from a box filter judged against Blackman-Harris."""
+    bh = PixelFilter("BLACKMAN_HARRIS", 1.5)
+    x = (np.random.default_rng(4).random(200_000) - 0.5) * 3.0
+    counts, edges = np.histogram(x, bins=40, range=(-1.5, 1.5))
+    expected = np.array([integrate.quad(bh.pdf_1d, a, b)[0] for a, b in zip(edges[:-1], edges[1:])])
+    expected *= len(x) / expected.sum()
+    keep = expected >= 5
+    assert stats.chisquare(counts[keep], expected[keep] * counts[keep].sum() / expected[keep].sum()).pvalue < ALPHA
