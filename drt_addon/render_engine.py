@@ -112,7 +112,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
 
     def render(self, depsgraph):
         last_render.update(ok=False, error=None, warnings=[], stats=None, pixels=None,
-                           scene=None, export_stats=None, passes={}, region=None)
+                           scene=None, export_stats=None, passes={}, region=None, progress=[])
         try:
             self._render(depsgraph)
         except ExportError as e:
@@ -120,6 +120,10 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         except Exception as e:  # never let an exception escape into Blender
             traceback.print_exc()
             self._fail(f"DRT: render failed: {type(e).__name__}: {e}")
+
+    def _cancel_requested(self) -> bool:
+        """Esc in Blender (polled between work units, so a cancel lands within one unit)."""
+        return self.test_break()
 
     def _fail(self, message):
         last_render.update(ok=False, error=message)
@@ -153,13 +157,14 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 combined.rect.foreach_set(_rgba_bottom_up(film.mean()))
                 self.update_result(result)
                 self.update_progress(fraction)
+                last_render["progress"].append((stats.samples_done, fraction))
                 rate = stats.paths_per_second()
                 left = stats.seconds * (1 - fraction) / max(fraction, 1e-9)
                 self.update_stats("", f"DRT | Sample {stats.samples_done}/{settings.samples} | "
                                       f"{rate / 1e3:.0f}k paths/s | {left:.0f} s left")
 
             film, stats = engine.render(description, settings, context=ctx, progress=progress,
-                                        cancelled=self.test_break)
+                                        cancelled=self._cancel_requested)
             image = film.mean()
             combined.rect.foreach_set(_rgba_bottom_up(image))
             if not stats.cancelled:

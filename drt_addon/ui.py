@@ -57,7 +57,24 @@ class DRT_PT_film(DRTPanel, bpy.types.Panel):
         col.prop(s, "filter_width")
 
 
-CLASSES = (DRT_PT_sampling, DRT_PT_light_paths, DRT_PT_film)
+class DRT_PT_passes(DRTPanel, bpy.types.Panel):
+    bl_label = "Passes"
+    bl_context = "view_layer"
+
+    def draw(self, context):
+        view_layer = context.view_layer
+        col = self.layout.column(heading="Data", align=True)
+        col.use_property_split = True
+        col.prop(view_layer, "use_pass_combined")
+        col.prop(view_layer, "use_pass_z")
+        col.prop(view_layer, "use_pass_normal")
+        drt = getattr(view_layer, "drt", None)
+        if drt is not None:
+            col.prop(drt, "use_pass_denoising_data")
+            col.prop(drt, "use_pass_noise")
+
+
+CLASSES = (DRT_PT_sampling, DRT_PT_light_paths, DRT_PT_film, DRT_PT_passes)
 
 # Blender's generic panels for what Cycles draws in panels of its own add-on: depth of
 # field, light type/colour/power, spot shape, the material slots and node surfaces.
@@ -70,7 +87,10 @@ def _builtin_panels():
     for name in dir(bpy.types):
         cls = getattr(bpy.types, name, None)
         engines = getattr(cls, "COMPAT_ENGINES", None)
-        if not isinstance(engines, set) or not getattr(cls, "__module__", "").startswith("bl_ui"):
+        module = getattr(cls, "__module__", "")
+        if not isinstance(engines, set) or not module.startswith("bl_ui"):
+            continue
+        if module == "bl_ui.properties_freestyle":     # DRT does not render Freestyle
             continue
         if "CYCLES" in engines or name in _EXTRA_PANELS:
             yield cls

@@ -22,7 +22,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .camera import CameraModel
-from .sampling import dimensions as D
+from .render import camera_rays
 
 DEPTH_MISS = 1.0e10
 AOV_SAMPLES = 16
@@ -53,21 +53,6 @@ def _build(ctx, hits, index, d, time):
     if time is None:
         return ctx.surfaces.build(hits, index, d)
     return ctx.surfaces.build(hits, index, d, time=time)
-
-
-def _camera_samples(ctx, pixel, index):
-    """The camera rays of samples `index` of `pixel`, drawn exactly as the renderer draws
-    them (sub-pixel position through the pixel filter, lens, shutter time)."""
-    w = ctx.scene.width
-    u_pix = ctx.sampler.get_2d(D.PIXEL, pixel, index)
-    offset = ctx.filter.sample(u_pix)
-    film_xy = np.stack([pixel % w + 0.5 + offset[:, 0], pixel // w + 0.5 + offset[:, 1]], axis=1)
-    lens_u = ctx.sampler.get_2d(D.LENS, pixel, index) if ctx.camera.has_lens else None
-    time = None
-    if getattr(ctx, "has_motion", False):
-        time = ctx.scene.shutter.sample(ctx.sampler.get_1d(D.TIME, pixel, index))
-        return ctx.camera.generate(film_xy, lens_u, time), time
-    return ctx.camera.generate(film_xy, lens_u), None
 
 
 def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16) -> FirstHitPasses:
@@ -104,7 +89,7 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16) -> F
         pixels = np.arange(start, min(start + per_chunk, n_pix), dtype=np.int64)
         pixel = np.repeat(pixels, k)
         index = np.tile(np.arange(k, dtype=np.int64), len(pixels))
-        rays, time = _camera_samples(ctx, pixel, index)
+        rays, time = camera_rays(ctx, pixel, index)
         hits = _intersect(ctx, rays.origins, rays.directions, rays.tmax, time)
         hit = np.nonzero(hits.hit)[0]
         if hit.size == 0:

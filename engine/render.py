@@ -44,6 +44,8 @@ class RenderStats:
     nonfinite_samples: int = 0
     seconds: float = 0.0
     cancelled: bool = False
+    units_done: int = 0
+    units_running_at_cancel: int = 0   # finished after the cancel (at most the thread count)
 
     def paths_per_second(self) -> float:
         return self.paths / self.seconds if self.seconds > 0 else 0.0
@@ -89,12 +91,10 @@ def _scene_radius(scene: Scene, accel: Accelerator) -> float:
     return float(max(np.linalg.norm(hi - lo) * 0.5, 1e-6))
 
 
-def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sample_end: int):
-    """Radiance of samples [sample_start, sample_end) of each pixel in `pixels`.
-    Returns (pixel ids, radiance (n, 3) float64)."""
-    k = sample_end - sample_start
-    pixel = np.repeat(pixels.astype(np.int64), k)
-    index = np.tile(np.arange(sample_start, sample_end, dtype=np.int64), len(pixels))
+def camera_rays(ctx: RenderContext, pixel: np.ndarray, index: np.ndarray):
+    """The camera rays of samples `index` of pixels `pixel`: sub-pixel position through the
+    pixel filter, a lens point only with an aperture, a shutter time only when something
+    moves. Returns (CameraRays, time or None). Every pass (radiance, AOVs) uses this."""
     w = ctx.scene.width
     u_pix = ctx.sampler.get_2d(D.PIXEL, pixel, index)
     offset = ctx.filter.sample(u_pix)
@@ -103,7 +103,16 @@ def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sampl
     # The time dimension exists only when something moves within an open shutter.
     time = ctx.scene.shutter.sample(ctx.sampler.get_1d(D.TIME, pixel, index)) \
         if ctx.has_motion else None
-    rays = ctx.camera.generate(film_xy, lens_u, time)
+    return ctx.camera.generate(film_xy, lens_u, time), time
+
+
+def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sample_end: int):
+    """Radiance of samples [sample_start, sample_end) of each pixel in `pixels`.
+    Returns (pixel ids, radiance (n, 3) float64)."""
+    k = sample_end - sample_start
+    pixel = np.repeat(pixels.astype(np.int64), k)
+    index = np.tile(np.arange(sample_start, sample_end, dtype=np.int64), len(pixels))
+    rays, time = camera_rays(ctx, pixel, index)
     radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
                                        time=time)
     return pixel, radiance
@@ -140,10 +149,18 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
     total = sample_end - sample_start
     stop = threading.Event()
 
+    running = [0]
+
     def run(pixels, a, b):
-        if stop.is_set():
-            return 0
-        pix, rad = render_unit(ctx, pixels, a, b)
+        with lock:
+            if stop.is_set():
+                return 0
+            running[0] += 1
+        try:
+            pix, rad = render_unit(ctx, pixels, a, b)
+        finally:
+            with lock:
+                running[0] -= 1
         bad = ~np.isfinite(rad).all(axis=1)
         if bad.any():
             rad[bad] = 0.0
@@ -151,6 +168,7 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
             film.add(pix, rad)
             stats.paths += len(pix)
             stats.nonfinite_samples += int(bad.sum())
+            stats.units_done += 1
         return len(pix)
 
     try:
@@ -164,7 +182,9 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
                     futures.append(pool.submit(run, pixels, a, b))
                 for f in futures:
                     if cancelled is not None and not stop.is_set() and cancelled():
-                        stop.set()
+                        with lock:
+                            stop.set()
+                            stats.units_running_at_cancel = running[0]
                     f.result()
                 if stop.is_set():
                     stats.cancelled = True

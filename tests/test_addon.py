@@ -56,7 +56,9 @@ def test_blender_panels_are_shared_with_drt(bpy_drt):
     from drt_addon import ui
     for cls in ui.CLASSES:
         assert cls.is_registered
-        assert cls.bl_context == "render"
+        assert cls.bl_context in ("render", "view_layer")
+    assert ui.DRT_PT_passes.bl_context == "view_layer"
+    assert "DRT" not in bpy.types.VIEWLAYER_PT_freestyle.COMPAT_ENGINES
 
 
 def test_manifest_is_a_valid_extension_manifest():

@@ -1,0 +1,79 @@
+"""The RenderEngine inside Blender: progressive passes with progress, cancel that stops
+within one work unit and leaves a valid partial image, and the error path."""
+import os
+
+import numpy as np
+
+from conftest import SAMPLES_DIR
+
+CORNELL = os.path.join(SAMPLES_DIR, "cornell_box.blend")
+
+
+def _open(bpy, samples=64, percentage=25):
+    bpy.ops.wm.open_mainfile(filepath=CORNELL, load_ui=False)
+    scene = bpy.context.scene
+    scene.render.engine = "DRT"
+    scene.render.resolution_percentage = percentage
+    scene.drt.samples = samples
+    return scene
+
+
+def test_render_is_progressive_with_monotonic_progress(bpy_drt):
+    from drt_addon.render_engine import last_render
+    _open(bpy_drt, samples=64)
+    bpy_drt.ops.render.render()
+    assert last_render["ok"]
+    progress = last_render["progress"]
+    samples = [s for s, _ in progress]
+    fractions = [f for _, f in progress]
+    assert len(progress) >= 5                       # several passes, each shown
+    assert samples == sorted(samples) and samples[-1] == 64
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+    assert samples[0] == 1                          # a first image after one sample
+
+
+def test_cancel_stops_within_one_work_unit_and_keeps_a_valid_image(bpy_drt):
+    from drt_addon.render_engine import DRTRenderEngine, last_render
+    scene = _open(bpy_drt, samples=4096, percentage=50)
+    scene.drt.threads = 2
+    polls = []
+
+    def cancel_after_a_few_polls(self):
+        polls.append(1)
+        return len(polls) > 6
+
+    original = DRTRenderEngine._cancel_requested
+    DRTRenderEngine._cancel_requested = cancel_after_a_few_polls
+    try:
+        bpy_drt.ops.render.render()
+    finally:
+        DRTRenderEngine._cancel_requested = original
+    stats = last_render["stats"]
+    assert stats.cancelled and last_render["error"] == "cancelled"
+    assert stats.units_running_at_cancel <= 2       # only units already running finish
+    img = last_render["pixels"]
+    assert img is not None and np.isfinite(img).all() and img.max() > 0
+    assert stats.paths < 128 * 128 * 4096 / 10     # it really stopped early
+    # Blender stays usable: the next render works.
+    _open(bpy_drt, samples=2)
+    bpy_drt.ops.render.render()
+    assert last_render["ok"]
+
+
+def test_extreme_but_legal_settings_render(bpy_drt):
+    from drt_addon.render_engine import last_render
+    scene = _open(bpy_drt, samples=2)
+    scene.drt.filter_width = 0.01
+    scene.drt.clamp_indirect = 0.0
+    scene.drt.max_bounces = 0
+    bpy_drt.ops.render.render()
+    assert last_render["ok"]
+    assert np.isfinite(last_render["pixels"]).all()
+
+
+def test_no_camera_is_refused_with_a_clear_error(bpy_drt):
+    import pytest
+    bpy_drt.ops.wm.read_factory_settings(use_empty=True)
+    bpy_drt.context.scene.render.engine = "DRT"
+    with pytest.raises(RuntimeError, match="camera"):   # Blender refuses before DRT runs
+        bpy_drt.ops.render.render()
