@@ -83,10 +83,21 @@ def _rgba_bottom_up(image: np.ndarray) -> np.ndarray:
     return out.reshape(-1)
 
 
+PREVIEW_SAMPLES = 16
+
+
+def preview_settings(settings):
+    """Material previews trade noise for speed: at most PREVIEW_SAMPLES samples and
+    Cycles' preview-like light paths; everything else as the scene says."""
+    from dataclasses import replace
+    return replace(settings, samples=min(settings.samples, PREVIEW_SAMPLES),
+                   max_bounces=min(settings.max_bounces, 4))
+
+
 class DRTRenderEngine(bpy.types.RenderEngine):
     bl_idname = "DRT"
     bl_label = "DRT"
-    bl_use_preview = False
+    bl_use_preview = True                 # material previews render with DRT
     bl_use_postprocess = True
     bl_use_shading_nodes_custom = False   # keep Cycles' shader nodes editable
     bl_use_eevee_viewport = True          # Material Preview and viewport use EEVEE
@@ -134,12 +145,15 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
         region = render_region(scene)
-        reporter = Reporter(self.report)
+        # Material previews: quick, and silent (their scene is Blender's, not the user's).
+        reporter = Reporter(None if self.is_preview else self.report)
         self.update_stats("", "DRT: exporting scene")
         t0 = time.perf_counter()
         export_stats = {}
         description = export_scene(depsgraph, reporter, region=region, stats=export_stats)
         settings = scene.drt.to_engine_settings()
+        if self.is_preview:
+            settings = preview_settings(settings)
         try:
             settings.validate()
         except ValueError as e:

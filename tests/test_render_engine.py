@@ -77,3 +77,15 @@ def test_no_camera_is_refused_with_a_clear_error(bpy_drt):
     bpy_drt.context.scene.render.engine = "DRT"
     with pytest.raises(RuntimeError, match="camera"):   # Blender refuses before DRT runs
         bpy_drt.ops.render.render()
+
+
+def test_material_previews_are_rendered_by_drt_quickly(bpy_drt):
+    """Blender draws material previews with an engine whose bl_use_preview is set; the
+    preview render itself only runs with a UI, so this checks the contract and the
+    preview settings (the bpy module renders no previews in background mode)."""
+    from drt_addon.render_engine import PREVIEW_SAMPLES, DRTRenderEngine, preview_settings
+    from drt_addon.engine_link import engine
+    assert DRTRenderEngine.bl_use_preview is True
+    s = preview_settings(engine.RenderSettings(samples=4096, max_bounces=12, seed=7))
+    assert s.samples == PREVIEW_SAMPLES and s.max_bounces == 4 and s.seed == 7
+    assert preview_settings(engine.RenderSettings(samples=4)).samples == 4
