@@ -25,7 +25,7 @@ class RenderSettings:
     filter_type: str = "BLACKMAN_HARRIS"
     filter_width: float = 1.5
     # Execution: paths per work unit bounds memory (about 1 KB of state per path).
-    chunk_paths: int = 1 << 16
+    chunk_paths: int = 1 << 15
     threads: int = 0                   # 0 = all cores
 
     def validate(self) -> "RenderSettings":
