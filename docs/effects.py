@@ -79,15 +79,16 @@ def effect_soft_shadows(lines):
     """One blocker, five light sources of the same size class."""
     panels, notes = [], []
     blocker = [box((-0.3, -0.3, 0.0), (0.3, 0.3, 0.8), "block", 0)]
+    pos = (-1.4, -0.6, 2.0)
     m = np.eye(4)
-    m[:3, 3] = (0.3, -0.3, 2.6)
-    glow = Material("glow", (0, 0, 0), specular_ior_level=0.0, emission=(25, 25, 25))
+    m[:3, 3] = pos
+    glow = Material("glow", (0, 0, 0), specular_ior_level=0.0, emission=(12, 12, 12))
     variants = [
-        ("area rectangle", [AreaLight(m, (150,) * 3, "RECTANGLE", 0.8, 0.4)], [], []),
-        ("area disk", [AreaLight(m, (150,) * 3, "DISK", 0.8)], [], []),
-        ("sphere (point, radius 0.3)", [PointLight((0.3, -0.3, 2.6), (400,) * 3, radius=0.3)], [], []),
-        ("sun, 10 degrees", [SunLight((-0.2, 0.3, -1.0), (3,) * 3, angle=np.radians(10))], [], []),
-        ("emissive mesh", [], [quad((0.3, -0.3, 2.6), (0.4, 0, 0), (0, -0.2, 0), "panel", 1)], [glow]),
+        ("area rectangle", [AreaLight(m, (40,) * 3, "RECTANGLE", 0.8, 0.4)], [], []),
+        ("area disk", [AreaLight(m, (40,) * 3, "DISK", 0.8)], [], []),
+        ("sphere (point, radius 0.3)", [PointLight(pos, (120,) * 3, radius=0.3)], [], []),
+        ("sun, 10 degrees", [SunLight((0.6, 0.3, -0.7), (1.5,) * 3, angle=np.radians(10))], [], []),
+        ("emissive mesh", [], [quad(pos, (0.4, 0, 0), (0, -0.2, 0), "panel", 1)], [glow]),
     ]
     for name, lights, extra, mats in variants:
         scene = stage(mats, blocker + extra, lights, default_camera(), size=(128, 96))
@@ -148,23 +149,91 @@ def effect_motion_blur(lines):
         rot.append(m)
     spin.motion = RigidMotion(np.linspace(0, 1, 5), rot)
     spin.positions = spin.positions - [0, 0, 0]
-    light = AreaLight(np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 3.0], [0, 0, 0, 1.0]]),
-                      (300,) * 3, "SQUARE", 1.5, 1.5)
-    scene = stage([red], [cube, spin], [light], default_camera(), size=(200, 150))
+    light = AreaLight(np.array([[1, 0, 0, -1.0], [0, 1, 0, -1.0], [0, 0, 1, 3.0],
+                                [0, 0, 0, 1.0]]), (60,) * 3, "SQUARE", 1.5, 1.5)
+    cam = Camera(look_at((0.2, -3.0, 1.4), (0.2, 0.3, 0.6)), lens=35.0)
+    scene = stage([red], [cube, spin], [light], cam, size=(200, 150))
     static = stage([red], [box((-0.25, -0.25, 0.0), (0.25, 0.25, 0.5), "cube", 1)], [light],
-                   default_camera(), size=(200, 150))
+                   cam, size=(200, 150))
     scene.shutter = Shutter()
     img, t, _ = run(scene, samples=64, integrator="distribution")
     img0, t0, _ = run(static, samples=64, integrator="distribution")
-    save("effect_motion_blur.png", [img])
-    lines.append(f"| Motion blur | effect_motion_blur.png | a cube translating 1 m and a bar "
+    save("effect_motion_blur.png", [img0, img])
+    lines.append(f"| Motion blur | effect_motion_blur.png | left: still; right: a cube translating 1 m and a bar "
                  f"turning 135 degrees over the shutter (5 motion steps), 64 samples, "
                  f"{t:.1f} s (the same stage with a still cube: {t0:.1f} s) |")
 
 
+def _spheres_row(materials, y=0.0):
+    xs = np.linspace(-1.2, 1.2, len(materials))
+    return [uv_sphere((x, y, 0.4), 0.38, 24, 48, "ball", 1 + i) for i, x in enumerate(xs)]
+
+
+def _lit_stage(materials, meshes, size=(240, 120)):
+    m = np.eye(4)
+    m[:3, 3] = (0.0, -1.0, 2.5)
+    light = AreaLight(m, (120,) * 3, "RECTANGLE", 2.0, 0.6)
+    stripes = [quad((x, 1.9, 1.0), (0.12, 0, 0), (0, 0, 1.0), "stripe", len(materials) + 1)
+               for x in np.linspace(-2.4, 2.4, 9)]
+    glow = Material("stripe", (0, 0, 0), specular_ior_level=0.0, emission=(3.0, 2.6, 2.0))
+    cam = Camera(look_at((0, -3.6, 1.2), (0, 0.2, 0.45)), lens=45.0)
+    mats = [Material("checker", (0.5, 0.5, 0.5), specular_ior_level=0.0)] + materials + [glow]
+    floor = [quad((0, 0, 0), (3, 0, 0), (0, 3, 0), "floor", 0)]
+    scene = Scene(cam, size[0], size[1], floor + meshes + stripes, mats, [light],
+                  World((0.05, 0.05, 0.06)))
+    return scene
+
+
+def effect_glossy(lines):
+    """GGX metals at three roughnesses (alpha = roughness^2, as Blender), and a plastic."""
+    mats = [Material("gold r0.05", (1.0, 0.78, 0.34), metallic=1.0, roughness=0.05),
+            Material("gold r0.25", (1.0, 0.78, 0.34), metallic=1.0, roughness=0.25),
+            Material("gold r0.5", (1.0, 0.78, 0.34), metallic=1.0, roughness=0.5),
+            Material("plastic", (0.1, 0.25, 0.7), roughness=0.2, specular_ior_level=0.5)]
+    scene = _lit_stage(mats, _spheres_row(mats))
+    img, t, _ = run(scene, samples=128, integrator="distribution")
+    save("effect_glossy.png", [img])
+    lines.append(f"| Glossy reflection | effect_glossy.png | GGX metal at roughness 0.05, 0.25, "
+                 f"0.5 and a blue plastic (dielectric coat over diffuse), distribution "
+                 f"integrator, 128 samples, {t:.1f} s |")
+
+
+def effect_translucency(lines):
+    """Smooth and rough glass (Fresnel, refraction, total internal reflection)."""
+    mats = [Material("glass", (1, 1, 1), transmission=1.0, roughness=0.0, ior=1.45),
+            Material("frosted", (1, 1, 1), transmission=1.0, roughness=0.3, ior=1.45),
+            Material("tinted", (0.6, 0.9, 0.7), transmission=1.0, roughness=0.1, ior=1.5)]
+    scene = _lit_stage(mats, _spheres_row(mats))
+    img, t, _ = run(scene, samples=128, integrator="path", max_bounces=12)
+    save("effect_translucency.png", [img])
+    lines.append(f"| Translucency | effect_translucency.png | smooth glass (IOR 1.45), rough "
+                 f"glass (roughness 0.3), tinted glass; path tracing, 128 samples, {t:.1f} s |")
+
+
+def effect_cameras(lines):
+    """Perspective, perspective with lens shift (verticals stay vertical), orthographic."""
+    mats = [Material("white", (0.8, 0.8, 0.8), specular_ior_level=0.0)]
+    towers = [box((x - 0.2, y - 0.2, 0), (x + 0.2, y + 0.2, 1.8), "tower", 1)
+              for x in (-1.0, 0.0, 1.0) for y in (0.0, 1.2)]
+    sun = [SunLight((-0.4, 0.6, -0.7), (3.0,) * 3, angle=np.radians(2))]
+    panels, notes = [], []
+    flat = look_at((0, -4.5, 0.9), (0, 0.5, 0.9))
+    for name, cam in (("perspective, tilted up", Camera(look_at((0, -4.5, 0.5), (0, 0.5, 1.4)),
+                                                        lens=30)),
+                      ("perspective, shift_y 0.15", Camera(flat, lens=30, shift_y=0.15)),
+                      ("orthographic, scale 5", Camera(flat, kind="ORTHO", ortho_scale=5.0))):
+        scene = stage(mats, towers, sun, cam, size=(128, 96))
+        img, t, _ = run(scene, samples=16, integrator="distribution")
+        panels.append(img)
+        notes.append(f"{name} {t:.1f} s")
+    save("effect_cameras.png", panels)
+    lines.append("| Cameras | effect_cameras.png | " + "; ".join(notes) + " |")
+
+
 EFFECTS = {"antialiasing": effect_antialiasing, "soft_shadows": effect_soft_shadows,
            "depth_of_field": effect_depth_of_field, "integrators": effect_integrators,
-           "motion_blur": effect_motion_blur}
+           "motion_blur": effect_motion_blur, "glossy": effect_glossy,
+           "translucency": effect_translucency, "cameras": effect_cameras}
 
 
 def main(names):

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .motion import DeformMotion, RigidMotion
+from .motion import DeformMotion, RigidMotion, inverse3
 from .scene import TriangleMesh
 
 MISS = -1
@@ -152,7 +152,7 @@ class Accelerator:
     def to_object_space(obj: MovingObject, origins, dirs, time):
         """Rays moved into a rigid object's space at each ray's own time."""
         m = obj.mesh.motion.at(time)
-        inv = np.linalg.inv(m[:, :3, :3])
+        inv = inverse3(m[:, :3, :3])
         o = np.einsum("nij,nj->ni", inv, origins - m[:, :3, 3])
         d = np.einsum("nij,nj->ni", inv, dirs)
         return o, d

@@ -94,6 +94,16 @@ def _slerp(q0: np.ndarray, q1: np.ndarray, f: np.ndarray) -> np.ndarray:
     return q / np.linalg.norm(q, axis=1, keepdims=True)
 
 
+def inverse3(a: np.ndarray) -> np.ndarray:
+    """Inverses of (n, 3, 3) matrices in closed form (adjugate over determinant): an
+    order of magnitude faster than batched LAPACK for 3x3, and exact enough in float64."""
+    c0, c1, c2 = a[:, :, 0], a[:, :, 1], a[:, :, 2]
+    r0, r1, r2 = np.cross(c1, c2), np.cross(c2, c0), np.cross(c0, c1)
+    det = (c0 * r0).sum(1)
+    det = np.where(np.abs(det) > 1e-300, det, 1e-300)
+    return np.stack([r0, r1, r2], axis=1) / det[:, None, None]
+
+
 @dataclass
 class RigidMotion:
     """A transform sampled at motion steps: times (K,) increasing in [0, 1] (shutter

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .accel import Accelerator, Hits
+from .motion import inverse3
 
 # Relative offset: 2**-17 ~ 7.6e-6 of the coordinate magnitude, i.e. 64 float32 ulps,
 # comfortably above Embree's watertight-test error and the float32 rounding of vertices
@@ -30,7 +31,7 @@ class SurfaceHit:
     front_facing: np.ndarray     # (n,) bool: the ray hit the triangle's front side
     material: np.ndarray         # (n,) int64 index into Scene.materials
     scale: np.ndarray            # (n,) float64 magnitude used for ray offsets
-    uv: np.ndarray | None = None
+    uv: np.ndarray | None = None   # (n, 2) texture coordinates, None if no mesh has UVs
 
 
 class SurfaceBuilder:
@@ -70,6 +71,18 @@ class SurfaceBuilder:
                     parts.append(np.repeat(flat[:, None, :], 3, axis=1))
                 offset += t
             self.corner_normals = np.concatenate(parts)
+        # Texture coordinates per triangle corner (Blender's UV map), for the meshes that
+        # have them; triangles of meshes without UVs read (0, 0), as in Cycles.
+        self.corner_uvs = None
+        if any(getattr(m, "uvs", None) is not None for m in ordered):
+            parts = []
+            for m in ordered:
+                t = len(m.triangles)
+                if m.uvs is not None:
+                    parts.append(np.asarray(m.uvs, np.float32).reshape(t, 3, 2))
+                else:
+                    parts.append(np.zeros((t, 3, 2), np.float32))
+            self.corner_uvs = np.concatenate(parts)
 
     def _moving_vertices(self, prim, time):
         """World vertices, normal matrices (or None) of hit triangles at the rays' times."""
@@ -89,7 +102,7 @@ class SurfaceBuilder:
                     dst[rows] = np.einsum("nij,nj->ni", a, obj.mesh.positions[tri[:, k]]) + t
                 if normal_m is None:
                     normal_m = np.broadcast_to(np.eye(3), (len(prim), 3, 3)).copy()
-                normal_m[rows] = np.transpose(np.linalg.inv(a), (0, 2, 1))
+                normal_m[rows] = np.transpose(inverse3(a), (0, 2, 1))
             else:
                 sl = obj.mesh.motion.slice_of(time[rows])
                 for s in np.unique(sl):
@@ -136,7 +149,12 @@ class SurfaceBuilder:
         else:
             ns = ng_f
         scale = np.maximum(np.max(np.abs(pos), axis=1), tri_scale)
-        return SurfaceHit(pos, ng_f, ns, front, self.material[prim], scale)
+        uv = None
+        if self.corner_uvs is not None:
+            # the same barycentric weights as the position: w vertex 0, u vertex 1, v vertex 2
+            cu = self.corner_uvs[prim].astype(np.float64)
+            uv = w * cu[:, 0] + u * cu[:, 1] + v * cu[:, 2]
+        return SurfaceHit(pos, ng_f, ns, front, self.material[prim], scale, uv)
 
 
 def _unit_normals(v0, v1, v2):
