@@ -107,6 +107,17 @@ from scipy import integrate, stats  # noqa: E402
 ALPHA = 0.01 / 6          # Bonferroni over the chi-square tests in this file
 
 
+def chi_square_pvalue(counts, expected):
+    """Pearson's chi-square p-value, cells with an expected count below 5 pooled."""
+    counts, expected = np.ravel(counts), np.ravel(expected)
+    keep = expected >= 5
+    obs = np.append(counts[keep], counts[~keep].sum())
+    exp = np.append(expected[keep], expected[~keep].sum())
+    if exp[-1] == 0:
+        obs, exp = obs[:-1], exp[:-1]
+    return stats.chisquare(obs, exp).pvalue
+
+
 def _inside_aperture(x, y, blades, rotation):
     if blades < 3:
         return x * x + y * y <= 1.0
@@ -135,12 +146,7 @@ def test_lens_sampling_chi_square(blades, rotation):
     X, Y = np.meshgrid(fine, fine, indexing="ij")
     frac = _inside_aperture(X, Y, blades, rotation).reshape(cells, sub, cells, sub).mean(axis=(1, 3))
     expected = n * frac / frac.sum()
-    keep = expected >= 5          # pool the rest into one cell
-    obs = np.append(counts[keep], counts[~keep].sum())
-    exp = np.append(expected[keep], expected[~keep].sum())
-    if exp[-1] == 0:
-        obs, exp = obs[:-1], exp[:-1]
-    p_value = stats.chisquare(obs, exp).pvalue
+    p_value = chi_square_pvalue(counts, expected)
     print(f"blades={blades}: chi-square p = {p_value:.3g}")
     assert p_value > ALPHA
     assert edges.size == cells + 1
@@ -155,12 +161,7 @@ def test_filter_importance_sampling_chi_square(kind, width):
     counts, edges = np.histogram(x, bins=bins, range=(-f.radius, f.radius))
     expected = np.array([integrate.quad(f.pdf_1d, a, b)[0] for a, b in zip(edges[:-1], edges[1:])])
     expected *= n / expected.sum()
-    keep = expected >= 5
-    obs = np.append(counts[keep], counts[~keep].sum())
-    exp = np.append(expected[keep], expected[~keep].sum())
-    if exp[-1] == 0:
-        obs, exp = obs[:-1], exp[:-1]
-    p_value = stats.chisquare(obs, exp).pvalue
+    p_value = chi_square_pvalue(counts, expected)
     print(f"{kind} {width}: chi-square p = {p_value:.3g}")
     assert p_value > ALPHA
 
