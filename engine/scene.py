@@ -20,10 +20,26 @@ import numpy as np
 
 @dataclass
 class Material:
-    """The part of a Principled BSDF the tracer understands, with Blender's meanings.
+    """The part of Blender's shader nodes the tracer understands, as Principled parameters
+    with Cycles' meanings (see drt_addon/export/materials.py for how nodes map here).
 
     roughness maps to GGX alpha = roughness**2 as in Cycles. `emission` is radiance
-    (colour times strength), no extra 1/pi.
+    (colour times strength), no extra 1/pi; like Cycles' Principled BSDF it is emitted by
+    the opaque part only (times `alpha` on average).
+
+    Textures: each `*_texture` (an `engine.textures.TextureInput`, None = plain value)
+    replaces the plain parameter at every hit by its value at the hit's UV; the plain value
+    is then only a summary (the texture's average) for code that needs one number.
+
+    Lobe colours (None = Principled's own rule from `base_color`):
+      metal_color  the F0 of the metallic lobe (a Glossy BSDF's colour);
+      glass_color  the tint of each refraction through the glass lobe (Principled uses
+                   sqrt(base colour); a Glass BSDF node its colour).
+
+    alpha: coverage, Cycles' Principled Alpha or 1 - the weight of a Transparent BSDF in
+    a Mix Shader. Where alpha < 1 the integrators let rays through with probability
+    1 - alpha, tinted by `transparent_color` (the Transparent BSDF's colour), counted
+    against the transparent bounce limit.
     """
     name: str = "default"
     base_color: tuple = (0.8, 0.8, 0.8)
@@ -34,9 +50,27 @@ class Material:
     specular_ior_level: float = 0.5
     emission: tuple = (0.0, 0.0, 0.0)
     alpha: float = 1.0
+    metal_color: Optional[tuple] = None
+    glass_color: Optional[tuple] = None
+    transparent_color: tuple = (1.0, 1.0, 1.0)
+    base_color_texture: Optional[object] = None
+    metallic_texture: Optional[object] = None
+    roughness_texture: Optional[object] = None
+    emission_texture: Optional[object] = None
+    alpha_texture: Optional[object] = None
+
+    TEXTURED = ("base_color", "metallic", "roughness", "emission", "alpha")
+
+    def textures(self) -> dict:
+        """{parameter name: TextureInput} of the textured parameters."""
+        return {k: getattr(self, k + "_texture") for k in self.TEXTURED
+                if getattr(self, k + "_texture") is not None}
 
     def is_emissive(self) -> bool:
-        return max(self.emission) > 0.0
+        return max(self.emission) > 0.0 or self.emission_texture is not None
+
+    def uses_uv(self) -> bool:
+        return bool(self.textures())
 
 
 @dataclass
@@ -72,6 +106,12 @@ class TriangleMesh:
         if len(self.material_indices) != len(self.triangles):
             raise ValueError(f"mesh {self.name!r}: {len(self.material_indices)} material indices "
                              f"for {len(self.triangles)} triangles")
+        if self.uvs is not None:
+            uvs = np.asarray(self.uvs, dtype=np.float32)
+            if uvs.size != len(self.triangles) * 6:
+                raise ValueError(f"mesh {self.name!r}: {uvs.size // 6} UV triangles for "
+                                 f"{len(self.triangles)} triangles")
+            self.uvs = np.ascontiguousarray(uvs.reshape(-1, 3, 2))
         if len(self.triangles) and (self.triangles.min() < 0
                                     or self.triangles.max() >= len(self.positions)):
             raise ValueError(f"mesh {self.name!r}: triangle index out of range")

@@ -26,11 +26,13 @@ class LocalMesh:
     triangles: np.ndarray                  # (T, 3) int32
     material: np.ndarray                   # (T,) int32 material slot index
     normals: Optional[np.ndarray] = None   # (T, 3, 3) float32 split normals, None if all flat
+    uvs: Optional[np.ndarray] = None       # (T, 3, 2) float32 corner UVs, None if not needed
+    uv_request: Optional[str] = None       # the UV map asked for ('' = default), None = none
 
 
 def mesh_arrays(mesh):
     """(positions (V,3) f64, triangles (T,3) i32, material index (T,) i32,
-    corner normals (T,3,3) f32 or None) in object space."""
+    corner normals (T,3,3) f32 or None) in object space (mesh_uvs gives the UVs)."""
     mesh.calc_loop_triangles()
     nv = len(mesh.vertices)
     nt = len(mesh.loop_triangles)
@@ -46,6 +48,45 @@ def mesh_arrays(mesh):
         mesh.loop_triangles.foreach_get("split_normals", normals)
         normals = normals.reshape(nt, 3, 3)
     return co.reshape(nv, 3).astype(np.float64), tris.reshape(nt, 3), mat, normals
+
+
+def mesh_uvs(mesh, name: str = "") -> Optional[np.ndarray]:
+    """Per-corner texture coordinates (T, 3, 2) float32 of the loop triangles (call after
+    `mesh_arrays`, which computes them), from the UV map `name`, or for '' (or a name the
+    mesh lacks) the map Cycles uses by default: the active render UV map (Blender's camera
+    icon in the UV Maps list), else the active one. None when the mesh has no UV map:
+    Cycles then reads (0, 0, 0) as UV, which the tracer does for a mesh without UVs."""
+    layers = mesh.uv_layers
+    if len(layers) == 0:
+        return None
+    layer = layers.get(name) if name else None
+    if layer is None:
+        layer = next((l for l in layers if l.active_render), None) or layers.active or layers[0]
+    nt = len(mesh.loop_triangles)
+    loops = np.empty(nt * 3, dtype=np.int32)
+    mesh.loop_triangles.foreach_get("loops", loops)
+    uv = np.empty(len(mesh.loops) * 2, dtype=np.float32)
+    if hasattr(layer, "uv"):                       # Blender 3.5+
+        layer.uv.foreach_get("vector", uv)
+    else:                                          # Blender 3.4
+        layer.data.foreach_get("uv", uv)
+    return uv.reshape(-1, 2)[loops].reshape(nt, 3, 2)
+
+
+def uv_request(obj) -> Optional[str]:
+    """Which UV map the object's materials read through image textures: None (no
+    textures, no UVs exported), '' (the default map) or a UV map's name (the first one a
+    UV Map node names)."""
+    from .materials import material_uv_maps
+    names = set()
+    for slot in getattr(obj, "material_slots", ()):
+        found = material_uv_maps(slot.material)
+        if found:
+            names |= found
+    if not names:
+        return None
+    named = sorted(n for n in names if n)
+    return named[0] if named else ""
 
 
 def _has_smooth_faces(mesh) -> bool:
@@ -85,25 +126,32 @@ class MeshCache:
 
     def local(self, obj) -> Optional[LocalMesh]:
         key = _cache_key(obj)
+        want_uv = uv_request(obj)
         if key is not None and key in self._local:
-            self.reuses += 1
-            return self._local[key]
-        local = _evaluate(obj)
+            cached = self._local[key]
+            # a shared mesh whose other user needed no UVs (object-linked materials)
+            if cached is None or want_uv is None or cached.uv_request == want_uv:
+                self.reuses += 1
+                return cached
+        local = _evaluate(obj, want_uv)
         self.evaluations += 1
         if key is not None:
             self._local[key] = local
         return local
 
 
-def _evaluate(obj) -> Optional[LocalMesh]:
+def _evaluate(obj, want_uv: Optional[str] = None) -> Optional[LocalMesh]:
     try:
         mesh = obj.to_mesh()
     except RuntimeError as e:
         raise ExportError(f"object {obj.name!r}: cannot evaluate its mesh ({e})") from e
+    uvs = None
     try:
         if mesh is None:
             return None
         pos, tris, mat, normals = mesh_arrays(mesh)
+        if want_uv is not None and len(tris):
+            uvs = mesh_uvs(mesh, want_uv)
     finally:
         obj.to_mesh_clear()
     if len(tris) == 0:
@@ -114,7 +162,9 @@ def _evaluate(obj) -> Optional[LocalMesh]:
                           "infinite) positions; fix or delete them to render")
     if normals is not None and not np.all(np.isfinite(normals)):
         normals = None                        # degenerate faces: fall back to flat shading
-    return LocalMesh(pos, tris, mat, normals)
+    if uvs is not None and not np.all(np.isfinite(uvs)):
+        uvs = np.where(np.isfinite(uvs), uvs, 0.0).astype(np.float32)
+    return LocalMesh(pos, tris, mat, normals, uvs, want_uv)
 
 
 def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engine.TriangleMesh":
@@ -128,6 +178,7 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
     world = local.positions @ m3.T + m[:3, 3]
     tris = local.triangles
     normals = local.normals
+    uvs = local.uvs
     det = float(np.linalg.det(m3))
     if normals is not None:
         normal_matrix = np.linalg.inv(m3).T if abs(det) > 1e-300 else m3
@@ -140,9 +191,11 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
         tris = tris[:, [0, 2, 1]]
         if normals is not None:
             normals = normals[:, [0, 2, 1]]
+        if uvs is not None:
+            uvs = uvs[:, [0, 2, 1]]
     slots = np.asarray(material_slots if len(material_slots) else [0], dtype=np.int32)
     global_mat = slots[np.clip(local.material, 0, len(slots) - 1)]
-    return engine.TriangleMesh(name, world, tris, global_mat, corner_normals=normals)
+    return engine.TriangleMesh(name, world, tris, global_mat, corner_normals=normals, uvs=uvs)
 
 
 def export_mesh_instance(obj, matrix_world, material_slots, name,

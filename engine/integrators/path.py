@@ -52,6 +52,120 @@ def _clamp(values, limit):
     return np.where(m > limit, values * (limit / np.maximum(m, 1e-300)), values)
 
 
+# Sampler dimensions of the pass-through decisions at transparent surfaces: outside the
+# per-bounce layout of engine.sampling.dimensions (so no other effect's numbers shift),
+# one per (path vertex, transparent layer).
+TRANSPARENT_DIM = 1 << 24
+
+
+def _alpha_dim(depth: int, layer: int) -> int:
+    return TRANSPARENT_DIM + depth * 1024 + min(layer, 1023)
+
+
+def intersect_alpha(ctx, o, d, tm, tp, px, ix, depth, used):
+    """Closest hits, seen through materials with alpha < 1 (stochastic transparency).
+
+    Cycles' Principled Alpha a (and a Transparent BSDF mixed in with weight 1 - a) is a
+    transparent closure: here a ray hitting such a surface passes through it with
+    probability 1 - a (a sampler number per path vertex and layer), tinted by the
+    material's transparent colour, and the hit it reports is the next surface beyond;
+    otherwise the surface is opaque. The expectation is Cycles' a x shading + (1 - a) x
+    what lies behind. Every pass-through counts one transparent bounce of the path
+    (`used`, Cycles' transparent bounce; not a bounce of `max_bounces`); a ray that would
+    pass through more than `settings.transparent_bounces` surfaces ends there (Cycles
+    terminates such a path).
+
+    Returns (hits with t measured from o, throughput factor (n, 3) or None, updated
+    `used`, stopped mask or None)."""
+    hits = ctx.accel.intersect(o, d, tm, tp)
+    mats = ctx.materials
+    if not mats.any_transparent or len(o) == 0:
+        return hits, None, used, None
+    n = len(o)
+    limit = ctx.settings.transparent_bounces
+    surfaces = ctx.surfaces
+    factor = np.ones((n, 3))
+    used = used.copy()
+    stopped = np.zeros(n, bool)
+    travelled = np.zeros(n)
+    t_all, prim_all, u_all, v_all = hits.t.copy(), hits.prim.copy(), hits.u.copy(), hits.v.copy()
+    rows = np.arange(n)
+    cur = hits
+    layer = 0
+    while rows.size:
+        hit = cur.prim >= 0
+        m = np.where(hit, surfaces.material[np.maximum(cur.prim, 0)], 0)
+        c = np.nonzero(hit & mats.maybe_transparent[m])[0]
+        if c.size == 0:
+            break
+        si = surfaces.build(cur, c, d[rows], None if tp is None else tp[rows])
+        alpha = mats.alpha_at(si.material, si.uv)
+        u_t = ctx.sampler.get_1d(_alpha_dim(depth, layer), px[rows[c]], ix[rows[c]])
+        through = u_t >= alpha
+        over = through & (used[rows[c]] >= limit)
+        stopped[rows[c[over]]] = True
+        go = np.nonzero(through & ~over)[0]
+        if go.size == 0:
+            break
+        g = rows[c[go]]
+        factor[g] *= mats.transparent_color[si.material[go]]
+        used[g] += 1
+        travelled[g] += cur.t[c[go]]
+        new_o = offset_origin(si.position[go], si.geometric_normal[go], si.scale[go], d[g])
+        remaining = np.maximum(np.asarray(tm)[g] - travelled[g], 0.0)
+        cur = ctx.accel.intersect(new_o, d[g], remaining, None if tp is None else tp[g])
+        found = cur.prim >= 0
+        t_all[g] = np.where(found, travelled[g] + cur.t, np.inf)
+        prim_all[g], u_all[g], v_all[g] = cur.prim, cur.u, cur.v
+        rows = g
+        layer += 1
+    return type(hits)(t_all, prim_all, u_all, v_all), factor, used, stopped
+
+
+def shadow_transmittance(ctx, org, dirs, far, time=None):
+    """Fraction (n, 3) of light that reaches org along dirs over [0, far): 0 behind an
+    opaque surface; through surfaces with alpha < 1 the product of (1 - alpha) x their
+    transparent colour (Cycles' transparent shadows), over at most
+    `settings.transparent_bounces` such surfaces (more block)."""
+    mats = ctx.materials
+    n = len(org)
+    if not mats.any_transparent:
+        vis = ~ctx.accel.occluded(org, dirs, far, time)
+        return np.repeat(vis[:, None].astype(np.float64), 3, axis=1)
+    limit = ctx.settings.transparent_bounces
+    surfaces = ctx.surfaces
+    T = np.ones((n, 3))
+    rows = np.arange(n)
+    o, remaining = org, np.asarray(far, dtype=np.float64)
+    layer = 0
+    while rows.size:
+        h = ctx.accel.intersect(o, dirs[rows], remaining, None if time is None else time[rows])
+        hr = np.nonzero((h.prim >= 0) & (h.t < remaining))[0]
+        if hr.size == 0:
+            break
+        m = surfaces.material[h.prim[hr]]
+        opaque = ~mats.maybe_transparent[m]
+        T[rows[hr[opaque]]] = 0.0
+        tr = hr[~opaque]
+        if tr.size == 0:
+            break
+        if layer >= limit:
+            T[rows[tr]] = 0.0
+            break
+        si = surfaces.build(h, tr, dirs[rows], None if time is None else time[rows])
+        alpha = mats.alpha_at(si.material, si.uv)
+        T[rows[tr]] *= (1.0 - alpha)[:, None] * mats.transparent_color[si.material]
+        still = T[rows[tr]].max(1) > 0
+        tr = tr[still]
+        g = rows[tr]
+        o = offset_origin(si.position[still], si.geometric_normal[still], si.scale[still],
+                          dirs[g])
+        remaining = np.maximum(remaining[tr] - h.t[tr], 0.0)
+        rows = g
+        layer += 1
+    return T
+
+
 class PathIntegrator:
     def __init__(self, ctx):
         self.ctx = ctx                       # engine.render.RenderContext
@@ -94,6 +208,7 @@ class PathIntegrator:
         # Per-path state, indexed by path id; `path` lists the live ones.
         beta = np.ones((n, 3))
         counts = np.zeros((n, 3), dtype=np.int64)
+        transparent = np.zeros(n, dtype=np.int64)     # transparent bounces per path
         path = np.arange(n)
         o, d, tm = origins, dirs, tmax
         prev_pdf = np.full(n, np.inf)        # camera rays count as specular: MIS weight 1
@@ -111,7 +226,11 @@ class PathIntegrator:
             px, ix = pixel[path], index[path]
             b = beta[path]
             tp = None if time is None else time[path]
-            hits = ctx.accel.intersect(o, d, tm, tp)
+            hits, tfac, t_used, stopped = intersect_alpha(ctx, o, d, tm, tp, px, ix, depth,
+                                                          transparent[path])
+            if tfac is not None:
+                transparent[path] = t_used
+                b = b * tfac
             t_geom = np.where(hits.hit, hits.t, tm)
             alive = np.ones(path.size, dtype=bool)
 
@@ -138,6 +257,8 @@ class PathIntegrator:
                     env += sun.escaped(d[sel]) * w[:, None]
                 add(path[sel], b[sel] * env, depth)
                 alive[sel] = False
+            if stopped is not None:
+                alive &= ~stopped               # past the transparent bounce limit
             live = np.nonzero(alive)[0]
             if live.size == 0:
                 break
@@ -153,7 +274,7 @@ class PathIntegrator:
             # 1c. emissive surfaces (two-sided, like Cycles' Emission shader), weighted
             # against next-event estimation of the emissive triangle that was hit
             if mats.any_emission:
-                em = mats.emission[si.material]
+                em = mats.emission_at(si.material, si.uv)
                 glow = np.nonzero((em != 0).any(axis=1))[0]
                 if glow.size:
                     g_live = live[glow]
@@ -162,7 +283,7 @@ class PathIntegrator:
                     w = self._hit_weight(prev_pdf[g_live], light_pdf)
                     add(rows[glow], b_live[glow] * em[glow] * w[:, None], depth)
 
-            bsdf = PrincipledBSDF.from_materials(mats, si.material, si.front_facing)
+            bsdf = PrincipledBSDF.from_materials(mats, si.material, si.front_facing, si.uv)
             c_live = counts[rows]
             allowed = (c_live < self.limits[None, :]) & (depth < self.max_bounces)
 
@@ -190,14 +311,15 @@ class PathIntegrator:
                     far = np.where(finite, seg * (1.0 - 2e-5), ctx.scene_radius * 4.0)
                     if ls.margin is not None:
                         far = np.where(finite, np.minimum(far, seg - ls.margin[sel]), far)
-                    vis = ~ctx.accel.occluded(org, sdir, np.maximum(far, 0.0),
-                                              None if t_live is None else t_live[sel])
+                    trans = shadow_transmittance(ctx, org, sdir, np.maximum(far, 0.0),
+                                                 None if t_live is None else t_live[sel])
+                    vis = trans.max(1) > 0
                     if vis.any():
                         sv = sel[vis]
                         bsdf_pdf = bsdf.pdf(wo, wi_local, allowed)[sv]
                         w = self._nee_weight(ls.pdf[sv], bsdf_pdf, delta[sv])
                         contrib = (b_live[sv] * f[sv] * np.abs(wi_local[sv, 2:3])
-                                   * ls.radiance[sv] * (w / ls.pdf[sv])[:, None])
+                                   * ls.radiance[sv] * trans[vis] * (w / ls.pdf[sv])[:, None])
                         add(rows[sv], contrib, depth, direct=depth == 0)
 
             # 3. continue by BSDF sampling

@@ -23,6 +23,7 @@ from ..lights import luminance
 from ..sampling import dimensions as D
 from ..surface import offset_origin
 from ..warp import INV_PI
+from .path import intersect_alpha, shadow_transmittance
 
 CENTRE = 0.5
 
@@ -66,11 +67,12 @@ class WhittedIntegrator:
                                 ls.wi[sel])
             far = np.where(np.isfinite(ls.dist[sel]), ls.dist[sel] * (1.0 - 2e-5),
                            ctx.scene_radius * 4.0)
-            vis = ~ctx.accel.occluded(org, ls.wi[sel], np.maximum(far, 0.0),
-                                      None if time is None else time[sel])
+            trans = shadow_transmittance(ctx, org, ls.wi[sel], np.maximum(far, 0.0),
+                                         None if time is None else time[sel])
+            vis = trans.max(1) > 0
             sv = sel[vis]
             out[sv] += (diffuse_albedo[sv] * INV_PI * cos[sv, None] * ls.radiance[sv]
-                        / ls.pdf[sv, None])
+                        * trans[vis] / ls.pdf[sv, None])
         return out
 
     def radiance(self, pixel, index, origins, dirs, tmax, time=None):
@@ -81,12 +83,17 @@ class WhittedIntegrator:
         beta = np.ones((n, 3))
         path = np.arange(n)
         o, d, tm = origins, dirs, tmax
+        transparent = np.zeros(n, dtype=np.int64)     # transparent bounces per path
         for depth in range(self.max_depth + 1):
             if path.size == 0:
                 break
             b = beta[path]
             tp = None if time is None else time[path]
-            hits = ctx.accel.intersect(o, d, tm, tp)
+            hits, tfac, t_used, stopped = intersect_alpha(
+                ctx, o, d, tm, tp, pixel[path], index[path], depth, transparent[path])
+            if tfac is not None:
+                transparent[path] = t_used
+                b = b * tfac
             t_geom = np.where(hits.hit, hits.t, tm)
             alive = np.ones(path.size, dtype=bool)
             if len(ctx.lights):
@@ -99,6 +106,8 @@ class WhittedIntegrator:
             escaped = alive & ~hits.hit
             L[path[escaped]] += b[escaped] * ctx.world_radiance
             alive &= ~escaped
+            if stopped is not None:
+                alive &= ~stopped               # past the transparent bounce limit
             live = np.nonzero(alive)[0]
             if live.size == 0:
                 break
@@ -106,8 +115,10 @@ class WhittedIntegrator:
             rows = path[live]
             bl = b[live]
             m = si.material
-            L[rows] += bl * mats.emission[m]
-            base, metal = mats.base_color[m], np.clip(mats.metallic[m], 0, 1)[:, None]
+            L[rows] += bl * mats.emission_at(m, si.uv)
+            base = mats.base_color_at(m, si.uv)
+            metal = np.clip(mats.metallic_at(m, si.uv), 0, 1)[:, None]
+            metal_f0 = mats.metal_color_at(m, base)
             trans = np.clip(mats.transmission[m], 0, 1)[:, None] * (1 - metal)
             dl = d[live]
             cos_o = np.clip(-(dl * si.shading_normal).sum(1), 0.0, 1.0)
@@ -115,7 +126,8 @@ class WhittedIntegrator:
             eta = np.where(si.front_facing, mats.ior[m], 1.0 / np.maximum(mats.ior[m], 1e-6))
             f_d = fresnel.dielectric(cos_o, eta)[:, None]
             spec = np.clip(2.0 * mats.specular_ior_level[m], 0.0, None)[:, None]
-            k_r = metal * fresnel.schlick(base, cos_o) + (1 - metal) * np.minimum(f_d * spec, 1.0)
+            k_r = (metal * fresnel.schlick(metal_f0, cos_o)
+                   + (1 - metal) * np.minimum(f_d * spec, 1.0))
             k_t = trans * (1.0 - f_d)
             k_d = base * (1 - metal) * (1 - trans) * (1.0 - np.minimum(f_d * spec, 1.0))
             if len(ctx.lights):

@@ -1,0 +1,595 @@
+"""Materials from Blender's shader nodes, with Cycles' meaning (drt_addon/export/materials.py).
+
+- Each supported node kind exports the engine Material values Cycles' reading of the
+  node implies (Principled, Diffuse, Glossy, Glass, Emission, Transparent, Mix, Add,
+  Fresnel-driven mixes), and Glossy / Glass land in the right BSDF lobes.
+- What DRT approximates is reported once per material, and the scene still renders.
+- Image textures: pixels exported once per image, with the node's interpolation and
+  extension, sRGB decoded like Cycles, UVs from the right UV map; and a textured scene
+  rendered by DRT matches Cycles (direct light only): per-channel means within
+  MEAN_TOLERANCE and a per-pixel mean absolute difference within MAD_TOLERANCE of the mean.
+"""
+import os
+import tempfile
+
+import numpy as np
+import pytest
+
+from conftest import read_image_linear
+
+MEAN_TOLERANCE = 0.02
+MAD_TOLERANCE = 0.05
+
+
+# --------------------------------------------------------------------------- helpers
+def _reset(bpy):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+
+
+def _material(bpy, name, keep_principled=False):
+    mat = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):
+        mat.use_nodes = True
+    nt = mat.node_tree
+    if not keep_principled:
+        nt.nodes.remove(nt.nodes["Principled BSDF"])
+    return mat, nt
+
+
+def _out(nt):
+    return nt.nodes["Material Output"].inputs["Surface"]
+
+
+def _export(mat):
+    from drt_addon.export.errors import Reporter
+    from drt_addon.export.materials import export_material
+    r = Reporter()
+    return export_material(mat, r), r.warnings
+
+
+def _single(bpy, kind, **inputs):
+    mat, nt = _material(bpy, kind)
+    node = nt.nodes.new(kind)
+    for k, v in inputs.items():
+        node.inputs[k].default_value = v
+    nt.links.new(node.outputs[0], _out(nt))
+    return mat, nt, node
+
+
+def close(a, b, tol=1e-6):
+    return np.allclose(np.asarray(a, float), np.asarray(b, float), atol=tol)
+
+
+# --------------------------------------------------------------------------- node kinds
+def test_principled_values(bpy_drt):
+    bpy = bpy_drt
+    _reset(bpy)
+    mat, nt = _material(bpy, "P", keep_principled=True)
+    p = nt.nodes["Principled BSDF"]
+    vals = {"Base Color": (0.2, 0.4, 0.6, 1.0), "Metallic": 0.3, "Roughness": 0.7,
+            "IOR": 1.33, "Transmission Weight": 0.4, "Specular IOR Level": 0.25,
+            "Emission Color": (1.0, 0.5, 0.25, 1.0), "Emission Strength": 4.0, "Alpha": 1.0}
+    for k, v in vals.items():
+        p.inputs[k].default_value = v
+    m, warnings = _export(mat)
+    assert close(m.base_color, (0.2, 0.4, 0.6)) and m.metallic == pytest.approx(0.3)
+    assert m.roughness == pytest.approx(0.7) and m.ior == pytest.approx(1.33)
+    assert m.transmission == pytest.approx(0.4)
+    assert m.specular_ior_level == pytest.approx(0.25)
+    assert close(m.emission, (4.0, 2.0, 1.0))               # colour x strength
+    assert m.alpha == 1.0 and m.metal_color is None and m.glass_color is None
+    assert warnings == []
+    # Alpha: coverage; emission stays colour x strength (emitted by the opaque part)
+    p.inputs["Alpha"].default_value = 0.25
+    m, _ = _export(mat)
+    assert m.alpha == pytest.approx(0.25) and close(m.emission, (4.0, 2.0, 1.0))
+    assert close(m.transparent_color, (1, 1, 1))
+    # coat is not modelled: reported, naming the material
+    p.inputs["Coat Weight"].default_value = 0.5
+    m, warnings = _export(mat)
+    assert len(warnings) == 1 and "'P'" in warnings[0] and "coat" in warnings[0]
+
+
+def test_diffuse_glossy_glass_emission_transparent(bpy_drt):
+    bpy = bpy_drt
+    _reset(bpy)
+    m, w = _export(_single(bpy, "ShaderNodeBsdfDiffuse", Color=(0.5, 0.25, 0.1, 1))[0])
+    assert close(m.base_color, (0.5, 0.25, 0.1)) and m.specular_ior_level == 0.0
+    assert m.metallic == 0.0 and m.transmission == 0.0 and w == []
+
+    m, w = _export(_single(bpy, "ShaderNodeBsdfGlossy", Color=(0.9, 0.6, 0.2, 1),
+                           Roughness=0.3)[0])
+    assert m.metallic == 1.0 and close(m.base_color, (0.9, 0.6, 0.2))
+    assert m.roughness == pytest.approx(0.3) and w == []
+
+    m, w = _export(_single(bpy, "ShaderNodeBsdfGlass", Color=(0.7, 0.9, 0.8, 1),
+                           Roughness=0.1, IOR=1.45)[0])
+    assert m.transmission == 1.0 and m.metallic == 0.0
+    assert m.ior == pytest.approx(1.45) and m.roughness == pytest.approx(0.1)
+    assert close(m.glass_color, (0.7, 0.9, 0.8)) and w == []
+
+    m, w = _export(_single(bpy, "ShaderNodeEmission", Color=(1.0, 0.5, 0.0, 1),
+                           Strength=3.0)[0])
+    assert close(m.emission, (3.0, 1.5, 0.0)) and close(m.base_color, (0, 0, 0))
+    assert m.specular_ior_level == 0.0 and m.alpha == 1.0
+
+    m, w = _export(_single(bpy, "ShaderNodeBsdfTransparent", Color=(1.0, 0.5, 0.25, 1))[0])
+    assert m.alpha == 0.0 and close(m.transparent_color, (1.0, 0.5, 0.25))
+
+
+def _mix(bpy, name, a, b, fac=0.5, add=False):
+    mat, nt = _material(bpy, name)
+    nodes = []
+    for kind, inputs in (a, b):
+        n = nt.nodes.new(kind)
+        for k, v in inputs.items():
+            n.inputs[k].default_value = v
+        nodes.append(n)
+    mix = nt.nodes.new("ShaderNodeAddShader" if add else "ShaderNodeMixShader")
+    off = 0 if add else 1
+    if not add:
+        mix.inputs[0].default_value = fac
+    nt.links.new(nodes[0].outputs[0], mix.inputs[off])
+    nt.links.new(nodes[1].outputs[0], mix.inputs[off + 1])
+    nt.links.new(mix.outputs[0], _out(nt))
+    return mat, nt, mix
+
+
+DIFFUSE = ("ShaderNodeBsdfDiffuse", {"Color": (0.8, 0.1, 0.1, 1)})
+GLOSSY = ("ShaderNodeBsdfGlossy", {"Color": (1.0, 1.0, 1.0, 1), "Roughness": 0.2})
+EMISSION = ("ShaderNodeEmission", {"Color": (1.0, 1.0, 0.5, 1), "Strength": 2.0})
+TRANSPARENT = ("ShaderNodeBsdfTransparent", {"Color": (1, 1, 1, 1)})
+PRINCIPLED = ("ShaderNodeBsdfPrincipled", {"Base Color": (0.2, 0.6, 0.2, 1),
+                                           "Roughness": 0.4})
+
+
+def test_mix_shader_blends_lobes_with_their_own_colours(bpy_drt):
+    bpy = bpy_drt
+    _reset(bpy)
+    m, w = _export(_mix(bpy, "DG", DIFFUSE, GLOSSY, fac=0.25)[0])
+    # 75% Lambert of the diffuse colour + 25% GGX mirror of the glossy colour
+    assert m.metallic == pytest.approx(0.25)
+    assert close(m.base_color, (0.8, 0.1, 0.1)) and close(m.metal_color, (1, 1, 1))
+    assert m.roughness == pytest.approx(0.2)             # only the glossy lobe is rough
+    assert m.specular_ior_level == 0.0 and w == []
+    # two Principled-like sides of one colour: plain parameter blend
+    b = ("ShaderNodeBsdfPrincipled", {"Base Color": (0.2, 0.6, 0.2, 1), "Roughness": 0.8,
+                                      "Metallic": 1.0})
+    m, w = _export(_mix(bpy, "PP", PRINCIPLED, b, fac=0.5)[0])
+    assert m.metallic == pytest.approx(0.5) and m.metal_color is None
+    assert m.roughness == pytest.approx(0.6) and close(m.base_color, (0.2, 0.6, 0.2))
+    # with a Transparent BSDF: alpha = 1 - fac
+    m, w = _export(_mix(bpy, "PT", PRINCIPLED, TRANSPARENT, fac=0.3)[0])
+    assert m.alpha == pytest.approx(0.7) and close(m.base_color, (0.2, 0.6, 0.2))
+    # with an Emission: half the emission, half the BSDF (a darker base colour)
+    m, w = _export(_mix(bpy, "DE", DIFFUSE, EMISSION, fac=0.5)[0])
+    assert close(m.emission, (1.0, 1.0, 0.5)) and close(m.base_color, (0.4, 0.05, 0.05))
+
+
+def test_fresnel_and_layer_weight_factors_are_approximated_and_reported(bpy_drt):
+    bpy = bpy_drt
+    _reset(bpy)
+    mat, nt, mix = _mix(bpy, "Plastic", DIFFUSE, GLOSSY)
+    f = nt.nodes.new("ShaderNodeFresnel")
+    f.inputs["IOR"].default_value = 1.6
+    nt.links.new(f.outputs[0], mix.inputs[0])
+    m, w = _export(mat)
+    # Principled's own Fresnel-weighted specular layer over the diffuse base
+    assert m.metallic == 0.0 and m.specular_ior_level == 0.5
+    assert m.ior == pytest.approx(1.6) and m.roughness == pytest.approx(0.2)
+    assert close(m.base_color, (0.8, 0.1, 0.1))
+    assert len(w) == 1 and "Plastic" in w[0] and "Fresnel" in w[0]
+    # Layer Weight Facing between two diffuse colours: a constant factor, reported
+    mat, nt, mix = _mix(bpy, "Facing", DIFFUSE, ("ShaderNodeBsdfDiffuse",
+                                                 {"Color": (0.0, 0.0, 0.8, 1)}))
+    lw = nt.nodes.new("ShaderNodeLayerWeight")
+    lw.inputs["Blend"].default_value = 0.5           # Facing = 1 - |cos|: average 1/3
+    nt.links.new(lw.outputs["Facing"], mix.inputs[0])
+    m, w = _export(mat)
+    assert close(m.base_color, (0.8 * 2 / 3, 0.1 * 2 / 3, 0.1 * 2 / 3 + 0.8 / 3), 1e-3)
+    assert len(w) == 1 and "Facing" in w[0]
+
+
+def test_add_shader(bpy_drt):
+    bpy = bpy_drt
+    _reset(bpy)
+    m, w = _export(_mix(bpy, "Glow", DIFFUSE, EMISSION, add=True)[0])
+    assert close(m.emission, (2.0, 2.0, 1.0)) and close(m.base_color, (0.8, 0.1, 0.1))
+    assert w == []                                     # exact: emission + BSDF
+    m, w = _export(_mix(bpy, "Sum", DIFFUSE, GLOSSY, add=True)[0])
+    assert m.metallic == pytest.approx(0.5)             # half the weight each, colours x2
+    assert close(m.base_color, (1.6, 0.2, 0.2)) and close(m.metal_color, (2, 2, 2))
+    assert len(w) == 1 and "Sum" in w[0] and "adds two BSDFs" in w[0]
+
+
+def test_glossy_and_glass_export_to_the_right_lobes(bpy_drt):
+    from engine.bsdf.principled import (L_DIFFUSE, L_GLASS, L_METAL, L_SPECULAR,
+                                        MaterialTable, PrincipledBSDF)
+    bpy = bpy_drt
+    _reset(bpy)
+    mats = [_export(_single(bpy, "ShaderNodeBsdfGlossy", Color=(0.9, 0.6, 0.2, 1),
+                            Roughness=0.3)[0])[0],
+            _export(_single(bpy, "ShaderNodeBsdfGlass", Color=(0.7, 0.9, 0.8, 1),
+                            Roughness=0.0, IOR=1.45)[0])[0],
+            _export(_mix(bpy, "DG", DIFFUSE, GLOSSY, fac=0.25)[0])[0]]
+    bsdf = PrincipledBSDF.from_materials(MaterialTable(mats), np.arange(3))
+    assert close(bsdf.weight[0], [0, 0, 1, 0])            # metal only
+    assert close(bsdf.base_clamped[0], (0.9, 0.6, 0.2))    # F0 = the glossy colour
+    assert bsdf.alpha[0] == pytest.approx(0.09)            # GGX alpha = roughness^2
+    assert close(bsdf.weight[1], [0, 0, 0, 1])            # glass only
+    assert close(bsdf.tint_t[1], (0.7, 0.9, 0.8))          # tint per crossing = colour
+    assert bsdf.eta_glass[1] == pytest.approx(1.45) and bsdf.glass_smooth[1]
+    assert bsdf.weight[2, L_DIFFUSE] == pytest.approx(0.75)
+    assert bsdf.weight[2, L_METAL] == pytest.approx(0.25)
+    assert bsdf.weight[2, L_SPECULAR] == 0.0 and bsdf.weight[2, L_GLASS] == 0.0
+    assert close(bsdf.diffuse_color[2], np.array([0.8, 0.1, 0.1]) * 0.75)
+    assert close(bsdf.base_clamped[2], (1, 1, 1))
+
+
+# --------------------------------------------------------------------------- warnings
+def _camera_and_sun(bpy, scene, ortho=2.0, size=(48, 48)):
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.data.type = "ORTHO"
+    cam.data.ortho_scale = ortho
+    cam.location = (0.0, 0.0, 5.0)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy = 3.0
+    sun.data.angle = 0.0
+    scene.collection.objects.link(sun)
+    scene.render.resolution_x, scene.render.resolution_y = size
+    scene.render.resolution_percentage = 100
+
+
+def _plane(bpy, name, x=0.0, half=1.0, uv=((0, 0), (1, 0), (1, 1), (0, 1))):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata([(x - half, -half, 0), (x + half, -half, 0), (x + half, half, 0),
+                      (x - half, half, 0)], [], [(0, 1, 2, 3)])
+    layer = mesh.uv_layers.new(name="UVMap")
+    for li, loop in enumerate(mesh.loops):
+        layer.uv[li].vector = uv[loop.vertex_index]
+    obj = bpy.data.objects.new(name, mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+def test_unsupported_nodes_warn_once_per_material_and_render(bpy_drt):
+    from drt_addon import render_engine
+    bpy = bpy_drt
+    _reset(bpy)
+    scene = bpy.context.scene
+    scene.render.engine = "DRT"
+    scene.drt.samples = 1
+    _camera_and_sun(bpy, scene, size=(8, 8))
+    mat, nt = _material(bpy, "Weird")
+    toon = nt.nodes.new("ShaderNodeBsdfToon")
+    sss = nt.nodes.new("ShaderNodeSubsurfaceScattering")
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    nt.links.new(toon.outputs[0], mix.inputs[1])
+    nt.links.new(sss.outputs[0], mix.inputs[2])
+    nt.links.new(mix.outputs[0], _out(nt))
+    ok_mat, _ = _material(bpy, "Fine", keep_principled=True)
+    for i, m in enumerate([mat, mat, ok_mat]):             # two objects share "Weird"
+        _plane(bpy, f"P{i}", x=2.5 * i - 2.5).data.materials.append(m)
+    bpy.ops.render.render()
+    last = render_engine.last_render
+    assert last["ok"], last["error"]
+    mine = [w for w in last["warnings"] if "'Weird'" in w]
+    assert len(mine) == 1, last["warnings"]
+    assert "Toon" in mine[0] and "Subsurface" in mine[0] and "viewport colour" in mine[0]
+    assert not any("'Fine'" in w for w in last["warnings"])
+    assert np.isfinite(last["pixels"]).all() and last["pixels"].max() > 0
+
+
+# --------------------------------------------------------------------------- textures
+# A 4 x 4 checker of saturated and mid colours (sRGB-encoded bytes), rows bottom-up.
+CHECKER = np.array([
+    [(0.9, 0.2, 0.1), (0.1, 0.3, 0.8), (0.9, 0.2, 0.1), (0.5, 0.5, 0.5)],
+    [(0.1, 0.8, 0.2), (0.95, 0.9, 0.3), (0.1, 0.8, 0.2), (0.2, 0.2, 0.2)],
+    [(0.9, 0.2, 0.1), (0.1, 0.3, 0.8), (0.7, 0.1, 0.6), (0.1, 0.3, 0.8)],
+    [(0.3, 0.3, 0.3), (0.95, 0.9, 0.3), (0.1, 0.8, 0.2), (0.95, 0.9, 0.3)]], np.float32)
+
+
+def _checker_image(bpy, name="Checker"):
+    img = bpy.data.images.new(name, 4, 4, alpha=True)
+    rgba = np.ones((4, 4, 4), np.float32)
+    rgba[:, :, :3] = CHECKER
+    img.pixels.foreach_set(rgba.ravel())
+    return img
+
+
+def _image_node(nt, img, interpolation="Linear", extension="REPEAT"):
+    node = nt.nodes.new("ShaderNodeTexImage")
+    node.image = img
+    node.interpolation = interpolation
+    node.extension = extension
+    return node
+
+
+def test_image_texture_export(bpy_drt):
+    from engine.textures import srgb_to_linear
+    bpy = bpy_drt
+    _reset(bpy)
+    img = _checker_image(bpy)
+    mat, nt = _material(bpy, "Tex", keep_principled=True)
+    p = nt.nodes["Principled BSDF"]
+    a = _image_node(nt, img, "Closest", "CLIP")
+    nt.links.new(a.outputs["Color"], p.inputs["Base Color"])
+    b = _image_node(nt, img, "Closest", "CLIP")             # same image and settings
+    nt.links.new(b.outputs["Color"], p.inputs["Emission Color"])
+    p.inputs["Emission Strength"].default_value = 2.0
+    data = bpy.data.images.new("Rough", 2, 2, alpha=True)
+    data.colorspace_settings.name = "Non-Color"
+    data.pixels.foreach_set(np.full(16, 0.25, np.float32))
+    c = _image_node(nt, data, "Linear", "EXTEND")
+    nt.links.new(c.outputs["Color"], p.inputs["Roughness"])
+    from drt_addon.export.errors import Reporter
+    from drt_addon.export.materials import export_material
+    reporter = Reporter()
+    m = export_material(mat, reporter)
+    assert reporter.warnings == []
+    tb, te, tr = m.base_color_texture, m.emission_texture, m.roughness_texture
+    assert tb is not None and te is not None and tr is not None
+    assert tb.texture is te.texture                          # exported once
+    t = tb.texture
+    assert (t.interpolation, t.extension, t.srgb) == ("Closest", "CLIP", True)
+    assert tb.channel == "rgb" and te.scale == pytest.approx(2.0)
+    # pixels as Blender stores them (8-bit: quantised to 1/255), rows bottom-up
+    assert np.allclose(t.pixels[:, :, :3], CHECKER, atol=0.5 / 255)
+    uv = np.array([[0.125 + 0.25 * i, 0.125 + 0.25 * j] for j in range(4) for i in range(4)])
+    looked = t.lookup(uv)[:, :3].reshape(4, 4, 3)
+    assert np.allclose(looked, srgb_to_linear(np.floor(CHECKER * 255 + 0.5) / 255), atol=1e-5)
+    assert (tr.texture.srgb, tr.texture.interpolation, tr.texture.extension, tr.channel) \
+        == (False, "Linear", "EXTEND", "luminance")
+    assert tr.evaluate(np.array([[0.3, 0.7]]))[0] == pytest.approx(0.25, abs=2 / 255)
+    # a second material with the same image, other settings: pixels still read once
+    mat2, nt2 = _material(bpy, "Tex2", keep_principled=True)
+    d = _image_node(nt2, img, "Linear", "REPEAT")
+    nt2.links.new(d.outputs["Color"], nt2.nodes["Principled BSDF"].inputs["Base Color"])
+    t2 = export_material(mat2, reporter).base_color_texture.texture
+    assert t2 is not t and np.shares_memory(t2.pixels, t.pixels)
+
+
+def test_uvs_exported_only_for_textured_materials_from_the_right_map(bpy_drt):
+    from drt_addon.export import export_scene
+    bpy = bpy_drt
+    _reset(bpy)
+    scene = bpy.context.scene
+    _camera_and_sun(bpy, scene, size=(8, 8))
+    img = _checker_image(bpy)
+    textured, nt = _material(bpy, "Textured", keep_principled=True)
+    node = _image_node(nt, img)
+    nt.links.new(node.outputs["Color"], nt.nodes["Principled BSDF"].inputs["Base Color"])
+    plain, _ = _material(bpy, "Plain", keep_principled=True)
+    a = _plane(bpy, "A", x=-1.5, uv=((0, 0), (2, 0), (2, 1), (0, 1)))
+    a.data.materials.append(textured)
+    b = _plane(bpy, "B", x=1.5)
+    b.data.materials.append(plain)
+    desc = export_scene(bpy.context.evaluated_depsgraph_get())
+    mesh = {m.name: m for m in desc.meshes}
+    assert mesh["B"].uvs is None
+    uvs = mesh["A"].uvs
+    assert uvs.shape == (2, 3, 2)
+    # each triangle corner carries its vertex's UV: u = (x + 2.5) (0..2), v = y + 1 / 2...
+    pos = mesh["A"].positions[mesh["A"].triangles]
+    assert np.allclose(uvs[..., 0], (pos[..., 0] + 2.5), atol=1e-6)
+    assert np.allclose(uvs[..., 1], (pos[..., 1] + 1.0) / 2.0, atol=1e-6)
+    # a UV Map node names a second map: that one is exported
+    second = a.data.uv_layers.new(name="Second")
+    for li in range(len(a.data.loops)):
+        second.uv[li].vector = (0.25, 0.75)
+    uvnode = nt.nodes.new("ShaderNodeUVMap")
+    uvnode.uv_map = "Second"
+    nt.links.new(uvnode.outputs["UV"], node.inputs["Vector"])
+    desc = export_scene(bpy.context.evaluated_depsgraph_get())
+    uvs = {m.name: m for m in desc.meshes}["A"].uvs
+    assert np.allclose(uvs, [0.25, 0.75])
+
+
+def _render(bpy, engine, samples):
+    scene = bpy.context.scene
+    scene.render.engine = engine
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+    scene.cycles.use_adaptive_sampling = False
+    scene.cycles.device = "CPU"
+    scene.cycles.diffuse_bounces = 0
+    scene.drt.samples = samples
+    scene.drt.diffuse_bounces = 0
+    bpy.ops.render.render()
+    if engine == "DRT":
+        from drt_addon import render_engine
+        assert render_engine.last_render["ok"], render_engine.last_render["error"]
+    settings = scene.render.image_settings
+    settings.file_format = "OPEN_EXR"
+    settings.color_depth = "32"
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "render.exr")
+        bpy.data.images["Render Result"].save_render(filepath=out, scene=scene)
+        return read_image_linear(bpy, out)
+
+
+def build_texture_scene(bpy):
+    """Two 2 x 2 m planes side by side under a sun straight above, seen by an orthographic
+    camera from above (64 x 32 pixels, 4 m wide): left, a Principled BSDF (no specular)
+    whose Base Color is the 4 x 4 sRGB checker, Linear / REPEAT, on UVs running from
+    -0.25 to 1.25 (so the image repeats past its edges); right, an Emission shader whose
+    Color is the same image, Closest / CLIP, on UVs from -0.1 to 1.1 (clipped to black
+    outside). Direct light only."""
+    _reset(bpy)
+    scene = bpy.context.scene
+    _camera_and_sun(bpy, scene, ortho=4.0, size=(64, 32))
+    img = _checker_image(bpy)
+    lam, nt = _material(bpy, "Lit", keep_principled=True)
+    p = nt.nodes["Principled BSDF"]
+    p.inputs["Specular IOR Level"].default_value = 0.0
+    node = _image_node(nt, img, "Linear", "REPEAT")
+    nt.links.new(node.outputs["Color"], p.inputs["Base Color"])
+    glow, nt = _material(bpy, "Glow")
+    em = nt.nodes.new("ShaderNodeEmission")
+    node = _image_node(nt, img, "Closest", "CLIP")
+    nt.links.new(node.outputs["Color"], em.inputs["Color"])
+    nt.links.new(em.outputs[0], _out(nt))
+    lo, hi = -0.25, 1.25
+    _plane(bpy, "Left", x=-1.0, uv=((lo, lo), (hi, lo), (hi, hi), (lo, hi))) \
+        .data.materials.append(lam)
+    lo, hi = -0.1, 1.1
+    _plane(bpy, "Right", x=1.0, uv=((lo, lo), (hi, lo), (hi, hi), (lo, hi))) \
+        .data.materials.append(glow)
+    return scene
+
+
+@pytest.fixture(scope="module")
+def texture_renders(bpy_drt):
+    bpy = bpy_drt
+    build_texture_scene(bpy)
+    cycles = _render(bpy, "CYCLES", 64)
+    drt = _render(bpy, "DRT", 64)
+    from drt_addon import render_engine
+    return drt, cycles, render_engine.last_render["scene"]
+
+
+def compare(drt, cycles):
+    m_drt, m_cyc = drt.mean(axis=(0, 1)), cycles.mean(axis=(0, 1))
+    rel = np.abs(m_drt - m_cyc) / m_cyc
+    mad = float(np.abs(drt - cycles).mean() / cycles.mean())
+    return rel, mad
+
+
+def test_textured_scene_matches_cycles(texture_renders):
+    drt, cycles, _ = texture_renders
+    assert drt.shape == cycles.shape == (32, 64, 3)
+    assert cycles.max() > 0.5 and cycles[:, :32].min() > 0.0    # lit, not a blank render
+    rel, mad = compare(drt, cycles)
+    print(f"\ntextured scene: DRT mean {drt.mean(axis=(0, 1))}, Cycles mean "
+          f"{cycles.mean(axis=(0, 1))}, relative difference {rel}, MAD {mad:.4f} of the mean")
+    for half, sl in (("lit", np.s_[:, :32]), ("emission", np.s_[:, 32:])):
+        r, m = compare(drt[sl], cycles[sl])
+        print(f"  {half} half: relative mean difference {r}, MAD {m:.4f}")
+    assert np.all(rel < MEAN_TOLERANCE), rel
+    assert mad < MAD_TOLERANCE, mad
+    for sl in (np.s_[:, :32], np.s_[:, 32:]):          # each half on its own too
+        r, m = compare(drt[sl], cycles[sl])
+        assert np.all(r < MEAN_TOLERANCE) and m < MAD_TOLERANCE, (r, m)
+
+
+def test_texture_comparison_rejects_wrong_texture_readings(texture_renders):
+    """The thresholds catch the mistakes a texture exporter can make, checked against the
+    same Cycles render by re-rendering DRT's exported scene with each mistake: the image
+    upside down (rows top-down), sRGB not decoded, sRGB decoded before interpolation
+    (Cycles decodes after), Closest instead of Linear, texels shifted by one column."""
+    import copy
+
+    from engine import RenderSettings, render
+    from engine.textures import Texture, srgb_to_linear
+    drt, cycles, scene = texture_renders
+
+    def rerender(mutate):
+        s = copy.deepcopy(scene)
+        for m in s.materials:
+            for ti in m.textures().values():
+                ti.texture = mutate(ti.texture)
+        film, _ = render(s, RenderSettings(samples=16, diffuse_bounces=0))
+        return film.mean()                  # row 0 at the top, like the EXR read back
+
+    def flipped(t):
+        return Texture(t.pixels[::-1], t.interpolation, t.extension, t.srgb, t.name)
+
+    def not_decoded(t):
+        return Texture(t.pixels, t.interpolation, t.extension, False, t.name)
+
+    def decoded_before_interpolation(t):
+        px = t.pixels.copy()
+        px[:, :, :3] = srgb_to_linear(px[:, :, :3]) if t.srgb else px[:, :, :3]
+        return Texture(px, t.interpolation, t.extension, False, t.name)
+
+    def closest(t):
+        return Texture(t.pixels, "Closest", t.extension, t.srgb, t.name)
+
+    def shifted(t):
+        return Texture(np.roll(t.pixels, 1, axis=1), t.interpolation, t.extension, t.srgb,
+                       t.name)
+
+    lit = np.s_[:, :32]                     # the Linear-filtered half
+    for mistake, region in ((flipped, np.s_[:, :]), (not_decoded, np.s_[:, :]),
+                            (decoded_before_interpolation, lit), (closest, lit),
+                            (shifted, np.s_[:, :])):
+        img = rerender(mistake)
+        assert img.shape == cycles.shape
+        rel, mad = compare(img[region], cycles[region])
+        assert np.any(rel > MEAN_TOLERANCE) or mad > MAD_TOLERANCE, (mistake.__name__, rel, mad)
+    # and the correct reading re-rendered the same way passes (so the check is sound)
+    img = rerender(lambda t: t)
+    for region in (np.s_[:, :], lit):
+        rel, mad = compare(img[region], cycles[region])
+        assert np.all(rel < MEAN_TOLERANCE) and mad < MAD_TOLERANCE, (rel, mad)
+
+
+def build_alpha_scene(bpy):
+    """Stochastic transparency against Cycles: the textured Lambertian plane (Linear /
+    REPEAT checker) under a sun, half covered 0.5 m above by a plane whose Principled Alpha
+    is 0.4 (base colour 0.8, no specular) and a quarter by a Mix Shader of a Diffuse BSDF
+    and a Transparent BSDF (Fac 0.7, i.e. alpha 0.3). 48 x 48 pixels, direct light only:
+    what the camera sees through the covers and the covers' transparent shadows."""
+    _reset(bpy)
+    scene = bpy.context.scene
+    _camera_and_sun(bpy, scene, ortho=2.0, size=(48, 48))
+    img = _checker_image(bpy)
+    lam, nt = _material(bpy, "Lit", keep_principled=True)
+    p = nt.nodes["Principled BSDF"]
+    p.inputs["Specular IOR Level"].default_value = 0.0
+    node = _image_node(nt, img, "Linear", "REPEAT")
+    nt.links.new(node.outputs["Color"], p.inputs["Base Color"])
+    _plane(bpy, "Floor").data.materials.append(lam)
+    veil, nt = _material(bpy, "Veil", keep_principled=True)
+    p = nt.nodes["Principled BSDF"]
+    p.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1.0)
+    p.inputs["Specular IOR Level"].default_value = 0.0
+    p.inputs["Alpha"].default_value = 0.4
+    cover = _plane(bpy, "Veil", x=0.5, half=0.5)
+    cover.scale = (1.0, 2.0, 1.0)
+    cover.location.z = 0.5
+    cover.data.materials.append(veil)
+    mat, nt, mix = _mix(bpy, "Screen", ("ShaderNodeBsdfDiffuse", {"Color": (0.2, 0.4, 0.9, 1)}),
+                        TRANSPARENT, fac=0.7)
+    screen = _plane(bpy, "Screen", x=-0.5, half=0.5)
+    screen.location = (0.0, 0.5, 0.25)
+    screen.data.materials.append(mat)
+    return scene
+
+
+@pytest.fixture(scope="module")
+def alpha_renders(bpy_drt):
+    bpy = bpy_drt
+    build_alpha_scene(bpy)
+    cycles = _render(bpy, "CYCLES", 256)
+    drt = _render(bpy, "DRT", 256)
+    from drt_addon import render_engine
+    return drt, cycles, render_engine.last_render["scene"]
+
+
+def test_alpha_matches_cycles(alpha_renders):
+    drt, cycles, _ = alpha_renders
+    rel, mad = compare(drt, cycles)
+    print(f"\nalpha scene: DRT mean {drt.mean(axis=(0, 1))}, Cycles mean "
+          f"{cycles.mean(axis=(0, 1))}, relative difference {rel}, MAD {mad:.4f}")
+    assert np.all(rel < MEAN_TOLERANCE), rel
+    assert mad < MAD_TOLERANCE, mad
+    # the covered half on its own (the uncovered one would dilute an error)
+    r, m = compare(drt[:, 24:], cycles[:, 24:])
+    assert np.all(r < MEAN_TOLERANCE) and m < MAD_TOLERANCE, (r, m)
+
+
+def test_alpha_comparison_rejects_ignoring_alpha(alpha_renders):
+    """The same comparison fails when DRT's exported scene is rendered opaque."""
+    import copy
+
+    from engine import RenderSettings, render
+    drt, cycles, scene = alpha_renders
+    s = copy.deepcopy(scene)
+    for m in s.materials:
+        m.alpha = 1.0
+    img = render(s, RenderSettings(samples=16, diffuse_bounces=0))[0].mean()
+    rel, mad = compare(img[:, 24:], cycles[:, 24:])
+    assert np.any(rel > MEAN_TOLERANCE) or mad > MAD_TOLERANCE, (rel, mad)
