@@ -36,6 +36,10 @@ class Material:
       glass_color  the tint of each refraction through the glass lobe (Principled uses
                    sqrt(base colour); a Glass BSDF node its colour).
 
+    glossy_model: the microfacet distribution of the specular and metal lobes: 'GGX'
+    (Blender's, default) or 'BLINN_PHONG' (the lecture's normalised Blinn-Phong lobe, with
+    the exponent n = 2 / alpha^2 - 2 that matches GGX's alpha, Walter et al. 2007).
+
     alpha: coverage, Cycles' Principled Alpha or 1 - the weight of a Transparent BSDF in
     a Mix Shader. Where alpha < 1 the integrators let rays through with probability
     1 - alpha, tinted by `transparent_color` (the Transparent BSDF's colour), counted
@@ -53,6 +57,7 @@ class Material:
     metal_color: Optional[tuple] = None
     glass_color: Optional[tuple] = None
     transparent_color: tuple = (1.0, 1.0, 1.0)
+    glossy_model: str = "GGX"
     base_color_texture: Optional[object] = None
     metallic_texture: Optional[object] = None
     roughness_texture: Optional[object] = None

@@ -86,6 +86,10 @@ PRINCIPLED = {
     # seen from inside a rough glass (relative IOR 1/1.5) with diffuse and specular
     "back_face_glass": dict(base_color=(0.9, 0.9, 0.9), metallic=0.0, transmission=0.6,
                             roughness=0.3, ior=1.5, specular_ior_level=0.5, front_facing=False),
+    # the lecture's Blinn-Phong distribution in the specular and metal lobes
+    "blinn_phong": dict(base_color=(0.7, 0.6, 0.2), metallic=0.5, transmission=0.0,
+                        roughness=0.3, ior=1.5, specular_ior_level=0.5, front_facing=True,
+                        blinn_phong=True),
 }
 ALLOWED = {
     "all": (True, True, True),
@@ -98,7 +102,8 @@ def make_principled(params, n):
     p = params
     return PrincipledBSDF(np.tile(p["base_color"], (n, 1)), full(p["metallic"], n),
                           full(p["transmission"], n), full(p["roughness"], n), full(p["ior"], n),
-                          full(p["specular_ior_level"], n), np.full(n, p["front_facing"]))
+                          full(p["specular_ior_level"], n), np.full(n, p["front_facing"]),
+                          np.full(n, p.get("blinn_phong", False)))
 
 
 def case_principled(deg, name, allowed="all"):

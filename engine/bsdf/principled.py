@@ -57,7 +57,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import dielectric, fresnel, lambert
+from . import blinn_phong, dielectric, fresnel, lambert
 from . import microfacet as mf
 from .lobes import DIFFUSE, GLOSSY, TRANSMISSION
 from ..warp import cosine_hemisphere
@@ -201,7 +201,7 @@ class PrincipledBSDF:
     """Diffuse, dielectric specular, metal and glass lobes with Blender's weights."""
 
     def __init__(self, base_color, metallic, transmission, roughness=None, ior=None,
-                 specular_ior_level=None, front_facing=None):
+                 specular_ior_level=None, front_facing=None, blinn_phong=None):
         base_color = np.asarray(base_color, dtype=np.float64).reshape(-1, 3)
         n = self.n = len(base_color)
 
@@ -221,6 +221,12 @@ class PrincipledBSDF:
         self.base = np.maximum(base_color, 0.0)         # Cycles: diffuse is not clamped
         self.base_clamped = np.minimum(self.base, 1.0)  # ... metal F0 and glass tint are
         self.alpha = mf.clamp_alpha(rough * rough)
+        # Reflection lobes with the lecture's Blinn-Phong distribution instead of GGX, at
+        # the exponent matching alpha (Walter et al. 2007: n = 2 / alpha^2 - 2).
+        self.blinn = (np.zeros(n, bool) if blinn_phong is None
+                      else np.broadcast_to(np.asarray(blinn_phong, bool), (n,)).copy())
+        self.any_blinn = bool(self.blinn.any())
+        self.exponent = np.maximum(2.0 / (self.alpha * self.alpha) - 2.0, 0.0)
         base_w = (1.0 - m) * (1.0 - t)
         # specular layer: F0 scaled by 2 * level, IOR recomputed from it
         f0 = fresnel.f0_from_ior(ior) * 2.0 * level
@@ -259,7 +265,8 @@ class PrincipledBSDF:
         base = table.base_color_at(index, uv)
         bsdf = cls(base, table.metallic_at(index, uv), table.transmission[index],
                    table.roughness_at(index, uv), table.ior[index],
-                   table.specular_ior_level[index], front_facing)
+                   table.specular_ior_level[index], front_facing,
+                   table.blinn_phong[index])
         if table.has_metal_color.any():
             own = table.has_metal_color[index]
             if own.any():
@@ -343,6 +350,46 @@ class PrincipledBSDF:
             return idx, None
         return idx[loc], loc
 
+    # -- the reflection distribution: GGX, or Blinn-Phong where asked ----------------------
+    def _reflection_eval(self, o, i, g):
+        """D G / (4 cos cos) of the reflection lobes at rows g (None = all) and h."""
+        if not self.any_blinn:
+            return mf.reflection_eval(o, i, _sub(self.alpha, g))
+        blinn = _sub(self.blinn, g)
+        h, _ = mf.half_vector(o, i)
+        base = np.zeros(len(o))
+        gg, bb = np.nonzero(~blinn)[0], np.nonzero(blinn)[0]
+        if len(gg):
+            base[gg] = mf.reflection_eval(o[gg], i[gg], _sub(self.alpha, g)[gg])[0]
+        if len(bb):
+            base[bb] = blinn_phong.eval_f(o[bb], i[bb], _sub(self.exponent, g)[bb])
+        return base, h
+
+    def _reflection_pdf(self, o, i, g):
+        if not self.any_blinn:
+            return mf.reflection_pdf(o, i, self.alpha[g])
+        blinn = self.blinn[g]
+        p = np.zeros(len(o))
+        gg, bb = np.nonzero(~blinn)[0], np.nonzero(blinn)[0]
+        if len(gg):
+            p[gg] = mf.reflection_pdf(o[gg], i[gg], self.alpha[g][gg])
+        if len(bb):
+            p[bb] = blinn_phong.pdf(o[bb], i[bb], self.exponent[g][bb])
+        return p
+
+    def _reflection_sample(self, o, u, g):
+        if not self.any_blinn:
+            w, _, v = mf.reflection_sample(o, self.alpha[g], u)
+            return w, v
+        blinn = self.blinn[g]
+        w, v = np.zeros((len(o), 3)), np.zeros(len(o), bool)
+        gg, bb = np.nonzero(~blinn)[0], np.nonzero(blinn)[0]
+        if len(gg):
+            w[gg], _, v[gg] = mf.reflection_sample(o[gg], self.alpha[g][gg], u[gg])
+        if len(bb):
+            w[bb], v[bb] = blinn_phong.sample(o[bb], u[bb], self.exponent[g][bb])
+        return w, v
+
     # -- evaluation ----------------------------------------------------------------------
     def _eval(self, idx, wo, wi, diffuse):
         f = np.zeros((len(wo), 3))
@@ -361,7 +408,7 @@ class PrincipledBSDF:
             if g is not None and not len(g):
                 continue
             o, i = _sub(wo, loc), _sub(wi, loc)
-            base, h = mf.reflection_eval(o, i, _sub(self.alpha, g))
+            base, h = self._reflection_eval(o, i, g)
             cos_oh = np.clip((o * h).sum(1), 0.0, 1.0)
             if lobe == L_SPECULAR:
                 F = fresnel.dielectric(cos_oh, _sub(self.eta_spec, g))[:, None]
@@ -404,7 +451,7 @@ class PrincipledBSDF:
             r = np.nonzero(q_refl > 0)[0]
             if len(r):
                 g = r if idx is None else idx[r]
-                p[r] += q_refl[r] * mf.reflection_pdf(wo[r], wi[r], self.alpha[g])
+                p[r] += q_refl[r] * self._reflection_pdf(wo[r], wi[r], g)
         if self.active[L_GLASS]:
             gl = q[:, L_GLASS] > 0
             gl &= ~_sub(self.glass_smooth, idx)
@@ -466,7 +513,7 @@ class PrincipledBSDF:
             ok[r] &= wo[r, 2] > 0
         r = np.nonzero(ok & ((lobe == L_SPECULAR) | (lobe == L_METAL)))[0]
         if len(r):
-            w, _, v = mf.reflection_sample(wo[r], self.alpha[r], u_dir[r])
+            w, v = self._reflection_sample(wo[r], u_dir[r], r)
             wi[r] = w
             kind[r] = GLOSSY
             ok[r] &= v
@@ -534,6 +581,12 @@ class MaterialTable:
         self.transmission = np.array([m.transmission for m in materials], dtype=np.float64)
         self.specular_ior_level = np.array([m.specular_ior_level for m in materials], np.float64)
         self.alpha = np.array([getattr(m, "alpha", 1.0) for m in materials], dtype=np.float64)
+        models = [getattr(m, "glossy_model", "GGX") for m in materials]
+        for m, model in zip(materials, models):
+            if model not in ("GGX", "BLINN_PHONG"):
+                raise ValueError(f"material {m.name!r}: glossy_model must be 'GGX' or "
+                                 f"'BLINN_PHONG', not {model!r}")
+        self.blinn_phong = np.array([model == "BLINN_PHONG" for model in models], bool)
         # Lobe colours: the metal F0 and the glass tint per crossing, when they are not
         # Principled's own (base colour, sqrt(base colour)).
         metal = [getattr(m, "metal_color", None) for m in materials]
