@@ -70,6 +70,14 @@ class CameraModel:
             self.half_x, self.half_y = half_fit * x_ratio / y_ratio, half_fit
         self.shift = np.array([camera.shift_x, camera.shift_y]) * 2.0 * half_fit
         self.has_lens = camera.kind == "PERSP" and camera.aperture_radius > 0.0
+        self.lens_motion = None
+        if camera.lens_motion is not None and camera.kind == "PERSP":
+            times, lenses = (np.asarray(a, dtype=np.float64).reshape(-1) for a in camera.lens_motion)
+            if len(times) != len(lenses) or len(times) < 1 or np.any(lenses <= 0) \
+                    or not np.all(np.isfinite(lenses)) or np.any(np.diff(times) <= 0):
+                raise ValueError("camera lens motion needs increasing times and positive "
+                                 "focal lengths")
+            self.lens_motion = (times, lenses)
 
     def plane_points(self, film_xy: np.ndarray) -> np.ndarray:
         """Raster positions (continuous, in pixels, y down) to view-plane x, y."""
@@ -86,6 +94,10 @@ class CameraModel:
         cam = self.camera
         p = self.plane_points(film_xy)
         n = len(p)
+        if time is not None and self.lens_motion is not None:
+            # Zooming: the view plane (shift included) scales as 1 / focal length.
+            lens_t = np.interp(time, *self.lens_motion)
+            p = p * (cam.lens / lens_t)[:, None]
         if cam.kind == "PERSP":
             d_cam = np.concatenate([p, -np.ones((n, 1))], axis=1)
             o_cam = np.zeros((n, 3))

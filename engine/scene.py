@@ -199,6 +199,7 @@ class Camera:
     blade_rotation: float = 0.0
     aperture_ratio: float = 1.0
     motion: Optional[object] = None      # engine.motion.RigidMotion of `matrix` over the shutter
+    lens_motion: Optional[tuple] = None  # (times (K,), focal lengths in mm (K,)) over the shutter
 
 
 @dataclass
@@ -236,7 +237,9 @@ class Scene:
             return False
         moving = [m for m in self.meshes if m.motion is not None and not _is_static(m.motion)]
         camera_moves = self.camera.motion is not None and not _is_static(self.camera.motion)
-        return bool(moving) or camera_moves
+        lm = self.camera.lens_motion
+        zooms = lm is not None and bool(np.ptp(np.asarray(lm[1], dtype=np.float64)) > 0)
+        return bool(moving) or camera_moves or zooms
 
     def triangle_count(self) -> int:
         return int(sum(len(m.triangles) for m in self.meshes))

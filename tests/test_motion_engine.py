@@ -157,3 +157,24 @@ def test_deformation_time_slices_approach_rigid_motion(slices, tolerance):
     err = np.abs(row - expected).max() / E
     print(f"{slices} slices: max error {err:.3f} of the bar's radiance")
     assert err < tolerance
+
+
+def test_zooming_camera_rays_follow_the_focal_length_at_their_time():
+    """A lens animated from 35 to 70 mm over the shutter: each ray equals the ray of a
+    still camera with the focal length at that ray's time."""
+    from engine.camera import CameraModel
+    cam = Camera(translate(0, 0, 1.0), lens=35.0, shift_x=0.1)
+    cam.lens_motion = ([0.0, 1.0], [35.0, 70.0])
+    model = CameraModel(cam, 32, 24)
+    rng = np.random.default_rng(0)
+    xy = rng.random((50, 2)) * [32, 24]
+    t = rng.random(50)
+    moving = model.generate(xy, None, t).directions
+    for k in range(50):
+        still = Camera(translate(0, 0, 1.0), lens=35.0 + 35.0 * t[k], shift_x=0.1)
+        ref = CameraModel(still, 32, 24).generate(xy[k:k + 1]).directions[0]
+        np.testing.assert_allclose(moving[k], ref, atol=1e-12)
+    scene = scene_with([bar_mesh(-0.5, 0.1)], camera=cam)
+    assert scene.has_motion()
+    cam.lens_motion = ([0.0, 1.0], [35.0, 35.0])
+    assert not scene.has_motion()
