@@ -266,6 +266,110 @@ LIGHT_SCENES = {f.__name__: f for f in (
 SCENES = {"cornell_box": cornell_box, **LIGHT_SCENES}
 
 
+
+# --- Motion blur scenes: something moves within the frame's shutter -------------------
+#
+# A grey floor, one area light, a black world, direct light only (diffuse bounces 0),
+# 64 x 48 pixels. Motion blur is on with a shutter of 0.5 frames, position CENTER; the
+# frame rendered is 1 and the animation is keyed at frames 0 and 2 with linear
+# interpolation, so the motion is uniform over any shutter position.
+
+MOTION_FRAME = 1
+MOTION_SHUTTER = 0.5
+MOTION_CUBE_SPEED = 2.0           # metres per frame, along +X
+MOTION_CUBE_SIZE = 0.5
+MOTION_TORUS_SPIN = 200.0         # degrees per frame about the world Z axis
+
+
+def _linear_keys(obj):
+    """Linear interpolation for every keyframe of `obj` (layered actions in 4.4+)."""
+    action = obj.animation_data.action
+    fcurves = getattr(action, "fcurves", None)
+    if fcurves is None:
+        from bpy_extras import anim_utils
+        fcurves = anim_utils.action_get_channelbag_for_slot(
+            action, obj.animation_data.action_slot).fcurves
+    for fc in fcurves:
+        for key in fc.keyframe_points:
+            key.interpolation = "LINEAR"
+
+
+def _motion_stage():
+    scene = reset()
+    grey = principled("Floor", (0.1, 0.1, 0.1), specular=0.0)
+    quad("Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)], grey)
+    light = bpy.data.lights.new("Light", "AREA")
+    light.shape = "SQUARE"
+    light.size = 1.0
+    light.energy = 150.0
+    lobj = bpy.data.objects.new("Light", light)
+    lobj.location = (1.0, -1.5, 3.0)
+    scene.collection.objects.link(lobj)
+    _aim(lobj, (0.0, 0.0, 0.0))
+    cam = camera(scene, (0.0, -3.2, 2.4), (0.0, 0.0, 0.0), lens=50.0)
+    _aim(cam, (0.0, 0.0, 0.4))
+    render_defaults(scene, size=(64, 48), samples=256)
+    scene.cycles.diffuse_bounces = 0
+    scene.cycles.use_adaptive_sampling = False
+    if hasattr(scene, "drt"):
+        scene.drt.diffuse_bounces = 0
+    scene.render.use_motion_blur = True
+    scene.render.motion_blur_shutter = MOTION_SHUTTER
+    scene.render.motion_blur_position = "CENTER"
+    return scene
+
+
+def motion_cube():
+    """A red 0.5 m cube sliding along +X at 2 m per frame: 1 m within the shutter."""
+    scene = _motion_stage()
+    red = principled("Red", (0.8, 0.1, 0.05), specular=0.0)
+    h = MOTION_CUBE_SIZE / 2
+    cube = cuboid("Cube", (-h, -h, 0.0), (h, h, MOTION_CUBE_SIZE), red)
+    for frame in (MOTION_FRAME - 1, MOTION_FRAME + 1):
+        cube.location.x = (frame - MOTION_FRAME) * MOTION_CUBE_SPEED
+        cube.keyframe_insert("location", index=0, frame=frame)
+    _linear_keys(cube)
+    scene.frame_set(MOTION_FRAME)
+    return scene
+
+
+def _torus(name, major, minor, material, segments=32, rings=12):
+    verts, faces = [], []
+    for i in range(segments):
+        a = 2 * math.pi * i / segments
+        for j in range(rings):
+            b = 2 * math.pi * j / rings
+            r = major + minor * math.cos(b)
+            verts.append((r * math.cos(a), r * math.sin(a), minor * math.sin(b)))
+    for i in range(segments):
+        for j in range(rings):
+            i2, j2 = (i + 1) % segments, (j + 1) % rings
+            faces.append((i * rings + j, i2 * rings + j, i2 * rings + j2, i * rings + j2))
+    obj = mesh_object(name, verts, faces, material)
+    for poly in obj.data.polygons:
+        poly.use_smooth = True
+    return obj
+
+
+def motion_torus():
+    """An upright yellow torus spinning about the vertical at 200 degrees per frame:
+    100 degrees within the shutter."""
+    scene = _motion_stage()
+    yellow = principled("Yellow", (0.8, 0.6, 0.1), specular=0.0)
+    torus = _torus("Torus", 0.5, 0.17, yellow)
+    torus.location = (0.0, 0.0, 0.72)
+    for frame in (MOTION_FRAME - 1, MOTION_FRAME + 1):
+        spin = math.radians((frame - MOTION_FRAME) * MOTION_TORUS_SPIN)
+        torus.rotation_euler = (math.radians(90.0), 0.0, spin)
+        torus.keyframe_insert("rotation_euler", frame=frame)
+    _linear_keys(torus)
+    scene.frame_set(MOTION_FRAME)
+    return scene
+
+
+MOTION_SCENES = {f.__name__: f for f in (motion_cube, motion_torus)}
+SCENES.update(MOTION_SCENES)
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("names", nargs="*", help=f"scenes to build (default all: {', '.join(SCENES)})")
@@ -278,7 +382,8 @@ def main(argv=None):
         SCENES[name]()
         path = os.path.join(os.path.abspath(args.out_dir), f"{name}.blend")
         # The small light scenes are stored compressed (86 KB instead of 440 KB each).
-        bpy.ops.wm.save_as_mainfile(filepath=path, compress=name in LIGHT_SCENES)
+        bpy.ops.wm.save_as_mainfile(filepath=path, compress=name in LIGHT_SCENES
+                                    or name in MOTION_SCENES)
         print(f"built {path}")
     return 0
 

@@ -9,6 +9,7 @@ from .errors import ExportError, Reporter
 from .lights import export_light
 from .materials import export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
+from .motion import MotionExport, find_render_engine, read_settings
 from .world import export_world
 
 __all__ = ["ExportError", "RenderRegion", "Reporter", "export_scene", "render_region",
@@ -35,16 +36,31 @@ def _is_holdout(inst, obj, view_layer) -> bool:
 
 
 def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
-                 region: RenderRegion | None = None, stats: dict | None = None
-                 ) -> "engine.Scene":
+                 region: RenderRegion | None = None, stats: dict | None = None,
+                 render_engine=None) -> "engine.Scene":
     """The scene as DRT's description.
 
     region: the pixels to render (default: Blender's render size and border, see
     `render_region`); the Scene then has the region's size and a camera for just that
     region. `size=(w, h)` renders the whole frame at that size instead. stats, if given,
-    receives counts of the export (mesh evaluations, reused instances, seconds)."""
-    t0 = time.perf_counter()
+    receives counts of the export (mesh evaluations, reused instances, seconds).
+
+    Motion blur (see `export.motion`): with it on, the scene is exported at the shutter's
+    middle and sampled at the motion steps with `render_engine.frame_set` (the
+    RenderEngine calling this, found on the stack when not given; a viewport depsgraph
+    uses Scene.frame_set); the frame is restored afterwards."""
     reporter = reporter or Reporter()
+    blur = read_settings(depsgraph.scene, reporter)
+    if blur is None:
+        return _export_scene(depsgraph, reporter, size, region, stats, None)
+    with MotionExport(depsgraph, blur, reporter,
+                      render_engine or find_render_engine(depsgraph)) as tracker:
+        return _export_scene(depsgraph, reporter, size, region, stats,
+                             tracker if tracker.usable else None)
+
+
+def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.Scene":
+    t0 = time.perf_counter()
     scene = depsgraph.scene
     if region is None:
         if size is not None:
@@ -53,6 +69,8 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
             region = render_region(scene)
     aspect = scene.render.pixel_aspect_x / max(scene.render.pixel_aspect_y, 1e-9)
     camera = window_camera(export_camera(scene.camera, depsgraph), region, aspect)
+    if tracker is not None:
+        tracker.note_camera(scene.camera)
     view_layer = depsgraph.view_layer
     materials, material_index = [], {}
 
@@ -82,17 +100,24 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
             slots = [material_id(s.material) for s in obj.material_slots] or [material_id(None)]
             name = f"{obj.name}#{k}" if inst.is_instance else obj.name
             meshes.append(instance_mesh(local, inst.matrix_world.copy(), slots, name))
+            if tracker is not None:
+                tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
         elif obj.type == "LIGHT":
             light = export_light(obj, inst.matrix_world.copy(), reporter)
             if light is not None:
                 lights.append(light)
+                if tracker is not None:
+                    tracker.note_light(inst, obj)
     if not materials:
         materials.append(engine.Material())
     world = export_world(scene.world, reporter)
+    shutter = tracker.finish(meshes, camera) if tracker is not None else None
     if stats is not None:
         stats.update(mesh_evaluations=cache.evaluations, mesh_reuses=cache.reuses,
                      meshes=len(meshes), lights=len(lights), holdouts=holdouts,
                      triangles=int(sum(len(m.triangles) for m in meshes)),
                      seconds=time.perf_counter() - t0)
+        if tracker is not None:
+            stats["motion"] = tracker.stats
     return engine.Scene(camera, region.width, region.height, meshes, materials, lights, world,
-                        pixel_aspect=aspect)
+                        pixel_aspect=aspect, shutter=shutter)

@@ -1,0 +1,469 @@
+"""Motion blur: Blender's shutter settings and the scene sampled over the shutter.
+
+Settings read (Blender 5.0 names, with Cycles' meaning):
+- `scene.render.use_motion_blur` and `scene.render.motion_blur_shutter` (the shutter's
+  length in frames; 0 or less renders like motion blur off);
+- `scene.render.motion_blur_position`: START opens the shutter at the frame
+  ([f, f + s]), CENTER centres it on the frame ([f - s/2, f + s/2]), END closes it at the
+  frame ([f - s, f]), as Cycles' `BlenderSync::sync_motion`;
+- `scene.render.motion_blur_shutter_curve`: the shutter's openness over the shutter
+  (a CurveMapping). Cycles samples it into a 256-entry table and draws ray times from
+  its inverted CDF; the default is flat (a box shutter), exported as `Shutter(None)`;
+  any other curve is sampled at the same 256 points into `Shutter(curve)`;
+- per object (`obj.cycles`, also on the camera): `use_motion_blur`, `use_deform_motion`
+  and `motion_steps`. As in Cycles (`object_motion_steps`), an object with motion
+  steps n is sampled at 2**n + 1 times evenly spread over the shutter (n = 1: open,
+  middle, close), and an instance needs its instancer's toggles on too (the larger of
+  the two step counts is used).
+
+How: everything that does not move is exported at the shutter's middle, as Cycles does
+(with position START or END that is half a shutter away from the frame). Then the
+depsgraph is re-evaluated at each other motion step with `RenderEngine.frame_set`
+(or `Scene.frame_set` when exporting a viewport depsgraph outside a render) and each
+object instance's `matrix_world` is recorded; the original frame and subframe are
+restored afterwards, also when the export fails. Per object:
+- transforms that change (keyframes, constraints, parents, drivers): `RigidMotion` of
+  the transforms at the steps; the mesh keeps its object-space arrays (evaluated once);
+- objects whose evaluated mesh may change (`Object.is_deform_modified`, Cycles' own
+  test: shape keys, armatures and other deform modifiers, modifiers that depend on time)
+  are evaluated at every step too; if the vertices move within the object, the mesh
+  gets a `DeformMotion` of its world-space vertex positions (rigid motion included). A
+  topology change within the shutter is reported and the deformation is dropped (the
+  transform still blurs), as Cycles does;
+- the camera: `Camera.motion`;
+- lights are not blurred by the tracer: a light that moves is rendered where it is at
+  the shutter's middle (as Cycles renders lamps) and a warning says so. Emissive meshes
+  blur like any other mesh.
+Motion blur off, a zero shutter or nothing moving: nothing is attached and the render
+takes the tracer's static path; with motion blur off the frame is never changed.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+import sys
+import time
+from dataclasses import dataclass, field
+from importlib import import_module
+from typing import Optional
+
+import numpy as np
+
+from ..engine_link import engine
+from .errors import ExportError
+from .matrices import to_numpy
+from .mesh import _cache_key, instance_mesh
+
+emotion = import_module(engine.__name__ + ".motion")   # engine.motion, either layout
+
+CURVE_SAMPLES = 256           # Cycles' RAMP_TABLE_SIZE for the shutter curve
+MOVE_TOLERANCE = 1e-7         # relative change below which a transform or vertex is still
+
+
+@dataclass
+class MotionSettings:
+    """The shutter in absolute frame time: open at `open`, close at `close`."""
+    frame: int
+    subframe: float
+    length: float             # frames
+    position: str             # START, CENTER, END
+    curve: Optional[np.ndarray] = None
+
+    @property
+    def centre(self) -> float:
+        f = self.frame + self.subframe
+        if self.position == "START":
+            return f + 0.5 * self.length
+        if self.position == "END":
+            return f - 0.5 * self.length
+        return f
+
+    @property
+    def open(self) -> float:
+        return self.centre - 0.5 * self.length
+
+    @property
+    def close(self) -> float:
+        return self.centre + 0.5 * self.length
+
+    def frame_time(self, t: float) -> float:
+        """Absolute frame time of normalised shutter time t in [0, 1]."""
+        return self.open + t * self.length
+
+
+def read_settings(scene, reporter=None) -> Optional[MotionSettings]:
+    """Blender's motion-blur settings, or None when the render has no motion blur."""
+    r = scene.render
+    if not getattr(r, "use_motion_blur", False):
+        return None
+    length = float(r.motion_blur_shutter)
+    if not (length > 0.0 and math.isfinite(length)):
+        return None
+    position = getattr(r, "motion_blur_position", None)
+    if position is None:                                  # before 4.2: Cycles' setting
+        position = getattr(getattr(scene, "cycles", None), "motion_blur_position", "CENTER")
+    rolling = getattr(getattr(scene, "cycles", None), "rolling_shutter_type", "NONE")
+    if rolling != "NONE" and reporter is not None:
+        reporter.warn("DRT: rolling shutter is not supported; the whole image is exposed "
+                      "over the same shutter", key="rolling shutter")
+    return MotionSettings(int(scene.frame_current), float(scene.frame_subframe), length,
+                          str(position), shutter_curve(r.motion_blur_shutter_curve))
+
+
+def shutter_curve(mapping) -> Optional[np.ndarray]:
+    """The shutter curve sampled as Cycles samples it (`curvemapping_to_array`: 256
+    values at i / 255), or None when it is flat (Blender's default, a box shutter)."""
+    if mapping is None:
+        return None
+    try:
+        mapping.initialize()
+    except (AttributeError, RuntimeError):
+        pass
+    curve = mapping.curves[0]
+    xs = np.arange(CURVE_SAMPLES) / (CURVE_SAMPLES - 1)
+    values = np.array([mapping.evaluate(curve, float(x)) for x in xs], dtype=np.float64)
+    if np.all(np.abs(values - values[0]) <= 1e-6) and values[0] > 0:
+        return None
+    values = np.clip(values, 0.0, None)
+    if not np.isfinite(values).all() or values.sum() <= 0:
+        raise ExportError("the motion-blur shutter curve is zero everywhere: no light "
+                          "would reach the film; reset the curve or turn motion blur off")
+    return values
+
+
+def _cycles(obj):
+    """The object's Cycles settings, read from the original object (an evaluated copy
+    may lag behind a property just changed)."""
+    if obj is None:
+        return None
+    original = getattr(obj, "original", None)
+    return getattr(original if original is not None else obj, "cycles", None)
+
+
+def motion_steps(obj, parent=None) -> int:
+    """Number of motion steps of an object (0: not blurred), Cycles' `object_motion_steps`:
+    2**motion_steps + 1, gated by the instancer's toggle for instanced objects."""
+    c = _cycles(obj)
+    if c is not None and not getattr(c, "use_motion_blur", True):
+        return 0
+    steps = max(1, int(getattr(c, "motion_steps", 1))) if c is not None else 1
+    if parent is not None and parent != obj:
+        pc = _cycles(parent)
+        if pc is not None:
+            if not getattr(pc, "use_motion_blur", True):
+                return 0
+            steps = max(steps, int(getattr(pc, "motion_steps", 1)))
+    return (2 << (steps - 1)) + 1
+
+
+def use_deform_motion(obj, parent=None) -> bool:
+    c = _cycles(obj)
+    use = bool(getattr(c, "use_deform_motion", True)) if c is not None else True
+    if use and parent is not None and parent != obj:
+        pc = _cycles(parent)
+        if pc is not None:
+            use = bool(getattr(pc, "use_deform_motion", True))
+    return use
+
+
+def set_frame(target, frame: int, subframe: float):
+    """Re-evaluate the depsgraph at `frame + subframe`: target is the RenderEngine
+    (`RenderEngine.frame_set`) or the Scene (`Scene.frame_set`). Tests spy on this."""
+    if hasattr(target, "frame_current"):                  # a Scene
+        target.frame_set(int(frame), subframe=float(subframe))
+    else:
+        target.frame_set(int(frame), float(subframe))
+
+
+def find_render_engine(depsgraph=None):
+    """The RenderEngine rendering now, found on the caller's stack (the export is called
+    from `RenderEngine.render`), or None."""
+    try:
+        import bpy
+    except ImportError:
+        return None
+    f = sys._getframe(1)
+    while f is not None:
+        candidate = f.f_locals.get("self")
+        if isinstance(candidate, bpy.types.RenderEngine):
+            return candidate
+        f = f.f_back
+    return None
+
+
+def _key(inst):
+    """What identifies one object instance across re-evaluations (Cycles' ObjectKey:
+    instancer, persistent id, object)."""
+    obj = inst.object
+    original = obj.original if obj.original is not None else obj
+    if inst.is_instance:
+        parent = inst.parent
+        pid = parent.original.session_uid if parent is not None and parent.original else 0
+        return (pid, tuple(inst.persistent_id), original.session_uid)
+    return (original.session_uid,)
+
+
+def _positions(obj):
+    """(object-space vertex positions (V, 3) float64, triangles (T, 3) int32) of an
+    evaluated object, or None."""
+    try:
+        mesh = obj.to_mesh()
+    except RuntimeError:
+        return None
+    try:
+        if mesh is None:
+            return None
+        mesh.calc_loop_triangles()
+        co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+        mesh.vertices.foreach_get("co", co)
+        tris = np.empty(len(mesh.loop_triangles) * 3, dtype=np.int32)
+        mesh.loop_triangles.foreach_get("vertices", tris)
+    finally:
+        obj.to_mesh_clear()
+    return co.reshape(-1, 3).astype(np.float64), tris.reshape(-1, 3)
+
+
+def _moves(arrays, scale) -> bool:
+    a = np.asarray(arrays)
+    return bool(np.max(np.abs(a - a[0])) > MOVE_TOLERANCE * max(scale, 1.0))
+
+
+@dataclass
+class _Tracked:
+    key: tuple
+    name: str
+    steps: int                              # number of motion steps (>= 3)
+    mesh_index: int = -1                    # into the exported meshes (-1: a light)
+    local: object = None                    # LocalMesh (object space, at the centre)
+    slots: list = None
+    deform: bool = False                    # evaluate the mesh at every step
+    matrices: dict = field(default_factory=dict)     # step index -> (4, 4)
+    positions: dict = field(default_factory=dict)    # step index -> (V, 3) object space
+    topology_changed: bool = False
+
+
+class MotionExport:
+    """Samples the scene over the shutter for `export_scene`. Use as a context manager
+    around the whole export: entering moves the depsgraph to the shutter's middle (when
+    that is not the frame), leaving restores the original frame and subframe."""
+
+    def __init__(self, depsgraph, settings: MotionSettings, reporter, render_engine=None):
+        self.depsgraph = depsgraph
+        self.scene = depsgraph.scene
+        self.settings = settings
+        self.reporter = reporter
+        self.target = render_engine
+        if self.target is None and getattr(depsgraph, "mode", "VIEWPORT") != "RENDER":
+            self.target = self.scene
+        self.original = (int(self.scene.frame_current), float(self.scene.frame_subframe))
+        self.at = float(self.original[0] + self.original[1])
+        self.moved = False
+        self.frame_sets = 0
+        self.tracked: dict = {}
+        self.lights: dict = {}
+        self.camera_steps = 0
+        self.camera_matrices: dict = {}
+        self.stats = {}
+
+    @property
+    def usable(self) -> bool:
+        return self.target is not None
+
+    # -- frames ------------------------------------------------------------------------
+    def goto(self, frame_time: float):
+        if frame_time == self.at:
+            return
+        frame = math.floor(frame_time)
+        subframe = frame_time - frame
+        self.moved = True
+        self.frame_sets += 1
+        set_frame(self.target, frame, subframe)
+        self.at = frame_time
+
+    def __enter__(self):
+        if not self.usable:
+            self.reporter.warn("DRT: motion blur needs the render engine to re-evaluate the "
+                               "scene at other times; rendering without motion blur",
+                               key="motion blur no engine")
+            return self
+        self.t0 = time.perf_counter()
+        self.goto(self.settings.centre)
+        return self
+
+    def __exit__(self, *exc):
+        if self.moved:
+            self.moved = False
+            set_frame(self.target, *self.original)
+            self.at = float(self.original[0] + self.original[1])
+        return False
+
+    # -- the main pass, at the shutter's middle -----------------------------------------
+    def note_mesh(self, inst, obj, local, slots, mesh_index: int, name: str):
+        if not self.usable:
+            return
+        parent = inst.parent if inst.is_instance else None
+        steps = motion_steps(obj, parent)
+        if steps == 0:
+            return
+        deform = use_deform_motion(obj, parent) and _deform_candidate(obj, self.depsgraph)
+        t = _Tracked(_key(inst), name, steps, mesh_index, local, list(slots), deform)
+        t.matrices[steps // 2] = to_numpy(inst.matrix_world)
+        if deform:
+            t.positions[steps // 2] = local.positions
+        self.tracked[t.key] = t
+
+    def note_light(self, inst, obj):
+        if not self.usable:
+            return
+        t = _Tracked(_key(inst), obj.name, 3)
+        t.matrices[1] = to_numpy(inst.matrix_world)
+        self.lights[t.key] = t
+
+    def note_camera(self, cam_obj):
+        if not self.usable or cam_obj is None:
+            return
+        self.camera_steps = motion_steps(cam_obj)
+        if self.camera_steps:
+            ev = cam_obj.evaluated_get(self.depsgraph)
+            self.camera_matrices[self.camera_steps // 2] = to_numpy(ev.matrix_world)
+
+    # -- the other steps -----------------------------------------------------------------
+    def finish(self, meshes: list, camera) -> Optional[object]:
+        """Sample the other motion steps, attach motion to `meshes` and `camera`, and
+        return the engine Shutter (None when motion blur cannot be rendered)."""
+        if not self.usable:
+            return None
+        step_counts = {t.steps for t in self.tracked.values()} | {3 if self.lights else 0,
+                                                                  self.camera_steps}
+        step_counts.discard(0)
+        times = sorted({i / (k - 1) for k in step_counts for i in range(k)} - {0.5})
+        for t in times:
+            self.goto(self.settings.frame_time(t))
+            self._sample(t)
+        rigid = deforming = 0
+        for tr in self.tracked.values():
+            kind = self._attach(tr, meshes)
+            rigid += kind == "rigid"
+            deforming += kind == "deform"
+        camera_moves = self._attach_camera(camera)
+        for tr in self.lights.values():
+            mats = [tr.matrices[i] for i in sorted(tr.matrices)]
+            if len(mats) > 1 and _moves(mats, np.abs(mats[0][:3, 3]).max()):
+                self.reporter.warn(
+                    f"DRT: light {tr.name!r} moves during the shutter; DRT does not blur lamps "
+                    "yet, it is rendered where it is at the shutter's middle",
+                    key=(tr.name, "moving light"))
+        self.stats = dict(frame_sets=self.frame_sets, times=[0.5] + times, rigid=rigid,
+                          deforming=deforming, camera=camera_moves,
+                          seconds=time.perf_counter() - self.t0)
+        return emotion.Shutter(self.settings.curve)
+
+    def _sample(self, t: float):
+        per_geometry = {}
+        for inst in self.depsgraph.object_instances:
+            key = None
+            obj = inst.object
+            if obj.type == "LIGHT" and self.lights and abs(t * 2 - round(t * 2)) < 1e-12:
+                key = _key(inst)
+                if key in self.lights:
+                    self.lights[key].matrices[int(round(t * 2))] = to_numpy(inst.matrix_world)
+                continue
+            if not self.tracked:
+                continue
+            key = _key(inst)
+            tr = self.tracked.get(key)
+            if tr is None:
+                continue
+            i = t * (tr.steps - 1)
+            if abs(i - round(i)) > 1e-9:
+                continue                        # not one of this object's steps
+            i = int(round(i))
+            tr.matrices[i] = to_numpy(inst.matrix_world)
+            if tr.deform:
+                gkey = _cache_key(obj) or key
+                if gkey not in per_geometry:
+                    per_geometry[gkey] = _positions(obj)
+                got = per_geometry[gkey]
+                if (got is None or got[0].shape != tr.local.positions.shape
+                        or not np.array_equal(got[1], tr.local.triangles)):
+                    tr.topology_changed = True
+                else:
+                    tr.positions[i] = got[0]
+        cam = self.scene.camera
+        if self.camera_steps and cam is not None:
+            i = t * (self.camera_steps - 1)
+            if abs(i - round(i)) < 1e-9:
+                ev = cam.evaluated_get(self.depsgraph)
+                self.camera_matrices[int(round(i))] = to_numpy(ev.matrix_world)
+
+    def _attach(self, tr: _Tracked, meshes: list) -> Optional[str]:
+        k = tr.steps
+        if len(tr.matrices) != k:
+            self.reporter.warn(f"DRT: object {tr.name!r} is not there for the whole shutter; "
+                               "it is rendered without motion blur",
+                               key=(tr.name, "motion missing"))
+            return None
+        times = np.arange(k) / (k - 1)
+        mats = np.stack([tr.matrices[i] for i in range(k)])
+        mesh = meshes[tr.mesh_index]
+        if tr.deform and tr.topology_changed:
+            self.reporter.warn(f"DRT: object {tr.name!r} changes topology during the shutter; "
+                               "its deformation is not blurred (its movement still is)",
+                               key=(tr.name, "topology"))
+        elif tr.deform and len(tr.positions) == k:
+            local = np.stack([tr.positions[i] for i in range(k)])
+            extent = float(np.abs(local[k // 2]).max()) if local.size else 1.0
+            if _moves(local, extent):
+                world = np.einsum("kij,kvj->kvi", mats[:, :3, :3], local) + mats[:, None, :3, 3]
+                mesh.motion = emotion.DeformMotion(times, world)
+                return "deform"
+        if not _moves(mats, np.abs(mats[:, :3, 3]).max()):
+            return None
+        dets = np.linalg.det(mats[:, :3, :3])
+        if (np.abs(dets) <= 1e-12 * max(np.abs(dets).max(), 1e-300)).any() or \
+                (np.sign(dets) != np.sign(dets[k // 2])).any():
+            # Scaled through zero (popping in, mirroring): no inverse at some time, so
+            # the transforms are applied to the vertices and traced as a deformation.
+            world = np.einsum("kij,vj->kvi", mats[:, :3, :3], tr.local.positions) \
+                + mats[:, None, :3, 3]
+            mesh.motion = emotion.DeformMotion(times, world)
+            return "deform"
+        # Rigid: the mesh in object space, placed by the transform at each ray's time.
+        obj_space = instance_mesh(tr.local, np.eye(4), tr.slots, mesh.name)
+        if np.linalg.det(mats[k // 2][:3, :3]) < 0:
+            obj_space = _flip_winding(obj_space)
+        obj_space.motion = emotion.RigidMotion(times, mats)
+        meshes[tr.mesh_index] = obj_space
+        return "rigid"
+
+    def _attach_camera(self, camera) -> bool:
+        k = self.camera_steps
+        if not k or len(self.camera_matrices) != k:
+            return False
+        mats = np.stack([self.camera_matrices[i] for i in range(k)])
+        if not _moves(mats, np.abs(mats[:, :3, 3]).max()):
+            return False
+        camera.motion = emotion.RigidMotion(np.arange(k) / (k - 1), mats)
+        return True
+
+
+def _flip_winding(mesh):
+    """Swap two corners of every triangle (and of every per-corner attribute), as
+    `instance_mesh` does for a mirroring transform."""
+    names = {f.name for f in dataclasses.fields(mesh)}
+    changes = {"triangles": mesh.triangles[:, [0, 2, 1]]}
+    for name in ("corner_normals", "uvs"):
+        value = getattr(mesh, name, None)
+        if name in names and value is not None:
+            changes[name] = np.asarray(value)[:, [0, 2, 1]]
+    return dataclasses.replace(mesh, **changes)
+
+
+def _deform_candidate(obj, depsgraph) -> bool:
+    """Cycles' test for geometry that may change over time (BKE_object_is_deform_modified:
+    shape keys, deform-only modifiers, modifiers depending on time)."""
+    original = obj.original if obj.original is not None else obj
+    try:
+        return bool(original.is_deform_modified(depsgraph.scene, "RENDER"))
+    except (AttributeError, TypeError, RuntimeError):
+        return False
