@@ -186,7 +186,8 @@ def main():
         f"{slices} time slices, each an Embree scene built from the positions at the "
         "slice's middle. A mesh whose topology changes within the shutter is not blurred "
         "as a deformation (a warning names it); its movement still is.",
-        "- **The camera**: its transform at the steps, interpolated per ray.",
+        "- **The camera**: its transform at the steps, interpolated per ray, and a "
+        "perspective camera's focal length (zoom blur).",
         "- **Lamps** are not blurred: a moving lamp is rendered where it is at the shutter's "
         "middle (as Cycles renders lamps), with a warning. Emissive meshes blur like any "
         "mesh (they are then found by BSDF rays only, not light-sampled).",

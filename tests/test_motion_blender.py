@@ -219,6 +219,36 @@ def test_moving_camera_matches_cycles(bpy_drt):
     assert not within(sharp, cycles)
 
 
+def _camera_zoom(scene):
+    """The cube stands still off-centre and the camera zooms from 10 to 90 mm over frames
+    0..2 (40 to 60 mm within the shutter)."""
+    import bpy
+    bpy.data.objects["Cube"].animation_data_clear()
+    bpy.data.objects["Cube"].location.x = 0.8
+    data = scene.camera.data
+    for frame, lens in ((0, 10.0), (2, 90.0)):
+        data.lens = lens
+        data.keyframe_insert("lens", frame=frame)
+    _linear(data)
+    scene.frame_set(1)
+
+
+def test_zooming_camera_matches_cycles(bpy_drt):
+    from drt_addon import render_engine
+    cycles = render(bpy_drt, CUBE, "CYCLES", "zoom", _camera_zoom)
+    drt = render(bpy_drt, CUBE, "DRT", "zoom", _camera_zoom, samples=128)
+    cam = render_engine.last_render["scene"].camera
+    assert cam.motion is None
+    np.testing.assert_allclose(cam.lens_motion[1], [40.0, 50.0, 60.0], rtol=1e-5)
+    rel, mad = compare(drt, cycles)
+    sharp = render(bpy_drt, CUBE, "DRT", "zoom off",
+                   lambda s: (_camera_zoom(s), _blur_off(s)), samples=64)
+    print(f"zooming camera: mean {100 * rel.max():.3f}%, MAD {100 * mad:.2f}%; without "
+          f"blur: {compare(sharp, cycles)}")
+    assert (rel <= MEAN_TOLERANCE).all() and mad <= MAD_TOLERANCE, (rel, mad)
+    assert not within(sharp, cycles)
+
+
 def test_object_without_motion_blur_sits_at_the_shutters_middle_as_in_cycles(bpy_drt):
     """Cycles exports everything at the shutter's middle and only samples the other
     times for blurred objects: with position START and the cube's motion blur off, the

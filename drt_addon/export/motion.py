@@ -30,7 +30,8 @@ restored afterwards, also when the export fails. Per object:
   gets a `DeformMotion` of its world-space vertex positions (rigid motion included). A
   topology change within the shutter is reported and the deformation is dropped (the
   transform still blurs), as Cycles does;
-- the camera: `Camera.motion`;
+- the camera: `Camera.motion`, and `Camera.lens_motion` when a perspective camera's
+  focal length changes (zoom blur);
 - lights are not blurred by the tracer: a light that moves is rendered where it is at
   the shutter's middle (as Cycles renders lamps) and a warning says so. Emissive meshes
   blur like any other mesh.
@@ -263,6 +264,7 @@ class MotionExport:
         self.lights: dict = {}
         self.camera_steps = 0
         self.camera_matrices: dict = {}
+        self.camera_lenses: dict = {}
         self.stats = {}
 
     @property
@@ -324,8 +326,12 @@ class MotionExport:
             return
         self.camera_steps = motion_steps(cam_obj)
         if self.camera_steps:
-            ev = cam_obj.evaluated_get(self.depsgraph)
-            self.camera_matrices[self.camera_steps // 2] = to_numpy(ev.matrix_world)
+            self._sample_camera(cam_obj, self.camera_steps // 2)
+
+    def _sample_camera(self, cam_obj, i: int):
+        ev = cam_obj.evaluated_get(self.depsgraph)
+        self.camera_matrices[i] = to_numpy(ev.matrix_world)
+        self.camera_lenses[i] = float(ev.data.lens)
 
     # -- the other steps -----------------------------------------------------------------
     def finish(self, meshes: list, camera) -> Optional[object]:
@@ -393,8 +399,7 @@ class MotionExport:
         if self.camera_steps and cam is not None:
             i = t * (self.camera_steps - 1)
             if abs(i - round(i)) < 1e-9:
-                ev = cam.evaluated_get(self.depsgraph)
-                self.camera_matrices[int(round(i))] = to_numpy(ev.matrix_world)
+                self._sample_camera(cam, int(round(i)))
 
     def _attach(self, tr: _Tracked, meshes: list) -> Optional[str]:
         k = tr.steps
@@ -437,14 +442,21 @@ class MotionExport:
         return "rigid"
 
     def _attach_camera(self, camera) -> bool:
+        """The camera's transform and, for a perspective camera, its focal length (zoom)
+        over the shutter (Cycles blurs both)."""
         k = self.camera_steps
         if not k or len(self.camera_matrices) != k:
             return False
+        times = np.arange(k) / (k - 1)
         mats = np.stack([self.camera_matrices[i] for i in range(k)])
-        if not _moves(mats, np.abs(mats[:, :3, 3]).max()):
-            return False
-        camera.motion = emotion.RigidMotion(np.arange(k) / (k - 1), mats)
-        return True
+        lenses = np.array([self.camera_lenses[i] for i in range(k)])
+        moves = _moves(mats, np.abs(mats[:, :3, 3]).max())
+        zooms = camera.kind == "PERSP" and _moves(lenses, float(lenses.max()))
+        if moves:
+            camera.motion = emotion.RigidMotion(times, mats)
+        if zooms and hasattr(camera, "lens_motion"):
+            camera.lens_motion = (times, lenses)
+        return bool(moves or zooms)
 
 
 def _flip_winding(mesh):
