@@ -370,6 +370,261 @@ def motion_torus():
 MOTION_SCENES = {f.__name__: f for f in (motion_cube, motion_torus)}
 SCENES.update(MOTION_SCENES)
 
+
+# --- Comparison scenes: one area of the renderer each, against Cycles ------------------
+#
+# 64 x 64 pixels, Principled BSDF only, Cycles' default light paths (full global
+# illumination), compared in tests/test_scenes_vs_cycles.py and docs/comparisons.md.
+# Two Cycles settings are changed so that both engines compute the same thing:
+# - specular materials use single-scattering GGX (`distribution = 'GGX'`): the
+#   Principled default, multiscatter GGX, adds energy that DRT does not model;
+# - Filter Glossy is 0 (`cycles.blur_glossy`, default 1): Cycles' default blurs glossy
+#   surfaces seen after a diffuse or rough bounce, a bias DRT does not have (measured:
+#   with the default, Cycles renders metals 1.4-2.7% and glass 4.6-5.9% darker).
+# Lamps are large and dim (radiance 3): no path contribution reaches Cycles' default
+# indirect clamp (10). Scenes with lamps have a black world and nothing behind the lamp,
+# and the glass is lit by the sky alone, which keeps two known differences out of these
+# images (tests/test_scenes_vs_cycles.py lists them).
+
+COMPARISON_SIZE = (64, 64)
+STRIPE_COLORS = [(0.8, 0.15, 0.1), (0.85, 0.85, 0.85), (0.1, 0.3, 0.8), (0.15, 0.6, 0.15)]
+
+
+def _ggx(mat):
+    """Single-scattering GGX for a Principled material (Cycles' default is multiscatter)."""
+    mat.node_tree.nodes["Principled BSDF"].distribution = "GGX"
+    return mat
+
+
+def uv_sphere(name, center, radius, material, segments=48, rings=24):
+    """A smooth-shaded UV sphere (segments x rings, poles on Z)."""
+    verts = [(0.0, 0.0, radius)]
+    for i in range(1, rings):
+        th = math.pi * i / rings
+        for j in range(segments):
+            ph = 2.0 * math.pi * j / segments
+            verts.append((radius * math.sin(th) * math.cos(ph),
+                          radius * math.sin(th) * math.sin(ph), radius * math.cos(th)))
+    verts.append((0.0, 0.0, -radius))
+    faces = [(0, 1 + j, 1 + (j + 1) % segments) for j in range(segments)]
+    for i in range(rings - 2):
+        a, b = 1 + i * segments, 1 + (i + 1) * segments
+        for j in range(segments):
+            k = (j + 1) % segments
+            faces.append((a + j, b + j, b + k, a + k))
+    last, a = len(verts) - 1, 1 + (rings - 2) * segments
+    faces += [(a + j, last, a + (j + 1) % segments) for j in range(segments)]
+    obj = mesh_object(name, verts, faces, material)
+    obj.data.polygons.foreach_set("use_smooth", [True] * len(obj.data.polygons))
+    obj.data.update()
+    obj.location = center
+    return obj
+
+
+def _area_light(scene, location, target, size, radiance, name="Light"):
+    """A square area light of `size` metres aimed at `target`, of the given radiance
+    (energy = radiance x pi x area, Cycles' meaning)."""
+    light = bpy.data.lights.new(name, "AREA")
+    light.shape = "SQUARE"
+    light.size = size
+    light.energy = radiance * math.pi * size * size
+    obj = bpy.data.objects.new(name, light)
+    obj.location = location
+    scene.collection.objects.link(obj)
+    _aim(obj, target)
+    return obj
+
+
+def _multi_material_mesh(name, quads, materials, indices):
+    """One mesh object of quads (4 corners each), quad k using materials[indices[k]]."""
+    verts = [v for q in quads for v in q]
+    faces = [tuple(range(4 * k, 4 * k + 4)) for k in range(len(quads))]
+    obj = mesh_object(name, verts, faces, materials[0])
+    for mat in materials[1:]:
+        obj.data.materials.append(mat)
+    obj.data.polygons.foreach_set("material_index", list(indices))
+    obj.data.update()
+    return obj
+
+
+def _stripes(name, x0, x1, z0, z1, y, colors, n):
+    """A wall in the plane y of n vertical stripes cycling through diffuse `colors`."""
+    mats = [principled(f"{name}{i}", c, specular=0.0) for i, c in enumerate(colors)]
+    quads = []
+    for i in range(n):
+        a, b = x0 + (x1 - x0) * i / n, x0 + (x1 - x0) * (i + 1) / n
+        quads.append([(a, y, z0), (b, y, z0), (b, y, z1), (a, y, z1)])
+    return _multi_material_mesh(name, quads, mats, [i % len(mats) for i in range(n)])
+
+
+def _checker(name, x0, x1, y0, y1, z, colors, n):
+    """A floor at height z of n x n squares alternating two diffuse colours."""
+    mats = [principled(f"{name}{i}", c, specular=0.0) for i, c in enumerate(colors)]
+    quads, index = [], []
+    for i in range(n):
+        for j in range(n):
+            a, b = x0 + (x1 - x0) * i / n, x0 + (x1 - x0) * (i + 1) / n
+            c, d = y0 + (y1 - y0) * j / n, y0 + (y1 - y0) * (j + 1) / n
+            quads.append([(a, c, z), (b, c, z), (b, d, z), (a, d, z)])
+            index.append((i + j) % 2)
+    return _multi_material_mesh(name, quads, mats, index)
+
+
+def _set_world(scene, color, strength=1.0):
+    bg = scene.world.node_tree.nodes["Background"]
+    bg.inputs["Color"].default_value = (*color, 1.0)
+    bg.inputs["Strength"].default_value = strength
+
+
+def _comparison_defaults(scene):
+    render_defaults(scene, size=COMPARISON_SIZE, samples=512)
+    scene.cycles.samples = 1024
+    scene.cycles.use_adaptive_sampling = False
+    scene.cycles.blur_glossy = 0.0
+
+
+def metals():
+    """Three metal spheres (gold, copper, silver at roughness 0.1, 0.3, 0.6; Principled
+    metallic 1, single-scatter GGX) on a grey floor before a striped wall that they
+    reflect, under a 2 m square area light."""
+    scene = reset()
+    floor = principled("Floor", (0.5, 0.5, 0.5), specular=0.0)
+    quad("Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)], floor)
+    _stripes("Wall", -4.0, 4.0, 0.0, 4.0, 2.0, STRIPE_COLORS, 12)
+    for x, rough, color in ((-1.15, 0.1, (1.0, 0.78, 0.34)), (0.0, 0.3, (0.95, 0.64, 0.54)),
+                            (1.15, 0.6, (0.95, 0.95, 0.95))):
+        mat = _ggx(principled(f"Metal{rough}", color, roughness=rough, metallic=1.0))
+        uv_sphere(f"Sphere{rough}", (x, 0.0, 0.5), 0.5, mat)
+    _area_light(scene, (0.0, -2.5, 3.0), (0.0, 0.5, 0.0), 2.0, 3.0)
+    camera(scene, (0.0, -4.2, 1.25), (math.radians(82.0), 0.0, 0.0), lens=50.0)
+    _comparison_defaults(scene)
+    return scene
+
+
+def glossy_dielectric():
+    """Plastic: Principled spheres with the default specular layer (IOR 1.5, Specular
+    IOR Level 0.5, single-scatter GGX) over red, green and blue diffuse base colours at
+    roughness 0.15, 0.35 and 0.7, on a grey plastic floor (roughness 0.25) before a
+    striped wall, under a 2 m square area light."""
+    scene = reset()
+    floor = _ggx(principled("Floor", (0.5, 0.5, 0.5), roughness=0.25))
+    quad("Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)], floor)
+    _stripes("Wall", -4.0, 4.0, 0.0, 4.0, 2.0, STRIPE_COLORS, 12)
+    for x, rough, color in ((-1.15, 0.15, (0.7, 0.08, 0.05)), (0.0, 0.35, (0.1, 0.55, 0.12)),
+                            (1.15, 0.7, (0.08, 0.15, 0.7))):
+        mat = _ggx(principled(f"Plastic{rough}", color, roughness=rough))
+        uv_sphere(f"Sphere{rough}", (x, 0.0, 0.5), 0.5, mat)
+    _area_light(scene, (0.0, -2.5, 3.0), (0.0, 0.5, 0.0), 2.0, 3.0)
+    camera(scene, (0.0, -4.2, 1.25), (math.radians(82.0), 0.0, 0.0), lens=50.0)
+    _comparison_defaults(scene)
+    return scene
+
+
+def glass():
+    """Glass (Principled, transmission 1, IOR 1.45, single-scatter GGX) over a checker
+    floor before a striped wall: a smooth sphere (roughness 0) with a pale blue base
+    colour (Cycles tints each crossing by its square root) and a clear rough slab
+    (roughness 0.3). Lit by a uniform sky (world colour x strength) alone: no lamps."""
+    scene = reset()
+    _checker("Floor", -2.0, 2.0, -2.0, 2.0, 0.0, [(0.8, 0.8, 0.8), (0.15, 0.15, 0.15)], 8)
+    _stripes("Wall", -4.0, 4.0, 0.0, 4.0, 2.0, STRIPE_COLORS, 12)
+    smooth = _ggx(principled("GlassSmooth", (0.7, 0.85, 1.0), roughness=0.0))
+    rough = _ggx(principled("GlassRough", (1.0, 1.0, 1.0), roughness=0.3))
+    for mat in (smooth, rough):
+        bsdf = mat.node_tree.nodes["Principled BSDF"]
+        bsdf.inputs["Transmission Weight"].default_value = 1.0
+        bsdf.inputs["IOR"].default_value = 1.45
+    uv_sphere("Sphere", (-0.6, 0.0, 0.55), 0.5, smooth)
+    cuboid("Slab", (0.25, -0.45, 0.15), (1.05, 0.35, 0.45), rough, math.radians(20))
+    camera(scene, (0.0, -3.2, 1.7), (math.radians(70.0), 0.0, 0.0), lens=50.0)
+    _comparison_defaults(scene)
+    _set_world(scene, (0.8, 0.9, 1.0), 1.0)
+    return scene
+
+
+def dof():
+    """Depth of field: a 50 mm lens at f/0.4 (aperture radius 62.5 mm) with six blades,
+    focused at 1.2 m (focus distance) on a block, a plastic sphere nearer (0.7 m) and one
+    farther (2.1 m), a fine checker floor and a striped wall at 4.5 m; a 1.5 m square
+    area light."""
+    scene = reset()
+    _checker("Floor", -2.0, 2.0, -0.5, 4.0, 0.0, [(0.85, 0.85, 0.85), (0.05, 0.05, 0.05)], 16)
+    _stripes("Wall", -2.5, 2.5, 0.0, 2.5, 4.0, STRIPE_COLORS, 24)
+    near = _ggx(principled("Near", (0.75, 0.12, 0.08), roughness=0.35))
+    uv_sphere("Near", (-0.22, 0.2, 0.12), 0.12, near)
+    mid = principled("Mid", (0.85, 0.85, 0.8), roughness=0.5, specular=0.0)
+    cuboid("Mid", (-0.1, 0.6, 0.0), (0.15, 0.85, 0.35), mid, math.radians(30))
+    far = _ggx(principled("Far", (0.1, 0.3, 0.8), roughness=0.35))
+    uv_sphere("Far", (0.55, 1.6, 0.25), 0.25, far)
+    _area_light(scene, (0.0, -1.0, 2.2), (0.0, 1.5, 0.0), 1.5, 3.0)
+    cam = camera(scene, (0.0, -0.5, 0.45), (math.radians(82.0), 0.0, 0.0), lens=50.0)
+    cam.data.dof.use_dof = True
+    cam.data.dof.focus_distance = 1.2
+    cam.data.dof.aperture_fstop = 0.4
+    cam.data.dof.aperture_blades = 6
+    cam.data.dof.aperture_rotation = 0.0
+    _comparison_defaults(scene)
+    return scene
+
+
+def instances():
+    """Instancing: a collection (a plastic block with a diffuse ball on it) that is not in
+    the scene itself, instanced by 36 empties on a 6 x 6 grid with varied rotations and
+    scales (two mirrored: negative X scale), and a row of 8 posts made by an Array
+    modifier; a grey floor and a 2 m square area light."""
+    scene = reset()
+    floor = principled("Floor", (0.5, 0.5, 0.5), specular=0.0)
+    quad("Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)], floor)
+    tile = bpy.data.collections.new("Tile")
+    block = _ggx(principled("Block", (0.7, 0.25, 0.1), roughness=0.4))
+    ball = principled("Ball", (0.2, 0.5, 0.8), specular=0.0)
+    for obj in (cuboid("TileBlock", (-0.12, -0.08, 0.0), (0.12, 0.08, 0.16), block),
+                uv_sphere("TileBall", (0.06, 0.0, 0.24), 0.08, ball, 24, 12)):
+        scene.collection.objects.unlink(obj)
+        tile.objects.link(obj)
+    for i in range(6):
+        for j in range(6):
+            e = bpy.data.objects.new(f"Inst{i}{j}", None)
+            e.instance_type = "COLLECTION"
+            e.instance_collection = tile
+            e.location = (-1.25 + 0.5 * i, -0.6 + 0.45 * j, 0.0)
+            e.rotation_euler = (0.0, 0.0, math.radians(17.0 * (i * 6 + j)))
+            s = 0.8 + 0.08 * ((i + 2 * j) % 5)
+            e.scale = (-s if (i, j) in ((1, 2), (4, 4)) else s, s, s)
+            scene.collection.objects.link(e)
+    white = principled("Post", (0.8, 0.8, 0.8), roughness=0.5, specular=0.0)
+    post = cuboid("Posts", (-0.05, -0.05, 0.0), (0.05, 0.05, 0.5), white)
+    post.location = (-1.75, 2.2, 0.0)
+    arr = post.modifiers.new("Array", "ARRAY")
+    arr.count = 8
+    arr.relative_offset_displace = (5.0, 0.0, 0.0)
+    _area_light(scene, (-1.0, -1.5, 3.0), (0.0, 0.8, 0.0), 2.0, 3.0)
+    camera(scene, (0.0, -2.3, 2.4), (math.radians(48.0), 0.0, 0.0), lens=35.0)
+    _comparison_defaults(scene)
+    return scene
+
+
+def world_light():
+    """A diffuse sphere and block on a diffuse floor lit only by a uniform world
+    background (colour (0.5, 0.7, 1.0) x strength 1.5); no lamps."""
+    scene = reset()
+    floor = principled("Floor", (0.6, 0.6, 0.6), specular=0.0)
+    quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], floor)
+    orange = principled("Orange", (0.8, 0.35, 0.1), specular=0.0)
+    uv_sphere("Sphere", (-0.45, 0.0, 0.5), 0.5, orange)
+    white = principled("White", (0.75, 0.75, 0.75), specular=0.0)
+    cuboid("Block", (0.2, -0.3, 0.0), (0.8, 0.3, 0.8), white, math.radians(25))
+    camera(scene, (0.0, -3.6, 2.6), (math.radians(55.0), 0.0, 0.0), lens=40.0)
+    _comparison_defaults(scene)
+    _set_world(scene, (0.5, 0.7, 1.0), 1.5)
+    return scene
+
+
+COMPARISON_SCENES = {f.__name__: f for f in (
+    metals, glossy_dielectric, glass, dof, instances, world_light)}
+SCENES.update(COMPARISON_SCENES)
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("names", nargs="*", help=f"scenes to build (default all: {', '.join(SCENES)})")
