@@ -150,7 +150,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         self.update_stats("", "DRT: exporting scene")
         t0 = time.perf_counter()
         export_stats = {}
-        description = export_scene(depsgraph, reporter, region=region, stats=export_stats)
+        description = export_scene(depsgraph, reporter, region=region, stats=export_stats,
+                                   render_engine=self)
         settings = scene.drt.to_engine_settings()
         if self.is_preview:
             settings = preview_settings(settings)

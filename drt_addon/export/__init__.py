@@ -9,7 +9,7 @@ from .errors import ExportError, Reporter
 from .lights import export_light
 from .materials import export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
-from .motion import MotionExport, find_render_engine, read_settings
+from .motion import MotionExport, read_settings
 from .world import export_world
 
 __all__ = ["ExportError", "RenderRegion", "Reporter", "export_scene", "render_region",
@@ -47,14 +47,13 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
 
     Motion blur (see `export.motion`): with it on, the scene is exported at the shutter's
     middle and sampled at the motion steps with `render_engine.frame_set` (the
-    RenderEngine calling this, found on the stack when not given; a viewport depsgraph
-    uses Scene.frame_set); the frame is restored afterwards."""
+    RenderEngine rendering; without one, as in export tests, Scene.frame_set); the frame
+    is restored afterwards."""
     reporter = reporter or Reporter()
     blur = read_settings(depsgraph.scene, reporter)
     if blur is None:
         return _export_scene(depsgraph, reporter, size, region, stats, None)
-    with MotionExport(depsgraph, blur, reporter,
-                      render_engine or find_render_engine(depsgraph)) as tracker:
+    with MotionExport(depsgraph, blur, reporter, render_engine) as tracker:
         return _export_scene(depsgraph, reporter, size, region, stats,
                              tracker if tracker.usable else None)
 

@@ -42,7 +42,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import sys
 import time
 from dataclasses import dataclass, field
 from importlib import import_module
@@ -174,22 +173,6 @@ def set_frame(target, frame: int, subframe: float):
         target.frame_set(int(frame), subframe=float(subframe))
     else:
         target.frame_set(int(frame), float(subframe))
-
-
-def find_render_engine(depsgraph=None):
-    """The RenderEngine rendering now, found on the caller's stack (the export is called
-    from `RenderEngine.render`), or None."""
-    try:
-        import bpy
-    except ImportError:
-        return None
-    f = sys._getframe(1)
-    while f is not None:
-        candidate = f.f_locals.get("self")
-        if isinstance(candidate, bpy.types.RenderEngine):
-            return candidate
-        f = f.f_back
-    return None
 
 
 def _key(inst):
