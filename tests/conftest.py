@@ -55,10 +55,12 @@ def render_blend(bpy, path, engine, samples, percentage=50, setup=None) -> np.nd
     scene.drt.samples = samples
     if setup is not None:
         setup(scene)
-    bpy.ops.render.render()
-    if engine == "DRT":
-        from drt_addon import render_engine
-        assert render_engine.last_render["ok"], render_engine.last_render["error"]
+    return render_current(bpy, scene)
+
+
+def read_render_result(bpy, scene) -> np.ndarray:
+    """Blender's Render Result as Blender writes it: scene-linear OpenEXR, read back as
+    float64 (h, w, 3), row 0 at the top."""
     settings = scene.render.image_settings
     settings.file_format = "OPEN_EXR"
     settings.color_depth = "32"
@@ -66,3 +68,12 @@ def render_blend(bpy, path, engine, samples, percentage=50, setup=None) -> np.nd
         out = os.path.join(d, "render.exr")
         bpy.data.images["Render Result"].save_render(filepath=out, scene=scene)
         return read_image_linear(bpy, out)
+
+
+def render_current(bpy, scene) -> np.ndarray:
+    """Render the open scene with its engine (asserting DRT succeeded) and read it back."""
+    bpy.ops.render.render()
+    if scene.render.engine == "DRT":
+        from drt_addon import render_engine
+        assert render_engine.last_render["ok"], render_engine.last_render["error"]
+    return read_render_result(bpy, scene)

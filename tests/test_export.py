@@ -10,12 +10,11 @@ focus object.
 """
 import math
 import os
-import tempfile
 
 import numpy as np
 import pytest
 
-from conftest import SAMPLES_DIR, read_image_linear, render_blend
+from conftest import SAMPLES_DIR, read_render_result, render_blend
 
 
 # --------------------------------------------------------------------------- helpers
@@ -346,13 +345,7 @@ def test_resolution_percentage_uses_blenders_integer_maths(bpy_drt):
 
 
 def _save_render(bpy, scene):
-    settings = scene.render.image_settings
-    settings.file_format = "OPEN_EXR"
-    settings.color_depth = "32"
-    with tempfile.TemporaryDirectory() as d:
-        out = os.path.join(d, "render.exr")
-        bpy.data.images["Render Result"].save_render(filepath=out, scene=scene)
-        return read_image_linear(bpy, out)
+    return read_render_result(bpy, scene)
 
 
 LIGHT_POINT = os.path.join(SAMPLES_DIR, "light_point.blend")

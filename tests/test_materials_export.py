@@ -10,12 +10,11 @@
   MEAN_TOLERANCE and a per-pixel mean absolute difference within MAD_TOLERANCE of the mean.
 """
 import os
-import tempfile
 
 import numpy as np
 import pytest
 
-from conftest import read_image_linear
+from conftest import render_current
 
 MEAN_TOLERANCE = 0.02
 MAD_TOLERANCE = 0.05
@@ -397,17 +396,7 @@ def _render(bpy, engine, samples):
     scene.cycles.diffuse_bounces = 0
     scene.drt.samples = samples
     scene.drt.diffuse_bounces = 0
-    bpy.ops.render.render()
-    if engine == "DRT":
-        from drt_addon import render_engine
-        assert render_engine.last_render["ok"], render_engine.last_render["error"]
-    settings = scene.render.image_settings
-    settings.file_format = "OPEN_EXR"
-    settings.color_depth = "32"
-    with tempfile.TemporaryDirectory() as d:
-        out = os.path.join(d, "render.exr")
-        bpy.data.images["Render Result"].save_render(filepath=out, scene=scene)
-        return read_image_linear(bpy, out)
+    return render_current(bpy, scene)
 
 
 def build_texture_scene(bpy):

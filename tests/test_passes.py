@@ -8,12 +8,11 @@ frame (`Camera.view_frame`), not from DRT's camera model. Passes are read back t
 the compositor (Render Layers node -> output -> saved OpenEXR), the way users get them.
 """
 import os
-import tempfile
 
 import numpy as np
 import pytest
 
-from conftest import read_image_linear
+from conftest import render_current
 
 W, H = 32, 24
 BASE = (0.7, 0.4, 0.2)
@@ -89,17 +88,7 @@ def composite(bpy, scene, pass_name):
 
 
 def render_and_save(bpy, scene):
-    from drt_addon import render_engine
-    bpy.ops.render.render()
-    if scene.render.engine == "DRT":
-        assert render_engine.last_render["ok"], render_engine.last_render["error"]
-    settings = scene.render.image_settings
-    settings.file_format = "OPEN_EXR"
-    settings.color_depth = "32"
-    with tempfile.TemporaryDirectory() as d:
-        out = os.path.join(d, "render.exr")
-        bpy.data.images["Render Result"].save_render(filepath=out, scene=scene)
-        return read_image_linear(bpy, out)
+    return render_current(bpy, scene)
 
 
 def camera_frame(bpy, scene):
