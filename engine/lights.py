@@ -140,7 +140,7 @@ class PointLightModel:
         sin2 = np.minimum(self.radius ** 2 / np.maximum(d2, 1e-300), 1.0)
         return sin2 / (1.0 + np.sqrt(1.0 - sin2))
 
-    def sample(self, p, u):
+    def sample(self, p, u, time=None):
         to = self.position - p
         d2 = (to * to).sum(1)
         axis, dist_c = _safe_unit(to)
@@ -192,7 +192,7 @@ class PointLightModel:
         c = (oc * oc).sum(1) - self.radius ** 2
         return -b + np.sqrt(np.maximum(b * b - c, 0.0))
 
-    def intersect(self, o, d):
+    def intersect(self, o, d, time=None):
         """Distance to the sphere (or facing disc) along each ray (inf if missed) and
         its radiance."""
         n = len(o)
@@ -217,7 +217,7 @@ class PointLightModel:
         t = np.where(t0 > 0, t0, np.where(t1 > 0, t1, INF))
         return np.where(ok, t, INF), rad
 
-    def pdf(self, p, wi, t):
+    def pdf(self, p, wi, t, time=None):
         to = self.position - p
         d2 = (to * to).sum(1)
         if self.delta:
@@ -251,7 +251,7 @@ class SunLightModel:
     def power(self, scene_radius):
         return luminance(self.irradiance) * np.pi * scene_radius ** 2
 
-    def sample(self, p, u):
+    def sample(self, p, u, time=None):
         n = len(p)
         if self.delta:
             wi = np.broadcast_to(self.to_light, (n, 3)).copy()
@@ -268,14 +268,14 @@ class SunLightModel:
         diff = d - self.to_light
         return 0.5 * (diff * diff).sum(1) <= self.one_minus
 
-    def escaped(self, d):
+    def escaped(self, d, time=None):
         """Radiance seen along escaping rays d (zero outside the sun's disc)."""
         n = len(d)
         if self.delta:
             return np.zeros((n, 3))
         return np.where(self._inside(d)[:, None], self.radiance[None, :], 0.0)
 
-    def pdf(self, p, wi, t):
+    def pdf(self, p, wi, t, time=None):
         if self.delta:
             return np.zeros(len(wi))
         return np.where(self._inside(wi), 1.0 / (TWO_PI * self.one_minus), 0.0)
@@ -428,7 +428,7 @@ class AreaLightModel:
     def _emitting_side(self, p):
         return (self.center - p) @ self.normal > 0          # p below the light's -Z face
 
-    def sample(self, p, u):
+    def sample(self, p, u, time=None):
         sr, use = self._spherical(p)
         if sr is not None and use.all():
             offset = sr.sample(u)
@@ -447,7 +447,7 @@ class AreaLightModel:
         rad = np.where(ok[:, None], self.radiance[None, :], 0.0)
         return LightSample(wi, dist, rad, pdf, False)
 
-    def intersect(self, o, d):
+    def intersect(self, o, d, time=None):
         denom = d @ self.normal
         # Only the emitting side counts: rays travelling along +Z hit the -Z face.
         front = denom > 0
@@ -463,7 +463,7 @@ class AreaLightModel:
         rad = np.broadcast_to(self.radiance, (len(o), 3))
         return t, rad
 
-    def pdf(self, p, wi, t):
+    def pdf(self, p, wi, t, time=None):
         """Solid-angle pdf of sample(p, .) producing wi, the light being hit at distance
         t (assumed: the caller found the hit with intersect)."""
         cos_l = np.abs(wi @ self.normal)
@@ -475,7 +475,75 @@ class AreaLightModel:
         return out
 
 
+class TimeSlicedLight:
+    """A lamp that moves during the shutter: the exporter gives the lamp at the middles of
+    K equal slices of the shutter (`light.motion_slices`), and each ray uses the lamp of
+    the slice its time falls in. Like time-sliced deformation (engine.motion) this is
+    exact at the slice middles and off by up to half a slice's movement elsewhere, and
+    it costs nothing for lamps that do not move."""
+
+    def __init__(self, slices):
+        self.slices = [make_light(l) for l in slices]
+        kinds = {type(m) for m in self.slices}
+        if len(kinds) != 1:
+            raise ValueError("a moving light must keep its type over the shutter")
+        first = self.slices[0]
+        self.delta, self.visible = first.delta, first.visible
+        self.visible_camera = getattr(first, "visible_camera", True)
+        self.is_sun = isinstance(first, SunLightModel)
+        self.k = len(self.slices)
+
+    def power(self, scene_radius):
+        return float(np.mean([m.power(scene_radius) for m in self.slices]))
+
+    def _groups(self, n, time):
+        if time is None:                      # no time: the middle of the shutter
+            yield self.slices[self.k // 2], slice(None)
+            return
+        sl = np.clip((np.asarray(time) * self.k).astype(np.int64), 0, self.k - 1)
+        for j in np.unique(sl):
+            yield self.slices[j], np.nonzero(sl == j)[0]
+
+    def sample(self, p, u, time=None):
+        n = len(p)
+        out = LightSample(np.zeros((n, 3)), np.zeros(n), np.zeros((n, 3)), np.zeros(n),
+                          self.delta, np.zeros(n))
+        for model, rows in self._groups(n, time):
+            s = model.sample(p[rows], u[rows])
+            out.wi[rows], out.dist[rows], out.radiance[rows], out.pdf[rows] = \
+                s.wi, s.dist, s.radiance, s.pdf
+            if s.margin is not None:
+                out.margin[rows] = s.margin
+        return out
+
+    def intersect(self, o, d, time=None):
+        n = len(o)
+        t, rad = np.full(n, INF), np.zeros((n, 3))
+        for model, rows in self._groups(n, time):
+            tt, rr = model.intersect(o[rows], d[rows])
+            t[rows] = tt
+            if rr is not None:
+                rad[rows] = rr
+        return t, rad
+
+    def pdf(self, p, wi, t, time=None):
+        out = np.zeros(len(wi))
+        for model, rows in self._groups(len(wi), time):
+            out[rows] = model.pdf(None if p is None else p[rows], wi[rows],
+                                  None if t is None else t[rows])
+        return out
+
+    def escaped(self, d, time=None):
+        out = np.zeros((len(d), 3))
+        for model, rows in self._groups(len(d), time):
+            out[rows] = model.escaped(d[rows])
+        return out
+
+
 def make_light(light):
+    slices = getattr(light, "motion_slices", None)
+    if slices:
+        return TimeSlicedLight(slices)
     if isinstance(light, PointLight):
         return PointLightModel(light)
     if isinstance(light, SunLight):
@@ -512,9 +580,10 @@ class LightSet:
     def __len__(self):
         return len(self.select_pdf)
 
-    def sample(self, p, u_pick, u_point):
-        """Pick one light per point and sample it. Returns (LightSample with pdf
-        including the pick probability, entry index, delta mask)."""
+    def sample(self, p, u_pick, u_point, time=None):
+        """Pick one light per point and sample it (time: the points' shutter times, for
+        moving lamps). Returns (LightSample with pdf including the pick probability,
+        entry index, delta mask)."""
         n = len(p)
         idx = np.searchsorted(self.cdf, u_pick, side="right").clip(0, len(self) - 1)
         wi = np.zeros((n, 3))
@@ -528,7 +597,7 @@ class LightSet:
             sel = np.nonzero(idx == k)[0]
             if sel.size == 0:
                 continue
-            s = model.sample(p[sel], u_point[sel])
+            s = model.sample(p[sel], u_point[sel], None if time is None else time[sel])
             wi[sel], dist[sel], rad[sel] = s.wi, s.dist, s.radiance
             pdf[sel] = s.pdf * self.select_pdf[k]
             delta[sel] = s.delta
@@ -541,7 +610,7 @@ class LightSet:
                 margin[sel] = s.margin
         return LightSample(wi, dist, rad, pdf, False, margin), idx, delta
 
-    def hit_surfaces(self, o, d, tmax):
+    def hit_surfaces(self, o, d, tmax, time=None):
         """The nearest area or sphere lamp along each ray before tmax:
         (t, lamp index or -1, radiance). Emissive triangles are scene geometry: the
         integrator finds them with the ordinary ray cast."""
@@ -550,9 +619,10 @@ class LightSet:
         best_i = np.full(n, -1, dtype=np.int64)
         rad = np.zeros((n, 3))
         for k, model in enumerate(self.models):
-            if not model.visible or isinstance(model, SunLightModel):
+            if not model.visible or isinstance(model, SunLightModel) \
+                    or getattr(model, "is_sun", False):
                 continue
-            t, r = model.intersect(o, d)
+            t, r = model.intersect(o, d, time)
             closer = t < best_t
             if closer.any():
                 best_t[closer] = t[closer]
@@ -560,14 +630,15 @@ class LightSet:
                 rad[closer] = r[closer]
         return best_t, best_i, rad
 
-    def pdf(self, k_index, p, wi, t):
+    def pdf(self, k_index, p, wi, t, time=None):
         """Solid-angle pdf, pick probability included, of sampling direction wi from p
         towards lamp k_index[i] (hit at distance t)."""
         out = np.zeros(len(p))
         for k, model in enumerate(self.models):
             sel = np.nonzero(k_index == k)[0]
             if sel.size:
-                out[sel] = model.pdf(p[sel], wi[sel], t[sel]) * self.select_pdf[k]
+                out[sel] = model.pdf(p[sel], wi[sel], t[sel],
+                                     None if time is None else time[sel]) * self.select_pdf[k]
         return out
 
     def mesh_pdf(self, prim, p, q):
@@ -584,4 +655,5 @@ class LightSet:
 
     def suns(self):
         return [(k, m) for k, m in enumerate(self.models)
-                if isinstance(m, SunLightModel) and not m.delta]
+                if (isinstance(m, SunLightModel) or getattr(m, "is_sun", False))
+                and not m.delta]

@@ -142,6 +142,7 @@ class PointLight:
     direction: tuple = (0.0, 0.0, -1.0)
     name: str = "point"
     soft_falloff: bool = False
+    motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
 
 
 @dataclass
@@ -152,6 +153,7 @@ class SunLight:
     strength: tuple
     angle: float = 0.0
     name: str = "sun"
+    motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
 
 
 @dataclass
@@ -169,6 +171,7 @@ class AreaLight:
     normalize: bool = True
     visible_camera: bool = True
     name: str = "area"
+    motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
 
 
 @dataclass
@@ -237,9 +240,10 @@ class Scene:
             return False
         moving = [m for m in self.meshes if m.motion is not None and not _is_static(m.motion)]
         camera_moves = self.camera.motion is not None and not _is_static(self.camera.motion)
+        lamps_move = any(getattr(l, "motion_slices", None) for l in self.lights)
         lm = self.camera.lens_motion
         zooms = lm is not None and bool(np.ptp(np.asarray(lm[1], dtype=np.float64)) > 0)
-        return bool(moving) or camera_moves or zooms
+        return bool(moving) or camera_moves or zooms or lamps_move
 
     def triangle_count(self) -> int:
         return int(sum(len(m.triangles) for m in self.meshes))

@@ -178,3 +178,38 @@ def test_zooming_camera_rays_follow_the_focal_length_at_their_time():
     assert scene.has_motion()
     cam.lens_motion = ([0.0, 1.0], [35.0, 35.0])
     assert not scene.has_motion()
+
+
+def test_moving_lamp_is_blurred_over_its_time_slices():
+    """A point lamp moving along x during the shutter, exported as 8 slices: with 64
+    jittered samples each slice gets exactly 8 samples, and a point lamp with direct light
+    only has no other randomness, so each pixel is the mean of the 8 still renders at the
+    slice positions (up to the 1e-4 px sub-pixel jitter, which pairs differently with the
+    slices) and differs from the still render at mid-shutter by far more."""
+    from engine import PointLight
+    plane = quad((0, 0, 0), (1, 0, 0), (0, 1, 0), "plane", 0)
+    grey = Material("grey", (0.8, 0.8, 0.8), specular_ior_level=0.0)
+    cam = Camera(translate(0, 0, 1.0), kind="ORTHO", ortho_scale=2.0, clip_start=1e-3)
+
+    def lamp_at(x):
+        return PointLight((x, 0.0, 0.3), (20.0,) * 3)
+
+    xs = -0.5 + (np.arange(8) + 0.5) / 8.0            # slice middles of a move -0.5 -> 0.5
+    moving = lamp_at(0.0)
+    moving.motion_slices = [lamp_at(x) for x in xs]
+    settings = RenderSettings(samples=64, diffuse_bounces=0, filter_type="BOX",
+                              filter_width=1e-4)
+
+    def rendered(lamp, shutter):
+        scene = Scene(cam, 16, 4, [plane], [grey], [lamp], World((0, 0, 0)), shutter=shutter)
+        film, _ = render(scene, settings)
+        return film.mean()
+
+    blurred = rendered(moving, Shutter())
+    stills = np.mean([rendered(lamp_at(x), None) for x in xs], axis=0)
+    np.testing.assert_allclose(blurred, stills, rtol=1e-4, atol=1e-9)
+    middle = rendered(lamp_at(0.0), None)
+    assert np.abs(blurred - middle).max() > 0.05 * middle.max()
+    # Without an open shutter the lamp is the middle slice's, and no time is sampled.
+    still_path = rendered(moving, None)
+    np.testing.assert_allclose(still_path, rendered(moving.motion_slices[4], None))

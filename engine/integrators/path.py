@@ -236,13 +236,14 @@ class PathIntegrator:
 
             # 1a. area and sphere lights in front of the geometry
             if len(lights):
-                t_l, k_l, le = lights.hit_surfaces(o, d, t_geom)
+                t_l, k_l, le = lights.hit_surfaces(o, d, t_geom, tp)
                 on_light = k_l >= 0
                 if depth == 0:
                     on_light &= ctx.light_visible_camera[np.maximum(k_l, 0)]
                 if on_light.any():
                     sel = np.nonzero(on_light)[0]
-                    light_pdf = lights.pdf(k_l[sel], prev_pos[sel], d[sel], t_l[sel])
+                    light_pdf = lights.pdf(k_l[sel], prev_pos[sel], d[sel], t_l[sel],
+                                           None if tp is None else tp[sel])
                     w = self._hit_weight(prev_pdf[sel], light_pdf)
                     add(path[sel], b[sel] * le[sel] * w[:, None], depth)
                     alive[sel] = False
@@ -251,10 +252,11 @@ class PathIntegrator:
             if escaped.any():
                 sel = np.nonzero(escaped)[0]
                 env = np.broadcast_to(ctx.world_radiance, (sel.size, 3)).copy()
+                t_sel = None if tp is None else tp[sel]
                 for k, sun in lights.suns():
-                    w = self._hit_weight(prev_pdf[sel],
-                                         sun.pdf(None, d[sel], None) * lights.select_pdf[k])
-                    env += sun.escaped(d[sel]) * w[:, None]
+                    w = self._hit_weight(prev_pdf[sel], sun.pdf(None, d[sel], None, t_sel)
+                                         * lights.select_pdf[k])
+                    env += sun.escaped(d[sel], t_sel) * w[:, None]
                 add(path[sel], b[sel] * env, depth)
                 alive[sel] = False
             if stopped is not None:
@@ -291,7 +293,7 @@ class PathIntegrator:
             if len(lights):
                 u_pick = sampler.get_1d(D.bounce_dim(depth, D.LIGHT_PICK), px_l, ix_l)
                 u_pt = sampler.get_2d(D.bounce_dim(depth, D.LIGHT_POINT), px_l, ix_l)
-                ls, _, delta = lights.sample(si.position, u_pick, u_pt)
+                ls, _, delta = lights.sample(si.position, u_pick, u_pt, t_live)
                 wi_local = to_local(ls.wi, ns)
                 f = bsdf.eval_f(wo, wi_local)
                 ok = ((ls.pdf > 0) & (ls.radiance.max(1) > 0) & (f.max(1) > 0)

@@ -56,7 +56,7 @@ class WhittedIntegrator:
         out = np.zeros((n, 3))
         centre = np.full((n, 2), CENTRE)
         for model in ctx.lights.models:
-            ls = model.sample(si.position, centre)
+            ls = model.sample(si.position, centre, time)
             cos = (ls.wi * si.shading_normal).sum(1)
             ok = (ls.pdf > 0) & (cos > 0) & ((ls.wi * si.geometric_normal).sum(1) > 0) \
                 & (ls.radiance.max(1) > 0)
@@ -97,7 +97,7 @@ class WhittedIntegrator:
             t_geom = np.where(hits.hit, hits.t, tm)
             alive = np.ones(path.size, dtype=bool)
             if len(ctx.lights):
-                t_l, k_l, le = ctx.lights.hit_surfaces(o, d, t_geom)
+                t_l, k_l, le = ctx.lights.hit_surfaces(o, d, t_geom, tp)
                 on_light = k_l >= 0
                 if depth == 0:
                     on_light &= ctx.light_visible_camera[np.maximum(k_l, 0)]
