@@ -188,9 +188,11 @@ def main():
         "as a deformation (a warning names it); its movement still is.",
         "- **The camera**: its transform at the steps, interpolated per ray, and a "
         "perspective camera's focal length (zoom blur).",
-        "- **Lamps** are not blurred: a moving lamp is rendered where it is at the shutter's "
-        "middle (as Cycles renders lamps), with a warning. Emissive meshes blur like any "
-        "mesh (they are then found by BSDF rays only, not light-sampled).",
+        "- **Lamps** that move are blurred over 8 time slices of the shutter (each ray uses "
+        "the lamp of the slice its time falls in: exact at the slice middles, off by up to "
+        "half a slice's movement elsewhere). Cycles does not blur lamps (it renders them at "
+        "the shutter's middle), so here DRT and Cycles differ on purpose. Emissive meshes "
+        "blur like any mesh (they are then found by BSDF rays only, not light-sampled).",
         "",
         "Motion blur off, a zero shutter or nothing moving: nothing is attached to the "
         "scene and the tracer takes its static path (one Embree scene, no time dimension), "

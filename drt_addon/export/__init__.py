@@ -106,11 +106,11 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
             if light is not None:
                 lights.append(light)
                 if tracker is not None:
-                    tracker.note_light(inst, obj)
+                    tracker.note_light(inst, obj, len(lights) - 1)
     if not materials:
         materials.append(engine.Material())
     world = export_world(scene.world, reporter)
-    shutter = tracker.finish(meshes, camera) if tracker is not None else None
+    shutter = tracker.finish(meshes, camera, lights) if tracker is not None else None
     if stats is not None:
         stats.update(mesh_evaluations=cache.evaluations, mesh_reuses=cache.reuses,
                      meshes=len(meshes), lights=len(lights), holdouts=holdouts,

@@ -32,9 +32,10 @@ restored afterwards, also when the export fails. Per object:
   transform still blurs), as Cycles does;
 - the camera: `Camera.motion`, and `Camera.lens_motion` when a perspective camera's
   focal length changes (zoom blur);
-- lights are not blurred by the tracer: a light that moves is rendered where it is at
-  the shutter's middle (as Cycles renders lamps) and a warning says so. Emissive meshes
-  blur like any other mesh.
+- lamps that move get `motion_slices`: the lamp exported at the middles of
+  LIGHT_SLICES equal slices of the shutter, from its transform interpolated like any
+  rigid motion (the tracer gives each ray the slice its time falls in, see
+  engine.lights.TimeSlicedLight). Emissive meshes blur like any other mesh.
 Motion blur off, a zero shutter or nothing moving: nothing is attached and the render
 takes the tracer's static path; with motion blur off the frame is never changed.
 """
@@ -51,6 +52,7 @@ import numpy as np
 
 from ..engine_link import engine
 from .errors import ExportError
+from .lights import export_light
 from .matrices import to_numpy
 from .mesh import _cache_key, instance_mesh
 
@@ -212,18 +214,22 @@ def _moves(arrays, scale) -> bool:
     return bool(np.max(np.abs(a - a[0])) > MOVE_TOLERANCE * max(scale, 1.0))
 
 
+LIGHT_SLICES = 8      # time slices of a moving lamp (see engine.lights.TimeSlicedLight)
+
+
 @dataclass
 class _Tracked:
     key: tuple
     name: str
     steps: int                              # number of motion steps (>= 3)
-    mesh_index: int = -1                    # into the exported meshes (-1: a light)
+    mesh_index: int = -1                    # into the exported meshes or lights
     local: object = None                    # LocalMesh (object space, at the centre)
     slots: list = None
     deform: bool = False                    # evaluate the mesh at every step
     matrices: dict = field(default_factory=dict)     # step index -> (4, 4)
     positions: dict = field(default_factory=dict)    # step index -> (V, 3) object space
     topology_changed: bool = False
+    source: object = None                   # the original Blender object (lights)
 
 
 class MotionExport:
@@ -297,10 +303,11 @@ class MotionExport:
             t.positions[steps // 2] = local.positions
         self.tracked[t.key] = t
 
-    def note_light(self, inst, obj):
+    def note_light(self, inst, obj, light_index: int):
         if not self.usable:
             return
-        t = _Tracked(_key(inst), obj.name, 3)
+        t = _Tracked(_key(inst), obj.name, 3, mesh_index=light_index,
+                     source=obj.original if obj.original is not None else obj)
         t.matrices[1] = to_numpy(inst.matrix_world)
         self.lights[t.key] = t
 
@@ -317,9 +324,10 @@ class MotionExport:
         self.camera_lenses[i] = float(ev.data.lens)
 
     # -- the other steps -----------------------------------------------------------------
-    def finish(self, meshes: list, camera) -> Optional[object]:
-        """Sample the other motion steps, attach motion to `meshes` and `camera`, and
-        return the engine Shutter (None when motion blur cannot be rendered)."""
+    def finish(self, meshes: list, camera, lights: list = ()) -> Optional[object]:
+        """Sample the other motion steps, attach motion to `meshes`, `camera` and the
+        exported `lights`, and return the engine Shutter (None when motion blur cannot be
+        rendered)."""
         if not self.usable:
             return None
         step_counts = {t.steps for t in self.tracked.values()} | {3 if self.lights else 0,
@@ -335,15 +343,20 @@ class MotionExport:
             rigid += kind == "rigid"
             deforming += kind == "deform"
         camera_moves = self._attach_camera(camera)
+        moving_lights = 0
         for tr in self.lights.values():
-            mats = [tr.matrices[i] for i in sorted(tr.matrices)]
-            if len(mats) > 1 and _moves(mats, np.abs(mats[0][:3, 3]).max()):
-                self.reporter.warn(
-                    f"DRT: light {tr.name!r} moves during the shutter; DRT does not blur lamps "
-                    "yet, it is rendered where it is at the shutter's middle",
-                    key=(tr.name, "moving light"))
+            steps = sorted(tr.matrices)
+            mats = [tr.matrices[i] for i in steps]
+            if len(mats) > 1 and _moves(mats, np.abs(mats[0][:3, 3]).max()) \
+                    and 0 <= tr.mesh_index < len(lights):
+                motion = emotion.RigidMotion(np.array(steps) / (len(steps) - 1), mats)
+                mids = (np.arange(LIGHT_SLICES) + 0.5) / LIGHT_SLICES
+                slices = [export_light(tr.source, m, self.reporter) for m in motion.at(mids)]
+                if all(sl is not None for sl in slices):
+                    lights[tr.mesh_index].motion_slices = slices
+                    moving_lights += 1
         self.stats = dict(frame_sets=self.frame_sets, times=[0.5] + times, rigid=rigid,
-                          deforming=deforming, camera=camera_moves,
+                          deforming=deforming, camera=camera_moves, lights=moving_lights,
                           seconds=time.perf_counter() - self.t0)
         return emotion.Shutter(self.settings.curve)
 
