@@ -74,12 +74,13 @@ def _bottom_up(image: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(image[::-1], dtype=np.float32).reshape(-1)
 
 
-def _rgba_bottom_up(image: np.ndarray) -> np.ndarray:
-    """(h, w, 3) top-down float image to Blender's flat bottom-up RGBA float32."""
+def _rgba_bottom_up(image: np.ndarray, alpha: np.ndarray | None = None) -> np.ndarray:
+    """(h, w, 3) top-down float image (premultiplied) and (h, w) alpha to Blender's flat
+    bottom-up RGBA float32."""
     h, w, _ = image.shape
     out = np.empty((h, w, 4), dtype=np.float32)
     out[..., :3] = image[::-1]
-    out[..., 3] = 1.0
+    out[..., 3] = 1.0 if alpha is None else alpha[::-1]
     return out.reshape(-1)
 
 
@@ -166,10 +167,10 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         result = self.begin_result(0, 0, region.width, region.height, layer=view_layer.name)
         layer = result.layers[0]
         combined = layer.passes["Combined"]
-        image = None
+        image = alpha = None
         try:
             def progress(film, stats, fraction):
-                combined.rect.foreach_set(_rgba_bottom_up(film.mean()))
+                combined.rect.foreach_set(_rgba_bottom_up(film.mean(), film.mean_alpha()))
                 self.update_result(result)
                 self.update_progress(fraction)
                 last_render["progress"].append((stats.samples_done, fraction))
@@ -180,8 +181,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
 
             film, stats = engine.render(description, settings, context=ctx, progress=progress,
                                         cancelled=self._cancel_requested)
-            image = film.mean()
-            combined.rect.foreach_set(_rgba_bottom_up(image))
+            image, alpha = film.mean(), film.mean_alpha()
+            combined.rect.foreach_set(_rgba_bottom_up(image, alpha))
             if not stats.cancelled:
                 self._write_passes(layer, ctx, film, view_layer, description)
         finally:
@@ -192,7 +193,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                           "were dropped")
         last_render.update(ok=not stats.cancelled, error="cancelled" if stats.cancelled else None,
                            warnings=reporter.warnings, stats=stats, pixels=image,
-                           export_seconds=export_seconds)
+                           alpha=alpha, export_seconds=export_seconds)
 
     def _write_passes(self, layer, ctx, film, view_layer, description):
         wanted = [name for name in enabled_passes(view_layer)

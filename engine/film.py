@@ -1,7 +1,8 @@
 """The film: per-pixel sample statistics, mergeable exactly.
 
-For each pixel it keeps the sample count, the sum and the sum of squares of the sampled
-radiance (float64: a 1080p frame at thousands of samples sums millions of float32-range
+For each pixel it keeps the sample count, the sum of the samples' alpha (coverage: 0
+where a camera ray saw the transparent film background) and the sum and the sum of
+squares of the sampled radiance (float64: a 1080p frame at thousands of samples sums millions of float32-range
 values per pixel, and the variance is a difference of two such sums). With filter
 importance sampling every sample counts in exactly one pixel with weight one, so two
 films rendered from disjoint sample ranges merge by addition into exactly the film of
@@ -19,11 +20,14 @@ class Film:
         self.count = np.zeros(n, dtype=np.int64)
         self.sum = np.zeros((n, 3), dtype=np.float64)
         self.sum_sq = np.zeros((n, 3), dtype=np.float64)
+        self.alpha_sum = np.zeros(n, dtype=np.float64)
 
-    def add(self, pixel: np.ndarray, radiance: np.ndarray) -> None:
+    def add(self, pixel: np.ndarray, radiance: np.ndarray, alpha: np.ndarray | None = None) -> None:
         n = self.count.size
         pixel = np.asarray(pixel, dtype=np.int64)
-        self.count += np.bincount(pixel, minlength=n)
+        counts = np.bincount(pixel, minlength=n)
+        self.count += counts
+        self.alpha_sum += counts if alpha is None else np.bincount(pixel, weights=alpha, minlength=n)
         for c in range(3):
             v = radiance[:, c]
             self.sum[:, c] += np.bincount(pixel, weights=v, minlength=n)
@@ -35,12 +39,18 @@ class Film:
         self.count += other.count
         self.sum += other.sum
         self.sum_sq += other.sum_sq
+        self.alpha_sum += other.alpha_sum
         return self
 
     def mean(self) -> np.ndarray:
         """(height, width, 3) float64 image, row 0 at the top; zero where no samples."""
         c = np.maximum(self.count, 1)[:, None]
         return (self.sum / c).reshape(self.height, self.width, 3)
+
+    def mean_alpha(self) -> np.ndarray:
+        """(height, width) coverage in [0, 1]; the colour from mean() is premultiplied by
+        it (background samples add no radiance), as Blender expects."""
+        return (self.alpha_sum / np.maximum(self.count, 1)).reshape(self.height, self.width)
 
     def variance_of_mean(self) -> np.ndarray:
         """Per-pixel estimate of the variance of the pixel mean (unbiased sample

@@ -108,14 +108,16 @@ def camera_rays(ctx: RenderContext, pixel: np.ndarray, index: np.ndarray):
 
 def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sample_end: int):
     """Radiance of samples [sample_start, sample_end) of each pixel in `pixels`.
-    Returns (pixel ids, radiance (n, 3) float64)."""
+    Returns (pixel ids, radiance (n, 3) float64, alpha (n,) or None when the film is
+    opaque)."""
     k = sample_end - sample_start
     pixel = np.repeat(pixels.astype(np.int64), k)
     index = np.tile(np.arange(sample_start, sample_end, dtype=np.int64), len(pixels))
     rays, time = camera_rays(ctx, pixel, index)
+    alpha = np.ones(len(pixel)) if ctx.scene.film_transparent else None
     radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
-                                       time=time)
-    return pixel, radiance
+                                       time=time, alpha_out=alpha)
+    return pixel, radiance, alpha
 
 
 def plan_passes(total: int, first: int = 1, growth: float = 2.0, largest: int = 64):
@@ -157,7 +159,7 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
                 return 0
             running[0] += 1
         try:
-            pix, rad = render_unit(ctx, pixels, a, b)
+            pix, rad, alpha = render_unit(ctx, pixels, a, b)
         finally:
             with lock:
                 running[0] -= 1
@@ -165,7 +167,7 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
         if bad.any():
             rad[bad] = 0.0
         with lock:
-            film.add(pix, rad)
+            film.add(pix, rad, alpha)
             stats.paths += len(pix)
             stats.nonfinite_samples += int(bad.sum())
             stats.units_done += 1

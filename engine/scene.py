@@ -222,6 +222,7 @@ class Scene:
     world: World = field(default_factory=World)
     pixel_aspect: float = 1.0
     shutter: Optional[object] = None     # engine.motion.Shutter; None = motion blur off
+    film_transparent: bool = False       # Blender's Film > Transparent: background alpha 0
 
     def __post_init__(self):
         if self.width < 1 or self.height < 1:

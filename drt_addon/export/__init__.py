@@ -119,4 +119,5 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
         if tracker is not None:
             stats["motion"] = tracker.stats
     return engine.Scene(camera, region.width, region.height, meshes, materials, lights, world,
-                        pixel_aspect=aspect, shutter=shutter)
+                        pixel_aspect=aspect, shutter=shutter,
+                        film_transparent=bool(scene.render.film_transparent))

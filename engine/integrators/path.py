@@ -197,8 +197,9 @@ class PathIntegrator:
             return np.where(delta | ~(bsdf_pdf > 0), 1.0, 0.0)
         raise ValueError(f"mis_mode must be one of {MIS_MODES}, got {mode!r}")
 
-    def radiance(self, pixel, index, origins, dirs, tmax, time=None):
+    def radiance(self, pixel, index, origins, dirs, tmax, time=None, alpha_out=None):
         """Radiance along camera rays; pixel/index give each path's sampler coordinates,
+        alpha_out (n,) if given receives each path's film coverage (Film > Transparent),
         time (or None when nothing moves) each path's shutter time, kept for all its
         rays so that moving objects are where they were when the path was taken."""
         ctx = self.ctx
@@ -257,7 +258,12 @@ class PathIntegrator:
                     w = self._hit_weight(prev_pdf[sel], sun.pdf(None, d[sel], None, t_sel)
                                          * lights.select_pdf[k])
                     env += sun.escaped(d[sel], t_sel) * w[:, None]
-                add(path[sel], b[sel] * env, depth)
+                if alpha_out is not None and depth == 0:
+                    # Film > Transparent: the camera sees no background; what got through
+                    # transparent surfaces to it is the uncovered part of the sample.
+                    alpha_out[path[sel]] = 1.0 - np.clip(b[sel].mean(1), 0.0, 1.0)
+                else:
+                    add(path[sel], b[sel] * env, depth)
                 alive[sel] = False
             if stopped is not None:
                 alive &= ~stopped               # past the transparent bounce limit

@@ -75,7 +75,7 @@ class WhittedIntegrator:
                         * trans[vis] / ls.pdf[sv, None])
         return out
 
-    def radiance(self, pixel, index, origins, dirs, tmax, time=None):
+    def radiance(self, pixel, index, origins, dirs, tmax, time=None, alpha_out=None):
         ctx = self.ctx
         mats = ctx.materials
         n = len(pixel)
@@ -104,7 +104,10 @@ class WhittedIntegrator:
                 L[path[on_light]] += b[on_light] * le[on_light]
                 alive &= ~on_light
             escaped = alive & ~hits.hit
-            L[path[escaped]] += b[escaped] * ctx.world_radiance
+            if alpha_out is not None and depth == 0:   # Film > Transparent
+                alpha_out[path[escaped]] = 1.0 - np.clip(b[escaped].mean(1), 0.0, 1.0)
+            else:
+                L[path[escaped]] += b[escaped] * ctx.world_radiance
             alive &= ~escaped
             if stopped is not None:
                 alive &= ~stopped               # past the transparent bounce limit

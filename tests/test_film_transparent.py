@@ -1,0 +1,70 @@
+"""Film > Transparent: alpha 0 where the camera sees the background, premultiplied colour,
+the world still lighting the scene; against Cycles' alpha."""
+import os
+import tempfile
+
+import numpy as np
+
+from engine import Camera, Material, RenderSettings, Scene, World, render
+from engine_scenes import look_at, quad
+
+
+def _scene(transparent):
+    plane = quad((0, 0, 0), (0.5, 0, 0), (0, 0.5, 0), "plane", 0)
+    cam = Camera(look_at((0, -0.01, 3.0), (0, 0, 0), up=(0, 1, 0)), lens=50.0)
+    return Scene(cam, 24, 24, [plane], [Material("m", (0.8, 0.8, 0.8), specular_ior_level=0.0)],
+                 [], World((0.5, 0.6, 0.7)), film_transparent=transparent)
+
+
+def test_background_is_transparent_and_still_lights_the_scene():
+    settings = RenderSettings(samples=16, seed=4, filter_type="BOX", filter_width=1.0)
+    opaque, _ = render(_scene(False), settings)
+    clear, _ = render(_scene(True), settings)
+    a = clear.mean_alpha()
+    corner, centre = (slice(0, 3), slice(0, 3)), (slice(10, 14), slice(10, 14))
+    assert (a[corner] == 0).all() and (clear.mean()[corner] == 0).all()
+    assert (opaque.mean()[corner] > 0.4).all()               # the world, seen directly
+    assert (a[centre] == 1).all()
+    # The plane is lit by the world exactly as before (same samples, same paths).
+    np.testing.assert_allclose(clear.mean()[centre], opaque.mean()[centre], rtol=1e-12)
+    edge = (a > 0) & (a < 1)
+    assert edge.any()                                         # anti-aliased coverage
+    assert (opaque.mean_alpha() == 1).all()
+
+
+def test_alpha_merges_exactly_across_sample_ranges():
+    settings = RenderSettings(samples=8, seed=2)
+    whole, _ = render(_scene(True), settings)
+    a, _ = render(_scene(True), settings, sample_start=0, sample_end=5)
+    b, _ = render(_scene(True), settings, sample_start=5, sample_end=8)
+    np.testing.assert_allclose(a.merge(b).alpha_sum, whole.alpha_sum, rtol=1e-12)
+
+
+def test_alpha_matches_cycles(bpy_drt):
+    from conftest import SAMPLES_DIR
+    bpy = bpy_drt
+    alphas = {}
+    for engine in ("DRT", "CYCLES"):
+        bpy.ops.wm.open_mainfile(filepath=os.path.join(SAMPLES_DIR, "world_light.blend"),
+                                 load_ui=False)
+        scene = bpy.context.scene
+        scene.render.use_motion_blur = False
+        scene.render.film_transparent = True
+        scene.render.engine = engine
+        scene.cycles.samples = 64
+        scene.drt.samples = 64
+        bpy.ops.render.render()
+        settings = scene.render.image_settings
+        settings.file_format, settings.color_depth, settings.color_mode = "OPEN_EXR", "32", "RGBA"
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "a.exr")
+            bpy.data.images["Render Result"].save_render(filepath=path, scene=scene)
+            img = bpy.data.images.load(path)
+            px = np.empty(img.size[0] * img.size[1] * 4, np.float32)
+            img.pixels.foreach_get(px)
+            bpy.data.images.remove(img)
+        alphas[engine] = px.reshape(-1, 4)[:, 3]
+    print("mean alpha DRT", alphas["DRT"].mean(), "Cycles", alphas["CYCLES"].mean())
+    assert 0.05 < alphas["CYCLES"].mean() < 0.95           # the view has background
+    assert abs(alphas["DRT"].mean() - alphas["CYCLES"].mean()) < 0.01
+    assert np.abs(alphas["DRT"] - alphas["CYCLES"]).mean() < 0.05
