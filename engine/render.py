@@ -114,7 +114,7 @@ def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sampl
     pixel = np.repeat(pixels.astype(np.int64), k)
     index = np.tile(np.arange(sample_start, sample_end, dtype=np.int64), len(pixels))
     rays, time = camera_rays(ctx, pixel, index)
-    alpha = np.ones(len(pixel)) if ctx.scene.film_transparent else None
+    alpha = np.ones(len(pixel)) if ctx.scene.needs_alpha() else None
     radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
                                        time=time, alpha_out=alpha)
     return pixel, radiance, alpha

@@ -100,6 +100,7 @@ class TriangleMesh:
     corner_normals: Optional[np.ndarray] = None
     uvs: Optional[np.ndarray] = None
     motion: Optional[object] = None
+    holdout: bool = False          # Cycles' holdout: a zero-alpha hole for camera rays
 
     def __post_init__(self):
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)
@@ -245,6 +246,13 @@ class Scene:
         lm = self.camera.lens_motion
         zooms = lm is not None and bool(np.ptp(np.asarray(lm[1], dtype=np.float64)) > 0)
         return bool(moving) or camera_moves or zooms or lamps_move
+
+    def has_holdouts(self) -> bool:
+        return any(m.holdout for m in self.meshes)
+
+    def needs_alpha(self) -> bool:
+        """Whether samples carry a coverage (alpha) below one anywhere."""
+        return self.film_transparent or self.has_holdouts()
 
     def triangle_count(self) -> int:
         return int(sum(len(m.triangles) for m in self.meshes))

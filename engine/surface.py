@@ -59,6 +59,9 @@ class SurfaceBuilder:
             if len(self.v0) else np.zeros(0)
         self.material = (np.concatenate([m.material_indices for m in ordered]).astype(np.int64)
                          if ordered else np.zeros(0, np.int64))
+        # Holdout triangles (None when the scene has none): camera rays end there.
+        self.holdout = (np.concatenate([np.full(len(m.triangles), m.holdout) for m in ordered])
+                        if any(m.holdout for m in ordered) else None)
         self.corner_normals = None
         if any(m.corner_normals is not None for m in ordered):
             parts, offset = [], 0

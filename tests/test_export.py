@@ -106,7 +106,8 @@ def build_scene(bpy):
         e.rotation_euler = (0.0, 0.0, 0.5 * i)
         scene.collection.objects.link(e)
 
-    # Left out: disabled in renders, in a collection disabled in renders, holdouts.
+    # Left out: disabled in renders, in a collection disabled in renders.
+    # Exported as holdouts: the object's own flag and a holdout collection.
     _mesh_object(bpy, "DisabledInRenders", CUBE_V, CUBE_F).hide_render = True
     off = bpy.data.collections.new("RenderOff")
     scene.collection.children.link(off)
@@ -179,11 +180,13 @@ def _by_name(scene, name):
 # --------------------------------------------------------------------------- geometry
 def test_objects_left_out_and_kept(exported):
     bpy, scene, stats, warnings = exported
-    names = sorted(m.name.split("#")[0] for m in scene.meshes)
+    names = sorted(m.name.split("#")[0] for m in scene.meshes if not m.holdout)
     assert names == sorted(["Modified", "Plain", "PlainDuplicate", "Instanced", "Instanced",
                             "ViewportHidden"]), names
+    assert sorted(m.name for m in scene.meshes if m.holdout) == ["Holdout",
+                                                                  "InHoldoutCollection"]
     assert stats["holdouts"] == 2
-    assert any("Holdout" in w and "left out" in w for w in warnings), warnings
+    assert not any("holdout" in w.lower() for w in warnings), warnings
     assert len(scene.lights) == 1
 
 
@@ -257,8 +260,9 @@ def test_instances_reuse_evaluated_meshes(exported):
     """One to_mesh per distinct evaluated geometry: the linked duplicate and the second
     collection instance reuse arrays read before."""
     bpy, scene, stats, _ = exported
-    assert stats["meshes"] == 6
-    assert stats["mesh_evaluations"] == 4, stats      # Modified, Plain, Instanced, ViewportHidden
+    assert stats["meshes"] == 8                       # 6 rendered + 2 holdouts
+    assert stats["mesh_evaluations"] == 6, stats      # Modified, Plain, Instanced,
+    #                                                   ViewportHidden and the 2 holdouts
     assert stats["mesh_reuses"] == 2, stats           # PlainDuplicate, second Instanced
     assert scene.triangle_count() == stats["triangles"]
 

@@ -68,3 +68,43 @@ def test_alpha_matches_cycles(bpy_drt):
     assert 0.05 < alphas["CYCLES"].mean() < 0.95           # the view has background
     assert abs(alphas["DRT"].mean() - alphas["CYCLES"].mean()) < 0.01
     assert np.abs(alphas["DRT"] - alphas["CYCLES"]).mean() < 0.05
+
+
+def test_holdout_matches_cycles(bpy_drt):
+    """The Cornell box's tall block as a holdout: a zero-alpha hole with no colour for the
+    camera (film opaque), while it still shadows and reflects light for everything else;
+    compared with Cycles' RGBA."""
+    from conftest import SAMPLES_DIR
+    bpy = bpy_drt
+    out = {}
+    for engine in ("DRT", "CYCLES"):
+        bpy.ops.wm.open_mainfile(filepath=os.path.join(SAMPLES_DIR, "cornell_box.blend"),
+                                 load_ui=False)
+        scene = bpy.context.scene
+        bpy.data.objects["TallBlock"].is_holdout = True
+        scene.render.engine = engine
+        scene.render.resolution_percentage = 25
+        scene.cycles.samples = 256
+        scene.cycles.use_denoising = False
+        scene.drt.samples = 64
+        scene.cycles.diffuse_bounces = scene.drt.diffuse_bounces = 0
+        bpy.ops.render.render()
+        settings = scene.render.image_settings
+        settings.file_format, settings.color_depth, settings.color_mode = "OPEN_EXR", "32", "RGBA"
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "h.exr")
+            bpy.data.images["Render Result"].save_render(filepath=path, scene=scene)
+            img = bpy.data.images.load(path)
+            px = np.empty(img.size[0] * img.size[1] * 4, np.float32)
+            img.pixels.foreach_get(px)
+            bpy.data.images.remove(img)
+        out[engine] = px.reshape(-1, 4).astype(np.float64)
+    a_drt, a_cyc = out["DRT"][:, 3], out["CYCLES"][:, 3]
+    hole = a_cyc < 0.01
+    print("hole pixels", hole.sum(), "alpha MAD", np.abs(a_drt - a_cyc).mean())
+    assert hole.sum() > 50                                   # the block is a hole in Cycles
+    assert (a_drt[hole] < 0.05).mean() > 0.95                # ... and in DRT
+    assert (out["DRT"][hole, :3] < 0.02).all()               # with no colour
+    assert np.abs(a_drt - a_cyc).mean() < 0.02
+    rgb_drt, rgb_cyc = out["DRT"][:, :3].mean(0), out["CYCLES"][:, :3].mean(0)
+    assert np.all(np.abs(rgb_drt - rgb_cyc) / rgb_cyc < 0.05), (rgb_drt, rgb_cyc)

@@ -88,17 +88,15 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
         if obj.type in GEOMETRY_TYPES:
             if not inst.is_instance and not inst.show_self:
                 continue
-            if _is_holdout(inst, obj, view_layer):
-                holdouts += 1
-                reporter.warn(f"DRT: holdout object {obj.name!r} is left out (DRT does not "
-                              "render holdouts yet)", key=(obj.name, "holdout"))
-                continue
+            holdout = _is_holdout(inst, obj, view_layer)
+            holdouts += holdout
             local = cache.local(obj)
             if local is None:
                 continue
             slots = [material_id(s.material) for s in obj.material_slots] or [material_id(None)]
             name = f"{obj.name}#{k}" if inst.is_instance else obj.name
             meshes.append(instance_mesh(local, inst.matrix_world.copy(), slots, name))
+            meshes[-1].holdout = holdout
             if tracker is not None:
                 tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
         elif obj.type == "LIGHT":

@@ -258,7 +258,7 @@ class PathIntegrator:
                     w = self._hit_weight(prev_pdf[sel], sun.pdf(None, d[sel], None, t_sel)
                                          * lights.select_pdf[k])
                     env += sun.escaped(d[sel], t_sel) * w[:, None]
-                if alpha_out is not None and depth == 0:
+                if alpha_out is not None and depth == 0 and ctx.scene.film_transparent:
                     # Film > Transparent: the camera sees no background; what got through
                     # transparent surfaces to it is the uncovered part of the sample.
                     alpha_out[path[sel]] = 1.0 - np.clip(b[sel].mean(1), 0.0, 1.0)
@@ -267,6 +267,15 @@ class PathIntegrator:
                 alive[sel] = False
             if stopped is not None:
                 alive &= ~stopped               # past the transparent bounce limit
+            if depth == 0 and ctx.surfaces.holdout is not None:
+                # Cycles' holdout: a camera ray (or its transparent continuation) that
+                # reaches a holdout surface adds no colour and leaves the sample uncovered;
+                # other rays see the object as usual.
+                hold = alive & hits.hit & ctx.surfaces.holdout[np.maximum(hits.prim, 0)]
+                if hold.any():
+                    if alpha_out is not None:
+                        alpha_out[path[hold]] = 1.0 - np.clip(b[hold].mean(1), 0.0, 1.0)
+                    alive &= ~hold
             live = np.nonzero(alive)[0]
             if live.size == 0:
                 break

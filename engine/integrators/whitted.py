@@ -104,13 +104,18 @@ class WhittedIntegrator:
                 L[path[on_light]] += b[on_light] * le[on_light]
                 alive &= ~on_light
             escaped = alive & ~hits.hit
-            if alpha_out is not None and depth == 0:   # Film > Transparent
+            if alpha_out is not None and depth == 0 and ctx.scene.film_transparent:
                 alpha_out[path[escaped]] = 1.0 - np.clip(b[escaped].mean(1), 0.0, 1.0)
             else:
                 L[path[escaped]] += b[escaped] * ctx.world_radiance
             alive &= ~escaped
             if stopped is not None:
                 alive &= ~stopped               # past the transparent bounce limit
+            if depth == 0 and ctx.surfaces.holdout is not None:     # Cycles' holdout
+                hold = alive & hits.hit & ctx.surfaces.holdout[np.maximum(hits.prim, 0)]
+                if alpha_out is not None:
+                    alpha_out[path[hold]] = 1.0 - np.clip(b[hold].mean(1), 0.0, 1.0)
+                alive &= ~hold
             live = np.nonzero(alive)[0]
             if live.size == 0:
                 break
