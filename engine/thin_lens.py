@@ -14,8 +14,8 @@ def sample_aperture(u: np.ndarray, radius: float, blades: int = 0, rotation: flo
                     ratio: float = 1.0) -> np.ndarray:
     """Points on the aperture (camera-space x, y in metres), uniform in area.
 
-    blades >= 3 gives a regular polygon inscribed in the circle of `radius`, rotated by
-    `rotation` radians; u.x picks the blade's triangle and is reused (rescaled) inside it,
+    blades >= 3 gives a regular polygon inscribed in the circle of `radius` with corners
+    at angles rotation + (2k + 1) pi / blades (Cycles' orientation); u.x picks the blade's triangle and is reused (rescaled) inside it,
     so strata stay strata. ratio is Blender's anamorphic aperture ratio: x is divided by
     it, as in Cycles.
     """
@@ -26,7 +26,9 @@ def sample_aperture(u: np.ndarray, radius: float, blades: int = 0, rotation: flo
         s = np.sqrt(u0)
         b1 = s * (1.0 - u[..., 1])                         # weight of corner k
         b2 = s * u[..., 1]                                 # weight of corner k+1
-        a0 = rotation + 2.0 * np.pi * k / blades
+        # Corners at rotation + (2k + 1) pi / blades, as Cycles places them (an edge,
+        # not a corner, faces +x at rotation 0).
+        a0 = rotation + np.pi * (2.0 * k + 1.0) / blades
         a1 = a0 + 2.0 * np.pi / blades
         x = b1 * np.cos(a0) + b2 * np.cos(a1)
         y = b1 * np.sin(a0) + b2 * np.sin(a1)

@@ -121,10 +121,10 @@ def chi_square_pvalue(counts, expected):
 def _inside_aperture(x, y, blades, rotation):
     if blades < 3:
         return x * x + y * y <= 1.0
-    # inside the regular polygon with corners at angles rotation + 2 pi k / blades
+    # inside the regular polygon with corners at angles rotation + (2k + 1) pi / blades
     inside = np.ones(np.shape(x), dtype=bool)
     for k in range(blades):
-        a0 = rotation + 2 * np.pi * k / blades
+        a0 = rotation + np.pi * (2 * k + 1) / blades
         a1 = a0 + 2 * np.pi / blades
         p0 = np.array([np.cos(a0), np.sin(a0)])
         p1 = np.array([np.cos(a1), np.sin(a1)])
@@ -175,3 +175,15 @@ def test_chi_square_harness_rejects_a_wrong_pdf():
     expected *= len(x) / expected.sum()
     keep = expected >= 5
     assert stats.chisquare(counts[keep], expected[keep] * counts[keep].sum() / expected[keep].sum()).pvalue < ALPHA
+
+
+def test_blades_are_oriented_as_in_cycles():
+    """Cycles puts the aperture polygon's corners at rotation + (2k+1) pi / blades: with 6
+    blades and no rotation a corner points at 30 degrees and an edge's middle at 0."""
+    u = np.random.default_rng(5).random((400000, 2))
+    p = sample_aperture(u, 1.0, 6, 0.0)
+    ang = np.degrees(np.arctan2(p[:, 1], p[:, 0]))
+    r = np.hypot(p[:, 0], p[:, 1])
+    near_30 = r[np.abs(ang - 30) < 1].max()
+    near_0 = r[np.abs(ang) < 1].max()
+    assert near_30 > 0.99 and near_0 < np.cos(np.radians(30)) + 0.01

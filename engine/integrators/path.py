@@ -247,7 +247,8 @@ class PathIntegrator:
                                            None if tp is None else tp[sel])
                     w = self._hit_weight(prev_pdf[sel], light_pdf)
                     add(path[sel], b[sel] * le[sel] * w[:, None], depth)
-                    alive[sel] = False
+                    # Lamps are not surfaces: as in Cycles the ray goes on to what lies
+                    # behind the lamp (hit below, or the background).
             # 1b. escaped rays: world background and sun discs
             escaped = alive & ~hits.hit
             if escaped.any():
@@ -311,8 +312,12 @@ class PathIntegrator:
                 ls, _, delta = lights.sample(si.position, u_pick, u_pt, t_live)
                 wi_local = to_local(ls.wi, ns)
                 f = bsdf.eval_f(wo, wi_local)
+                # Lights behind the surface count only through materials that transmit
+                # (rough refraction), as Cycles samples both sides of those.
+                front_side = (ls.wi * ng).sum(1) > 0
+                through = mats.transmission[si.material] * (1.0 - mats.metallic[si.material]) > 0
                 ok = ((ls.pdf > 0) & (ls.radiance.max(1) > 0) & (f.max(1) > 0)
-                      & ((ls.wi * ng).sum(1) > 0))
+                      & (front_side | through))
                 if ok.any():
                     sel = np.nonzero(ok)[0]
                     org = offset_origin(si.position[sel], ng[sel], si.scale[sel], ls.wi[sel])

@@ -101,8 +101,7 @@ class WhittedIntegrator:
                 on_light = k_l >= 0
                 if depth == 0:
                     on_light &= ctx.light_visible_camera[np.maximum(k_l, 0)]
-                L[path[on_light]] += b[on_light] * le[on_light]
-                alive &= ~on_light
+                L[path[on_light]] += b[on_light] * le[on_light]   # and the ray goes on
             escaped = alive & ~hits.hit
             if alpha_out is not None and depth == 0 and ctx.scene.film_transparent:
                 alpha_out[path[escaped]] = 1.0 - np.clip(b[escaped].mean(1), 0.0, 1.0)
