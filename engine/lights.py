@@ -475,6 +475,33 @@ class AreaLightModel:
         return out
 
 
+class EnvironmentLightModel:
+    """The world's uniform background as a light, as Cycles samples it: next-event
+    estimation from every vertex (uniform directions over the sphere, pdf 1 / (4 pi)),
+    weighted by MIS against BSDF rays that escape. Never hit as a surface."""
+    delta = False
+    visible = False
+    visible_camera = False
+    is_environment = True
+
+    def __init__(self, radiance):
+        self.radiance = np.asarray(radiance, dtype=np.float64)[:3]
+        self.pdf_value = 1.0 / (4.0 * np.pi)
+
+    def power(self, scene_radius):
+        # irradiance pi L on a scene of cross-section pi R^2 (as for the sun)
+        return luminance(self.radiance) * np.pi * np.pi * scene_radius ** 2
+
+    def sample(self, p, u, time=None):
+        n = len(p)
+        wi = uniform_sphere(u)
+        rad = np.broadcast_to(self.radiance, (n, 3)).copy()
+        return LightSample(wi, np.full(n, INF), rad, np.full(n, self.pdf_value), False)
+
+    def pdf(self, p, wi, t, time=None):
+        return np.full(len(wi), self.pdf_value)
+
+
 class TimeSlicedLight:
     """A lamp that moves during the shutter: the exporter gives the lamp at the middles of
     K equal slices of the shutter (`light.motion_slices`), and each ray uses the lamp of
@@ -561,13 +588,17 @@ class LightSet:
     lights and triangles, of strength for points, of irradiance x pi R^2 for suns):
     `select_pdf`, over len(self) entries; entry k >= n_lamps is triangle k - n_lamps."""
 
-    def __init__(self, lights, scene_radius: float, mesh_lights=None):
+    def __init__(self, lights, scene_radius: float, mesh_lights=None, world=None):
         self.models = [make_light(l) for l in lights]
+        if world is not None and luminance(world) > 0:
+            self.models.append(EnvironmentLightModel(world))
         power = np.array([max(m.power(scene_radius), 0.0) for m in self.models], dtype=np.float64)
         power = np.where(np.isfinite(power), power, 0.0)
         keep = power > 0
         self.models = [m for m, k in zip(self.models, keep) if k]
         self.n_lamps = len(self.models)
+        env = [k for k, m in enumerate(self.models) if getattr(m, "is_environment", False)]
+        self.env_index = env[0] if env else None
         self.mesh = mesh_lights if mesh_lights is not None and len(mesh_lights) else None
         mesh_power = self.mesh.power if self.mesh is not None else np.zeros(0)
         power = np.concatenate([power[keep], mesh_power])
@@ -652,6 +683,13 @@ class LightSet:
         sel = np.maximum(entry, 0)
         pdf = self.mesh.pdf_area_to_solid_angle(sel, p, q)
         return np.where(is_light, pdf * self.select_pdf[self.n_lamps + sel], 0.0)
+
+    def environment_pdf(self, n):
+        """Pick probability x solid-angle pdf of the world light for n escaped rays
+        (zeros when the world is not a light)."""
+        if self.env_index is None:
+            return np.zeros(n)
+        return np.full(n, self.models[self.env_index].pdf_value * self.select_pdf[self.env_index])
 
     def suns(self):
         return [(k, m) for k, m in enumerate(self.models)

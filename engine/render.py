@@ -66,12 +66,13 @@ class RenderContext:
         self.surfaces = SurfaceBuilder(self.accel, scene.meshes)
         self.materials = MaterialTable(scene.materials)
         self.scene_radius = _scene_radius(scene, self.accel)
+        self.world_radiance = np.asarray(scene.world.color, dtype=np.float64)[:3]
         self.lights = LightSet(scene.lights, self.scene_radius,
                                mesh_lights=EmissiveTriangles.from_scene(
-                                   scene, self.accel, self.materials.emission))
+                                   scene, self.accel, self.materials.emission),
+                               world=self.world_radiance)
         self.light_visible_camera = np.array(
             [getattr(m, "visible_camera", True) for m in self.lights.models] or [True])
-        self.world_radiance = np.asarray(scene.world.color, dtype=np.float64)[:3]
         self.integrator = make_integrator(settings.integrator, self)
 
     def close(self):

@@ -56,3 +56,20 @@ def test_diffuse_limit_applies_even_with_a_larger_total():
     film, _ = render(furnace(rho), settings)
     expected = LE * (1 + rho + rho ** 2)
     assert abs(film.mean().mean() - expected) / expected < 0.01
+
+
+@pytest.mark.parametrize("integrator,diffuse", [("path", 0), ("path", 4), ("distribution", 4)])
+def test_plane_under_a_uniform_sky(integrator, diffuse):
+    """A diffuse plane facing up under a uniform world sees only sky: its radiance is
+    rho * L_sky whatever the bounce limits, because the world is light-sampled like a lamp
+    (as Cycles does), not only reached by continuing paths."""
+    from engine_scenes import quad
+    rho, sky = 0.6, np.array([0.5, 0.7, 1.0])
+    plane = quad((0, 0, 0), (50, 0, 0), (0, 50, 0), "plane", 0)
+    cam = Camera(look_at((0, -0.5, 2.0), (0, 0, 0)), lens=80.0)
+    scene = Scene(cam, 8, 8, [plane], [Material("m", (rho,) * 3, specular_ior_level=0.0)],
+                  [], World(tuple(sky)))
+    film, _ = render(scene, RenderSettings(samples=256, seed=3, integrator=integrator,
+                                           diffuse_bounces=diffuse))
+    got = film.mean().reshape(-1, 3).mean(0)
+    np.testing.assert_allclose(got, rho * sky, rtol=0.01)

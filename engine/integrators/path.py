@@ -253,7 +253,9 @@ class PathIntegrator:
             escaped = alive & ~hits.hit
             if escaped.any():
                 sel = np.nonzero(escaped)[0]
-                env = np.broadcast_to(ctx.world_radiance, (sel.size, 3)).copy()
+                # the world, weighted against its own next-event estimation
+                w_env = self._hit_weight(prev_pdf[sel], lights.environment_pdf(sel.size))
+                env = ctx.world_radiance[None, :] * w_env[:, None]
                 t_sel = None if tp is None else tp[sel]
                 for k, sun in lights.suns():
                     w = self._hit_weight(prev_pdf[sel], sun.pdf(None, d[sel], None, t_sel)

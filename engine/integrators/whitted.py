@@ -56,6 +56,8 @@ class WhittedIntegrator:
         out = np.zeros((n, 3))
         centre = np.full((n, 2), CENTRE)
         for model in ctx.lights.models:
+            if getattr(model, "is_environment", False):
+                continue        # Whitted sees the world only along mirror rays
             ls = model.sample(si.position, centre, time)
             cos = (ls.wi * si.shading_normal).sum(1)
             ok = (ls.pdf > 0) & (cos > 0) & ((ls.wi * si.geometric_normal).sum(1) > 0) \
