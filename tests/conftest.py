@@ -70,6 +70,22 @@ def read_render_result(bpy, scene) -> np.ndarray:
         return read_image_linear(bpy, out)
 
 
+def read_render_rgba(bpy, scene) -> np.ndarray:
+    """Blender's Render Result with its alpha, as (h * w, 4) float64 (bottom-up rows)."""
+    settings = scene.render.image_settings
+    settings.file_format, settings.color_depth, settings.color_mode = "OPEN_EXR", "32", "RGBA"
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "rgba.exr")
+        bpy.data.images["Render Result"].save_render(filepath=path, scene=scene)
+        img = bpy.data.images.load(path, check_existing=False)
+        try:
+            px = np.empty(img.size[0] * img.size[1] * 4, np.float32)
+            img.pixels.foreach_get(px)
+        finally:
+            bpy.data.images.remove(img)
+    return px.reshape(-1, 4).astype(np.float64)
+
+
 def render_current(bpy, scene) -> np.ndarray:
     """Render the open scene with its engine (asserting DRT succeeded) and read it back."""
     bpy.ops.render.render()

@@ -1,10 +1,10 @@
 """Film > Transparent: alpha 0 where the camera sees the background, premultiplied colour,
 the world still lighting the scene; against Cycles' alpha."""
 import os
-import tempfile
 
 import numpy as np
 
+from conftest import SAMPLES_DIR, read_render_rgba
 from engine import Camera, Material, RenderSettings, Scene, World, render
 from engine_scenes import look_at, quad
 
@@ -41,7 +41,6 @@ def test_alpha_merges_exactly_across_sample_ranges():
 
 
 def test_alpha_matches_cycles(bpy_drt):
-    from conftest import SAMPLES_DIR
     bpy = bpy_drt
     alphas = {}
     for engine in ("DRT", "CYCLES"):
@@ -54,16 +53,7 @@ def test_alpha_matches_cycles(bpy_drt):
         scene.cycles.samples = 64
         scene.drt.samples = 64
         bpy.ops.render.render()
-        settings = scene.render.image_settings
-        settings.file_format, settings.color_depth, settings.color_mode = "OPEN_EXR", "32", "RGBA"
-        with tempfile.TemporaryDirectory() as d:
-            path = os.path.join(d, "a.exr")
-            bpy.data.images["Render Result"].save_render(filepath=path, scene=scene)
-            img = bpy.data.images.load(path)
-            px = np.empty(img.size[0] * img.size[1] * 4, np.float32)
-            img.pixels.foreach_get(px)
-            bpy.data.images.remove(img)
-        alphas[engine] = px.reshape(-1, 4)[:, 3]
+        alphas[engine] = read_render_rgba(bpy, scene)[:, 3]
     print("mean alpha DRT", alphas["DRT"].mean(), "Cycles", alphas["CYCLES"].mean())
     assert 0.05 < alphas["CYCLES"].mean() < 0.95           # the view has background
     assert abs(alphas["DRT"].mean() - alphas["CYCLES"].mean()) < 0.01
@@ -74,7 +64,6 @@ def test_holdout_matches_cycles(bpy_drt):
     """The Cornell box's tall block as a holdout: a zero-alpha hole with no colour for the
     camera (film opaque), while it still shadows and reflects light for everything else;
     compared with Cycles' RGBA."""
-    from conftest import SAMPLES_DIR
     bpy = bpy_drt
     out = {}
     for engine in ("DRT", "CYCLES"):
@@ -89,16 +78,7 @@ def test_holdout_matches_cycles(bpy_drt):
         scene.drt.samples = 64
         scene.cycles.diffuse_bounces = scene.drt.diffuse_bounces = 0
         bpy.ops.render.render()
-        settings = scene.render.image_settings
-        settings.file_format, settings.color_depth, settings.color_mode = "OPEN_EXR", "32", "RGBA"
-        with tempfile.TemporaryDirectory() as d:
-            path = os.path.join(d, "h.exr")
-            bpy.data.images["Render Result"].save_render(filepath=path, scene=scene)
-            img = bpy.data.images.load(path)
-            px = np.empty(img.size[0] * img.size[1] * 4, np.float32)
-            img.pixels.foreach_get(px)
-            bpy.data.images.remove(img)
-        out[engine] = px.reshape(-1, 4).astype(np.float64)
+        out[engine] = read_render_rgba(bpy, scene)
     a_drt, a_cyc = out["DRT"][:, 3], out["CYCLES"][:, 3]
     hole = a_cyc < 0.01
     print("hole pixels", hole.sum(), "alpha MAD", np.abs(a_drt - a_cyc).mean())

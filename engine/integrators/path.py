@@ -32,6 +32,7 @@ from ..bsdf.lobes import TRANSMISSION
 from ..bsdf.principled import PrincipledBSDF
 from ..sampling import dimensions as D
 from ..surface import offset_origin
+from .coverage import end_at_holdouts, uncovered
 from ..warp import to_local, to_world
 
 ROULETTE_START = 3
@@ -264,21 +265,13 @@ class PathIntegrator:
                 if alpha_out is not None and depth == 0 and ctx.scene.film_transparent:
                     # Film > Transparent: the camera sees no background; what got through
                     # transparent surfaces to it is the uncovered part of the sample.
-                    alpha_out[path[sel]] = 1.0 - np.clip(b[sel].mean(1), 0.0, 1.0)
+                    alpha_out[path[sel]] = uncovered(b[sel])
                 else:
                     add(path[sel], b[sel] * env, depth)
                 alive[sel] = False
             if stopped is not None:
                 alive &= ~stopped               # past the transparent bounce limit
-            if depth == 0 and ctx.surfaces.holdout is not None:
-                # Cycles' holdout: a camera ray (or its transparent continuation) that
-                # reaches a holdout surface adds no colour and leaves the sample uncovered;
-                # other rays see the object as usual.
-                hold = alive & hits.hit & ctx.surfaces.holdout[np.maximum(hits.prim, 0)]
-                if hold.any():
-                    if alpha_out is not None:
-                        alpha_out[path[hold]] = 1.0 - np.clip(b[hold].mean(1), 0.0, 1.0)
-                    alive &= ~hold
+            alive = end_at_holdouts(ctx, hits, alive, b, path, alpha_out, depth)
             live = np.nonzero(alive)[0]
             if live.size == 0:
                 break

@@ -22,6 +22,7 @@ from ..bsdf import fresnel
 from ..lights import luminance
 from ..sampling import dimensions as D
 from ..surface import offset_origin
+from .coverage import end_at_holdouts, uncovered
 from ..warp import INV_PI
 from .path import intersect_alpha, shadow_transmittance
 
@@ -106,17 +107,13 @@ class WhittedIntegrator:
                 L[path[on_light]] += b[on_light] * le[on_light]   # and the ray goes on
             escaped = alive & ~hits.hit
             if alpha_out is not None and depth == 0 and ctx.scene.film_transparent:
-                alpha_out[path[escaped]] = 1.0 - np.clip(b[escaped].mean(1), 0.0, 1.0)
+                alpha_out[path[escaped]] = uncovered(b[escaped])
             else:
                 L[path[escaped]] += b[escaped] * ctx.world_radiance
             alive &= ~escaped
             if stopped is not None:
                 alive &= ~stopped               # past the transparent bounce limit
-            if depth == 0 and ctx.surfaces.holdout is not None:     # Cycles' holdout
-                hold = alive & hits.hit & ctx.surfaces.holdout[np.maximum(hits.prim, 0)]
-                if alpha_out is not None:
-                    alpha_out[path[hold]] = 1.0 - np.clip(b[hold].mean(1), 0.0, 1.0)
-                alive &= ~hold
+            alive = end_at_holdouts(ctx, hits, alive, b, path, alpha_out, depth)
             live = np.nonzero(alive)[0]
             if live.size == 0:
                 break
