@@ -178,13 +178,13 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
         with ThreadPoolExecutor(threads) as pool:
             for a, b in plan_passes(total):
                 a, b = a + sample_start, b + sample_start
-                # at most chunk_paths paths per unit, at least two units per thread in
-                # a pass where that keeps units of 8192 paths or more (smaller arrays cost
-                # more in per-call overhead, which holds the GIL, than threads win)
+                # Pixels per unit: two units per thread, but no unit over chunk_paths
+                # paths (memory) nor under 8192 (smaller arrays cost more in per-call
+                # overhead, which holds the GIL, than the threads win).
                 k = b - a
-                per_unit = max(1, -(-8192 // k),
-                               min(settings.chunk_paths // k, -(-n_pixels // (2 * threads))))
-                per_unit = min(per_unit, max(1, settings.chunk_paths // k))
+                most = max(1, settings.chunk_paths // k)
+                least = -(-8192 // k)
+                per_unit = min(most, max(least, -(-n_pixels // (2 * threads))))
                 futures = []
                 for start in range(0, n_pixels, per_unit):
                     pixels = np.arange(start, min(start + per_unit, n_pixels))

@@ -429,14 +429,18 @@ def build_texture_scene(bpy):
     return scene
 
 
-@pytest.fixture(scope="module")
-def texture_renders(bpy_drt):
-    bpy = bpy_drt
-    build_texture_scene(bpy)
-    cycles = _render(bpy, "CYCLES", 64)
-    drt = _render(bpy, "DRT", 64)
+def _render_both(bpy, build, samples):
+    """(DRT image, Cycles image, DRT's exported scene) of the scene `build` makes."""
+    build(bpy)
+    cycles = _render(bpy, "CYCLES", samples)
+    drt = _render(bpy, "DRT", samples)
     from drt_addon import render_engine
     return drt, cycles, render_engine.last_render["scene"]
+
+
+@pytest.fixture(scope="module")
+def texture_renders(bpy_drt):
+    return _render_both(bpy_drt, build_texture_scene, 64)
 
 
 def compare(drt, cycles):
@@ -550,12 +554,7 @@ def build_alpha_scene(bpy):
 
 @pytest.fixture(scope="module")
 def alpha_renders(bpy_drt):
-    bpy = bpy_drt
-    build_alpha_scene(bpy)
-    cycles = _render(bpy, "CYCLES", 256)
-    drt = _render(bpy, "DRT", 256)
-    from drt_addon import render_engine
-    return drt, cycles, render_engine.last_render["scene"]
+    return _render_both(bpy_drt, build_alpha_scene, 256)
 
 
 def test_alpha_matches_cycles(alpha_renders):

@@ -15,6 +15,13 @@ def uncovered(b: np.ndarray) -> np.ndarray:
     return 1.0 - np.clip(b.mean(1), 0.0, 1.0)
 
 
+def background_is_transparent(ctx, alpha_out, depth) -> bool:
+    """Whether rays escaping at this depth show the film's transparent background (camera
+    rays, continued only through transparent surfaces, with Film > Transparent): they then
+    add no world radiance and write their coverage instead."""
+    return alpha_out is not None and depth == 0 and ctx.scene.film_transparent
+
+
 def end_at_holdouts(ctx, hits, alive, b, path, alpha_out, depth) -> np.ndarray:
     """Camera-ray paths (depth 0) alive and hitting a holdout end there, with their alpha
     written; returns the updated `alive` mask. Other rays see holdout objects as usual."""

@@ -32,7 +32,7 @@ from ..bsdf.lobes import TRANSMISSION
 from ..bsdf.principled import PrincipledBSDF
 from ..sampling import dimensions as D
 from ..surface import offset_origin
-from .coverage import end_at_holdouts, uncovered
+from .coverage import background_is_transparent, end_at_holdouts, uncovered
 from ..warp import to_local, to_world
 
 ROULETTE_START = 3
@@ -262,9 +262,7 @@ class PathIntegrator:
                     w = self._hit_weight(prev_pdf[sel], sun.pdf(None, d[sel], None, t_sel)
                                          * lights.select_pdf[k])
                     env += sun.escaped(d[sel], t_sel) * w[:, None]
-                if alpha_out is not None and depth == 0 and ctx.scene.film_transparent:
-                    # Film > Transparent: the camera sees no background; what got through
-                    # transparent surfaces to it is the uncovered part of the sample.
+                if background_is_transparent(ctx, alpha_out, depth):
                     alpha_out[path[sel]] = uncovered(b[sel])
                 else:
                     add(path[sel], b[sel] * env, depth)

@@ -22,7 +22,7 @@ from ..bsdf import fresnel
 from ..lights import luminance
 from ..sampling import dimensions as D
 from ..surface import offset_origin
-from .coverage import end_at_holdouts, uncovered
+from .coverage import background_is_transparent, end_at_holdouts, uncovered
 from ..warp import INV_PI
 from .path import intersect_alpha, shadow_transmittance
 
@@ -106,7 +106,7 @@ class WhittedIntegrator:
                     on_light &= ctx.light_visible_camera[np.maximum(k_l, 0)]
                 L[path[on_light]] += b[on_light] * le[on_light]   # and the ray goes on
             escaped = alive & ~hits.hit
-            if alpha_out is not None and depth == 0 and ctx.scene.film_transparent:
+            if background_is_transparent(ctx, alpha_out, depth):
                 alpha_out[path[escaped]] = uncovered(b[escaped])
             else:
                 L[path[escaped]] += b[escaped] * ctx.world_radiance
