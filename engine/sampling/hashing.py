@@ -4,71 +4,127 @@ A sample value depends only on (seed, pixel, sample index, dimension), never on 
 in which samples are drawn, so any range of sample indices of any pixel renders on its
 own and two halves of a render merge into exactly the same image as one whole render.
 
-All arithmetic is on uint64 / uint32 NumPy arrays, where overflow wraps modulo 2**64
-(or 2**32) as the mixing functions require.
+The functions are compiled scalar kernels on uint64 words (overflow wraps modulo 2**64,
+as the mixing functions require); `hash_keys` and `permute_index` also take NumPy arrays
+for callers outside the kernels.
+
+A hash of several keys is a chain: h = mix64(h ^ (key + GOLDEN)) per key, starting from
+H0. So the prefix over (seed, pixel) is computed once per path (`pixel_key`) and every
+dimension's key continues the chain from there: the same value as hashing all the keys
+at once.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..kernels.jit import kernel
+
+H0 = np.uint64(0x243F6A8885A308D3)
+GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
 _M2 = np.uint64(0x94D049BB133111EB)
-_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 _S30, _S27, _S31 = np.uint64(30), np.uint64(27), np.uint64(31)
+_S11 = np.uint64(11)
+_ONE = np.uint64(1)
 
 
-def mix64(x: np.ndarray) -> np.ndarray:
+@kernel
+def mix64(x):
     """SplitMix64's finaliser: a bijection on 64-bit words with full avalanche."""
-    x = np.asarray(x, dtype=np.uint64)
-    with np.errstate(over="ignore"):
-        x = (x ^ (x >> _S30)) * _M1
-        x = (x ^ (x >> _S27)) * _M2
+    x = np.uint64(x)
+    x = (x ^ (x >> _S30)) * _M1
+    x = (x ^ (x >> _S27)) * _M2
     return x ^ (x >> _S31)
+
+
+@kernel
+def chain(h, key):
+    """One link of the key chain: h, then key."""
+    return mix64(np.uint64(h) ^ (np.uint64(key) + GOLDEN))
+
+
+@kernel
+def pixel_key(seed, pixel):
+    """The chain over (seed, pixel): computed once per path, continued per dimension."""
+    return chain(chain(H0, seed), pixel)
+
+
+@kernel
+def unit_float(h):
+    """The top 53 bits of a uint64 hash as a float64 in [0, 1)."""
+    return np.float64(np.uint64(h) >> _S11) * (1.0 / 9007199254740992.0)
+
+
+@kernel
+def permute(i, n, key):
+    """A keyed pseudo-random permutation of range(n), evaluated at i.
+
+    Each key selects one permutation. A four-round Feistel network on the smallest even
+    number of bits 2h with 2**(2h) >= n (each round is a bijection whatever its round
+    function, here SplitMix64 of the half and the key), with cycle walking back into
+    [0, n): fewer than four steps per value on average."""
+    n = np.uint64(n)
+    bits = 1
+    while (np.uint64(1) << np.uint64(bits)) < n:
+        bits += 1
+    h = np.uint64((bits + 1) >> 1)
+    hmask = (_ONE << h) - _ONE
+    key = np.uint64(key)
+    r0 = mix64(key)
+    r1 = mix64(key ^ np.uint64(0x9E3779B97F4A7C15))
+    r2 = mix64(key ^ np.uint64(0x3C6EF372FE94F82A))
+    r3 = mix64(key ^ np.uint64(0xDAA66D2C7DDF743F))
+    x = np.uint64(i)
+    for _ in range(256):                # a walk this long has probability < 4**-256
+        left, right = x >> h, x & hmask
+        left, right = right, left ^ (mix64(right ^ r0) & hmask)
+        left, right = right, left ^ (mix64(right ^ r1) & hmask)
+        left, right = right, left ^ (mix64(right ^ r2) & hmask)
+        left, right = right, left ^ (mix64(right ^ r3) & hmask)
+        x = (left << h) | right
+        if x < n:
+            break
+    return x
+
+
+@kernel
+def _hash_rows(keys):
+    out = np.empty(keys.shape[0], np.uint64)
+    for r in range(keys.shape[0]):
+        h = H0
+        for c in range(keys.shape[1]):
+            h = chain(h, keys[r, c])
+        out[r] = h
+    return out
+
+
+@kernel
+def _permute_rows(i, n, key):
+    out = np.empty(i.shape[0], np.uint64)
+    for r in range(i.shape[0]):
+        out[r] = permute(i[r], n[r], key[r])
+    return out
 
 
 def hash_keys(*keys) -> np.ndarray:
     """Hash any number of integer keys (scalars or broadcastable arrays) to uint64."""
-    h = np.uint64(0x243F6A8885A308D3)
-    with np.errstate(over="ignore"):
-        for k in keys:
-            k = np.asarray(k).astype(np.uint64)
-            h = mix64(h ^ (k + _GOLDEN))
-    return np.asarray(h, dtype=np.uint64)
+    arrays = np.broadcast_arrays(*[np.asarray(k).astype(np.uint64) for k in keys])
+    shape = arrays[0].shape
+    stacked = np.stack([a.ravel() for a in arrays], axis=1)
+    return _hash_rows(np.ascontiguousarray(stacked)).reshape(shape)
 
 
 def to_unit_float(h: np.ndarray) -> np.ndarray:
     """The top 53 bits of a uint64 hash as a float64 in [0, 1)."""
-    return (np.asarray(h, dtype=np.uint64) >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)
+    return (np.asarray(h, dtype=np.uint64) >> np.uint64(11)).astype(np.float64) \
+        * (1.0 / 9007199254740992.0)
 
 
-def permute_index(i: np.ndarray, n, key: np.ndarray) -> np.ndarray:
-    """A keyed pseudo-random permutation of range(n), evaluated element-wise.
-
-    Each key selects one permutation; element i maps to perm_key(i). A four-round
-    Feistel network on the smallest even number of bits 2h with 2**(2h) >= n (each round
-    is a bijection whatever its round function, here SplitMix64 of the half and the key),
-    with cycle walking back into [0, n): expected fewer than four steps per element.
-    `n` may be a scalar or an array broadcastable with i.
-    """
+def permute_index(i, n, key) -> np.ndarray:
+    """`permute` element-wise over broadcastable arrays i, n, key."""
     i, n, key = np.broadcast_arrays(np.asarray(i, dtype=np.uint64),
                                     np.asarray(n, dtype=np.uint64),
                                     np.asarray(key, dtype=np.uint64))
     shape = i.shape
-    n = n.ravel()
-    bits = np.ceil(np.log2(np.maximum(n, 2).astype(np.float64))).astype(np.uint64)
-    h = (bits + np.uint64(1)) >> np.uint64(1)           # half width, >= 1
-    hmask = (np.uint64(1) << h) - np.uint64(1)
-    round_keys = [mix64(key.ravel() ^ np.uint64(r * 0x9E3779B97F4A7C15 % 2**64)) for r in range(4)]
-    x = i.ravel().copy()
-    active = np.arange(x.size)
-    for _ in range(256):                    # a walk this long has probability < 4**-256
-        y, hh, hm = x[active], h[active], hmask[active]
-        left, right = y >> hh, y & hm
-        for rk in round_keys:
-            left, right = right, left ^ (mix64(right ^ rk[active]) & hm)
-        y = (left << hh) | right
-        x[active] = y
-        active = active[y >= n[active]]
-        if active.size == 0:
-            break
-    return x.reshape(shape)
+    out = _permute_rows(np.array(i.ravel()), np.array(n.ravel()), np.array(key.ravel()))
+    return out.reshape(shape)

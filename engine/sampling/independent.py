@@ -1,18 +1,22 @@
 """Independent uniform random samples: the baseline the other samplers must beat."""
 from __future__ import annotations
 
-import numpy as np
-
-from .hashing import hash_keys, to_unit_float
+from ..kernels.jit import kernel
+from .hashing import H0, chain, unit_float
 from .sampler import Sampler
+
+
+@kernel
+def random_1d(pkey, index, dim):
+    return unit_float(chain(chain(chain(pkey, index), dim), 0))
+
+
+@kernel
+def random_2d(pkey, index, dim):
+    h = chain(chain(pkey, index), dim)
+    return unit_float(chain(chain(H0, h), 1)), unit_float(chain(chain(H0, h), 2))
 
 
 class IndependentSampler(Sampler):
     name = "random"
-
-    def get_1d(self, dim, pixel, index):
-        return to_unit_float(hash_keys(self.seed, pixel, index, dim, 0))
-
-    def get_2d(self, dim, pixel, index):
-        h = hash_keys(self.seed, pixel, index, dim)
-        return np.stack([to_unit_float(hash_keys(h, 1)), to_unit_float(hash_keys(h, 2))], axis=-1)
+    kind = 2

@@ -16,10 +16,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .hashing import hash_keys
+from ..kernels.jit import kernel
+from .hashing import H0, chain
 from .sampler import ONE_MINUS_EPSILON, Sampler
 
-_U32 = np.uint32
+_MASK32 = np.uint64(0xFFFFFFFF)
 
 
 def _direction_numbers_dim1() -> np.ndarray:
@@ -27,78 +28,101 @@ def _direction_numbers_dim1() -> np.ndarray:
     v[0] = 1 << 31
     for k in range(1, 32):
         v[k] = int(v[k - 1]) ^ (int(v[k - 1]) >> 1)
-    return v.astype(np.uint32)
+    return v
 
 
 _V1 = _direction_numbers_dim1()
 
 
-def reverse_bits32(x: np.ndarray) -> np.ndarray:
-    x = np.asarray(x, dtype=np.uint32)
-    x = ((x >> _U32(1)) & _U32(0x55555555)) | ((x & _U32(0x55555555)) << _U32(1))
-    x = ((x >> _U32(2)) & _U32(0x33333333)) | ((x & _U32(0x33333333)) << _U32(2))
-    x = ((x >> _U32(4)) & _U32(0x0F0F0F0F)) | ((x & _U32(0x0F0F0F0F)) << _U32(4))
-    x = ((x >> _U32(8)) & _U32(0x00FF00FF)) | ((x & _U32(0x00FF00FF)) << _U32(8))
-    return (x >> _U32(16)) | (x << _U32(16))
+@kernel
+def reverse_bits32(x):
+    """The 32 low bits of x in reverse order (a uint64 holding a 32-bit word)."""
+    x = np.uint64(x) & _MASK32
+    x = ((x >> np.uint64(1)) & np.uint64(0x55555555)) | ((x & np.uint64(0x55555555)) << np.uint64(1))
+    x = ((x >> np.uint64(2)) & np.uint64(0x33333333)) | ((x & np.uint64(0x33333333)) << np.uint64(2))
+    x = ((x >> np.uint64(4)) & np.uint64(0x0F0F0F0F)) | ((x & np.uint64(0x0F0F0F0F)) << np.uint64(4))
+    x = ((x >> np.uint64(8)) & np.uint64(0x00FF00FF)) | ((x & np.uint64(0x00FF00FF)) << np.uint64(8))
+    return ((x >> np.uint64(16)) | (x << np.uint64(16))) & _MASK32
+
+
+@kernel
+def sobol_dim1_word(index):
+    """Unscrambled Sobol dimension 1 of a 32-bit index, as 32-bit fixed point."""
+    index = np.uint64(index) & _MASK32
+    out = np.uint64(0)
+    k = 0
+    while index != 0:
+        if index & np.uint64(1):
+            out ^= _V1[k]
+        index >>= np.uint64(1)
+        k += 1
+    return out
+
+
+@kernel
+def _laine_karras(x, seed):
+    """Burley's improved Laine-Karras hash on 32-bit words: on bit-reversed values it is a
+    nested uniform (Owen) scramble, each bit flipped by a hash of the bits above it."""
+    x = (np.uint64(x) + np.uint64(seed)) & _MASK32
+    x ^= (x * np.uint64(0x6C50B47C)) & _MASK32
+    x ^= (x * np.uint64(0xB82F1E52)) & _MASK32
+    x ^= (x * np.uint64(0xC7AFE638)) & _MASK32
+    x ^= (x * np.uint64(0x8D22F6E6)) & _MASK32
+    return x
+
+
+@kernel
+def owen_scramble(x, seed):
+    return reverse_bits32(_laine_karras(reverse_bits32(x), seed))
+
+
+@kernel
+def _to_float(x32):
+    return min(np.float64(x32) * (1.0 / 4294967296.0), ONE_MINUS_EPSILON)
+
+
+@kernel
+def _seeds(pkey, dim):
+    h = chain(pkey, dim)
+    return (chain(chain(H0, h), 0) & _MASK32, chain(chain(H0, h), 1) & _MASK32,
+            chain(chain(H0, h), 2) & _MASK32)
+
+
+@kernel
+def sobol_1d(pkey, index, dim):
+    s_index, s_x, _ = _seeds(pkey, dim)
+    i = owen_scramble(np.uint64(index) & _MASK32, s_index)
+    return _to_float(owen_scramble(reverse_bits32(i), s_x))
+
+
+@kernel
+def sobol_2d(pkey, index, dim):
+    s_index, s_x, s_y = _seeds(pkey, dim)
+    i = owen_scramble(np.uint64(index) & _MASK32, s_index)
+    return (_to_float(owen_scramble(reverse_bits32(i), s_x)),
+            _to_float(owen_scramble(sobol_dim1_word(i), s_y)))
+
+
+@kernel
+def _words(f, index):
+    out = np.empty(index.shape[0], np.uint64)
+    for r in range(index.shape[0]):
+        out[r] = f(index[r])
+    return out
 
 
 def sobol_dim0(index: np.ndarray) -> np.ndarray:
     """Unscrambled Sobol dimension 0 as 32-bit fixed point (bit reversal of the index)."""
-    return reverse_bits32(index)
+    index = np.asarray(index, dtype=np.uint64)
+    return _words(reverse_bits32, index.ravel()).reshape(index.shape)
 
 
 def sobol_dim1(index: np.ndarray) -> np.ndarray:
     """Unscrambled Sobol dimension 1 as 32-bit fixed point."""
-    index = np.asarray(index, dtype=np.uint32)
-    out = np.zeros(index.shape, dtype=np.uint32)
-    for k in range(32):
-        bit = (index >> _U32(k)) & _U32(1)
-        if not bit.any():
-            if (index >> _U32(k)).max(initial=0) == 0:
-                break
-            continue
-        out ^= _V1[k] * bit
-    return out
-
-
-def _laine_karras(x: np.ndarray, seed: np.ndarray) -> np.ndarray:
-    """Burley's improved Laine-Karras hash: on bit-reversed values it is a nested
-    uniform (Owen) scramble, each bit flipped by a hash of the bits above it."""
-    with np.errstate(over="ignore"):
-        x = x + seed
-        x ^= x * _U32(0x6C50B47C)
-        x ^= x * _U32(0xB82F1E52)
-        x ^= x * _U32(0xC7AFE638)
-        x ^= x * _U32(0x8D22F6E6)
-    return x
-
-
-def owen_scramble(x: np.ndarray, seed: np.ndarray) -> np.ndarray:
-    return reverse_bits32(_laine_karras(reverse_bits32(x), seed))
-
-
-def _to_float(x32: np.ndarray) -> np.ndarray:
-    # add half a fixed-point step of jitter-free centring is not wanted: Owen scrambling
-    # already randomises the low bits; map to [0,1) exactly.
-    return np.minimum(x32.astype(np.float64) * (1.0 / 4294967296.0), ONE_MINUS_EPSILON)
+    index = np.asarray(index, dtype=np.uint64)
+    return _words(sobol_dim1_word, index.ravel()).reshape(index.shape)
 
 
 class SobolSampler(Sampler):
     name = "sobol"
-
-    def _seeds(self, dim, pixel):
-        h = hash_keys(self.seed, pixel, dim)
-        s = [(hash_keys(h, k) & np.uint64(0xFFFFFFFF)).astype(np.uint32) for k in range(3)]
-        return s
-
-    def get_1d(self, dim, pixel, index):
-        s_index, s_x, _ = self._seeds(dim, pixel)
-        i = owen_scramble(np.asarray(index, dtype=np.uint64).astype(np.uint32), s_index)
-        return _to_float(owen_scramble(sobol_dim0(i), s_x))
-
-    def get_2d(self, dim, pixel, index):
-        s_index, s_x, s_y = self._seeds(dim, pixel)
-        i = owen_scramble(np.asarray(index, dtype=np.uint64).astype(np.uint32), s_index)
-        x = owen_scramble(sobol_dim0(i), s_x)
-        y = owen_scramble(sobol_dim1(i), s_y)
-        return np.stack([_to_float(x), _to_float(y)], axis=-1)
+    kind = 1

@@ -13,43 +13,52 @@ any N, not only squares.
 
 Sample indices past N start a fresh, independently permuted generation of N, so
 progressive and adaptive rendering can ask for more samples without breaking anything.
+
+`pkey` is the path's `hashing.pixel_key(seed, pixel)`; the key of one (pixel, dimension,
+generation) continues that chain.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from .hashing import hash_keys, permute_index, to_unit_float
+from ..kernels.jit import kernel
+from .hashing import H0, chain, permute, unit_float
 from .sampler import ONE_MINUS_EPSILON, Sampler
+
+
+@kernel
+def _key(pkey, spp, index, dim):
+    n = np.uint64(spp)
+    index = np.uint64(index)
+    return chain(chain(pkey, dim), index // n), index % n
+
+
+@kernel
+def stratified_1d(pkey, spp, index, dim):
+    key, s = _key(pkey, spp, index, dim)
+    stratum = permute(s, spp, key)
+    jitter = unit_float(chain(chain(chain(H0, key), s), 11))
+    return min((np.float64(stratum) + jitter) / spp, ONE_MINUS_EPSILON)
+
+
+@kernel
+def stratified_2d(pkey, spp, index, dim):
+    key, s = _key(pkey, spp, index, dim)
+    m = max(1, int(math.floor(math.sqrt(spp))))
+    n = (spp + m - 1) // m
+    s = permute(s, spp, key)                               # Cook's ray-id chaining
+    um = np.uint64(m)
+    col = permute(s % um, m, chain(chain(H0, key), 1))
+    row = permute(s // um, n, chain(chain(H0, key), 2))
+    jx = unit_float(chain(chain(chain(H0, key), s), 3))
+    jy = unit_float(chain(chain(chain(H0, key), s), 4))
+    x = (np.float64(col) + (np.float64(row) + jx) / n) / m
+    y = (np.float64(s) + jy) / spp
+    return min(x, ONE_MINUS_EPSILON), min(y, ONE_MINUS_EPSILON)
 
 
 class StratifiedSampler(Sampler):
     name = "jittered"
-
-    def _split(self, dim, pixel, index):
-        index = np.asarray(index, dtype=np.uint64)
-        n = np.uint64(self.samples_per_pixel)
-        generation = index // n
-        local = index % n
-        key = hash_keys(self.seed, pixel, dim, generation)
-        return key, local
-
-    def get_1d(self, dim, pixel, index):
-        key, s = self._split(dim, pixel, index)
-        n = self.samples_per_pixel
-        stratum = permute_index(s, n, key)
-        jitter = to_unit_float(hash_keys(key, s, 11))
-        return np.minimum((stratum + jitter) / n, ONE_MINUS_EPSILON)
-
-    def get_2d(self, dim, pixel, index):
-        key, s = self._split(dim, pixel, index)
-        big_n = self.samples_per_pixel
-        m = max(1, int(np.floor(np.sqrt(big_n))))
-        n = (big_n + m - 1) // m
-        s = permute_index(s, big_n, key)                    # Cook's ray-id chaining
-        col = permute_index(s % np.uint64(m), m, hash_keys(key, 1))
-        row = permute_index(s // np.uint64(m), n, hash_keys(key, 2))
-        jx = to_unit_float(hash_keys(key, s, 3))
-        jy = to_unit_float(hash_keys(key, s, 4))
-        x = (col + (row + jx) / n) / m
-        y = (s + jy) / big_n
-        return np.minimum(np.stack([x, y], axis=-1), ONE_MINUS_EPSILON)
+    kind = 0
