@@ -21,6 +21,7 @@ rebuilt in float64 from the hit's barycentrics (`engine.surface`).
 from __future__ import annotations
 
 import os
+import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
@@ -119,6 +120,12 @@ class Accelerator:
             self.moving.append(obj)
             offset += len(m.triangles)
         self.total_triangles = offset
+        # Rays traced per query kind (all threads), and an optional recorder: a list that
+        # receives (query, origins, dirs, tmax) of every static-scene batch, so that a
+        # benchmark can replay exactly the same rays through bare Embree.
+        self.rays_traced = {"INTERSECT": 0, "OCCLUDED": 0}
+        self.recorder = None
+        self._count_lock = threading.Lock()
         self.scene_count = (self._scene is not None) + sum(len(o.scenes) for o in self.moving)
 
     def close(self):
@@ -132,6 +139,10 @@ class Accelerator:
         d = np.ascontiguousarray(dirs, dtype=np.float32)
         dist = np.ascontiguousarray(np.minimum(tmax, _BIG), dtype=np.float32)
         n = len(o)
+        with self._count_lock:
+            self.rays_traced[query] += n
+            if self.recorder is not None and scene is self._scene:
+                self.recorder.append((query, o, d, dist))
         if self._pool is None or n < _MIN_SPLIT:
             return [scene.run(o, d, dists=dist, query=query, output=output)]
         bounds = np.linspace(0, n, self.threads + 1).astype(int)

@@ -3,19 +3,32 @@
 `kernel` is Numba's `njit` with the GIL released (`nogil=True`), so work units on
 threads run in parallel, and with an on-disk cache so a second render starts at once.
 
-Cache location, in order:
-  1. `NUMBA_CACHE_DIR` when the user (or the Blender add-on) sets it;
-  2. Numba's own choice: `__pycache__` beside the source, else a per-user cache folder;
-  3. nowhere: when no cache location can be written (a read-only install with a
-     read-only home), kernels compile in memory on every process start instead of
-     failing. `DRT_NUMBA_CACHE=0` forces this (a test and debug switch).
+The cache is keyed by ALL of the engine's sources, not by each function's own file as
+Numba does by default: a kernel inlines the kernels it calls, so a change to a callee in
+another module (or an upgraded add-on) must recompile its callers. `EngineCacheLocator`
+stamps every cached kernel of the `engine` package with one fingerprint (the SHA-256 of
+every engine source file and the Numba version).
+
+Cache folder, the first writable of:
+  1. `NUMBA_CACHE_DIR` when set (the Blender add-on points it at the extension's user
+     folder, since an installed extension's own folder may be read-only);
+  2. `engine/kernels/__pycache__/numba` beside the sources;
+  3. a per-user cache folder (`drt-numba` in Numba's user cache location).
+When none can be written, kernels compile in memory on every process start instead of
+failing. `DRT_NUMBA_CACHE=0` forces that (a test and debug switch).
 """
 from __future__ import annotations
 
+import glob
+import hashlib
 import os
 import tempfile
 
+import numba
 from numba import njit
+from numba.core import caching
+
+ENGINE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def _writable(folder: str) -> bool:
@@ -28,28 +41,67 @@ def _writable(folder: str) -> bool:
         return False
 
 
-def _cache_possible() -> bool:
+def _cache_root() -> str | None:
     if os.environ.get("DRT_NUMBA_CACHE", "1") == "0":
-        return False
-    explicit = os.environ.get("NUMBA_CACHE_DIR")
-    if explicit:
-        return _writable(explicit)
-    beside = os.path.join(os.path.dirname(os.path.abspath(__file__)), "__pycache__")
-    if _writable(beside):
-        return True
-    # Numba's per-user fallback (its _UserWideCacheLocator)
+        return None
+    candidates = []
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        candidates.append(os.path.join(os.environ["NUMBA_CACHE_DIR"], "drt"))
+    candidates.append(os.path.join(ENGINE_DIR, "kernels", "__pycache__", "numba"))
     try:
         from numba.misc.appdirs import AppDirs
-        return _writable(AppDirs(appname="numba", appauthor=False).user_cache_dir)
+        candidates.append(os.path.join(AppDirs(appname="numba", appauthor=False)
+                                       .user_cache_dir, "drt-numba"))
     except Exception:
-        return False
+        pass
+    for folder in candidates:
+        if _writable(folder):
+            return folder
+    return None
 
 
-CACHE = _cache_possible()
+def _fingerprint() -> bytes:
+    h = hashlib.sha256(numba.__version__.encode())
+    for path in sorted(glob.glob(os.path.join(ENGINE_DIR, "**", "*.py"), recursive=True)):
+        h.update(os.path.relpath(path, ENGINE_DIR).encode())
+        with open(path, "rb") as f:
+            h.update(f.read())
+    return h.digest()
+
+
+CACHE_ROOT = _cache_root()
+CACHE = CACHE_ROOT is not None
+FINGERPRINT = _fingerprint() if CACHE else b""
+
+
+class EngineCacheLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
+    """Caches the engine's kernels under CACHE_ROOT, stamped with the engine-wide
+    FINGERPRINT; functions outside the engine package are left to Numba's locators."""
+
+    def __init__(self, py_func, py_file):
+        self._py_file = py_file
+        self._lineno = py_func.__code__.co_firstlineno
+        self._cache_path = os.path.join(CACHE_ROOT, self.get_suitable_cache_subpath(py_file))
+
+    def get_cache_path(self):
+        return self._cache_path
+
+    def get_source_stamp(self):
+        return FINGERPRINT
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        if CACHE_ROOT is None or not os.path.abspath(py_file).startswith(ENGINE_DIR + os.sep):
+            return None
+        return super().from_function(py_func, py_file)
+
+
+if CACHE and EngineCacheLocator not in caching.CacheImpl._locator_classes:
+    caching.CacheImpl._locator_classes.insert(0, EngineCacheLocator)
 
 
 def kernel(fn=None, **options):
-    """@kernel or @kernel(inline='always', ...): njit, GIL released, cached when possible.
+    """@kernel or @kernel(option=...): njit, GIL released, cached when possible.
     Floating-point semantics stay IEEE (no fastmath), so results match the NumPy
     reference implementations bit for bit where the operations are the same."""
     opts = dict(nogil=True, cache=CACHE, error_model="numpy")

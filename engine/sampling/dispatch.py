@@ -45,3 +45,12 @@ def batch_2d(kind, seed, spp, dim, pixel, index):
         out[r, 0] = x
         out[r, 1] = y
     return out
+
+
+@kernel
+def pixel_keys(seed, pixel):
+    """`hashing.pixel_key` of every path of a work unit, computed once per unit."""
+    out = np.empty(pixel.shape[0], np.uint64)
+    for r in range(pixel.shape[0]):
+        out[r] = pixel_key(seed, pixel[r])
+    return out

@@ -59,29 +59,36 @@ def unit_float(h):
 def permute(i, n, key):
     """A keyed pseudo-random permutation of range(n), evaluated at i.
 
-    Each key selects one permutation. A four-round Feistel network on the smallest even
-    number of bits 2h with 2**(2h) >= n (each round is a bijection whatever its round
-    function, here SplitMix64 of the half and the key), with cycle walking back into
-    [0, n): fewer than four steps per value on average."""
+    Each key selects one permutation. A four-round Feistel network on exactly the b bits
+    that hold n - 1 (unbalanced when b is odd: halves of floor(b/2) and ceil(b/2) bits
+    that swap places every round, so four rounds restore them; each round is a bijection
+    whatever its round function, here SplitMix64 of the half and a round key), with
+    cycle walking back into [0, n): fewer than two steps per value on average, whatever
+    n is. For n = 2 a key bit decides the swap."""
     n = np.uint64(n)
-    bits = 1
-    while (np.uint64(1) << np.uint64(bits)) < n:
-        bits += 1
-    h = np.uint64((bits + 1) >> 1)
-    hmask = (_ONE << h) - _ONE
     key = np.uint64(key)
+    x = np.uint64(i)
+    if n <= _ONE:
+        return np.uint64(0)
+    bits = np.uint64(1)
+    while (_ONE << bits) < n:
+        bits += _ONE
+    if bits == _ONE:
+        return x ^ (mix64(key) & _ONE)
+    a = bits >> _ONE              # width of the left half; the right half has bits - a
+    b = bits - a
     r0 = mix64(key)
     r1 = mix64(key ^ np.uint64(0x9E3779B97F4A7C15))
     r2 = mix64(key ^ np.uint64(0x3C6EF372FE94F82A))
     r3 = mix64(key ^ np.uint64(0xDAA66D2C7DDF743F))
-    x = np.uint64(i)
-    for _ in range(256):                # a walk this long has probability < 4**-256
-        left, right = x >> h, x & hmask
-        left, right = right, left ^ (mix64(right ^ r0) & hmask)
-        left, right = right, left ^ (mix64(right ^ r1) & hmask)
-        left, right = right, left ^ (mix64(right ^ r2) & hmask)
-        left, right = right, left ^ (mix64(right ^ r3) & hmask)
-        x = (left << h) | right
+    ma, mb = (_ONE << a) - _ONE, (_ONE << b) - _ONE
+    for _ in range(1024):         # a walk this long has probability < 2**-1024
+        left, right = x >> b, x & mb                      # widths (a, b)
+        left, right = right, left ^ (mix64(right ^ r0) & ma)   # (b, a)
+        left, right = right, left ^ (mix64(right ^ r1) & mb)   # (a, b)
+        left, right = right, left ^ (mix64(right ^ r2) & ma)   # (b, a)
+        left, right = right, left ^ (mix64(right ^ r3) & mb)   # (a, b)
+        x = (left << b) | right
         if x < n:
             break
     return x

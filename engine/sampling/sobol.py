@@ -45,18 +45,30 @@ def reverse_bits32(x):
     return ((x >> np.uint64(16)) | (x << np.uint64(16))) & _MASK32
 
 
+def _byte_tables(v: np.ndarray) -> np.ndarray:
+    """(4, 256): entry [k, b] is the XOR of the direction numbers v[8k + j] over the set
+    bits j of byte b, so a 32-bit index needs four look-ups instead of a loop over bits."""
+    t = np.zeros((4, 256), dtype=np.uint64)
+    for k in range(4):
+        for byte in range(256):
+            acc = 0
+            for j in range(8):
+                if byte >> j & 1:
+                    acc ^= int(v[8 * k + j])
+            t[k, byte] = acc
+    return t
+
+
+_V1_BYTES = _byte_tables(_V1)
+
+
 @kernel
 def sobol_dim1_word(index):
     """Unscrambled Sobol dimension 1 of a 32-bit index, as 32-bit fixed point."""
     index = np.uint64(index) & _MASK32
-    out = np.uint64(0)
-    k = 0
-    while index != 0:
-        if index & np.uint64(1):
-            out ^= _V1[k]
-        index >>= np.uint64(1)
-        k += 1
-    return out
+    m = np.uint64(0xFF)
+    return (_V1_BYTES[0, index & m] ^ _V1_BYTES[1, (index >> np.uint64(8)) & m]
+            ^ _V1_BYTES[2, (index >> np.uint64(16)) & m] ^ _V1_BYTES[3, index >> np.uint64(24)])
 
 
 @kernel

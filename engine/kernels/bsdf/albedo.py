@@ -1,0 +1,89 @@
+"""Directional albedo of the Principled specular layer (GGX reflection with exact
+dielectric Fresnel), looked up in the tables of engine/bsdf/principled.py: the compiled
+twin of `principled.specular_albedo` (same coordinates, same trilinear interpolation).
+
+The tables are built by the NumPy module (lazily, once per process, thread-safe) and
+handed to the kernels as one tuple, `kernel_tables()`:
+    (table for eta >= 1, table for eta < 1, grid of F0^(1/4), grid of roughness,
+     grid of the cos theta_o coordinate t)
+each table indexed [F0^(1/4), roughness, t].
+"""
+from __future__ import annotations
+
+import math
+import threading
+
+import numpy as np
+
+from ..jit import kernel
+from . import microfacet as mf
+
+T_SIDE0, T_SIDE1, T_GRID_S, T_GRID_R, T_GRID_T = 0, 1, 2, 3, 4
+
+_lock = threading.Lock()
+_tables = None
+
+
+def kernel_tables() -> tuple:
+    """The specular albedo tables and their grids as C-contiguous float64 arrays (see
+    the module docstring), built on first use and then shared."""
+    global _tables
+    if _tables is None:
+        from ...bsdf import principled as npp
+        with _lock:
+            if _tables is None:
+                def arr(a):
+                    return np.ascontiguousarray(a, dtype=np.float64)
+                _tables = (arr(npp._get_table(0)), arr(npp._get_table(1)),
+                           arr(npp._TABLE_S), arr(npp._TABLE_R), arr(npp._TABLE_T))
+    return _tables
+
+
+@kernel
+def critical_cos(eta):
+    """cos of the critical angle for relative IOR eta < 1 (0 for eta >= 1)."""
+    return math.sqrt(min(max(1.0 - eta * eta, 0.0), 1.0))
+
+
+@kernel
+def t_of_mu(mu, c):
+    """Table coordinate t in [0, 1] of cos theta_o = mu for critical cosine c."""
+    mu = min(max(mu, 0.0), 1.0)
+    if c > 0.0:
+        if mu <= c:
+            return math.asin(math.sqrt(min(max(mu / c, 0.0), 1.0))) / math.pi
+        return 0.5 + 0.5 * math.sqrt(min(max((mu - c) / max(1.0 - c, 1e-300), 0.0), 1.0))
+    return math.sqrt(mu)
+
+
+@kernel
+def lerp_coords(grid, v):
+    """(i0, f): the cell and the fraction of v on a uniform grid, v clamped to it."""
+    n = grid.shape[0]
+    f = (min(max(v, grid[0]), grid[n - 1]) - grid[0]) / (grid[1] - grid[0])
+    i0 = min(int(f), n - 2)
+    return i0, f - i0
+
+
+@kernel
+def specular_albedo(cos_o, alpha, eta, tables):
+    """Directional albedo of GGX reflection with dielectric Fresnel of relative IOR eta
+    (single scattering), interpolated trilinearly from the tables."""
+    alpha = mf.clamp_alpha(alpha)
+    if eta < 1.0:
+        table = tables[T_SIDE1]
+    else:
+        table = tables[T_SIDE0]
+    x = abs(eta - 1.0) / (eta + 1.0)
+    i, fi = lerp_coords(tables[T_GRID_S], math.sqrt(x))
+    j, fj = lerp_coords(tables[T_GRID_R], math.sqrt(alpha))
+    k, fk = lerp_coords(tables[T_GRID_T], t_of_mu(cos_o, critical_cos(eta)))
+    acc = 0.0
+    for di in range(2):
+        wi_ = fi if di else 1.0 - fi
+        for dj in range(2):
+            wj = fj if dj else 1.0 - fj
+            for dk in range(2):
+                wk = fk if dk else 1.0 - fk
+                acc = acc + wi_ * wj * wk * table[i + di, j + dj, k + dk]
+    return acc

@@ -1,0 +1,192 @@
+"""Dielectric interfaces, smooth (delta) and rough (GGX, Walter et al. 2007), scalar: the
+compiled twin of engine/bsdf/dielectric.py.
+
+`eta` is the material IOR relative to the outside; a direction wo below the surface is
+mirrored to the upper side ("canonical") with relative index 1/eta, and the results are
+mirrored back, as in the NumPy module (see there for the sources, the radiance scaling
+1/eta^2 of refraction and the allow flags of the reflect/refract choice).
+"""
+from __future__ import annotations
+
+import math
+
+from ..jit import kernel
+from . import fresnel
+from . import microfacet as mf
+
+# Below this GGX alpha a rough interface is treated as smooth; |eta - 1| below
+# INDEX_MATCHED is no interface at all (same constants as engine/bsdf/dielectric.py).
+SMOOTH_ALPHA = 10.0 ** -3.5
+INDEX_MATCHED = 1e-6
+
+
+@kernel
+def is_smooth(alpha, eta):
+    """Whether (alpha, eta) is handled by the smooth (delta) model."""
+    return alpha <= SMOOTH_ALPHA or abs(eta - 1.0) < INDEX_MATCHED
+
+
+@kernel
+def canonical(oz, eta):
+    """(sign, eta_rel): wo_z * sign >= 0 and the relative index seen from that side."""
+    if oz < 0.0:
+        return -1.0, 1.0 / eta
+    return 1.0, eta
+
+
+@kernel
+def choice_probs(F, allow_reflect, allow_refract):
+    """Probabilities of choosing reflection and refraction."""
+    if allow_reflect and allow_refract:
+        return F, 1.0 - F
+    return (1.0 if allow_reflect else 0.0), (1.0 if allow_refract else 0.0)
+
+
+# --- smooth interface ------------------------------------------------------------------
+
+@kernel
+def smooth_sample(ox, oy, oz, eta, u, allow_reflect, allow_refract):
+    """Delta reflection or refraction chosen by Fresnel (or forced by the allow flags):
+    (wi_x, wi_y, wi_z, weight, refracted, valid); its pdf is a delta."""
+    sign, eta_rel = canonical(oz, eta)
+    cz = oz * sign
+    F, cos_t, eta_t = fresnel.dielectric_full(cz, eta_rel)
+    pr, pt = choice_probs(F, allow_reflect, allow_refract)
+    refr = u >= pr
+    if refr:
+        ix, iy, iz = -ox / eta_t, -oy / eta_t, -cos_t
+        p = pt
+        ok = p > 0.0 and cz > 0.0 and F < 1.0
+        w = (1.0 - F) / (eta_t * eta_t)
+    else:
+        ix, iy, iz = -ox, -oy, cz
+        p = pr
+        ok = p > 0.0 and cz > 0.0
+        w = F
+    w = w / p if ok else 0.0
+    return ix, iy, iz * sign, w, refr, ok
+
+
+# --- rough interface -------------------------------------------------------------------
+
+@kernel
+def refraction_half(ox, oy, oz, ix, iy, iz, eta_rel):
+    """Generalised half vector h ~ wo + eta wi (Walter eq. 16), facing +Z, with wo.h,
+    wi.h and its validity (canonical directions)."""
+    hx = ox + eta_rel * ix
+    hy = oy + eta_rel * iy
+    hz = oz + eta_rel * iz
+    n = math.sqrt(hx * hx + hy * hy + hz * hz)
+    ok = n > 1e-12
+    if not ok:
+        n = 1.0
+    hx, hy, hz = hx / n, hy / n, hz / n
+    if hz < 0.0:
+        hx, hy, hz = -hx, -hy, -hz
+    cos_oh = mf.dot(ox, oy, oz, hx, hy, hz)
+    cos_ih = mf.dot(ix, iy, iz, hx, hy, hz)
+    ok = ok and cos_oh > 0.0 and cos_ih < 0.0 and hz > 0.0
+    return hx, hy, hz, cos_oh, cos_ih, ok
+
+
+@kernel
+def rough_eval(ox, oy, oz, ix, iy, iz, eta, alpha):
+    """(f_reflect, f_refract) in 1/sr; one of them is zero for each pair."""
+    a = mf.clamp_alpha(alpha)
+    sign, eta_rel = canonical(oz, eta)
+    oz = oz * sign
+    iz = iz * sign
+    if iz > 0.0:
+        base_r, hx, hy, hz = mf.reflection_eval(ox, oy, oz, ix, iy, iz, a)
+        if base_r == 0.0:
+            return 0.0, 0.0
+        F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
+        return F_r * base_r, 0.0
+    hx, hy, hz, cos_oh, cos_ih, ok = refraction_half(ox, oy, oz, ix, iy, iz, eta_rel)
+    if not (ok and oz > 0.0 and iz < 0.0):
+        return 0.0, 0.0
+    F_t = fresnel.dielectric(cos_oh, eta_rel)
+    a2 = a * a
+    zo, zi = oz, -iz
+    g_den = zi * mf.r_len(ox, oy, oz, a2) + zo * mf.r_len(ix, iy, iz, a2)
+    s = cos_oh + eta_rel * cos_ih
+    den = s * s
+    if not (g_den > 0.0 and den > 0.0):
+        return 0.0, 0.0
+    val = (2.0 * mf.D(hx, hy, hz, a) * (1.0 - F_t) * (-cos_ih) * cos_oh
+           / (g_den * den))
+    return 0.0, val
+
+
+@kernel
+def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract):
+    """pdf over wi (1/sr) of `rough_sample` with the same allow flags."""
+    a = mf.clamp_alpha(alpha)
+    sign, eta_rel = canonical(oz, eta)
+    oz = oz * sign
+    iz = iz * sign
+    g1c = mf.G1_over_cos(ox, oy, oz, a)
+    if iz > 0.0:
+        # reflection: P(reflect | h) D_wo(h) / (4 wo.h)
+        hx, hy, hz, ok = mf.half_vector(ox, oy, oz, ix, iy, iz)
+        if not (ok and oz > 0.0):
+            return 0.0
+        F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
+        pr, _ = choice_probs(F_r, allow_reflect, allow_refract)
+        return pr * 0.25 * g1c * mf.D(hx, hy, hz, a)
+    # refraction: P(refract | h) D_wo(h) |dh/dwi|
+    hx, hy, hz, cos_oh, cos_ih, ok = refraction_half(ox, oy, oz, ix, iy, iz, eta_rel)
+    if not (ok and oz > 0.0):
+        return 0.0
+    F_t = fresnel.dielectric(cos_oh, eta_rel)
+    _, pt = choice_probs(F_t, allow_reflect, allow_refract)
+    s = cos_oh + eta_rel * cos_ih
+    den = s * s
+    if not den > 0.0:
+        return 0.0
+    jac = eta_rel * eta_rel * (-cos_ih) / den
+    return pt * g1c * cos_oh * mf.D(hx, hy, hz, a) * jac
+
+
+@kernel
+def rough_sample(ox, oy, oz, eta, alpha, u_choice, u0, u1, allow_reflect, allow_refract):
+    """Sample the rough interface: u_choice picks reflection or refraction, (u0, u1) the
+    visible normal. Returns (wi_x, wi_y, wi_z, refracted, valid); the weight and pdf of
+    the choice are left to the caller (the Principled mixture recomputes both)."""
+    a = mf.clamp_alpha(alpha)
+    sign, eta_rel = canonical(oz, eta)
+    oz = oz * sign
+    hx, hy, hz = mf.sample_visible_normal(ox, oy, oz, a, u0, u1)
+    cos_oh = mf.dot(ox, oy, oz, hx, hy, hz)
+    F, cos_t, eta_t = fresnel.dielectric_full(max(cos_oh, 0.0), eta_rel)
+    pr, pt = choice_probs(F, allow_reflect, allow_refract)
+    refr = u_choice >= pr
+    if refr:
+        k = cos_oh / eta_t - cos_t
+        ix = -ox / eta_t + k * hx
+        iy = -oy / eta_t + k * hy
+        iz = -oz / eta_t + k * hz
+        p = pt
+    else:
+        ix, iy, iz = mf.reflect(ox, oy, oz, hx, hy, hz)
+        p = pr
+    # renormalise against rounding (the refraction formula is unit only up to ulps)
+    ix, iy, iz = mf.normalize(ix, iy, iz)
+    ok = p > 0.0 and oz > 0.0 and cos_oh > 0.0 and hz > 0.0
+    if refr:
+        ok = ok and F < 1.0 and iz < 0.0
+    else:
+        ok = ok and iz > 0.0
+    # the pdf of the choice made must be positive
+    g1c = mf.G1_over_cos(ox, oy, oz, a)
+    d = mf.D(hx, hy, hz, a)
+    if refr:
+        cos_ih = mf.dot(ix, iy, iz, hx, hy, hz)
+        s = cos_oh + eta_t * cos_ih
+        den = s * s
+        ok = ok and den > 0.0
+        pdf = p * (g1c * cos_oh * d * eta_t * eta_t * abs(cos_ih) / (den if den > 0.0 else 1.0))
+    else:
+        pdf = p * (0.25 * g1c * d)
+    ok = ok and pdf > 0.0
+    return ix, iy, iz * sign, refr, ok

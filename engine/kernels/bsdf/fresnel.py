@@ -1,0 +1,62 @@
+"""Fresnel reflectance, scalar: the compiled twin of engine/bsdf/fresnel.py.
+
+Same formulas and the same order of floating-point operations as the NumPy module, so
+results agree to the last bit where the maths library agrees (see that module for the
+sources and the sign conventions of `cos_i` and `eta`).
+"""
+from __future__ import annotations
+
+import math
+
+from ..jit import kernel
+
+
+@kernel
+def dielectric_full(cos_i, eta):
+    """(F, cos_t, eta_rel) of the exact unpolarised dielectric Fresnel equations:
+    reflectance in [0, 1], |cos| of the refracted direction (0 under total internal
+    reflection) and the relative IOR used (1/eta when cos_i < 0)."""
+    eta_rel = 1.0 / eta if cos_i < 0.0 else eta
+    ci = min(abs(cos_i), 1.0)
+    sin2_t = (1.0 - ci * ci) / (eta_rel * eta_rel)
+    if sin2_t >= 1.0:
+        return 1.0, 0.0, eta_rel
+    ct = math.sqrt(max(0.0, 1.0 - sin2_t))
+    den_s = ci + eta_rel * ct
+    den_p = eta_rel * ci + ct
+    if not (den_s > 0.0 and den_p > 0.0):
+        return 1.0, ct, eta_rel
+    rs = (ci - eta_rel * ct) / den_s
+    rp = (eta_rel * ci - ct) / den_p
+    F = 0.5 * (rs * rs + rp * rp)
+    return min(max(F, 0.0), 1.0), ct, eta_rel
+
+
+@kernel
+def dielectric(cos_i, eta):
+    """Exact unpolarised dielectric reflectance (see `dielectric_full`)."""
+    return dielectric_full(cos_i, eta)[0]
+
+
+@kernel
+def schlick(f0, cos_theta):
+    """Schlick's approximation for one channel, cos clamped to [0, 1]."""
+    c = min(max(cos_theta, 0.0), 1.0)
+    m = 1.0 - c
+    m2 = m * m
+    m5 = m2 * m2 * m
+    return f0 + (1.0 - f0) * m5
+
+
+@kernel
+def f0_from_ior(ior):
+    """Normal-incidence reflectance ((ior - 1) / (ior + 1))^2."""
+    r = (ior - 1.0) / (ior + 1.0)
+    return r * r
+
+
+@kernel
+def ior_from_f0(f0):
+    """The IOR >= 1 with normal-incidence reflectance f0 (f0 clamped to [0, 0.9999])."""
+    s = math.sqrt(min(max(f0, 0.0), 0.9999))
+    return (1.0 + s) / (1.0 - s)

@@ -1,0 +1,45 @@
+"""The material parameter row the Principled kernels read: column constants and
+`pack_materials`, which turns a `MaterialTable` into one float64 row per material.
+
+A row holds each material's plain (un-textured) values; where a material is textured the
+integrator overwrites P_BASE / P_METALLIC / P_ROUGHNESS in a per-hit copy of the row, so
+`principled.setup` reads everything from the row and nothing from the table.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+P_BASE = 0               # 3 columns: base colour r, g, b
+P_METALLIC = 3
+P_ROUGHNESS = 4
+P_IOR = 5
+P_TRANSMISSION = 6
+P_SPEC_LEVEL = 7         # specular_ior_level
+P_METAL_COLOR = 8        # 3 columns: the metal lobe's F0 when P_HAS_METAL_COLOR is 1
+P_HAS_METAL_COLOR = 11   # 0 / 1
+P_GLASS_COLOR = 12       # 3 columns: the refraction tint when P_HAS_GLASS_COLOR is 1
+P_HAS_GLASS_COLOR = 15   # 0 / 1
+P_GLOSSY_MODEL = 16      # GLOSSY_GGX or GLOSSY_BLINN_PHONG
+NPARAM = 17
+
+GLOSSY_GGX = 0
+GLOSSY_BLINN_PHONG = 1
+
+
+def pack_materials(table) -> np.ndarray:
+    """(M, NPARAM) float64: the plain value of every parameter of every material of the
+    `engine.bsdf.principled.MaterialTable` `table`."""
+    m = len(table.metallic)
+    rows = np.zeros((m, NPARAM), dtype=np.float64)
+    rows[:, P_BASE:P_BASE + 3] = table.base_color
+    rows[:, P_METALLIC] = table.metallic
+    rows[:, P_ROUGHNESS] = table.roughness
+    rows[:, P_IOR] = table.ior
+    rows[:, P_TRANSMISSION] = table.transmission
+    rows[:, P_SPEC_LEVEL] = table.specular_ior_level
+    rows[:, P_METAL_COLOR:P_METAL_COLOR + 3] = table.metal_color
+    rows[:, P_HAS_METAL_COLOR] = table.has_metal_color
+    rows[:, P_GLASS_COLOR:P_GLASS_COLOR + 3] = table.glass_color
+    rows[:, P_HAS_GLASS_COLOR] = table.has_glass_color
+    rows[:, P_GLOSSY_MODEL] = np.where(table.blinn_phong, GLOSSY_BLINN_PHONG, GLOSSY_GGX)
+    return rows

@@ -1,0 +1,300 @@
+"""Blender's Principled BSDF as a mixture of lobes, one hit at a time: the compiled twin
+of `engine.bsdf.principled.PrincipledBSDF` (see that module for the model: diffuse under
+a dielectric specular layer with albedo scaling, Schlick metal, smooth or rough glass;
+the lobe selection by albedo estimates with the MIN_SELECTION floor; the `allowed`
+masks). Same formulas, same order of operations, so the values agree with the NumPy
+class to rounding (to the bit where the maths library agrees).
+
+Use, per hit:
+    setup(row, front_facing, wox, woy, woz, tables, state)   # fills state[:NSTATE]
+    eval_f(state, wo..., wi...)      -> (r, g, b)   the whole BSDF, every lobe
+    pdf(state, wo..., wi..., allow_d, allow_g, allow_t) -> mixture pdf of `sample`
+    sample(state, wo..., u_lobe, u1, u2, allow_d, allow_g, allow_t)
+        -> (wix, wiy, wiz, weight_r, weight_g, weight_b, pdf, kind, delta, valid)
+    transmits(state) -> whether light from behind the surface can contribute
+`row` is a material parameter row (`params`, `pack_materials`), `tables` is
+`kernel_tables()`, directions are in the local shading frame with wo_z > 0 (the
+integrator flips the normal towards the incoming ray), and `front_facing` says whether
+the ray arrived from outside (the glass lobe's relative IOR is 1/ior otherwise).
+"""
+from __future__ import annotations
+
+import math
+
+from ..jit import kernel
+from . import blinn_phong, dielectric, fresnel
+from . import microfacet as mf
+from .albedo import kernel_tables, specular_albedo  # noqa: F401  (re-exported)
+from .params import (GLOSSY_BLINN_PHONG, GLOSSY_GGX, NPARAM, P_BASE,  # noqa: F401
+                     P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
+                     P_HAS_METAL_COLOR, P_IOR, P_METAL_COLOR, P_METALLIC, P_ROUGHNESS,
+                     P_SPEC_LEVEL, P_TRANSMISSION, pack_materials)
+from ..warp import INV_PI, cosine_hemisphere
+
+# Constants of the NumPy model, repeated here rather than imported: Numba freezes globals
+# into its on-disk cache, keyed on this file, so an imported value could go stale
+# silently; tests/test_kernel_bsdf.py checks that they agree.
+DIFFUSE, GLOSSY, TRANSMISSION = 0, 1, 2    # lobe kinds, engine/bsdf/lobes.py
+MIN_SELECTION = 0.02                       # engine/bsdf/principled.py
+# Largest float below 1: the rescaled lobe coordinate stays in [0, 1)
+ONE_MINUS_EPS = 1.0 - 2.0 ** -53
+
+# --- the per-hit state vector ------------------------------------------------------------
+S_DIFFUSE = 0        # 3: diffuse colour under the specular layer at wo, lobe weight included
+S_EST = 3            # 5: selection estimates: diffuse, specular, metal, glass R, glass T
+S_W_SPEC = 8         # lobe weights (the diffuse one is inside S_DIFFUSE)
+S_W_METAL = 9
+S_W_GLASS = 10
+S_ALPHA = 11         # GGX alpha, clamped
+S_EXPONENT = 12      # Blinn-Phong exponent matching alpha
+S_BLINN = 13         # 1: the reflection lobes use Blinn-Phong instead of GGX
+S_ETA_SPEC = 14      # IOR of the specular layer (adjusted by specular_ior_level)
+S_METAL_F0 = 15      # 3: Schlick F0 of the metal lobe
+S_ETA_GLASS = 18     # relative IOR of the glass lobe (1/ior on back faces)
+S_GLASS_SMOOTH = 19  # 1: the glass lobe is the smooth (delta) interface
+S_TINT = 20          # 3: refraction tint per crossing
+NSTATE = 23
+
+
+@kernel
+def setup(row, front_facing, wox, woy, woz, tables, state):
+    """Fill state[:NSTATE] with the lobes' parameters at this hit for outgoing wo."""
+    # parameters, clamped as PrincipledBSDF.__init__ does
+    m = min(max(row[P_METALLIC], 0.0), 1.0)
+    t = min(max(row[P_TRANSMISSION], 0.0), 1.0)
+    rough = min(max(row[P_ROUGHNESS], 0.0), 1.0)
+    ior = max(row[P_IOR], 1e-5)
+    level = max(row[P_SPEC_LEVEL], 0.0)
+    alpha = mf.clamp_alpha(rough * rough)
+    state[S_ALPHA] = alpha
+    state[S_BLINN] = 1.0 if row[P_GLOSSY_MODEL] == GLOSSY_BLINN_PHONG else 0.0
+    state[S_EXPONENT] = max(2.0 / (alpha * alpha) - 2.0, 0.0)
+    base_w = (1.0 - m) * (1.0 - t)
+    # specular layer: F0 scaled by 2 * level, IOR recomputed from it
+    f0 = fresnel.f0_from_ior(ior) * 2.0 * level
+    eta_s = fresnel.ior_from_f0(f0)
+    if ior < 1.0:
+        eta_s = 1.0 / eta_s
+    eta_spec = ior if level == 0.5 else eta_s
+    state[S_ETA_SPEC] = eta_spec
+    spec_on = f0 > 0.0 and abs(eta_spec - 1.0) > 1e-7
+    eta_glass = ior if front_facing else 1.0 / ior
+    state[S_ETA_GLASS] = eta_glass
+    state[S_GLASS_SMOOTH] = 1.0 if dielectric.is_smooth(alpha, eta_glass) else 0.0
+    has_metal = row[P_HAS_METAL_COLOR] != 0.0
+    has_glass = row[P_HAS_GLASS_COLOR] != 0.0
+    diffuse_max = 0.0
+    for c in range(3):
+        base = max(row[P_BASE + c], 0.0)          # Cycles: diffuse is not clamped
+        clamped = min(base, 1.0)                  # ... metal F0 and glass tint are
+        if has_metal:
+            state[S_METAL_F0 + c] = min(max(row[P_METAL_COLOR + c], 0.0), 1.0)
+        else:
+            state[S_METAL_F0 + c] = clamped
+        if has_glass:
+            state[S_TINT + c] = min(max(row[P_GLASS_COLOR + c], 0.0), 1.0)
+        else:
+            state[S_TINT + c] = math.sqrt(clamped)
+        state[S_DIFFUSE + c] = base * base_w
+        diffuse_max = max(diffuse_max, state[S_DIFFUSE + c])
+    w_diff = base_w if diffuse_max > 0.0 else 0.0
+    w_spec = base_w if spec_on else 0.0
+    w_glass = (1.0 - m) * t
+    state[S_W_SPEC] = w_spec
+    state[S_W_METAL] = m
+    state[S_W_GLASS] = w_glass
+
+    # albedo-dependent weights at wo (PrincipledBSDF._wo_state)
+    cos_o = min(max(woz, 0.0), 1.0)
+    e_spec = 0.0
+    est_spec = 0.0
+    if w_spec > 0.0:
+        e_spec = specular_albedo(cos_o, alpha, eta_spec, tables)
+        est_spec = w_spec * e_spec
+    est_diff = 0.0
+    for c in range(3):
+        state[S_DIFFUSE + c] = state[S_DIFFUSE + c] * (1.0 - e_spec)
+        est_diff = max(est_diff, state[S_DIFFUSE + c])
+    est_metal = 0.0
+    if m > 0.0:
+        F = 0.0
+        for c in range(3):
+            F = max(F, fresnel.schlick(state[S_METAL_F0 + c], cos_o))
+        est_metal = m * F
+    est_gr = 0.0
+    est_gt = 0.0
+    if w_glass > 0.0:
+        F = fresnel.dielectric(woz, eta_glass)
+        eta_rel = 1.0 / eta_glass if woz < 0.0 else eta_glass
+        tint_max = max(state[S_TINT], max(state[S_TINT + 1], state[S_TINT + 2]))
+        est_gr = w_glass * F
+        est_gt = w_glass * (1.0 - F) * tint_max / (eta_rel * eta_rel)
+    # floors so that every present lobe can be sampled
+    state[S_EST] = max(est_diff, MIN_SELECTION * w_diff) if w_diff > 0.0 else 0.0
+    state[S_EST + 1] = max(est_spec, MIN_SELECTION * w_spec) if w_spec > 0.0 else 0.0
+    state[S_EST + 2] = max(est_metal, MIN_SELECTION * m) if m > 0.0 else 0.0
+    half_floor = 0.5 * (MIN_SELECTION * w_glass)
+    state[S_EST + 3] = max(est_gr, half_floor) if w_glass > 0.0 else 0.0
+    state[S_EST + 4] = max(est_gt, half_floor) if w_glass > 0.0 else 0.0
+
+
+@kernel
+def transmits(state):
+    """True where light from behind the surface can contribute (a glass lobe)."""
+    return state[S_W_GLASS] > 0.0
+
+
+@kernel
+def selection(state, allow_d, allow_g, allow_t):
+    """Lobe probabilities (diffuse, specular, metal, glass) over the allowed kinds."""
+    w0 = state[S_EST] if allow_d else 0.0
+    w1 = state[S_EST + 1] if allow_g else 0.0
+    w2 = state[S_EST + 2] if allow_g else 0.0
+    w3 = (state[S_EST + 3] if allow_g else 0.0) + (state[S_EST + 4] if allow_t else 0.0)
+    total = w0 + w1 + w2 + w3
+    if not total > 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    return w0 / total, w1 / total, w2 / total, w3 / total
+
+
+@kernel
+def reflection_eval(state, ox, oy, oz, ix, iy, iz):
+    """D G / (4 cos cos) of the reflection lobes (GGX or Blinn-Phong) and h."""
+    if state[S_BLINN] != 0.0:
+        hx, hy, hz, _ = mf.half_vector(ox, oy, oz, ix, iy, iz)
+        return blinn_phong.eval_f(ox, oy, oz, ix, iy, iz, state[S_EXPONENT]), hx, hy, hz
+    return mf.reflection_eval(ox, oy, oz, ix, iy, iz, state[S_ALPHA])
+
+
+@kernel
+def reflection_pdf(state, ox, oy, oz, ix, iy, iz):
+    if state[S_BLINN] != 0.0:
+        return blinn_phong.pdf(ox, oy, oz, ix, iy, iz, state[S_EXPONENT])
+    return mf.reflection_pdf(ox, oy, oz, ix, iy, iz, state[S_ALPHA])
+
+
+@kernel
+def reflection_sample(state, ox, oy, oz, u1, u2):
+    if state[S_BLINN] != 0.0:
+        return blinn_phong.sample(ox, oy, oz, u1, u2, state[S_EXPONENT])
+    return mf.reflection_sample(ox, oy, oz, state[S_ALPHA], u1, u2)
+
+
+@kernel
+def eval_f(state, wox, woy, woz, wix, wiy, wiz):
+    """The whole BSDF f(wo, wi) in 1/sr, every lobe (delta parts excluded)."""
+    fr = 0.0
+    fg = 0.0
+    fb = 0.0
+    if woz > 0.0 and wiz > 0.0:                   # Lambert under the specular layer
+        fr = state[S_DIFFUSE] * INV_PI
+        fg = state[S_DIFFUSE + 1] * INV_PI
+        fb = state[S_DIFFUSE + 2] * INV_PI
+    w_spec = state[S_W_SPEC]
+    w_metal = state[S_W_METAL]
+    if w_spec > 0.0 or w_metal > 0.0:
+        base, hx, hy, hz = reflection_eval(state, wox, woy, woz, wix, wiy, wiz)
+        cos_oh = min(max(mf.dot(wox, woy, woz, hx, hy, hz), 0.0), 1.0)
+        if w_spec > 0.0:
+            F = fresnel.dielectric(cos_oh, state[S_ETA_SPEC])
+            v = F * (base * w_spec)
+            fr += v
+            fg += v
+            fb += v
+        if w_metal > 0.0:
+            bw = base * w_metal
+            fr += fresnel.schlick(state[S_METAL_F0], cos_oh) * bw
+            fg += fresnel.schlick(state[S_METAL_F0 + 1], cos_oh) * bw
+            fb += fresnel.schlick(state[S_METAL_F0 + 2], cos_oh) * bw
+    w_glass = state[S_W_GLASS]
+    if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0:
+        f_r, f_t = dielectric.rough_eval(wox, woy, woz, wix, wiy, wiz,
+                                         state[S_ETA_GLASS], state[S_ALPHA])
+        fr += (f_r + f_t * state[S_TINT]) * w_glass
+        fg += (f_r + f_t * state[S_TINT + 1]) * w_glass
+        fb += (f_r + f_t * state[S_TINT + 2]) * w_glass
+    return fr, fg, fb
+
+
+@kernel
+def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3, allow_g, allow_t):
+    """sum_i q_i pdf_i over the lobes, for selection probabilities q."""
+    p = 0.0
+    if woz > 0.0 and wiz > 0.0:
+        p += q0 * (wiz * INV_PI)
+    q_refl = q1 + q2
+    if q_refl > 0.0:
+        p += q_refl * reflection_pdf(state, wox, woy, woz, wix, wiy, wiz)
+    if q3 > 0.0 and state[S_GLASS_SMOOTH] == 0.0:
+        p += q3 * dielectric.rough_pdf(wox, woy, woz, wix, wiy, wiz, state[S_ETA_GLASS],
+                                       state[S_ALPHA], allow_g, allow_t)
+    return p
+
+
+@kernel
+def pdf(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t):
+    """Mixture pdf (1/sr) of `sample` with the same allow flags."""
+    q0, q1, q2, q3 = selection(state, allow_d, allow_g, allow_t)
+    return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3,
+                       allow_g, allow_t)
+
+
+@kernel
+def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
+    """Choose a lobe with u_lobe, a direction with (u1, u2) (the rest of u_lobe, rescaled,
+    picks a glass reflection or refraction). Returns
+    (wix, wiy, wiz, weight_r, weight_g, weight_b, pdf, kind, delta, valid): weight is
+    f |cos| / pdf (zero where invalid), pdf the mixture pdf over the allowed lobes (inf
+    for the delta choices of a smooth glass, with delta True)."""
+    q0, q1, q2, q3 = selection(state, allow_d, allow_g, allow_t)
+    c0 = q0
+    c1 = c0 + q1
+    c2 = c1 + q2
+    total = c2 + q3
+    lobe = 0
+    lo = 0.0
+    q_sel = q0
+    if u_lobe >= c0:
+        lobe, lo, q_sel = 1, c0, q1
+    if u_lobe >= c1:
+        lobe, lo, q_sel = 2, c1, q2
+    if u_lobe >= c2:
+        lobe, lo, q_sel = 3, c2, q3
+    u_re = min(max((u_lobe - lo) / (q_sel if q_sel > 0.0 else 1.0), 0.0), ONE_MINUS_EPS)
+
+    wix, wiy, wiz = 0.0, 0.0, 1.0
+    kind = DIFFUSE
+    ok = total > 0.0 and q_sel > 0.0
+    if not ok:
+        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
+    if lobe == 0:
+        wix, wiy, wiz = cosine_hemisphere(u1, u2)
+        ok = woz > 0.0
+    elif lobe == 1 or lobe == 2:
+        wix, wiy, wiz, ok = reflection_sample(state, wox, woy, woz, u1, u2)
+        kind = GLOSSY
+    elif state[S_GLASS_SMOOTH] != 0.0:
+        wix, wiy, wiz, ws, refr, ok = dielectric.smooth_sample(
+            wox, woy, woz, state[S_ETA_GLASS], u_re, allow_g, allow_t)
+        kind = TRANSMISSION if refr else GLOSSY
+        if not ok:
+            return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
+        w = ws * state[S_W_GLASS] / q_sel
+        if refr:
+            return (wix, wiy, wiz, state[S_TINT] * w, state[S_TINT + 1] * w,
+                    state[S_TINT + 2] * w, math.inf, kind, True, True)
+        return wix, wiy, wiz, w, w, w, math.inf, kind, True, True
+    else:
+        wix, wiy, wiz, refr, ok = dielectric.rough_sample(
+            wox, woy, woz, state[S_ETA_GLASS], state[S_ALPHA], u_re, u1, u2,
+            allow_g, allow_t)
+        kind = TRANSMISSION if refr else GLOSSY
+    if not ok:
+        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
+    # non-delta choices: one-sample mixture estimator f |cos| / sum_j q_j pdf_j
+    fr, fg, fb = eval_f(state, wox, woy, woz, wix, wiy, wiz)
+    p = mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3, allow_g, allow_t)
+    if not (p > 0.0 and p < math.inf):
+        return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
+    s = abs(wiz) / p
+    return wix, wiy, wiz, fr * s, fg * s, fb * s, p, kind, False, True

@@ -1,0 +1,84 @@
+"""Array drivers of the light kernels (compiled loops over rows): what the tests and the
+chi-square harnesses call. Inputs are (n, 3) float64 points / directions, (n,) arrays of
+uniforms, distances and indices; outputs are freshly allocated arrays."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..jit import kernel
+from .light_set import hit_lamps, lamp_pdf, mesh_pdf, sample, sun_escaped
+
+
+@kernel
+def sample_batch(L, p, u_pick, u):
+    """LightSet.sample over n points: (k (n,) int64, wi (n, 3), dist (n,), radiance
+    (n, 3), pdf (n,) with the pick probability, delta (n,) bool, margin (n,))."""
+    n = p.shape[0]
+    k_out = np.empty(n, dtype=np.int64)
+    wi = np.empty((n, 3))
+    dist = np.empty(n)
+    rad = np.empty((n, 3))
+    pdf = np.empty(n)
+    delta = np.empty(n, dtype=np.bool_)
+    margin = np.empty(n)
+    for i in range(n):
+        k, wx, wy, wz, d, r, g, b, pd, dl, m = sample(L, p[i, 0], p[i, 1], p[i, 2],
+                                                      u_pick[i], u[i, 0], u[i, 1])
+        k_out[i] = k
+        wi[i, 0], wi[i, 1], wi[i, 2] = wx, wy, wz
+        dist[i] = d
+        rad[i, 0], rad[i, 1], rad[i, 2] = r, g, b
+        pdf[i] = pd
+        delta[i] = dl
+        margin[i] = m
+    return k_out, wi, dist, rad, pdf, delta, margin
+
+
+@kernel
+def hit_lamps_batch(L, o, d, tmax):
+    """LightSet.hit_surfaces over n rays: (t (n,), k (n,) int64, radiance (n, 3))."""
+    n = o.shape[0]
+    t_out = np.empty(n)
+    k_out = np.empty(n, dtype=np.int64)
+    rad = np.empty((n, 3))
+    for i in range(n):
+        t, k, r, g, b = hit_lamps(L, o[i, 0], o[i, 1], o[i, 2], d[i, 0], d[i, 1], d[i, 2],
+                                  tmax[i])
+        t_out[i] = t
+        k_out[i] = k
+        rad[i, 0], rad[i, 1], rad[i, 2] = r, g, b
+    return t_out, k_out, rad
+
+
+@kernel
+def lamp_pdf_batch(L, k, p, wi, t):
+    """LightSet.pdf over n rows: (n,) pdfs, pick probability included."""
+    n = p.shape[0]
+    out = np.empty(n)
+    for i in range(n):
+        out[i] = lamp_pdf(L, k[i], p[i, 0], p[i, 1], p[i, 2], wi[i, 0], wi[i, 1], wi[i, 2],
+                          t[i])
+    return out
+
+
+@kernel
+def mesh_pdf_batch(L, prim, p, q):
+    """LightSet.mesh_pdf over n rows: (n,) pdfs, pick probability included."""
+    n = p.shape[0]
+    out = np.empty(n)
+    for i in range(n):
+        out[i] = mesh_pdf(L, prim[i], p[i, 0], p[i, 1], p[i, 2], q[i, 0], q[i, 1], q[i, 2])
+    return out
+
+
+@kernel
+def sun_escaped_batch(L, j, d):
+    """The j-th non-delta sun for n escaped rays: (radiance (n, 3), pdf (n,))."""
+    n = d.shape[0]
+    rad = np.empty((n, 3))
+    pdf = np.empty(n)
+    for i in range(n):
+        r, g, b, pd = sun_escaped(L, j, d[i, 0], d[i, 1], d[i, 2])
+        rad[i, 0], rad[i, 1], rad[i, 2] = r, g, b
+        pdf[i] = pd
+    return rad, pdf

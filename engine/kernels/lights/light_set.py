@@ -1,0 +1,175 @@
+"""The whole light set for one shading point or one ray (`engine.lights.LightSet`):
+pick an entry by its power (the CDF searched as np.searchsorted(side='right')), sample
+it, find lamps hit by rays, and every pdf multiple importance sampling needs. Entry k <
+n_lamps is lamp k (row k of L[LAMPS]); entry n_lamps + j is emissive triangle j."""
+from __future__ import annotations
+
+from ..jit import kernel
+from .area import intersect_area, pdf_area, sample_area
+from .environment import pdf_environment, sample_environment
+from .pack import (C_TYPE, C_VIS_CAMERA, C_VISIBLE, CDF, ENV, LAMPS, SELECT_PDF, SUNS,
+                   T_AREA, T_DISC, T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA)
+from .point import intersect_point, pdf_point, sample_point
+from .sun import escaped_sun, pdf_sun, sample_sun
+from .triangles import pdf_triangle, sample_triangle, triangle_entry
+
+
+@kernel
+def n_entries(L):
+    """len(LightSet): lamps and emissive triangles."""
+    return L[SELECT_PDF].shape[0]
+
+
+@kernel
+def n_lamps(L):
+    return L[LAMPS].shape[0]
+
+
+@kernel
+def pick(L, u_pick):
+    """np.searchsorted(cdf, u_pick, side='right').clip(0, n - 1): the first entry whose
+    CDF value exceeds u_pick (-1 for an empty set, as the clip gives)."""
+    cdf = L[CDF]
+    lo = 0
+    hi = cdf.shape[0]
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if u_pick < cdf[mid]:
+            hi = mid
+        else:
+            lo = mid + 1
+    n = cdf.shape[0]
+    if lo > n - 1:
+        lo = n - 1
+    return lo
+
+
+@kernel
+def sample_lamp(lamps, k, px, py, pz, u0, u1):
+    """Lamp k's own sample (pick probability not included):
+    (wix, wiy, wiz, dist, r, g, b, pdf, delta)."""
+    kind = lamps[k, C_TYPE]
+    if kind == T_AREA:
+        return sample_area(lamps, k, px, py, pz, u0, u1)
+    if kind == T_POINT or kind == T_SPHERE or kind == T_DISC:
+        return sample_point(lamps, k, px, py, pz, u0, u1)
+    if kind == T_SUN or kind == T_SUN_DELTA:
+        return sample_sun(lamps, k, u0, u1)
+    return sample_environment(lamps, k, u0, u1)
+
+
+@kernel
+def sample(L, px, py, pz, u_pick, u1, u2):
+    """LightSet.sample for one shading point p: pick an entry with u_pick, sample it with
+    (u1, u2). Returns (k, wix, wiy, wiz, dist, r, g, b, pdf, delta, margin): k the entry
+    (-1 for an empty set), dist inf for suns and the world, pdf in solid angle including
+    the pick probability (0 = no sample), delta for points and zero-angle suns, margin
+    the shadow-ray stop before dist for emissive triangles (0 for lamps)."""
+    k = pick(L, u_pick)
+    if k < 0:
+        return k, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, 0.0
+    select = L[SELECT_PDF][k]
+    lamps = L[LAMPS]
+    if k < lamps.shape[0]:
+        wx, wy, wz, dist, r, g, b, pdf, delta = sample_lamp(lamps, k, px, py, pz, u1, u2)
+        return k, wx, wy, wz, dist, r, g, b, pdf * select, delta, 0.0
+    wx, wy, wz, dist, r, g, b, pdf, margin = sample_triangle(L, k - lamps.shape[0],
+                                                             px, py, pz, u1, u2)
+    return k, wx, wy, wz, dist, r, g, b, pdf * select, False, margin
+
+
+@kernel
+def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax):
+    """LightSet.hit_surfaces for one ray: the nearest visible sphere, disc or area lamp
+    closer than tmax: (t, k, r, g, b); (tmax, -1, 0, 0, 0) when there is none."""
+    lamps = L[LAMPS]
+    best_t = tmax
+    best_k = -1
+    br, bg, bb = 0.0, 0.0, 0.0
+    for k in range(lamps.shape[0]):
+        kind = lamps[k, C_TYPE]
+        if lamps[k, C_VISIBLE] == 0.0 or kind == T_SUN or kind == T_SUN_DELTA:
+            continue
+        if kind == T_AREA:
+            t, r, g, b = intersect_area(lamps, k, ox, oy, oz, dx, dy, dz)
+        elif kind == T_SPHERE or kind == T_DISC:
+            t, r, g, b = intersect_point(lamps, k, ox, oy, oz, dx, dy, dz)
+        else:
+            continue                    # not a surface (the world, delta lights)
+        if t < best_t:
+            best_t, best_k, br, bg, bb = t, k, r, g, b
+    return best_t, best_k, br, bg, bb
+
+
+@kernel
+def lamp_visible_camera(L, k):
+    """Whether camera rays see lamp k (Blender's visible_camera; True for lamps without
+    that option, and for k outside the lamps)."""
+    lamps = L[LAMPS]
+    if k < 0 or k >= lamps.shape[0]:
+        return True
+    return lamps[k, C_VIS_CAMERA] != 0.0
+
+
+@kernel
+def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t):
+    """LightSet.pdf for one direction: solid-angle pdf, pick probability included, of
+    sampling wi from p towards lamp k hit at distance t (0 when k is not a lamp)."""
+    lamps = L[LAMPS]
+    if k < 0 or k >= lamps.shape[0]:
+        return 0.0
+    kind = lamps[k, C_TYPE]
+    if kind == T_AREA:
+        pdf = pdf_area(lamps, k, px, py, pz, wix, wiy, wiz, t)
+    elif kind == T_POINT or kind == T_SPHERE or kind == T_DISC:
+        pdf = pdf_point(lamps, k, px, py, pz, wix, wiy, wiz, t)
+    elif kind == T_SUN or kind == T_SUN_DELTA:
+        pdf = pdf_sun(lamps, k, wix, wiy, wiz)
+    else:
+        pdf = pdf_environment(lamps, k)
+    return pdf * L[SELECT_PDF][k]
+
+
+@kernel
+def mesh_pdf(L, prim, px, py, pz, qx, qy, qz):
+    """LightSet.mesh_pdf for one hit: solid-angle pdf, pick probability included, of
+    next-event estimation from p sampling the point q of global triangle prim (0 when
+    that triangle is not a light)."""
+    j = triangle_entry(L, prim)
+    if j < 0:
+        return 0.0
+    return pdf_triangle(L, j, px, py, pz, qx, qy, qz) * L[SELECT_PDF][L[LAMPS].shape[0] + j]
+
+
+@kernel
+def environment_pdf(L):
+    """LightSet.environment_pdf for one escaped ray: pick probability x 1 / (4 pi), 0
+    when the world is not a light."""
+    env = L[ENV]
+    k = int(env[0])
+    if k < 0:
+        return 0.0
+    return pdf_environment(L[LAMPS], k) * L[SELECT_PDF][k]
+
+
+@kernel
+def environment_radiance(L):
+    """The world light's radiance (zeros when the world is not a light)."""
+    env = L[ENV]
+    return env[1], env[2], env[3]
+
+
+@kernel
+def n_suns(L):
+    """len(LightSet.suns()): the suns with an angular diameter."""
+    return L[SUNS].shape[0]
+
+
+@kernel
+def sun_escaped(L, j, dx, dy, dz):
+    """The j-th non-delta sun seen by an escaped ray d: (r, g, b, pdf) with the radiance
+    of sun.escaped(d) and pdf = sun.pdf(None, d, None) x its pick probability."""
+    k = L[SUNS][j]
+    lamps = L[LAMPS]
+    r, g, b = escaped_sun(lamps, k, dx, dy, dz)
+    return r, g, b, pdf_sun(lamps, k, dx, dy, dz) * L[SELECT_PDF][k]

@@ -1,0 +1,187 @@
+"""`pack_lights`: an `engine.lights.LightSet` as a tuple of NumPy arrays for the kernels.
+
+The tuple L (one Numba argument; always the same array types, so one compilation serves
+every scene):
+
+  L[LAMPS]       float64 (n_lamps, N_COLUMNS): one row per lamp model, in the order of
+                 `LightSet.models` (entry k < n_lamps is lamp k); the columns are the
+                 C_* constants below, the kind in column C_TYPE (the T_* codes).
+  L[SELECT_PDF]  float64 (n_entries,): `LightSet.select_pdf` (lamps, then triangles).
+  L[CDF]         float64 (n_entries,): `LightSet.cdf` (last entry 1).
+  L[SUNS]        int64 (n_suns,): lamp index of each non-delta sun, in the order of
+                 `LightSet.suns()`.
+  L[TRI_V0], L[TRI_E1], L[TRI_E2], L[TRI_NORMAL]   float64 (n_tri, 3): the emissive
+                 triangles (`EmissiveTriangles` v0, e1 = v1 - v0, e2 = v2 - v0, unit normal);
+                 triangle j is entry n_lamps + j. Empty when the set has no mesh lights.
+  L[TRI_AREA], L[TRI_SCALE]   float64 (n_tri,): area; largest |coordinate| of its vertices.
+  L[TRI_RADIANCE]  float64 (n_tri, 3): emitted radiance (two-sided).
+  L[TRI_ENTRY]   int64 (n_prims,): global triangle id -> triangle entry j, or -1
+                 (`EmissiveTriangles.entry`; empty without mesh lights).
+  L[ENV]         float64 (5,): [lamp index of the world light or -1, radiance r, g, b,
+                 solid-angle pdf 1 / (4 pi)]; radiance 0 when the world is not a light.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ...lights import (AreaLightModel, EnvironmentLightModel, PointLightModel,
+                       SunLightModel, TimeSlicedLight)
+
+# ---------------------------------------------------------------- fields of the tuple L
+LAMPS = 0
+SELECT_PDF = 1
+CDF = 2
+SUNS = 3
+TRI_V0 = 4
+TRI_E1 = 5
+TRI_E2 = 6
+TRI_NORMAL = 7
+TRI_AREA = 8
+TRI_SCALE = 9
+TRI_RADIANCE = 10
+TRI_ENTRY = 11
+ENV = 12
+
+# ---------------------------------------------------------------- lamp kinds (C_TYPE)
+T_POINT = 0         # delta point or spot (radius 0)
+T_SPHERE = 1        # point light with radius > 0, soft_falloff off
+T_DISC = 2          # point light with radius > 0 and soft_falloff: the facing disc
+T_SUN_DELTA = 3     # sun with (near) zero angle
+T_SUN = 4           # sun with an angular diameter: a uniform cone
+T_AREA = 5          # SQUARE, RECTANGLE, DISK or ELLIPSE area light
+T_ENV = 6           # the uniform world
+
+# ---------------------------------------------------------------- lamp table columns
+C_TYPE = 0
+C_VISIBLE = 1       # 1: BSDF rays can hit it (hit_surfaces), 0: not (delta, sun, world)
+C_VIS_CAMERA = 2    # Blender's visible_camera (1 for lamps without the option)
+C_DELTA = 3         # 1 for point and zero-angle sun lights
+C_RAD = 4           # 3: radiance (sphere / disc, sun disc, area, world)
+# point, spot, sphere, disc
+C_POS = 7           # 3: position
+C_INTENSITY = 10    # 3: strength / (4 pi)
+C_RADIUS = 13
+C_IS_SPOT = 14
+C_AXIS = 15         # 3: unit spot direction
+C_COS_HALF = 18
+C_SMOOTH = 19       # spot blend x (1 - cos_half)
+# sun
+C_TO_LIGHT = 20     # 3: unit direction towards the sun
+C_IRRADIANCE = 23   # 3
+C_ONE_MINUS = 26    # 1 - cos(half angle)
+C_SUN_T = 27        # 3: tangent of the sun's cone frame
+C_SUN_B = 30        # 3: bitangent
+# area
+C_CENTER = 33       # 3
+C_AX = 36           # 3: half-extent vector along local x
+C_AY = 39           # 3: half-extent vector along local y
+C_NORMAL = 42       # 3: local +Z (emission along -Z)
+C_AREA = 45
+C_INV = 46          # 9: inverse of [ax ay normal], row-major
+C_ROUND = 55        # 1 for DISK / ELLIPSE
+C_SR_OK = 56        # 1: spherical rectangle sampling possible (perpendicular edges)
+C_LX = 57
+C_LY = 58
+C_XH = 59           # 3: unit edge x
+C_YH = 62           # 3: unit edge y
+C_ZH = 65           # 3: xh cross yh
+C_CORNER = 68       # 3: center - ax - ay
+# world
+C_ENV_PDF = 71
+N_COLUMNS = 72
+
+
+def _put(row, col, values):
+    values = np.asarray(values, dtype=np.float64).reshape(-1)
+    row[col:col + len(values)] = values
+
+
+def _lamp_row(model) -> np.ndarray:
+    if isinstance(model, TimeSlicedLight):
+        raise NotImplementedError("moving lamps")
+    row = np.zeros(N_COLUMNS)
+    row[C_VISIBLE] = float(bool(model.visible))
+    row[C_VIS_CAMERA] = float(bool(getattr(model, "visible_camera", True)))
+    row[C_DELTA] = float(bool(model.delta))
+    if isinstance(model, PointLightModel):
+        row[C_TYPE] = T_POINT if model.delta else (T_DISC if model.disc else T_SPHERE)
+        _put(row, C_POS, model.position)
+        _put(row, C_INTENSITY, model.intensity)
+        row[C_RADIUS] = model.radius
+        if model.sphere_radiance is not None and not model.delta:
+            _put(row, C_RAD, model.sphere_radiance)
+        row[C_IS_SPOT] = float(model.is_spot)
+        if model.is_spot:
+            _put(row, C_AXIS, model.axis)
+            row[C_COS_HALF] = model.cos_half
+            row[C_SMOOTH] = model.smooth
+    elif isinstance(model, SunLightModel):
+        row[C_TYPE] = T_SUN_DELTA if model.delta else T_SUN
+        _put(row, C_TO_LIGHT, model.to_light)
+        _put(row, C_IRRADIANCE, model.irradiance)
+        row[C_ONE_MINUS] = model.one_minus
+        if not model.delta:
+            _put(row, C_RAD, model.radiance)
+            _put(row, C_SUN_T, model.t)
+            _put(row, C_SUN_B, model.b)
+    elif isinstance(model, AreaLightModel):
+        row[C_TYPE] = T_AREA
+        _put(row, C_RAD, model.radiance)
+        _put(row, C_CENTER, model.center)
+        _put(row, C_AX, model.ax)
+        _put(row, C_AY, model.ay)
+        _put(row, C_NORMAL, model.normal)
+        row[C_AREA] = model.area
+        _put(row, C_INV, model.inv)
+        row[C_ROUND] = float(model.round)
+        row[C_SR_OK] = float(bool(model.solid_angle_ok))
+        row[C_LX], row[C_LY] = model.lx, model.ly
+        _put(row, C_XH, model.xh)
+        _put(row, C_YH, model.yh)
+        _put(row, C_ZH, model.zh)
+        _put(row, C_CORNER, model.corner)
+    elif isinstance(model, EnvironmentLightModel):
+        row[C_TYPE] = T_ENV
+        _put(row, C_RAD, model.radiance)
+        row[C_ENV_PDF] = model.pdf_value
+    else:
+        raise TypeError(f"no kernel for light model {type(model).__name__}")
+    return row
+
+
+def _f64(a, shape):
+    """A writable C-ordered float64 copy: the kernels' argument types never vary."""
+    return np.array(np.asarray(a, dtype=np.float64).reshape(shape), order="C", copy=True)
+
+
+def pack_lights(light_set) -> tuple:
+    """The LightSet as the kernels' tuple L (fields: this module's docstring).
+    Raises NotImplementedError("moving lamps") when a lamp moves during the shutter
+    (`TimeSlicedLight`): the caller then uses the NumPy LightSet."""
+    models = light_set.models
+    lamps = np.zeros((len(models), N_COLUMNS))
+    for k, model in enumerate(models):
+        lamps[k] = _lamp_row(model)
+    select_pdf = _f64(light_set.select_pdf, (-1,))
+    cdf = _f64(light_set.cdf, (-1,))
+    suns = np.array([k for k, _ in light_set.suns()], dtype=np.int64)
+    mesh = light_set.mesh
+    if mesh is not None and len(mesh):
+        tri = (_f64(mesh.v0, (-1, 3)), _f64(mesh.e1, (-1, 3)), _f64(mesh.e2, (-1, 3)),
+               _f64(mesh.normal, (-1, 3)), _f64(mesh.area, (-1,)),
+               _f64(mesh.tri_scale, (-1,)), _f64(mesh.radiance, (-1, 3)),
+               np.array(mesh.entry, dtype=np.int64, order="C", copy=True))
+    else:
+        z3 = np.zeros((0, 3))
+        tri = (z3, z3.copy(), z3.copy(), z3.copy(), np.zeros(0), np.zeros(0), z3.copy(),
+               np.zeros(0, dtype=np.int64))
+    env = np.zeros(5)
+    env[0] = -1.0
+    if light_set.env_index is not None:
+        m = models[light_set.env_index]
+        env[0] = light_set.env_index
+        env[1:4] = m.radiance[:3]
+        env[4] = m.pdf_value
+    if len(select_pdf) != len(models) + len(tri[4]):
+        raise ValueError("LightSet entries do not match its lamps and triangles")
+    return (lamps, select_pdf, cdf, suns) + tri + (env,)

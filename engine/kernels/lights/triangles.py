@@ -1,0 +1,69 @@
+"""Emissive triangles as lights (`engine.mesh_lights.EmissiveTriangles`): Heitz's
+low-distortion square-to-triangle map, uniform by area, two-sided emission."""
+from __future__ import annotations
+
+import math
+
+from ...surface import RELATIVE_OFFSET
+from ..jit import kernel
+from .pack import (TRI_AREA, TRI_E1, TRI_E2, TRI_ENTRY, TRI_NORMAL, TRI_RADIANCE,
+                   TRI_SCALE, TRI_V0)
+
+
+@kernel
+def square_to_triangle(u0, u1):
+    """EmissiveTriangles.square_to_triangle: edge weights (b1, b2), uniform in area."""
+    if u1 > u0:
+        return 0.5 * u0, u1 - 0.5 * u0
+    return u0 - 0.5 * u1, 0.5 * u1
+
+
+@kernel
+def sample_triangle(L, j, px, py, pz, u0, u1):
+    """EmissiveTriangles.sample for triangle entry j (pick probability NOT included):
+    (wix, wiy, wiz, dist, r, g, b, pdf, margin)."""
+    v0, e1, e2, nrm = L[TRI_V0], L[TRI_E1], L[TRI_E2], L[TRI_NORMAL]
+    b1, b2 = square_to_triangle(u0, u1)
+    qx = v0[j, 0] + b1 * e1[j, 0] + b2 * e2[j, 0]
+    qy = v0[j, 1] + b1 * e1[j, 1] + b2 * e2[j, 1]
+    qz = v0[j, 2] + b1 * e1[j, 2] + b2 * e2[j, 2]
+    tx, ty, tz = qx - px, qy - py, qz - pz
+    dist = math.sqrt(tx * tx + ty * ty + tz * tz)
+    if dist > 0.0:
+        wx, wy, wz = tx / dist, ty / dist, tz / dist
+    else:
+        wx, wy, wz = 0.0, 0.0, 1.0
+    cos_l = abs(wx * nrm[j, 0] + wy * nrm[j, 1] + wz * nrm[j, 2])
+    if not (dist > 0.0 and cos_l > 0.0):
+        return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0, 0.0
+    pdf = dist * dist / (L[TRI_AREA][j] * cos_l)
+    rad = L[TRI_RADIANCE]
+    # shadow rays stop this far before q (engine.mesh_lights: float32 self-occlusion)
+    scale = max(max(abs(qx), abs(qy)), abs(qz))
+    ts = L[TRI_SCALE][j]
+    if not scale >= ts:
+        scale = ts
+    margin = RELATIVE_OFFSET * scale / cos_l
+    return wx, wy, wz, dist, rad[j, 0], rad[j, 1], rad[j, 2], pdf, margin
+
+
+@kernel
+def triangle_entry(L, prim):
+    """EmissiveTriangles.entry_of: triangle entry of global triangle id prim, or -1."""
+    entry = L[TRI_ENTRY]
+    if prim >= 0 and prim < entry.shape[0]:
+        return entry[prim]
+    return -1
+
+
+@kernel
+def pdf_triangle(L, j, px, py, pz, qx, qy, qz):
+    """EmissiveTriangles.pdf_area_to_solid_angle: solid-angle pdf at p of the point q
+    on triangle entry j, d^3 / (A |n . (q - p)|)."""
+    tx, ty, tz = qx - px, qy - py, qz - pz
+    d2 = tx * tx + ty * ty + tz * tz
+    nrm = L[TRI_NORMAL]
+    cos_abs_d = abs(tx * nrm[j, 0] + ty * nrm[j, 1] + tz * nrm[j, 2])
+    if cos_abs_d > 0.0 and d2 > 0.0:
+        return d2 * math.sqrt(d2) / (L[TRI_AREA][j] * cos_abs_d)
+    return 0.0

@@ -1,0 +1,247 @@
+"""One vertex of Kajiya's path tracer for every live path of a wavefront: the compiled
+form of the loop body of `engine.integrators.path.PathIntegrator.radiance` (read its
+docstring for the estimator; the steps and names here are the same).
+
+`shade` runs after the closest-hit query of the bounce. For each live path it adds the
+emission the incoming ray found (lamps hit analytically, the world and sun discs for
+escaped rays, emissive triangles), weighted by multiple importance sampling against
+next-event estimation; it prepares one shadow ray of next-event estimation with its
+unoccluded contribution; and it samples the BSDF for the next ray, with Russian roulette.
+The caller traces the shadow rays (`Accelerator.occluded`), adds the contributions of
+the visible ones, and traces the next rays: the Embree queries stay between the stages.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..bsdf.lobes import TRANSMISSION
+from ..sampling import dimensions as D
+from ..sampling.dispatch import sample_1d, sample_2d
+from . import lights as lt
+from .bsdf import principled as bsdf
+from .frame import dot, to_local, to_world
+from .jit import kernel
+from .surface import offset_origin, rebuild
+
+MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
+ROULETTE_START = 3
+_INF = np.inf
+
+
+@kernel
+def power_heuristic(a, b):
+    if math.isinf(a):
+        return 1.0
+    if math.isinf(b):
+        return 0.0
+    a2, b2 = a * a, b * b
+    return a2 / (a2 + b2) if a2 + b2 > 0.0 else 0.0
+
+
+@kernel
+def hit_weight(mode, prev_pdf, light_pdf):
+    """Weight of emission found by a BSDF-sampled ray (pdf prev_pdf; inf after a camera
+    ray or a specular bounce) that light sampling reaches with light_pdf."""
+    if mode == MIS:
+        return power_heuristic(prev_pdf, light_pdf)
+    if mode == LIGHT_ONLY:
+        return 1.0 if (math.isinf(prev_pdf) or not light_pdf > 0.0) else 0.0
+    return 1.0
+
+
+@kernel
+def nee_weight(mode, light_pdf, bsdf_pdf, delta):
+    """Weight of a light sample that the BSDF would have sampled with bsdf_pdf."""
+    if mode == MIS:
+        return 1.0 if delta else power_heuristic(light_pdf, bsdf_pdf)
+    if mode == LIGHT_ONLY:
+        return 1.0
+    return 1.0 if (delta or not bsdf_pdf > 0.0) else 0.0
+
+
+@kernel
+def clamp_scale(r, g, b, limit):
+    """Cycles' clamp: the factor that scales (r, g, b) so no channel exceeds limit."""
+    m = max(r, g, b)
+    if limit > 0.0 and m > limit:
+        return limit / max(m, 1e-300)
+    return 1.0
+
+
+@kernel
+def _add(L, p, r, g, b, limit):
+    s = clamp_scale(r, g, b, limit)
+    L[p, 0] += r * s
+    L[p, 1] += g * s
+    L[p, 2] += b * s
+
+
+@kernel
+def uncovered(br, bg, bb):
+    """Alpha of a camera sample whose ray got through with throughput b (see
+    engine.integrators.coverage)."""
+    return 1.0 - min(max((br + bg + bb) / 3.0, 0.0), 1.0)
+
+
+@kernel
+def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
+          live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v,
+          geometry, params, emission, tables, lights, world,
+          sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir):
+    """One bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
+
+    cfg: float64 [sampler kind, spp, max_bounces, diffuse, glossy, transmission limits,
+    clamp_direct, clamp_indirect, mis mode, scene radius, film transparent].
+    geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout) of the
+    static triangles (corner_normals and holdout may be empty). alpha: each path's film
+    coverage, or empty when the film is opaque. Writes the shadow rays to sh_* and the
+    continuing paths' next rays to nx_*; returns (shadow count, next count). beta,
+    counts, L, alpha, prev_pdf, prev_pos are per-path state, updated in place."""
+    v0, v1, v2, normal, tri_scale, tri_material, corner_normals, holdout = geometry
+    film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
+    kind, spp = int(cfg[0]), int(cfg[1])
+    max_bounces = int(cfg[2])
+    clamp_direct, clamp_indirect, mode = cfg[6], cfg[7], int(cfg[8])
+    scene_radius = cfg[9]
+    clamp_hit = clamp_indirect if depth > 0 else 0.0   # what the camera sees: unclamped
+    n_lights = lt.n_entries(lights)
+    state = np.empty(bsdf.NSTATE)
+    row = np.empty(params.shape[1])
+    ns_out, nn_out = 0, 0
+    base = D.FIRST_BOUNCE + depth * D.PER_BOUNCE
+    for j in range(live.shape[0]):
+        p = live[j]
+        ox, oy, oz = ro[j, 0], ro[j, 1], ro[j, 2]
+        dx, dy, dz = rd[j, 0], rd[j, 1], rd[j, 2]
+        br, bg, bb = beta[p, 0], beta[p, 1], beta[p, 2]
+        hit = hit_prim[j] >= 0
+        t_geom = hit_t[j] if hit else rt[j]
+        # 1a. area and sphere lamps in front of the geometry; the ray goes on behind them
+        if n_lights > 0:
+            t_l, k_l, lr, lg, lb = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_geom)
+            if k_l >= 0 and (depth > 0 or lt.lamp_visible_camera(lights, k_l)):
+                lpdf = lt.lamp_pdf(lights, k_l, prev_pos[p, 0], prev_pos[p, 1],
+                                   prev_pos[p, 2], dx, dy, dz, t_l)
+                w = hit_weight(mode, prev_pdf[p], lpdf)
+                _add(L, p, br * lr * w, bg * lg * w, bb * lb * w, clamp_hit)
+        # 1b. escaped rays: the world and sun discs (or, for camera rays on a transparent
+        # film, no colour and the coverage left)
+        if not hit:
+            if depth == 0 and film_transparent:
+                alpha[p] = uncovered(br, bg, bb)
+                continue
+            w = hit_weight(mode, prev_pdf[p], lt.environment_pdf(lights))
+            er, eg, eb = world[0] * w, world[1] * w, world[2] * w
+            for s in range(lt.n_suns(lights)):
+                sr, sg, sb, spdf = lt.sun_escaped(lights, s, dx, dy, dz)
+                w = hit_weight(mode, prev_pdf[p], spdf)
+                er += sr * w
+                eg += sg * w
+                eb += sb * w
+            _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)
+            continue
+        prim = hit_prim[j]
+        if depth == 0 and holdout.shape[0] > 0 and holdout[prim]:
+            if alpha.shape[0] > 0:        # Cycles' holdout: a hole, for camera rays only
+                alpha[p] = uncovered(br, bg, bb)
+            continue
+        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild(
+            v0, v1, v2, normal, tri_scale, corner_normals, prim, hit_u[j], hit_v[j],
+            dx, dy, dz)
+        m = tri_material[prim]
+        # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
+        er, eg, eb = emission[m, 0], emission[m, 1], emission[m, 2]
+        if er != 0.0 or eg != 0.0 or eb != 0.0:
+            lpdf = lt.mesh_pdf(lights, prim, prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2],
+                               px, py, pz)
+            w = hit_weight(mode, prev_pdf[p], lpdf)
+            _add(L, p, br * er * w, bg * eg * w, bb * eb * w, clamp_hit)
+        wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
+        row[:] = params[m]
+        bsdf.setup(row, front, wox, woy, woz, tables, state)
+        room = depth < max_bounces
+        ad = room and counts[p, 0] < cfg[3]
+        ag = room and counts[p, 1] < cfg[4]
+        at = room and counts[p, 2] < cfg[5]
+        # 2. next-event estimation: one light entry, one point, one shadow ray
+        if n_lights > 0:
+            u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK)
+            u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
+            k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
+                lights, px, py, pz, u_pick, u1, u2)
+            lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
+            fr, fg, fb = bsdf.eval_f(state, wox, woy, woz, lx, ly, lz)
+            front_side = dot(wx, wy, wz, gx, gy, gz) > 0.0
+            if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0
+                    and (front_side or bsdf.transmits(state))):
+                sox, soy, soz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
+                sdx, sdy, sdz = wx, wy, wz
+                if math.isfinite(dist):
+                    # to the sampled point, stopping short of it by the origin's margin
+                    tx = px + wx * dist - sox
+                    ty = py + wy * dist - soy
+                    tz = pz + wz * dist - soz
+                    seg = math.sqrt(tx * tx + ty * ty + tz * tz)
+                    if seg > 0.0:
+                        sdx, sdy, sdz = tx / seg, ty / seg, tz / seg
+                    far = min(seg * (1.0 - 2e-5), seg - margin)
+                else:
+                    far = scene_radius * 4.0
+                bpdf = bsdf.pdf(state, wox, woy, woz, lx, ly, lz, ad, ag, at)
+                w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * abs(lz)
+                cr, cg, cb = br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w
+                s = clamp_scale(cr, cg, cb, clamp_direct if depth == 0 else clamp_indirect)
+                sh_path[ns_out] = p
+                sh_org[ns_out, 0], sh_org[ns_out, 1], sh_org[ns_out, 2] = sox, soy, soz
+                sh_dir[ns_out, 0], sh_dir[ns_out, 1], sh_dir[ns_out, 2] = sdx, sdy, sdz
+                sh_far[ns_out] = max(far, 0.0)
+                sh_contrib[ns_out, 0] = cr * s
+                sh_contrib[ns_out, 1] = cg * s
+                sh_contrib[ns_out, 2] = cb * s
+                ns_out += 1
+        # 3. continue by BSDF sampling
+        if not (ad or ag or at):
+            continue
+        u_lobe = sample_1d(kind, pkey[p], spp, index[p], base + D.BSDF_LOBE)
+        u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.BSDF_DIR)
+        ix, iy, iz, wr, wg, wb, spdf, skind, sdelta, valid = bsdf.sample(
+            state, wox, woy, woz, u_lobe, u1, u2, ad, ag, at)
+        if not valid:
+            continue
+        wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
+        side = dot(wx, wy, wz, gx, gy, gz)
+        if (side >= 0.0) if skind == TRANSMISSION else (side <= 0.0):
+            continue       # reflection leaves on the geometric normal's side, refraction through
+        br, bg, bb = br * wr, bg * wg, bb * wb
+        if depth + 1 >= ROULETTE_START:
+            u_rr = sample_1d(kind, pkey[p], spp, index[p], base + D.ROULETTE)
+            q = min(max(max(br, bg, bb), 0.0), 0.95)
+            if not u_rr < q:
+                continue
+            q = max(q, 1e-300)
+            br, bg, bb = br / q, bg / q, bb / q
+        if not max(br, bg, bb) > 0.0:
+            continue
+        beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
+        counts[p, skind] += 1
+        nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
+        nx_path[nn_out] = p
+        nx_org[nn_out, 0], nx_org[nn_out, 1], nx_org[nn_out, 2] = nox, noy, noz
+        nx_dir[nn_out, 0], nx_dir[nn_out, 1], nx_dir[nn_out, 2] = wx, wy, wz
+        prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2] = px, py, pz
+        prev_pdf[p] = _INF if sdelta else spdf
+        nn_out += 1
+    return ns_out, nn_out
+
+
+@kernel
+def add_unoccluded(L, sh_path, sh_contrib, blocked):
+    """Add the contributions of the shadow rays that reached their light."""
+    for i in range(sh_path.shape[0]):
+        if not blocked[i]:
+            p = sh_path[i]
+            L[p, 0] += sh_contrib[i, 0]
+            L[p, 1] += sh_contrib[i, 1]
+            L[p, 2] += sh_contrib[i, 2]

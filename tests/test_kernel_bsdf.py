@@ -1,0 +1,319 @@
+"""The compiled Principled BSDF (engine/kernels/bsdf) against the NumPy reference
+(engine.bsdf.principled.PrincipledBSDF): the same values for eval_f, pdf and sample over
+random materials, hits, directions, random numbers and `allowed` masks.
+
+Materials are `engine.scene.Material` objects packed through MaterialTable and
+`pack_materials`, so the packing is tested too. The kernels follow the NumPy code
+operation by operation, so the tolerance is tight (RTOL 1e-9, ATOL 1e-12); the only
+looser comparison is the sample weight of a batch of plain diffuse materials, where the
+NumPy class takes a shortcut (weight = albedo) that the mixture estimator
+f |cos| / pdf reproduces only to rounding.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from engine.bsdf import principled as npp
+from engine.bsdf.lobes import DIFFUSE, GLOSSY, TRANSMISSION
+from engine.bsdf.principled import MaterialTable, PrincipledBSDF
+from engine.kernels import bsdf as kb
+from engine.kernels.bsdf import albedo, batch
+from engine.scene import Material
+
+RTOL = 1e-9
+ATOL = 1e-12
+N_MATERIALS = 300
+N_HITS = 20_000
+
+
+# --- random materials and hits -------------------------------------------------------------
+
+def random_materials(rng, n):
+    mats = []
+    for k in range(n):
+        kind = rng.integers(6)
+        base = tuple(rng.uniform(0.0, 1.0, 3))
+        if rng.random() < 0.1:
+            base = tuple(rng.uniform(0.0, 1.6, 3))       # > 1: diffuse unclamped
+        if rng.random() < 0.05:
+            base = (0.0, 0.0, 0.0)
+        m = Material(
+            name=f"m{k}", base_color=base,
+            metallic=float(rng.choice([0.0, 0.0, 0.5, 1.0, rng.random()])),
+            roughness=float(rng.choice([0.0, 1e-3, 0.0187, 0.05, 0.5, 1.0, rng.random()])),
+            ior=float(rng.choice([1.0, 1.01, 1.45, 1.5, 2.4, 0.75])),
+            transmission=float(rng.choice([0.0, 0.0, 0.5, 1.0])),
+            specular_ior_level=float(rng.choice([0.0, 0.5, 0.5, 1.0, rng.random()])),
+            glossy_model="BLINN_PHONG" if rng.random() < 0.25 else "GGX")
+        if kind == 0:                                     # plain diffuse
+            m.metallic, m.transmission, m.specular_ior_level = 0.0, 0.0, 0.0
+        if rng.random() < 0.2:
+            m.metal_color = tuple(rng.uniform(0.0, 1.2, 3))
+        if rng.random() < 0.2:
+            m.glass_color = tuple(rng.uniform(0.0, 1.2, 3))
+        mats.append(m)
+    return mats
+
+
+def unit(v):
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+def random_hits(rng, n, n_mat):
+    index = rng.integers(0, n_mat, n)
+    front = rng.random(n) < 0.6
+    # wo: uniform over the upper hemisphere, some grazing and some at the normal
+    z = rng.uniform(0.0, 1.0, n)
+    phi = rng.uniform(0.0, 2.0 * np.pi, n)
+    special = rng.random(n)
+    z = np.where(special < 0.05, 1e-4, z)
+    z = np.where((special >= 0.05) & (special < 0.08), 1.0, z)
+    z = np.maximum(z, 1e-4)
+    s = np.sqrt(np.maximum(0.0, 1.0 - z * z))
+    wo = unit(np.stack([s * np.cos(phi), s * np.sin(phi), z], -1))
+    # wi on the whole sphere, some at the mirror direction and straight through
+    wi = unit(rng.normal(size=(n, 3)))
+    pick = rng.random(n)
+    mirror = np.stack([-wo[:, 0], -wo[:, 1], wo[:, 2]], -1)
+    wi = np.where((pick < 0.05)[:, None], mirror, wi)
+    wi = np.where(((pick >= 0.05) & (pick < 0.08))[:, None], -wo, wi)
+    u_lobe = rng.random(n)
+    u_dir = rng.random((n, 2))
+    u_dir[rng.random(n) < 0.01, 0] = 0.0
+    u_lobe[rng.random(n) < 0.01] = 0.0
+    allowed = rng.random((n, 3)) < 0.8
+    allowed[rng.random(n) < 0.4] = True
+    return index, front, wo, wi, u_lobe, u_dir, allowed
+
+
+@pytest.fixture(scope="module")
+def case():
+    rng = np.random.default_rng(20240607)
+    mats = random_materials(rng, N_MATERIALS)
+    table = MaterialTable(mats)
+    index, front, wo, wi, u_lobe, u_dir, allowed = random_hits(rng, N_HITS, len(mats))
+    ref = PrincipledBSDF.from_materials(table, index, front)
+    assert not ref.diffuse_only          # the mixed batch takes the general code path
+    rows = kb.pack_materials(table)[index]
+    return dict(mats=mats, table=table, index=index, front=front, wo=wo, wi=wi,
+                u_lobe=u_lobe, u_dir=u_dir, allowed=allowed, ref=ref, rows=rows,
+                tables=kb.kernel_tables())
+
+
+def close(a, b, rtol=RTOL, atol=ATOL):
+    """Elementwise |a - b| <= atol + rtol |b|, with equal infinities."""
+    a, b = np.asarray(a, np.float64), np.asarray(b, np.float64)
+    same_inf = np.isinf(a) & np.isinf(b) & (np.sign(a) == np.sign(b))
+    with np.errstate(invalid="ignore"):
+        return same_inf | (np.abs(a - b) <= atol + rtol * np.abs(b))
+
+
+def assert_close(a, b, what, rtol=RTOL, atol=ATOL):
+    ok = close(a, b, rtol, atol)
+    if not ok.all():
+        bad = np.nonzero(~ok.reshape(len(ok), -1).all(1))[0]
+        k = bad[0]
+        raise AssertionError(f"{what}: {len(bad)} mismatches, first at {k}: "
+                             f"kernel {a[k]} vs numpy {b[k]}")
+
+
+# --- packing and tables ------------------------------------------------------------------
+
+def test_pack_materials_columns():
+    mats = [Material(base_color=(0.1, 0.2, 0.3), metallic=0.4, roughness=0.6, ior=1.7,
+                     transmission=0.8, specular_ior_level=0.9, metal_color=(0.5, 0.6, 0.7),
+                     glossy_model="BLINN_PHONG"),
+            Material(glass_color=(0.2, 0.3, 0.4))]
+    rows = kb.pack_materials(MaterialTable(mats))
+    assert rows.shape == (2, kb.NPARAM) and rows.dtype == np.float64
+    r = rows[0]
+    assert tuple(r[kb.P_BASE:kb.P_BASE + 3]) == (0.1, 0.2, 0.3)
+    assert (r[kb.P_METALLIC], r[kb.P_ROUGHNESS], r[kb.P_IOR], r[kb.P_TRANSMISSION],
+            r[kb.P_SPEC_LEVEL]) == (0.4, 0.6, 1.7, 0.8, 0.9)
+    assert tuple(r[kb.P_METAL_COLOR:kb.P_METAL_COLOR + 3]) == (0.5, 0.6, 0.7)
+    assert r[kb.P_HAS_METAL_COLOR] == 1 and r[kb.P_HAS_GLASS_COLOR] == 0
+    assert r[kb.P_GLOSSY_MODEL] == kb.GLOSSY_BLINN_PHONG
+    r = rows[1]
+    assert r[kb.P_HAS_METAL_COLOR] == 0 and r[kb.P_HAS_GLASS_COLOR] == 1
+    assert tuple(r[kb.P_GLASS_COLOR:kb.P_GLASS_COLOR + 3]) == (0.2, 0.3, 0.4)
+    assert r[kb.P_GLOSSY_MODEL] == kb.GLOSSY_GGX
+
+
+def test_constants_match_numpy():
+    """The kernels repeat the NumPy model's constants (Numba freezes globals into its
+    cache, so they are not imported): they must agree."""
+    from engine.bsdf import dielectric, microfacet
+    from engine.kernels.bsdf import dielectric as kd, microfacet as km, principled as kp
+    assert (kp.DIFFUSE, kp.GLOSSY, kp.TRANSMISSION) == (DIFFUSE, GLOSSY, TRANSMISSION)
+    assert kp.MIN_SELECTION == npp.MIN_SELECTION
+    assert km.ALPHA_MIN == microfacet.ALPHA_MIN
+    assert (kd.SMOOTH_ALPHA, kd.INDEX_MATCHED) == (dielectric.SMOOTH_ALPHA,
+                                                   dielectric.INDEX_MATCHED)
+
+
+def test_kernel_tables_are_the_numpy_tables():
+    t = kb.kernel_tables()
+    assert t is kb.kernel_tables()
+    assert t[0] is npp._get_table(0) and t[1] is npp._get_table(1)
+    for a, b in zip(t[2:], (npp._TABLE_S, npp._TABLE_R, npp._TABLE_T)):
+        assert np.array_equal(a, b)
+
+
+def test_specular_albedo_matches():
+    rng = np.random.default_rng(3)
+    n = 4000
+    cos_o = np.concatenate([rng.random(n), [0.0, 1.0, 1e-4]])
+    alpha = np.concatenate([rng.random(n) ** 2, [1e-4, 1.0, 0.3]])
+    eta = np.concatenate([rng.uniform(0.3, 3.0, n), [1.0, 0.5, 2.0]])
+    eta[:50] = 1.0 / eta[50:100]
+    ref = npp.specular_albedo(cos_o, alpha, eta)
+    tables = kb.kernel_tables()
+    got = np.array([albedo.specular_albedo(c, a, e, tables)
+                    for c, a, e in zip(cos_o, alpha, eta)])
+    assert_close(got, ref, "specular albedo")
+
+
+# --- the mixture against NumPy -----------------------------------------------------------
+
+def test_eval_f_matches(case):
+    c = case
+    ref = c["ref"].eval_f(c["wo"], c["wi"])
+    got = batch.eval_f_batch(c["rows"], c["front"], c["wo"], c["wi"], c["tables"])
+    assert np.isfinite(got).all() and (got >= 0).all()
+    assert (ref > 0).any(1).mean() > 0.3            # the comparison sees real values
+    assert_close(got, ref, "eval_f")
+
+
+def test_pdf_matches(case):
+    c = case
+    for allowed in (c["allowed"], np.ones_like(c["allowed"])):
+        ref = c["ref"].pdf(c["wo"], c["wi"], allowed)
+        got = batch.pdf_batch(c["rows"], c["front"], c["wo"], c["wi"], allowed, c["tables"])
+        assert np.isfinite(got).all() and (got >= 0).all()
+        assert (ref > 0).mean() > 0.3
+        assert_close(got, ref, "pdf")
+
+
+def test_sample_matches(case):
+    c = case
+    ref = c["ref"].sample(c["wo"], c["u_lobe"], c["u_dir"], c["allowed"])
+    wi, weight, pdf, kind, delta, valid = batch.sample_batch(
+        c["rows"], c["front"], c["wo"], c["u_lobe"], c["u_dir"], c["allowed"], c["tables"])
+    assert np.array_equal(valid, ref.valid)
+    assert np.array_equal(delta, ref.delta)
+    assert np.array_equal(kind, ref.kind)
+    # every field, including the direction of rejected samples
+    assert_close(wi, ref.wi, "sample wi")
+    assert_close(weight, ref.weight, "sample weight")
+    assert_close(pdf, ref.pdf, "sample pdf")
+    # sanity of the outputs
+    assert np.isfinite(wi).all() and np.isfinite(weight).all()
+    assert (weight >= 0).all() and (pdf >= 0).all()
+    assert np.isinf(pdf[delta]).all() and np.isfinite(pdf[~delta]).all()
+    assert (weight[~valid] == 0).all() and (pdf[~valid] == 0).all()
+    assert (pdf[valid] > 0).all()
+    # every kind, delta and non-delta, valid and rejected samples occur
+    for k in (DIFFUSE, GLOSSY, TRANSMISSION):
+        assert (valid & (kind == k) & ~delta).sum() > 100
+    for k in (GLOSSY, TRANSMISSION):
+        assert (valid & (kind == k) & delta).sum() > 50
+    assert (~valid).sum() > 50
+    # the lobe kinds respect the allowed masks
+    assert c["allowed"][np.nonzero(valid)[0], kind[valid]].all()
+
+
+def test_eval_and_pdf_at_sampled_directions(case):
+    """At sampled directions (the lobes' peaks: mirror-like GGX at alpha 1e-4, Blinn-Phong
+    exponents up to 2e8, refraction) eval_f and pdf agree too."""
+    c = case
+    ref = c["ref"].sample(c["wo"], c["u_lobe"], c["u_dir"], c["allowed"])
+    ok = ref.valid & ~ref.delta
+    idx = np.nonzero(ok)[0]
+    sub = PrincipledBSDF.from_materials(c["table"], c["index"][idx], c["front"][idx])
+    wo, wi, allowed = c["wo"][idx], ref.wi[idx], c["allowed"][idx]
+    rows, front = c["rows"][idx], c["front"][idx]
+    f_ref = sub.eval_f(wo, wi)
+    p_ref = sub.pdf(wo, wi, allowed)
+    f = batch.eval_f_batch(rows, front, wo, wi, c["tables"])
+    p = batch.pdf_batch(rows, front, wo, wi, allowed, c["tables"])
+    assert p_ref.max() > 1e6                       # really near-specular lobes
+    assert_close(f, f_ref, "eval_f at sampled wi")
+    assert_close(p, p_ref, "pdf at sampled wi")
+    assert_close(p, ref.pdf[idx], "pdf at sampled wi vs the sample's pdf")
+
+
+def test_plain_diffuse_batch():
+    """A batch of plain diffuse materials: NumPy's Lambert-only shortcut."""
+    rng = np.random.default_rng(11)
+    mats = [Material(base_color=tuple(rng.uniform(0, 1, 3)), specular_ior_level=0.0)
+            for _ in range(20)] + [Material(base_color=(0.0, 0.0, 0.0),
+                                            specular_ior_level=0.0)]
+    table = MaterialTable(mats)
+    index, front, wo, wi, u_lobe, u_dir, allowed = random_hits(rng, 5000, len(mats))
+    ref = PrincipledBSDF.from_materials(table, index, front)
+    assert ref.diffuse_only
+    rows, tables = kb.pack_materials(table)[index], kb.kernel_tables()
+    assert_close(batch.eval_f_batch(rows, front, wo, wi, tables), ref.eval_f(wo, wi), "f")
+    assert_close(batch.pdf_batch(rows, front, wo, wi, allowed, tables),
+                 ref.pdf(wo, wi, allowed), "pdf")
+    s = ref.sample(wo, u_lobe, u_dir, allowed)
+    wi_k, weight, pdf, kind, delta, valid = batch.sample_batch(
+        rows, front, wo, u_lobe, u_dir, allowed, tables)
+    assert np.array_equal(valid, s.valid) and not delta.any() and (kind == DIFFUSE).all()
+    # the shortcut's rejected samples keep a cosine direction, the mixture's (0, 0, 1)
+    assert_close(wi_k[valid], s.wi[valid], "wi")
+    assert_close(pdf, s.pdf, "pdf")
+    # weight = albedo there, = f |cos| / pdf here: equal up to a few ulps
+    assert_close(weight, s.weight, "weight", rtol=1e-14, atol=0.0)
+
+
+def test_transmits():
+    mats = [Material(transmission=1.0), Material(transmission=0.5, metallic=0.5),
+            Material(transmission=1.0, metallic=1.0), Material(transmission=0.0),
+            Material(transmission=2.0, metallic=-1.0)]
+    rows = kb.pack_materials(MaterialTable(mats))
+    state = np.empty(kb.NSTATE)
+    got = []
+    for row in rows:
+        kb.setup(row, True, 0.0, 0.0, 1.0, kb.kernel_tables(), state)
+        got.append(kb.transmits(state))
+    assert got == [True, True, False, False, True]
+
+
+def test_scalar_interface_matches_batch(case):
+    """The scalar kernels called one by one (the integrator's interface, argument order
+    and return order) give what the batch drivers give."""
+    c = case
+    state = np.zeros(kb.NSTATE)
+    for k in range(0, N_HITS, 997):
+        row, fr, o, i = c["rows"][k], bool(c["front"][k]), c["wo"][k], c["wi"][k]
+        a = [bool(x) for x in c["allowed"][k]]
+        kb.setup(row, fr, o[0], o[1], o[2], c["tables"], state)
+        f = kb.eval_f(state, *o, *i)
+        p = kb.pdf(state, *o, *i, *a)
+        s = kb.sample(state, *o, c["u_lobe"][k], *c["u_dir"][k], *a)
+        one = slice(k, k + 1)
+        args = (c["rows"][one], c["front"][one], c["wo"][one])
+        assert np.array_equal(f, batch.eval_f_batch(*args, c["wi"][one], c["tables"])[0])
+        assert p == batch.pdf_batch(*args, c["wi"][one], c["allowed"][one], c["tables"])[0]
+        bs = batch.sample_batch(*args, c["u_lobe"][one], c["u_dir"][one],
+                                c["allowed"][one], c["tables"])
+        assert s[0:3] == tuple(bs[0][0]) and s[3:6] == tuple(bs[1][0])
+        assert (s[6], s[7], s[8], s[9]) == (bs[2][0], bs[3][0], bs[4][0], bs[5][0])
+
+
+# --- negative control --------------------------------------------------------------------
+
+def test_negative_control_perturbed_roughness(case):
+    """A roughness 1 % off (or a wrong facing flag) is caught by the same comparison."""
+    c = case
+    rows = c["rows"].copy()
+    rows[:, kb.P_ROUGHNESS] *= 1.01
+    ref = c["ref"].eval_f(c["wo"], c["wi"])
+    got = batch.eval_f_batch(rows, c["front"], c["wo"], c["wi"], c["tables"])
+    assert (~close(got, ref)).any(1).sum() > 100
+    got = batch.pdf_batch(rows, c["front"], c["wo"], c["wi"], c["allowed"], c["tables"])
+    assert (~close(got, c["ref"].pdf(c["wo"], c["wi"], c["allowed"]))).sum() > 100
+    got = batch.eval_f_batch(c["rows"], ~c["front"], c["wo"], c["wi"], c["tables"])
+    assert (~close(got, ref)).any(1).sum() > 100

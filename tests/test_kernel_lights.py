@@ -1,0 +1,504 @@
+"""The compiled light kernels (engine.kernels.lights) against the NumPy LightSet.
+
+Every light model and the LightSet's own rules (pick CDF, strategy choice, pdfs with the
+pick probability, margins, deltas, visible_camera) are ported as scalar Numba code; here
+both run on the same inputs and must agree to RTOL = 1e-9 (directions to 1e-12 absolute,
+being unit vectors). The two compute the same operations in the same order, so most
+values agree bit for bit (97 % of the sampled rows of a stress run, all fields).
+
+The one place they may not: NumPy's `@` on a batch of rows is BLAS (gemv, fusing
+multiply-adds), the kernels' dot products are plain sums, so an area lamp's frame
+coordinates of p (x0, y0, z of SphericalRectangle; the plane distance in intersect; the
+cosine at the lamp) can differ by an ulp of |p - light|. Near the lamp's plane that ulp
+is a relative error eps |p - light| / h in the height h, which the spherical rectangle's
+solid angle and sampling map amplify (measured: wi off by 1.7e-8 at h = 5e-6 m with
+omega = 1.2e-4 sr), and where the exact value is a tie (a direction in the lamp's plane,
+a ray through its rim) rounding decides it. For one row, NumPy's (1, 3) @ (3,) is the
+plain sum (checked on this machine's OpenBLAS), so every row that differs from the batch
+NumPy result beyond the tolerance is evaluated again by NumPy alone and must match that
+to the same tolerance (`agree`); at most 2 % of the rows may need this. The lamp
+coordinates of a hit, (1, 3) @ (3, 3), still go through BLAS for one row, so a ray
+exactly through an area lamp's rim (a sample at a uniform of 0 or 1 aims there) may hit
+in one code and miss in the other: accepted only when it is at the rim (`compare_hits`).
+
+Scenes: each light type alone (point, spots, sphere, soft-falloff disc, suns with zero,
+tiny and finite angles, area SQUARE / RECTANGLE / DISK / ELLIPSE scaled, rotated,
+sheared and mirrored with normalize on and off, world, emissive triangles), tiny lights,
+all together, and an empty set. Shading points: a box about each light, close to it
+(1e-8 .. 3), near an area light's plane, inside sphere lights, at a light's centre and
+1e4 away. A negative control checks that the comparison does fail on a 1e-6 change.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from engine.kernels.lights import (environment_pdf, environment_radiance, hit_lamps,
+                                   lamp_pdf, lamp_visible_camera, mesh_pdf, n_entries,
+                                   n_suns, pack_lights, sample, sun_escaped)
+from engine.kernels.lights.batch import (hit_lamps_batch, lamp_pdf_batch, mesh_pdf_batch,
+                                         sample_batch, sun_escaped_batch)
+from engine.kernels.lights.pack import C_RAD, LAMPS, SELECT_PDF
+from engine.lights import LightSet
+from engine.mesh_lights import EmissiveTriangles
+from engine.scene import AreaLight, PointLight, SunLight
+
+# engine.lights divides by r^2 = 0 for the 1e-170 m sphere of the "tiny" scene (which then
+# becomes a point light, as intended)
+pytestmark = pytest.mark.filterwarnings("ignore:divide by zero:RuntimeWarning")
+
+RTOL = 1e-9
+WI_ATOL = 1e-12
+ONE_MINUS = 1.0 - 2.0 ** -53          # the largest uniform below 1
+
+
+# ------------------------------------------------------------------ scene builders
+
+def rotation(axis, angle):
+    a = np.asarray(axis, float)
+    a = a / np.linalg.norm(a)
+    k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
+
+
+def matrix(center, axis=(1, 0, 0), angle=0.0, scale=(1, 1, 1), shear=0.0):
+    """light-to-world T R Sh S: scaled, sheared (x gains shear * y) and rotated."""
+    m = np.eye(4)
+    sh = np.eye(3)
+    sh[0, 1] = shear
+    m[:3, :3] = rotation(axis, angle) @ sh @ np.diag(scale)
+    m[:3, 3] = center
+    return m
+
+
+def triangles(offset=(0.0, 0.0, 0.0), size=1.0):
+    o = np.asarray(offset, float)
+    v0 = o + size * np.array([[0, 0, 0], [1, 0, 0.2], [0, 1, 0.5], [2, 2, 2], [-1, 0, 0],
+                              [0.5, 0.5, 0.5], [3, 0, 1]])
+    v1 = o + size * np.array([[1, 0, 0], [1, 1, 0.1], [0.2, 1, 1.5], [2, 2, 2], [-1, 1, 0],
+                              [0.6, 0.5, 0.5], [3, 1, 1]])
+    v2 = o + size * np.array([[0, 1, 0], [2, 0, 0.3], [0, 2, 0.4], [2, 2, 2], [-1, 0, 1],
+                              [0.5, 0.7, 0.5], [3, 0, 2]])
+    rad = np.array([[1, 1, 1], [4, 2, 1], [0.2, 0.5, 3], [5, 5, 5], [0, 0, 0],
+                    [1, 0, 0], [2, 2, 0]], float)    # row 3 degenerate, row 4 dark
+    prims = np.array([2, 5, 6, 7, 9, 11, 14])
+    return EmissiveTriangles(v0, v1, v2, rad, prims, 16)
+
+
+def scene(name):
+    """(lights, mesh, world, scene_radius, anchors): anchors are points the shading
+    points gather around (light positions and centres)."""
+    if name == "point":
+        lights = [PointLight((0.3, -0.2, 1.5), (10, 8, 6)),
+                  PointLight((-1, 0.5, 2.0), (5, 5, 9), spot_size=1.0, spot_blend=0.3,
+                             direction=(0.2, 0.1, -1)),
+                  PointLight((1, 1, 1.0), (3, 4, 5), spot_size=0.8, spot_blend=0.0,
+                             direction=(-0.3, 0.0, -1))]
+    elif name == "sphere":
+        lights = [PointLight((0.3, -0.2, 1.5), (10, 8, 6), radius=0.25),
+                  PointLight((-1, 0.5, 2.0), (5, 5, 9), radius=0.4, spot_size=1.2,
+                             spot_blend=0.5, direction=(0.2, 0.1, -1))]
+    elif name == "disc":
+        lights = [PointLight((0.3, -0.2, 1.5), (10, 8, 6), radius=0.25, soft_falloff=True),
+                  PointLight((-1, 0.5, 2.0), (5, 5, 9), radius=0.4, soft_falloff=True,
+                             spot_size=1.2, spot_blend=0.5, direction=(0.2, 0.1, -1))]
+    elif name == "sun":
+        lights = [SunLight((0.3, -0.2, -1), (2, 2, 2), angle=0.0),
+                  SunLight((-0.5, 0.1, -1), (1, 2, 3), angle=0.05),
+                  SunLight((0.0, 0.6, -1), (3, 2, 1), angle=0.6),
+                  SunLight((0.1, 0.1, -1), (1, 1, 1), angle=1e-9)]     # a delta
+    elif name == "area":
+        lights = [AreaLight(matrix((0, 0, 2), (1, 0, 0), np.pi, (1.5, 0.7, 1)),
+                            (20, 18, 16), "SQUARE", 0.7),
+                  AreaLight(matrix((1, -1, 1.5), (1, 1, 0), 2.6, (1, 2, 1)),
+                            (9, 9, 9), "RECTANGLE", 1.2, 0.4, normalize=False),
+                  AreaLight(matrix((-1, 0.5, 2.2), (0.3, 1, 0.2), 2.9, (0.5, 0.5, 0.5)),
+                            (5, 6, 7), "DISK", 0.5),
+                  AreaLight(matrix((0.5, 1.5, 1.8), (1, 0, 0.4), 3.0, (1.3, 0.6, 1)),
+                            (8, 4, 2), "ELLIPSE", 0.8, 0.3, visible_camera=False),
+                  AreaLight(matrix((-1.2, -1.0, 1.0), (0, 1, 0), 2.8, (1, 1, 1), shear=0.4),
+                            (6, 6, 6), "RECTANGLE", 1.0, 0.5),           # parallelogram
+                  AreaLight(matrix((0.2, 0.0, 3.0), (1, 0, 0), np.pi, (-1, 1, 1)),
+                            (7, 7, 7), "SQUARE", 0.9, normalize=False)]  # mirrored
+    elif name == "world":
+        lights = [PointLight((0.3, -0.2, 1.5), (10, 8, 6))]
+    elif name == "triangles":
+        lights = []
+    elif name == "tiny":
+        lights = [PointLight((0.3, -0.2, 1.5), (1e-9, 1e-9, 1e-9), radius=1e-6),
+                  PointLight((0.0, 0.2, 1.0), (1e-9, 1e-9, 1e-9), radius=1e-6,
+                             soft_falloff=True),
+                  PointLight((0.1, 0.3, 1.2), (1, 1, 1), radius=1e-170),    # r^2 = 0: a point
+                  AreaLight(matrix((0, 0, 2), (1, 0, 0), np.pi), (1e-9, 1e-9, 1e-9),
+                            "SQUARE", 1e-6),
+                  AreaLight(matrix((1, 0, 2), (1, 0, 0), np.pi), (1e-9, 1e-9, 1e-9),
+                            "DISK", 1e-6)]
+    elif name == "all":
+        lights = (scene("point")[0] + scene("sphere")[0] + scene("disc")[0]
+                  + scene("sun")[0] + scene("area")[0])
+    elif name == "empty":
+        lights = []
+    else:
+        raise KeyError(name)
+    mesh = {"triangles": triangles(), "all": triangles((0.5, 0.5, -0.5)),
+            "tiny": triangles((0.0, 0.0, 1.0), 1e-6)}.get(name)
+    world = {"world": (0.2, 0.3, 0.4), "all": (0.05, 0.04, 0.03)}.get(name)
+    anchors = [np.asarray(getattr(l, "position", (0, 0, 0)), float) if not isinstance(
+        l, AreaLight) else np.asarray(l.matrix)[:3, 3] for l in lights
+        if not isinstance(l, SunLight)]
+    if mesh is not None and len(mesh):
+        anchors += list(mesh.v0 + (mesh.e1 + mesh.e2) / 3.0)
+    if not anchors:
+        anchors = [np.zeros(3)]
+    return lights, mesh, world, 5.0, np.array(anchors)
+
+
+SCENES = ["point", "sphere", "disc", "sun", "area", "world", "triangles", "tiny", "all",
+          "empty"]
+
+
+def light_set(name):
+    lights, mesh, world, radius, anchors = scene(name)
+    return LightSet(lights, radius, mesh_lights=mesh, world=world), anchors
+
+
+# ------------------------------------------------------------------ inputs
+
+def unit(v):
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def near_plane_points(ls, rng, n):
+    """Points at heights 1e-6 .. 1 (relative to the light's size) above and below each
+    area lamp's plane, over and beside it."""
+    out = []
+    for m in ls.models:
+        if not hasattr(m, "ax"):
+            continue
+        size = np.linalg.norm(m.ax) + np.linalg.norm(m.ay)
+        st = rng.uniform(-1.6, 1.6, (n, 2))
+        h = size * 10.0 ** rng.uniform(-6, 0, n) * rng.choice([-1.0, 1.0], n)
+        out.append(m.center + st[:, :1] * m.ax + st[:, 1:2] * m.ay + h[:, None] * m.normal)
+    return np.concatenate(out) if out else np.zeros((0, 3))
+
+
+def inside_points(ls, rng, n):
+    out = []
+    for m in ls.models:
+        if getattr(m, "radius", 0.0) > 0.0:
+            r = m.radius * rng.uniform(0, 1, n) ** (1 / 3)
+            out.append(m.position + r[:, None] * unit(rng.normal(size=(n, 3))))
+    return np.concatenate(out) if out else np.zeros((0, 3))
+
+
+def shading_points(ls, anchors, rng, n=400):
+    a = anchors[rng.integers(0, len(anchors), n)]
+    pts = [rng.uniform(-3, 3, (n, 3)) + a,                                   # a box
+           a + unit(rng.normal(size=(n, 3))) * 10.0 ** rng.uniform(-8, 0.5, (n, 1)),
+           a[: n // 4] + unit(rng.normal(size=(n // 4, 3))) * 1e4,          # far away
+           anchors,                                                          # at centres
+           near_plane_points(ls, rng, n // 2),
+           inside_points(ls, rng, n // 4)]
+    return np.ascontiguousarray(np.concatenate(pts))
+
+
+def uniforms(rng, n):
+    """Random uniforms with the edges mixed in: 0, 0.5, u0 == u1, the largest < 1."""
+    u = rng.random((n, 2))
+    edges = np.array([0.0, 0.5, ONE_MINUS, 0.25])
+    m = n // 8
+    u[:m, 0] = rng.choice(edges, m)
+    u[m:2 * m, 1] = rng.choice(edges, m)
+    u[2 * m:3 * m, 1] = u[2 * m:3 * m, 0]
+    return u
+
+
+def pick_uniforms(ls, rng, n):
+    """Uniform picks plus the CDF's own values (side='right' ties) and 0."""
+    u = rng.random(n)
+    if len(ls):
+        m = n // 8
+        u[:m] = rng.choice(np.concatenate([ls.cdf[:-1], [0.0, ONE_MINUS]]), m)
+    return u
+
+
+# ------------------------------------------------------------------ comparison
+
+MAX_REDONE = 0.02          # share of rows that may need NumPy's one-row evaluation
+EXACT = (0.0, 0.0)
+VALUE = (RTOL, 0.0)
+DIRECTION = (0.0, WI_ATOL)
+
+
+def mismatched(kernel, numpy, rtol, atol):
+    """Rows where kernel and numpy disagree: beyond atol + rtol |numpy|, or one finite
+    and the other not, or different infinities / NaNs."""
+    k = np.asarray(kernel, float).reshape(len(kernel), -1)
+    n = np.asarray(numpy, float).reshape(len(numpy), -1)
+    assert k.shape == n.shape
+    with np.errstate(invalid="ignore", over="ignore"):
+        ok = (k == n) | (np.isnan(k) & np.isnan(n)) | (
+            np.isfinite(k) & np.isfinite(n) & (np.abs(k - n) <= atol + rtol * np.abs(n)))
+    return ~ok.all(axis=1)
+
+
+def close(kernel, numpy, what, rtol=RTOL, atol=0.0):
+    """Every row agrees (no NumPy `@` on these paths: no fallback)."""
+    bad = mismatched(np.atleast_1d(kernel), np.atleast_1d(numpy), rtol, atol)
+    assert not bad.any(), (f"{what}: {bad.sum()} rows differ, first kernel "
+                           f"{np.atleast_1d(kernel)[bad][:2]} vs NumPy "
+                           f"{np.atleast_1d(numpy)[bad][:2]}")
+
+
+def agree(what, names, tols, kernel, numpy, numpy_row):
+    """The kernel's arrays equal NumPy's batch results to the tolerances, or, for the
+    rows where they do not, NumPy's result for that row alone (`numpy_row(i)`); see the
+    module docstring."""
+    redo = np.zeros(len(kernel[0]), dtype=bool)
+    for k, n, (rtol, atol) in zip(kernel, numpy, tols):
+        redo |= mismatched(k, n, rtol, atol)
+    assert redo.mean() <= MAX_REDONE, \
+        f"{what}: {redo.sum()} of {len(redo)} rows differ from NumPy's batch"
+    for i in np.nonzero(redo)[0]:
+        one = numpy_row(i)
+        for name, k, n, o, (rtol, atol) in zip(names, kernel, numpy, one, tols):
+            assert not mismatched(k[i:i + 1], o, rtol, atol)[0], (
+                f"{what}, row {i}, {name}: kernel {k[i]} vs NumPy {o[0]} "
+                f"(in a batch {n[i]})")
+
+
+SAMPLE_FIELDS = ("entry", "wi", "dist", "radiance", "pdf", "delta", "margin")
+SAMPLE_TOLS = (EXACT, DIRECTION, VALUE, VALUE, VALUE, EXACT, VALUE)
+
+
+def compare_sample(L, ls, p, up, u):
+    """LightSet.sample against sample_batch; returns NumPy's (LightSample, entries)."""
+    def fields(s, idx, delta):
+        return idx, s.wi, s.dist, s.radiance, s.pdf, delta, s.margin
+
+    s, idx, delta = ls.sample(p, up, u)
+    agree("sample", SAMPLE_FIELDS, SAMPLE_TOLS, sample_batch(L, p, up, u),
+          fields(s, idx, delta),
+          lambda i: fields(*ls.sample(p[i:i + 1], up[i:i + 1], u[i:i + 1])))
+    return s, idx
+
+
+def on_rim(ls, k, o, d, eps=1e-12):
+    """Rays that meet area lamp k's plane within eps of its rim (|s|, |t| or s^2 + t^2 at
+    1 in the lamp's own coordinates): hit or miss is a tie there, decided by rounding."""
+    m = ls.models[k]
+    if not hasattr(m, "ax"):
+        return np.zeros(len(o), dtype=bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = ((m.center - o) @ m.normal) / (d @ m.normal)
+        st = (o + d * t[:, None] - m.center) @ m.inv.T
+    edge = (st[:, 0] ** 2 + st[:, 1] ** 2 if m.round
+            else np.maximum(np.abs(st[:, 0]), np.abs(st[:, 1])))
+    return np.abs(edge - 1.0) < eps
+
+
+def compare_hits(L, ls, o, d, tmax):
+    """hit_surfaces against hit_lamps_batch; a row where one finds lamp j and the other
+    not (or another lamp) is accepted when the ray meets j's rim (`on_rim`): a sample at
+    a uniform of 0 or 1 lies exactly there, and single-row NumPy still uses BLAS (gemm)
+    for the lamp coordinates. Such rows are few and must be exactly at the rim."""
+    kernel = hit_lamps_batch(L, o, d, tmax)
+    numpy = ls.hit_surfaces(o, d, tmax)
+    tie = np.zeros(len(o), dtype=bool)
+    for i in np.nonzero(kernel[1] != numpy[1])[0]:
+        tie[i] = all(on_rim(ls, j, o[i:i + 1], d[i:i + 1])[0]
+                     for j in {kernel[1][i], numpy[1][i]} - {-1})
+    assert tie.mean() <= MAX_REDONE
+    keep = ~tie
+
+    def numpy_hits(rows):
+        return ls.hit_surfaces(o[keep][rows], d[keep][rows], tmax[keep][rows])
+
+    agree("hit_surfaces", ("t", "lamp", "radiance"), (VALUE, EXACT, VALUE),
+          tuple(a[keep] for a in kernel), tuple(a[keep] for a in numpy),
+          lambda i: numpy_hits(slice(i, i + 1)))
+    return numpy[0], numpy[1]
+
+
+def compare_pdf(L, ls, k, p, wi, t, what="pdf"):
+    def numpy_pdf(rows):
+        return (ls.pdf(k[rows], p[rows], wi[rows], t[rows]),)
+
+    agree(what, ("pdf",), (VALUE,), (lamp_pdf_batch(L, k, p, wi, t),),
+          numpy_pdf(slice(None)), lambda i: numpy_pdf(slice(i, i + 1)))
+
+
+# ------------------------------------------------------------------ tests
+
+@pytest.mark.parametrize("name", SCENES)
+def test_sample_matches_numpy(name):
+    ls, anchors = light_set(name)
+    L = pack_lights(ls)
+    rng = np.random.default_rng(SCENES.index(name))
+    p = shading_points(ls, anchors, rng)
+    compare_sample(L, ls, p, pick_uniforms(ls, rng, len(p)), uniforms(rng, len(p)))
+    assert n_entries(L) == len(ls)
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_each_entry_sampled_and_pdf_matches(name):
+    """Every entry forced (u_pick inside its CDF step), then LightSet.pdf for every lamp
+    index (and -1, and triangle entries) with the sampled directions and distances."""
+    ls, anchors = light_set(name)
+    L = pack_lights(ls)
+    rng = np.random.default_rng(100 + SCENES.index(name))
+    p = shading_points(ls, anchors, rng, n=200)
+    lo = np.concatenate([[0.0], ls.cdf[:-1]])
+    for k in range(len(ls)):
+        if not ls.cdf[k] > lo[k]:
+            continue                                      # a step lost to rounding
+        up = lo[k] + rng.random(len(p)) * (ls.cdf[k] - lo[k])
+        up = np.clip(up, lo[k], np.nextafter(ls.cdf[k], 0.0))
+        s, idx = compare_sample(L, ls, p, up, uniforms(rng, len(p)))
+        assert np.all(idx == k)
+        for kk in range(-1, len(ls) + 1):
+            kidx = np.full(len(p), kk, dtype=np.int64)
+            compare_pdf(L, ls, kidx, p, s.wi, s.dist,
+                        f"pdf of lamp {kk} for samples of entry {k}")
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_hits_and_their_pdfs_match(name):
+    ls, anchors = light_set(name)
+    L = pack_lights(ls)
+    rng = np.random.default_rng(200 + SCENES.index(name))
+    o = shading_points(ls, anchors, rng, n=300)
+    n = len(o)
+    s, _, _ = ls.sample(o, pick_uniforms(ls, rng, n), uniforms(rng, n))   # rims too
+    a = anchors[rng.integers(0, len(anchors), n)]
+    towards = unit(a + rng.normal(scale=0.3, size=(n, 3)) - o + 1e-300)
+    d = np.concatenate([s.wi, unit(rng.normal(size=(n, 3))), towards])
+    o3 = np.concatenate([o, o, o])
+    tmax = np.where(rng.random(3 * n) < 0.7, np.inf, rng.uniform(0, 4, 3 * n))
+    t, k = compare_hits(L, ls, o3, np.ascontiguousarray(d), tmax)
+    assert name in ("point", "sun", "world", "triangles", "empty") or np.any(k >= 0), \
+        "no ray hit a lamp: the test would show nothing"
+    compare_pdf(L, ls, k, o3, d, t, "pdf of the lamps hit")
+    vis = [getattr(m, "visible_camera", True) for m in ls.models]
+    assert [lamp_visible_camera(L, j) for j in range(len(vis))] == vis
+
+
+@pytest.mark.parametrize("name", ["triangles", "all", "tiny", "area", "empty"])
+def test_mesh_pdf_matches(name):
+    ls, anchors = light_set(name)
+    L = pack_lights(ls)
+    rng = np.random.default_rng(300 + SCENES.index(name))
+    p = shading_points(ls, anchors, rng, n=200)
+    n = len(p)
+    prims = rng.integers(-2, 20, n)
+    q = rng.normal(size=(n, 3))
+    if ls.mesh is not None:
+        j = rng.integers(0, len(ls.mesh), n)
+        s = ls.mesh.sample(p, j, uniforms(rng, n))
+        q[: n // 2] = (p + s.wi * s.dist[:, None])[: n // 2]
+        prims[: n // 2] = ls.mesh.prim[j[: n // 2]]
+        q[-5:] = p[-5:]                                           # q == p: pdf 0
+    agree("mesh pdf", ("pdf",), (VALUE,), (mesh_pdf_batch(L, prims, p, q),),
+          (ls.mesh_pdf(prims, p, q),), lambda i: (ls.mesh_pdf(prims[i:i + 1], p[i:i + 1],
+                                                             q[i:i + 1]),))
+    assert mesh_pdf(L, 10 ** 6, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0) == 0.0
+
+
+@pytest.mark.parametrize("name", ["sun", "all", "world", "empty"])
+def test_suns_and_world_match(name):
+    ls, _ = light_set(name)
+    L = pack_lights(ls)
+    rng = np.random.default_rng(400 + SCENES.index(name))
+    suns = ls.suns()
+    assert n_suns(L) == len(suns)
+    for j, (k, sun) in enumerate(suns):
+        half = np.sqrt(sun.one_minus * 2.0)
+        around = unit(sun.to_light + rng.normal(scale=half, size=(500, 3)))
+        s = sun.sample(np.zeros((200, 3)), uniforms(rng, 200))
+        d = np.ascontiguousarray(np.concatenate([around, s.wi, unit(rng.normal(size=(200, 3))),
+                                                 [sun.to_light]]))
+        rad, pdf = sun_escaped_batch(L, j, d)
+        close(rad, sun.escaped(d), f"sun {j} radiance")
+        close(pdf, sun.pdf(None, d, None) * ls.select_pdf[k], f"sun {j} pdf")
+        assert 0 < np.count_nonzero(pdf) < len(d)          # inside and outside the disc
+        assert sun_escaped(L, j, *d[-1])[:3] == tuple(sun.radiance)
+    close(environment_pdf(L), ls.environment_pdf(1)[0], "world pdf")
+    world = (ls.models[ls.env_index].radiance if ls.env_index is not None else np.zeros(3))
+    assert environment_radiance(L) == tuple(world)
+    assert (environment_pdf(L) > 0) == (name in ("world", "all"))
+
+
+def test_scalar_kernels_equal_batch_rows():
+    ls, anchors = light_set("all")
+    L = pack_lights(ls)
+    rng = np.random.default_rng(5)
+    p = shading_points(ls, anchors, rng, n=20)[:40]
+    up, u = pick_uniforms(ls, rng, len(p)), uniforms(rng, len(p))
+    rows = sample_batch(L, p, up, u)
+    for i in range(len(p)):
+        one = sample(L, *p[i], up[i], *u[i])
+        assert one[0] == rows[0][i] and one[9] == rows[5][i]
+        assert one[1:4] == tuple(rows[1][i]) and one[5:8] == tuple(rows[3][i])
+        assert (one[4], one[8], one[10]) == (rows[2][i], rows[4][i], rows[6][i])
+        d = rows[1][i]
+        t, k, r, g, b = hit_lamps(L, *p[i], *d, np.inf)
+        assert (t, k) == tuple(x[0] for x in hit_lamps_batch(L, p[i:i + 1], d[None],
+                                                             np.array([np.inf]))[:2])
+        assert lamp_pdf(L, k, *p[i], *d, t) == lamp_pdf_batch(
+            L, np.array([k]), p[i:i + 1], d[None], np.array([t]))[0]
+
+
+def test_empty_set():
+    ls = LightSet([], 1.0)
+    L = pack_lights(ls)
+    assert n_entries(L) == 0 and n_suns(L) == 0
+    k, wx, wy, wz, dist, r, g, b, pdf, delta, margin = sample(L, 0.0, 0.0, 0.0, 0.3, 0.5, 0.5)
+    s, idx, dl = ls.sample(np.zeros((1, 3)), np.array([0.3]), np.array([[0.5, 0.5]]))
+    assert k == idx[0] == -1 and pdf == s.pdf[0] == 0.0 and not delta
+    assert (wx, wy, wz) == tuple(s.wi[0]) and (r, g, b) == (0.0, 0.0, 0.0)
+    assert hit_lamps(L, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 7.0) == (7.0, -1, 0.0, 0.0, 0.0)
+    assert environment_pdf(L) == 0.0 and environment_radiance(L) == (0.0, 0.0, 0.0)
+    black = pack_lights(LightSet([], 1.0, world=(0.0, 0.0, 0.0)))   # a black world: no light
+    assert n_entries(black) == 0 and environment_radiance(black) == (0.0, 0.0, 0.0)
+
+
+def test_one_compilation_serves_every_scene():
+    """pack_lights gives the same Numba type for every scene (the empty and mesh-less
+    packs included), so the kernels compile once, not once per scene."""
+    from numba import typeof
+    types = {typeof(pack_lights(light_set(name)[0])) for name in SCENES}
+    assert len(types) == 1, types
+
+
+def test_moving_lamp_is_not_packed():
+    moving = PointLight((0, 0, 1), (1, 1, 1), motion_slices=[
+        PointLight((0, 0, 1), (1, 1, 1)), PointLight((0, 0, 2), (1, 1, 1))])
+    with pytest.raises(NotImplementedError, match="moving lamps"):
+        pack_lights(LightSet([PointLight((1, 0, 1), (1, 1, 1)), moving], 1.0))
+
+
+def test_negative_control_comparison_fails():
+    """The comparison must fail on a 1e-6 change: one lamp's radiance seen by 3 rows only
+    (caught by the one-row re-evaluation), one pick probability on every row (caught by
+    the batch comparison), and a kernel fed another scene's lamps."""
+    ls, anchors = light_set("all")
+    rng = np.random.default_rng(9)
+    p = shading_points(ls, anchors, rng, n=100)
+    up, u = pick_uniforms(ls, rng, len(p)), uniforms(rng, len(p))
+    L = pack_lights(ls)
+    compare_sample(L, ls, p, up, u)                       # the unchanged pack passes
+    k_area = next(k for k, m in enumerate(ls.models) if hasattr(m, "ax"))
+    in_area = (ls.cdf[k_area - 1] if k_area else 0.0) + 0.5 * ls.select_pdf[k_area]
+    up_few = np.where(np.arange(len(p)) < 3, in_area, ls.cdf[0] * 0.5)   # lamp 0 else
+    compare_sample(L, ls, p, up_few, u)
+    bad = tuple(a.copy() for a in L)
+    bad[LAMPS][k_area, C_RAD] *= 1.0 + 1e-6
+    with pytest.raises(AssertionError, match="row [012], radiance"):
+        compare_sample(bad, ls, p, up_few, u)
+    bad = tuple(a.copy() for a in L)
+    bad[SELECT_PDF][k_area] *= 1.0 + 1e-6
+    with pytest.raises(AssertionError, match="rows differ"):
+        compare_sample(bad, ls, p, np.full(len(p), in_area), u)
+    other = pack_lights(light_set("area")[0])
+    with pytest.raises(AssertionError):
+        compare_sample(other, ls, p, up, u)
