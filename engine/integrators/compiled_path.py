@@ -1,16 +1,16 @@
 """The path tracer on compiled kernels: the wavefront loop in Python, the per-path work in
 `engine.kernels.path_vertex`, the ray queries in Embree.
 
-Per bounce: one closest-hit query for the live paths, one `shade` kernel (emission found,
-a shadow ray and a continuation ray per path), one occlusion query for the shadow rays,
-one kernel adding what got through. Python touches each bounce a handful of times
-whatever the number of paths, and every stage releases the GIL, so work units on
-threads run in parallel.
+Per bounce: one closest-hit query for the live paths (repeated through transparent
+layers where materials have alpha), one `shade` kernel (emission found, a shadow ray and
+a continuation ray per path), one occlusion query for the shadow rays (closest-hit
+queries through transparent layers where needed), one kernel adding what got through.
+Python touches each bounce a handful of times whatever the number of paths, and every
+stage releases the GIL, so work units on threads run in parallel.
 
 It computes the same estimator as `engine.integrators.path.PathIntegrator`, which
-remains the reference implementation and serves the scenes this one does not handle yet
-(`unsupported` names the reason): motion blur, stochastic transparency and image
-textures.
+remains the reference implementation (tests compare the two) and serves the scenes this
+one does not handle yet (`unsupported` names the reason): motion blur.
 """
 from __future__ import annotations
 
@@ -18,7 +18,10 @@ import numpy as np
 
 from ..kernels import lights as klights
 from ..kernels.bsdf import principled as kbsdf
-from ..kernels.path_vertex import BSDF_ONLY, LIGHT_ONLY, MIS, add_unoccluded, shade
+from ..kernels.path_vertex import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
+                                   add_unoccluded, shade)
+from ..kernels.textures import pack_textures
+from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
 from ..sampling.dispatch import pixel_keys
 from .path import MIS_MODES
 
@@ -29,10 +32,6 @@ def unsupported(ctx) -> str | None:
     """Why the compiled path tracer cannot render this context yet (None: it can)."""
     if ctx.has_motion:
         return "motion blur"
-    if ctx.materials.any_transparent:
-        return "stochastic transparency"
-    if ctx.materials.any_textures:
-        return "image textures"
     try:
         klights.pack_lights(ctx.lights)
     except NotImplementedError as e:
@@ -40,25 +39,34 @@ def unsupported(ctx) -> str | None:
     return None
 
 
+def _or_empty(a, shape, dtype):
+    return np.ascontiguousarray(a) if a is not None else np.zeros(shape, dtype)
+
+
 class CompiledPathIntegrator:
     def __init__(self, ctx):
         self.ctx = ctx
         s = ctx.settings
-        surf = ctx.surfaces
+        surf, mats = ctx.surfaces, ctx.materials
         self.max_bounces = s.max_bounces
+        self.transparent_limit = s.transparent_bounces
         self._mode = "mis"
         self.cfg = np.array([ctx.sampler.kind, ctx.sampler.samples_per_pixel, s.max_bounces,
                              s.diffuse_bounces, s.glossy_bounces, s.transmission_bounces,
                              s.clamp_direct, s.clamp_indirect, MIS, ctx.scene_radius,
-                             float(ctx.scene.film_transparent)],
-                            dtype=np.float64)
-        self.geometry = (surf.v0, surf.v1, surf.v2, surf.normal, surf.tri_scale,
-                         surf.material,
-                         surf.corner_normals if surf.corner_normals is not None
-                         else np.zeros((0, 3, 3), np.float32),
-                         surf.holdout if surf.holdout is not None else np.zeros(0, bool))
-        self.params = kbsdf.pack_materials(ctx.materials)
-        self.emission = np.ascontiguousarray(ctx.materials.emission, dtype=np.float64)
+                             float(ctx.scene.film_transparent)], dtype=np.float64)
+        self.geometry = (surf.v0, surf.v1, surf.v2, surf.normal, surf.tri_scale, surf.material,
+                         _or_empty(surf.corner_normals, (0, 3, 3), np.float32),
+                         _or_empty(surf.holdout, 0, bool),
+                         _or_empty(surf.corner_uvs, (0, 3, 2), np.float32))
+        self.params = kbsdf.pack_materials(mats)
+        self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)
+        self.textures = pack_textures(mats)
+        self.materials = (surf.material, np.ascontiguousarray(mats.maybe_transparent),
+                          np.ascontiguousarray(mats.alpha, dtype=np.float64),
+                          np.ascontiguousarray(mats.transparent_color, dtype=np.float64),
+                          self.textures)
+        self.any_transparent = mats.any_transparent
         self.tables = kbsdf.kernel_tables()
         self.lights = klights.pack_lights(ctx.lights)
         self.world = np.ascontiguousarray(ctx.world_radiance, dtype=np.float64)
@@ -73,10 +81,56 @@ class CompiledPathIntegrator:
         if mode in _MODE_IDS:
             self.cfg[8] = _MODE_IDS[mode]
 
+    # -- transparency: repeated queries through surfaces with alpha < 1 ----------------
+    def _through_transparent(self, depth, paths, live, used, o, d, tm, hits):
+        """Closest hits seen through transparent layers (see path.intersect_alpha):
+        returns (t, prim, u, v, throughput factor (m, 3), stopped (m,))."""
+        m = len(live)
+        t_all, prim_all = hits.t.copy(), hits.prim.copy()
+        u_all, v_all = hits.u.copy(), hits.v.copy()
+        factor, stopped = np.ones((m, 3)), np.zeros(m, bool)
+        travelled = np.zeros(m)
+        rows = np.arange(m, dtype=np.int64)
+        cur = hits
+        out_rows, out_org, out_far = np.empty(m, np.int64), np.empty((m, 3)), np.empty(m)
+        cfg = self.cfg
+        layer = 0
+        while rows.size:
+            k = alpha_pass(depth, layer, self.transparent_limit, int(cfg[0]), int(cfg[1]),
+                           paths[0], paths[1], live, used, rows, d, tm,
+                           cur.t, cur.prim, cur.u, cur.v, travelled, factor, stopped,
+                           self.geometry, self.materials, out_rows, out_org, out_far)
+            if k == 0:
+                break
+            rows = out_rows[:k].copy()
+            cur = self.ctx.accel.intersect(out_org[:k], d[rows], out_far[:k])
+            merge_layer(rows, travelled, cur.t, cur.prim, cur.u, cur.v,
+                        t_all, prim_all, u_all, v_all)
+            layer += 1
+        return t_all, prim_all, u_all, v_all, factor, stopped
+
+    def _transmittance(self, org, dirs, far):
+        """Transmittance (n, 3) of shadow rays through transparent layers."""
+        n = len(org)
+        trans = np.ones((n, 3))
+        rows = np.arange(n, dtype=np.int64)
+        o, remaining = org, far
+        out_rows, out_org, out_far = np.empty(n, np.int64), np.empty((n, 3)), np.empty(n)
+        layer = 0
+        while rows.size:
+            h = self.ctx.accel.intersect(o, dirs[rows], remaining)
+            k = shadow_pass(layer, self.transparent_limit, rows, dirs, remaining, h.t, h.prim,
+                            h.u, h.v, trans, self.geometry, self.materials,
+                            out_rows, out_org, out_far)
+            rows = out_rows[:k].copy()
+            o, remaining = out_org[:k].copy(), out_far[:k].copy()
+            layer += 1
+        return trans
+
     def radiance(self, pixel, index, origins, dirs, tmax, time=None, alpha_out=None):
         if self._mode not in _MODE_IDS:
             raise ValueError(f"mis_mode must be one of {MIS_MODES}, got {self._mode!r}")
-        ctx = self.ctx
+        ctx, s = self.ctx, self.ctx.settings
         n = len(pixel)
         pkey = pixel_keys(np.uint64(ctx.sampler.seed), np.asarray(pixel, np.int64))
         index = np.ascontiguousarray(index, dtype=np.int64)
@@ -84,7 +138,8 @@ class CompiledPathIntegrator:
         coverage = alpha_out if alpha_out is not None else np.zeros(0)
         beta = np.ones((n, 3))
         counts = np.zeros((n, 3), dtype=np.int64)
-        prev_pdf = np.full(n, np.inf)           # camera rays count as specular: weight 1
+        used = np.zeros(n, dtype=np.int64)         # transparent bounces per path
+        prev_pdf = np.full(n, np.inf)              # camera rays count as specular: weight 1
         prev_pos = np.ascontiguousarray(origins, dtype=np.float64).copy()
         live = np.arange(n, dtype=np.int64)
         o = np.ascontiguousarray(origins, dtype=np.float64)
@@ -95,19 +150,30 @@ class CompiledPathIntegrator:
         sh_far, sh_contrib = np.empty(n), np.empty((n, 3))
         nx_path = np.empty(n, np.int64)
         nx_org, nx_dir = np.empty((n, 3)), np.empty((n, 3))
+        no_stop = np.zeros(n, bool)
         for depth in range(self.max_bounces + 1):
             if live.size == 0:
                 break
             hits = ctx.accel.intersect(o, d, tm)
+            t, prim, u, v, stopped = hits.t, hits.prim, hits.u, hits.v, no_stop
+            if self.any_transparent:
+                t, prim, u, v, factor, stopped = self._through_transparent(
+                    depth, (pkey, index), live, used, o, d, tm, hits)
+                beta[live] *= factor
             ns, nn = shade(depth, self.cfg, pkey, index, beta, counts, L, coverage,
-                           prev_pdf, prev_pos, live, o, d, tm, hits.t, hits.prim, hits.u, hits.v,
-                           self.geometry, self.params, self.emission, self.tables,
-                           self.lights, self.world,
+                           prev_pdf, prev_pos, live, o, d, tm, t, prim, u, v, stopped,
+                           self.geometry, self.params, self.emission, self.textures,
+                           self.tables, self.lights, self.world,
                            sh_path, sh_org, sh_dir, sh_far, sh_contrib,
                            nx_path, nx_org, nx_dir)
             if ns:
-                blocked = ctx.accel.occluded(sh_org[:ns], sh_dir[:ns], sh_far[:ns])
-                add_unoccluded(L, sh_path[:ns], sh_contrib[:ns], blocked)
+                limit = s.clamp_direct if depth == 0 else s.clamp_indirect
+                if self.any_transparent:
+                    trans = self._transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns])
+                    add_transmitted(L, sh_path[:ns], sh_contrib[:ns], trans, limit)
+                else:
+                    blocked = ctx.accel.occluded(sh_org[:ns], sh_dir[:ns], sh_far[:ns])
+                    add_unoccluded(L, sh_path[:ns], sh_contrib[:ns], blocked, limit)
             live = nx_path[:nn].copy()
             o, d = nx_org[:nn].copy(), nx_dir[:nn].copy()
             tm = np.full(nn, np.inf)

@@ -23,7 +23,9 @@ from . import lights as lt
 from .bsdf import principled as bsdf
 from .frame import dot, to_local, to_world
 from .jit import kernel
-from .surface import offset_origin, rebuild
+from .bsdf.params import P_BASE, P_METALLIC, P_ROUGHNESS
+from .surface import hit_uv, offset_origin, rebuild
+from .textures import apply_to_row, emission_at
 
 MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
 ROULETTE_START = 3
@@ -87,19 +89,23 @@ def uncovered(br, bg, bb):
 
 @kernel
 def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
-          live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v,
-          geometry, params, emission, tables, lights, world,
+          live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
+          geometry, params, emission, textures, tables, lights, world,
           sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
 
     cfg: float64 [sampler kind, spp, max_bounces, diffuse, glossy, transmission limits,
     clamp_direct, clamp_indirect, mis mode, scene radius, film transparent].
-    geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout) of the
-    static triangles (corner_normals and holdout may be empty). alpha: each path's film
-    coverage, or empty when the film is opaque. Writes the shadow rays to sh_* and the
-    continuing paths' next rays to nx_*; returns (shadow count, next count). beta,
-    counts, L, alpha, prev_pdf, prev_pos are per-path state, updated in place."""
-    v0, v1, v2, normal, tri_scale, tri_material, corner_normals, holdout = geometry
+    geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout,
+    corner_uvs) of the static triangles (the last three may be empty). alpha: each
+    path's film coverage, or empty when the film is opaque. stopped: rays that ended at
+    the transparent bounce limit. Writes the shadow rays to sh_* (their contributions
+    before the clamp, which `add_transmitted` applies) and the continuing paths' next
+    rays to nx_*; returns (shadow count, next count). beta, counts, L, alpha, prev_pdf,
+    prev_pos are per-path state, updated in place."""
+    (v0, v1, v2, normal, tri_scale, tri_material, corner_normals, holdout,
+     corner_uvs) = geometry
+    any_textures = textures[1].shape[0] > 0
     film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
     kind, spp = int(cfg[0]), int(cfg[1])
     max_bounces = int(cfg[2])
@@ -142,6 +148,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
                 eb += sb * w
             _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)
             continue
+        if stopped[j]:
+            continue                      # past the transparent bounce limit
         prim = hit_prim[j]
         if depth == 0 and holdout.shape[0] > 0 and holdout[prim]:
             if alpha.shape[0] > 0:        # Cycles' holdout: a hole, for camera rays only
@@ -151,8 +159,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
             v0, v1, v2, normal, tri_scale, corner_normals, prim, hit_u[j], hit_v[j],
             dx, dy, dz)
         m = tri_material[prim]
+        uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
-        er, eg, eb = emission[m, 0], emission[m, 1], emission[m, 2]
+        er, eg, eb = emission_at(textures, emission, m, uu, vv)
         if er != 0.0 or eg != 0.0 or eb != 0.0:
             lpdf = lt.mesh_pdf(lights, prim, prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2],
                                px, py, pz)
@@ -160,6 +169,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
             _add(L, p, br * er * w, bg * eg * w, bb * eb * w, clamp_hit)
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
         row[:] = params[m]
+        if any_textures:
+            apply_to_row(textures, m, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
         bsdf.setup(row, front, wox, woy, woz, tables, state)
         room = depth < max_bounces
         ad = room and counts[p, 0] < cfg[3]
@@ -191,15 +202,13 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
                     far = scene_radius * 4.0
                 bpdf = bsdf.pdf(state, wox, woy, woz, lx, ly, lz, ad, ag, at)
                 w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * abs(lz)
-                cr, cg, cb = br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w
-                s = clamp_scale(cr, cg, cb, clamp_direct if depth == 0 else clamp_indirect)
                 sh_path[ns_out] = p
                 sh_org[ns_out, 0], sh_org[ns_out, 1], sh_org[ns_out, 2] = sox, soy, soz
                 sh_dir[ns_out, 0], sh_dir[ns_out, 1], sh_dir[ns_out, 2] = sdx, sdy, sdz
                 sh_far[ns_out] = max(far, 0.0)
-                sh_contrib[ns_out, 0] = cr * s
-                sh_contrib[ns_out, 1] = cg * s
-                sh_contrib[ns_out, 2] = cb * s
+                sh_contrib[ns_out, 0] = br * fr * lr * w
+                sh_contrib[ns_out, 1] = bg * fg * lg * w
+                sh_contrib[ns_out, 2] = bb * fb * lb * w
                 ns_out += 1
         # 3. continue by BSDF sampling
         if not (ad or ag or at):
@@ -237,11 +246,17 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
 
 
 @kernel
-def add_unoccluded(L, sh_path, sh_contrib, blocked):
-    """Add the contributions of the shadow rays that reached their light."""
+def add_unoccluded(L, sh_path, sh_contrib, blocked, limit):
+    """Add the contributions of the shadow rays that reached their light, clamped."""
     for i in range(sh_path.shape[0]):
         if not blocked[i]:
-            p = sh_path[i]
-            L[p, 0] += sh_contrib[i, 0]
-            L[p, 1] += sh_contrib[i, 1]
-            L[p, 2] += sh_contrib[i, 2]
+            _add(L, sh_path[i], sh_contrib[i, 0], sh_contrib[i, 1], sh_contrib[i, 2], limit)
+
+
+@kernel
+def add_transmitted(L, sh_path, sh_contrib, trans, limit):
+    """Add the contributions of shadow rays times their transmittance, clamped."""
+    for i in range(sh_path.shape[0]):
+        if trans[i, 0] > 0.0 or trans[i, 1] > 0.0 or trans[i, 2] > 0.0:
+            _add(L, sh_path[i], sh_contrib[i, 0] * trans[i, 0], sh_contrib[i, 1] * trans[i, 1],
+                 sh_contrib[i, 2] * trans[i, 2], limit)

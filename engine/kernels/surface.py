@@ -52,3 +52,15 @@ def offset_origin(px, py, pz, nx, ny, nz, scale, dx, dy, dz):
     side = 1.0 if dot(nx, ny, nz, dx, dy, dz) >= 0.0 else -1.0
     eps = RELATIVE_OFFSET * max(scale, 1e-30) * side
     return px + nx * eps, py + ny * eps, pz + nz * eps
+
+
+@kernel
+def hit_uv(corner_uvs, prim, u, v):
+    """Texture coordinates at barycentrics (u, v) of triangle prim, from its corner UVs
+    (T, 3, 2) float32; (0, 0) when the scene has none (Cycles' missing UV map)."""
+    if corner_uvs.shape[0] == 0:
+        return 0.0, 0.0
+    w = 1.0 - u - v
+    c = corner_uvs
+    return (w * np.float64(c[prim, 0, 0]) + u * np.float64(c[prim, 1, 0]) + v * np.float64(c[prim, 2, 0]),
+            w * np.float64(c[prim, 0, 1]) + u * np.float64(c[prim, 1, 1]) + v * np.float64(c[prim, 2, 1]))

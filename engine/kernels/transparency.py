@@ -1,0 +1,116 @@
+"""Stochastic transparency (Cycles' transparent closure, Principled Alpha), compiled: the
+per-hit decisions of `engine.integrators.path.intersect_alpha` and
+`shadow_transmittance` (read those for the estimator). The caller loops: closest-hit
+query, one of these kernels, the next query for the rays that go on.
+
+`materials` is the tuple (material of each triangle, maybe_transparent per material,
+alpha per material, transparent colour per material (M, 3), textures T); `geometry` the
+tuple `path_vertex.shade` takes, plus corner UVs."""
+from __future__ import annotations
+
+from ..sampling.dispatch import sample_1d
+from .jit import kernel
+from .surface import hit_uv, offset_origin, rebuild
+from .textures import alpha_at
+
+TRANSPARENT_DIM = 1 << 24      # the pass-through numbers' own dimensions (see path.py)
+
+
+@kernel
+def alpha_dim(depth, layer):
+    return TRANSPARENT_DIM + depth * 1024 + min(layer, 1023)
+
+
+@kernel
+def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz):
+    v0, v1, v2, normal, tri_scale, tri_material, corner_normals, holdout, corner_uvs = geometry
+    _, _, alpha_table, _, T = materials
+    px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild(
+        v0, v1, v2, normal, tri_scale, corner_normals, prim, u, v, dx, dy, dz)
+    uu, vv = hit_uv(corner_uvs, prim, u, v)
+    m = tri_material[prim]
+    return alpha_at(T, alpha_table, m, uu, vv), m, px, py, pz, gx, gy, gz, scale
+
+
+@kernel
+def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, rows, rd, tmax,
+               cur_t, cur_prim, cur_u, cur_v, travelled, factor, stopped,
+               geometry, materials, out_rows, out_org, out_far):
+    """One transparent layer for the camera or bounce rays `rows` (indices into the
+    wavefront `live`) whose current closest hits are cur_*: each ray whose hit surface
+    lets it through (a sampler number >= alpha) goes on beyond it, tinted, counting one
+    transparent bounce of its path (`used`, per path); past `limit` such bounces the
+    path stops. Writes the rays that go on (row, origin, remaining distance); returns
+    their count."""
+    tri_material, maybe_transparent, _, tcolor, _ = materials
+    n_out = 0
+    for i in range(rows.shape[0]):
+        r = rows[i]
+        prim = cur_prim[i]
+        if prim < 0 or not maybe_transparent[tri_material[prim]]:
+            continue
+        dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
+        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim,
+                                                         cur_u[i], cur_v[i], dx, dy, dz)
+        p = live[r]
+        if not sample_1d(kind, pkey[p], spp, index[p], alpha_dim(depth, layer)) >= a:
+            continue
+        if used[p] >= limit:
+            stopped[r] = True
+            continue
+        factor[r, 0] *= tcolor[m, 0]
+        factor[r, 1] *= tcolor[m, 1]
+        factor[r, 2] *= tcolor[m, 2]
+        used[p] += 1
+        travelled[r] += cur_t[i]
+        ox, oy, oz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
+        out_rows[n_out] = r
+        out_org[n_out, 0], out_org[n_out, 1], out_org[n_out, 2] = ox, oy, oz
+        out_far[n_out] = max(tmax[r] - travelled[r], 0.0)
+        n_out += 1
+    return n_out
+
+
+@kernel
+def shadow_pass(layer, limit, rows, sd, remaining, cur_t, cur_prim, cur_u, cur_v, trans,
+                geometry, materials, out_rows, out_org, out_far):
+    """One layer of transparent shadows for the shadow rays `rows`: an opaque surface (or
+    one past `limit` transparent layers) blocks; a transparent one multiplies the
+    transmittance by (1 - alpha) x its transparent colour and the ray goes on."""
+    tri_material, maybe_transparent, _, tcolor, _ = materials
+    n_out = 0
+    for i in range(rows.shape[0]):
+        r = rows[i]
+        prim = cur_prim[i]
+        if prim < 0 or not cur_t[i] < remaining[i]:
+            continue
+        if not maybe_transparent[tri_material[prim]] or layer >= limit:
+            trans[r, 0] = trans[r, 1] = trans[r, 2] = 0.0
+            continue
+        dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
+        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim,
+                                                         cur_u[i], cur_v[i], dx, dy, dz)
+        trans[r, 0] *= (1.0 - a) * tcolor[m, 0]
+        trans[r, 1] *= (1.0 - a) * tcolor[m, 1]
+        trans[r, 2] *= (1.0 - a) * tcolor[m, 2]
+        if not max(trans[r, 0], trans[r, 1], trans[r, 2]) > 0.0:
+            continue
+        ox, oy, oz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
+        out_rows[n_out] = r
+        out_org[n_out, 0], out_org[n_out, 1], out_org[n_out, 2] = ox, oy, oz
+        out_far[n_out] = max(remaining[i] - cur_t[i], 0.0)
+        n_out += 1
+    return n_out
+
+
+@kernel
+def merge_layer(rows, travelled, found_t, found_prim, found_u, found_v,
+                t_all, prim_all, u_all, v_all):
+    """The hits beyond a transparent layer replace the rows' hits (t from the start)."""
+    for i in range(rows.shape[0]):
+        r = rows[i]
+        if found_prim[i] >= 0:
+            t_all[r] = travelled[r] + found_t[i]
+        else:
+            t_all[r] = 1e300 * 1e300
+        prim_all[r], u_all[r], v_all[r] = found_prim[i], found_u[i], found_v[i]
