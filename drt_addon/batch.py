@@ -1,7 +1,8 @@
 """The headless batch renderer on the bpy module.
 
     python -m drt_addon render SCENE.blend -o OUT.png [--samples N] [--seed S] [--frame F]
-    python -m drt_addon package [-o DIR]   (build the extension zip; see docs/install.md)
+    python -m drt_addon package [-o DIR] [--platform P]   (build the extension zips;
+                                                           see docs/install.md)
 
 Exit codes: 0 success, 2 bad arguments, 3 file missing or not a .blend, 4 render or package failed.
 Errors go to stderr as one line; no traceback reaches the user.
@@ -43,11 +44,17 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--samples", type=int, help="samples per pixel (default: the scene's)")
     r.add_argument("--seed", type=int, help="random seed (default: the scene's)")
     r.add_argument("--frame", type=int, help="frame to render (default: the current frame)")
+    r.add_argument("--percentage", type=int,
+                   help="resolution percentage, 1..10000 (default: the scene's)")
     r.add_argument("--engine", default="DRT", choices=("DRT", "CYCLES"),
                    help="render engine (CYCLES for reference images)")
-    pk = sub.add_parser("package", help="build and validate the Blender extension zip "
-                                        "(downloads the pinned embreex wheels into wheels/)")
-    pk.add_argument("-o", "--output-dir", help="folder for the zip (default: build/)")
+    pk = sub.add_parser("package", help="build and validate the Blender extension zips, one "
+                                        "per platform (downloads the pinned wheels into "
+                                        "wheels/); prints one zip path per line")
+    pk.add_argument("-o", "--output-dir", help="folder for the zips (default: build/)")
+    pk.add_argument("--platform", action="append", dest="platforms", metavar="PLATFORM",
+                    help="build only this platform's zip (one of the manifest's platforms, "
+                         "e.g. linux-x64; repeatable; default: every platform)")
     return p
 
 
@@ -69,14 +76,24 @@ def run_package(args) -> int:
     from . import packaging
     if args.output_dir and os.path.exists(args.output_dir) and not os.path.isdir(args.output_dir):
         raise CliError(EXIT_USAGE, f"drt: error: {args.output_dir} is not a folder")
+    if args.platforms:
+        try:
+            listed = packaging.manifest_platforms()
+        except packaging.PackagingError as e:
+            raise CliError(EXIT_RENDER, f"drt: error: package failed: {e}") from None
+        unknown = [p for p in args.platforms if p not in listed]
+        if unknown:
+            raise CliError(EXIT_USAGE, f"drt: error: unknown platform {', '.join(unknown)}; "
+                                       f"the manifest lists {', '.join(listed)}")
     try:
-        zip_path = packaging.package(args.output_dir)
+        zip_paths = packaging.package(args.output_dir, platforms=args.platforms)
     except packaging.PackagingError as e:
         raise CliError(EXIT_RENDER, f"drt: error: package failed: {e}") from None
     except Exception as e:
         raise CliError(EXIT_RENDER, f"drt: error: package failed: {type(e).__name__}: {e}") \
             from None
-    print(zip_path)
+    for zip_path in zip_paths:
+        print(zip_path)
     return EXIT_OK
 
 
@@ -122,6 +139,10 @@ def run(argv) -> int:
         scene.drt.seed = args.seed
         if args.engine == "CYCLES":
             scene.cycles.seed = args.seed
+    if args.percentage is not None:
+        if not 1 <= args.percentage <= 10000:
+            raise CliError(EXIT_USAGE, "drt: error: --percentage must be in 1..10000")
+        scene.render.resolution_percentage = args.percentage
     if scene.camera is None:
         raise CliError(EXIT_RENDER, "drt: error: render failed: the scene has no active camera")
     t0 = time.perf_counter()

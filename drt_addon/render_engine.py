@@ -150,6 +150,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         reporter = Reporter(None if self.is_preview else self.report)
         self.update_stats("", "DRT: exporting scene")
         t0 = time.perf_counter()
+        last_render["first_sample_seconds"] = None
         export_stats = {}
         description = export_scene(depsgraph, reporter, region=region, stats=export_stats,
                                    render_engine=self)
@@ -170,6 +171,9 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         image = alpha = None
         try:
             def progress(film, stats, fraction):
+                if last_render.get("first_sample_seconds") is None:
+                    # depsgraph to first sample: export, BVH build, first pass
+                    last_render["first_sample_seconds"] = time.perf_counter() - t0
                 combined.rect.foreach_set(_rgba_bottom_up(film.mean(), film.mean_alpha()))
                 self.update_result(result)
                 self.update_progress(fraction)

@@ -24,14 +24,17 @@ import numpy as np
 
 from .accel import Accelerator
 from .bsdf.principled import MaterialTable
-from .camera import CameraModel
+from .camera import CameraModel, CameraRays
 from .film import Film
 from .integrators import make_integrator
+from .kernels.camera_rays import generate as generate_camera_rays
+from .kernels.camera_rays import pack_camera
 from .lights import LightSet
 from .mesh_lights import EmissiveTriangles
 from .pixel_filter import PixelFilter
 from .sampling import dimensions as D
 from .sampling import make_sampler
+from .sampling.dispatch import pixel_keys
 from .scene import Scene
 from .settings import RenderSettings
 from .surface import SurfaceBuilder
@@ -74,6 +77,8 @@ class RenderContext:
         self.light_visible_camera = np.array(
             [getattr(m, "visible_camera", True) for m in self.lights.models] or [True])
         self.integrator = make_integrator(settings.integrator, self)
+        # A camera that does not move gets its rays from one compiled kernel.
+        self.camera_kernel = None if self.has_motion else pack_camera(self.camera, self.filter)
 
     def close(self):
         self.accel.close()
@@ -96,6 +101,15 @@ def camera_rays(ctx: RenderContext, pixel: np.ndarray, index: np.ndarray):
     """The camera rays of samples `index` of pixels `pixel`: sub-pixel position through the
     pixel filter, a lens point only with an aperture, a shutter time only when something
     moves. Returns (CameraRays, time or None). Every pass (radiance, AOVs) uses this."""
+    if ctx.camera_kernel is not None:
+        n = len(pixel)
+        o, d, tmax = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
+        pixel = np.ascontiguousarray(pixel, dtype=np.int64)
+        generate_camera_rays(*ctx.camera_kernel, ctx.sampler.kind,
+                             ctx.sampler.samples_per_pixel,
+                             pixel_keys(np.uint64(ctx.sampler.seed), pixel), pixel,
+                             np.ascontiguousarray(index, dtype=np.int64), o, d, tmax)
+        return CameraRays(o, d, tmax), None
     w = ctx.scene.width
     u_pix = ctx.sampler.get_2d(D.PIXEL, pixel, index)
     offset = ctx.filter.sample(u_pix)

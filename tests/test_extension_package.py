@@ -1,9 +1,14 @@
 """The extension zip, end to end, along the path a Blender 4.2+ user takes:
 
-`python -m drt_addon package` builds and validates the zip; the zip holds the add-on, the
-tracer and the embreex wheels and nothing of the development tree; installed with Blender's
-own operator into a throwaway user extension repository it is enabled as
-`bl_ext.user_default.drt` and renders the Cornell box with the DRT engine.
+`python -m drt_addon package --platform linux-x64` builds and validates this machine's zip
+(one zip per platform; only this one is built, so a run downloads only its wheels); the zip
+holds the add-on, the tracer and the embreex, numba and llvmlite wheels for linux-x64 and
+nothing of the development tree; installed with Blender's own operator into a throwaway user
+extension repository it is enabled as `bl_ext.user_default.drt` and renders the Cornell box
+with the DRT engine, its kernels compiled by the bundled numba and cached in the
+extension's user folder (<user>/extensions/.user/user_default/drt/numba_cache), which a
+second Blender start reads back. Without a writable cache (DRT_NUMBA_CACHE=0, and a truly
+read-only user folder where user namespaces allow a read-only bind mount) it still renders.
 
 Blender runs in subprocesses (`python -I -c ...`, cwd outside the repository): this pytest
 process may hold the source-checkout add-on, and Blender cannot register a second engine
@@ -16,8 +21,10 @@ import hashlib
 import importlib.util
 import json
 import os
+import shutil
 import subprocess
 import sys
+import time
 import tomllib
 import zipfile
 
@@ -49,26 +56,53 @@ def _validate(path: str) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=120)
 
 
+PLATFORM = "linux-x64"  # this machine's; the only zip the tests build
+BUNDLED = {"embreex", "numba", "llvmlite"}
+
+
+def _platform_wheels(platform: str = PLATFORM) -> list[str]:
+    return packaging.wheels_by_platform(ROOT)[platform]
+
+
 # ----------------------------------------------------------------------------- building
 
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
-    """Run the documented command; return (zip path, the command's stdout and stderr)."""
+    """Run the documented command for this platform; return (zip path, the finished
+    process)."""
     out_dir = tmp_path_factory.mktemp("dist")
-    proc = subprocess.run([sys.executable, "-m", "drt_addon", "package", "-o", str(out_dir)],
+    t0 = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "drt_addon", "package", "-o", str(out_dir),
+                           "--platform", PLATFORM],
                           cwd=ROOT, capture_output=True, text=True, timeout=900)
+    seconds = time.perf_counter() - t0
     assert proc.returncode == 0, f"package failed ({proc.returncode}):\n{proc.stderr}"
     lines = proc.stdout.strip().splitlines()
     assert lines, f"package printed no zip path; stderr:\n{proc.stderr}"
+    print(f"package --platform {PLATFORM}: {seconds:.1f} s, "
+          f"{os.path.getsize(lines[-1]) / 1e6:.1f} MB")
     return lines[-1], proc
 
 
 def test_package_command_prints_the_zip_it_built(built):
     zip_path, proc = built
     m = _manifest()
-    assert os.path.basename(zip_path) == f"{m['id']}-{m['version']}.zip"
+    assert proc.stdout.strip().splitlines() == [zip_path]  # one platform, one line
+    assert os.path.basename(zip_path) == f"{m['id']}-{m['version']}-linux_x64.zip"
     assert os.path.isfile(zip_path) and zipfile.is_zipfile(zip_path)
     assert "validated" in proc.stderr
+    # Only that zip: no other platform's, and no staging folder left behind.
+    assert os.listdir(os.path.dirname(zip_path)) == [os.path.basename(zip_path)]
+
+
+def test_package_rejects_a_platform_the_manifest_does_not_list(tmp_path):
+    # macos-x64 is not listed: numba 0.68.1 and llvmlite 0.50.0 have no Intel-macOS wheels.
+    proc = subprocess.run([sys.executable, "-m", "drt_addon", "package", "-o", str(tmp_path),
+                           "--platform", "macos-x64"],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.startswith("drt: error:") and "Traceback" not in proc.stderr
+    assert "macos-x64" in proc.stderr and os.listdir(tmp_path) == []
 
 
 def test_package_rejects_a_file_as_output_dir(tmp_path):
@@ -102,15 +136,19 @@ def test_zip_holds_the_addon_tracer_and_wheels_only(built):
     with zipfile.ZipFile(zip_path) as z:
         names = z.namelist()
         zipped_manifest = tomllib.loads(z.read("blender_manifest.toml").decode())
+    # The repository's manifest with platforms and wheels narrowed to this platform (which
+    # the tool also records under [build.generated], the table Blender installs from).
+    wheels = _platform_wheels()
+    generated = zipped_manifest["build"].pop("generated")
+    assert generated == {"platforms": [PLATFORM], "wheels": wheels}
+    assert zipped_manifest == {**_manifest(), "platforms": [PLATFORM], "wheels": wheels}
     for required in ("blender_manifest.toml", "__init__.py", "drt_addon/__init__.py",
                      "drt_addon/render_engine.py", "drt_addon/engine_link.py",
                      "engine/__init__.py", "engine/accel.py", "engine/render.py"):
         assert required in names, required
-    wheels = zipped_manifest["wheels"]
-    assert wheels == _manifest()["wheels"]
-    for w in wheels:
-        assert os.path.normpath(w).replace(os.sep, "/") in names, w
-    assert any("manylinux" in w and w.endswith("x86_64.whl") for w in wheels)
+    zipped_wheels = sorted(n for n in names if n.endswith(".whl"))
+    assert zipped_wheels == sorted(os.path.normpath(w).replace(os.sep, "/") for w in wheels)
+    assert all("manylinux" in w and w.endswith("x86_64.whl") for w in wheels)
     forbidden_tops = {"tests", "docs", "sample_blends", ".venv", ".git", ".ci", "build",
                       "renders", "requirements.txt", "pytest.ini", ".gitignore",
                       ".pytest_cache"}
@@ -125,23 +163,62 @@ def test_zip_holds_the_addon_tracer_and_wheels_only(built):
                for x in extras), sorted(extras)
 
 
-def test_bundled_wheels_are_the_pinned_embreex_for_every_listed_platform(built):
+def test_zip_bundles_the_pinned_embreex_numba_and_llvmlite_for_linux(built):
     zip_path, _ = built
-    pin = packaging.read_pins(ROOT)["embreex"]
-    m = _manifest()
+    pins = packaging.read_pins(ROOT)
     blender_ext = _blender_ext_module()
-    covered = set()
+    found = set()
     with zipfile.ZipFile(zip_path) as z:
-        for rel in m["wheels"]:
-            dist, version, py_tag, abi_tag, plat = packaging.parse_wheel_filename(rel)
-            assert (dist, version, py_tag, abi_tag) == ("embreex", pin, "cp311", "cp311"), rel
-            covered.update(blender_ext.blender_platforms_from_wheel_platform(plat))
-            member = os.path.normpath(rel).replace(os.sep, "/")
-            with open(os.path.join(ROOT, rel), "rb") as f:
+        members = {n for n in z.namelist() if n.endswith(".whl")}
+        for member in sorted(members):
+            dist, version, py_tag, abi_tag, plat = packaging.parse_wheel_filename(member)
+            found.add(dist)
+            assert (version, py_tag, abi_tag) == (pins[dist], "cp311", "cp311"), member
+            assert blender_ext.blender_platforms_from_wheel_platform(plat) == [PLATFORM]
+            # Byte for byte the wheel that was downloaded (and checked intact) in wheels/.
+            with open(os.path.join(ROOT, member), "rb") as f:
                 on_disk = hashlib.sha256(f.read()).hexdigest()
-            assert hashlib.sha256(z.read(member)).hexdigest() == on_disk, rel
-    # Each listed platform has its wheel, and no wheel is for an unlisted platform.
-    assert covered == set(m["platforms"])
+            assert hashlib.sha256(z.read(member)).hexdigest() == on_disk, member
+            with zipfile.ZipFile(z.open(member)) as wheel:
+                assert wheel.testzip() is None, member
+    assert found == BUNDLED and len(members) == len(BUNDLED)
+
+
+def test_manifest_has_one_pinned_wheel_of_each_package_for_every_platform():
+    """The check `package` runs for all platforms, here without downloading anything:
+    no listed platform lacks a wheel (macos-x64 was dropped for that reason)."""
+    pins = packaging.read_pins(ROOT)
+    per_platform = packaging.wheels_by_platform(ROOT)
+    assert list(per_platform) == _manifest()["platforms"]
+    assert "macos-x64" not in per_platform
+    blender_ext = _blender_ext_module()
+    for platform, wheels in per_platform.items():
+        parsed = [packaging.parse_wheel_filename(w) for w in wheels]
+        assert sorted(p[0] for p in parsed) == sorted(BUNDLED), platform
+        for dist, version, py_tag, abi_tag, plat in parsed:
+            assert (version, py_tag, abi_tag) == (pins[dist], "cp311", "cp311")
+            assert platform in blender_ext.blender_platforms_from_wheel_platform(plat)
+    assert sorted(w for ws in per_platform.values() for w in ws) == sorted(_manifest()["wheels"])
+
+
+def test_packaging_refuses_a_platform_without_all_its_wheels(tmp_path):
+    (tmp_path / "blender_manifest.toml").write_text(
+        'id = "drt"\nplatforms = ["linux-x64", "windows-x64"]\nwheels = [\n'
+        '  "./wheels/numba-0.68.1-cp311-cp311-manylinux_2_27_x86_64.manylinux_2_28_x86_64.whl",\n'
+        '  "./wheels/numba-0.68.1-cp311-cp311-win_amd64.whl",\n'
+        '  "./wheels/llvmlite-0.50.0-cp311-cp311-win_amd64.whl",\n]\n')
+    (tmp_path / "requirements.txt").write_text("numba==0.68.1\nllvmlite==0.50.0\n")
+    with pytest.raises(packaging.PackagingError, match="linux-x64 but has 0 llvmlite"):
+        packaging.fetch_wheels(str(tmp_path), platforms=["linux-x64"])
+    assert not (tmp_path / "wheels").exists()
+
+
+def test_filtered_manifest_changes_only_platforms_and_wheels():
+    with open(os.path.join(ROOT, "blender_manifest.toml"), encoding="utf-8") as f:
+        text = f.read()
+    wheels = _platform_wheels()
+    filtered = packaging.manifest_text_for(text, [PLATFORM], wheels)
+    assert tomllib.loads(filtered) == {**_manifest(), "platforms": [PLATFORM], "wheels": wheels}
 
 
 @pytest.mark.parametrize("wheel, requirements, message", [
@@ -161,33 +238,43 @@ def test_packaging_refuses_wheels_that_do_not_match_the_pins(tmp_path, wheel, re
 # ----------------------------------------------------------------------------- installing
 
 # Runs in a fresh interpreter, as Blender would: install (or restart), enable, render.
-SESSION = r'''
+SESSION = r"""
 import json, os, site, sys, time
 args = json.loads(sys.argv[1])
 facts = {}
 
-if args["hide_env_embreex"]:
-    # A Blender's own Python has no embreex: hide the one in this environment's
-    # site-packages so that only the extension's bundled wheel can provide it.
+if args["hide_env"]:
+    # A Blender's own Python has none of the bundled packages: hide this environment's
+    # so that only the extension's wheels can provide them.
     import importlib.abc, importlib.machinery
     env_sites = {os.path.realpath(p) for p in site.getsitepackages()}
-    class HideEnvEmbreex(importlib.abc.MetaPathFinder):
+    class HideEnvPackages(importlib.abc.MetaPathFinder):
         def find_spec(self, name, path=None, target=None):
-            if name != "embreex":
+            if name not in args["hide_env"]:
                 return None
             dirs = [p for p in sys.path if os.path.realpath(p) not in env_sites]
             spec = importlib.machinery.PathFinder.find_spec(name, dirs)
             if spec is None:
-                raise ModuleNotFoundError("No module named 'embreex' (environment's hidden)",
+                raise ModuleNotFoundError(f"No module named {name!r} (environment's hidden)",
                                           name=name)
             return spec
-    sys.meta_path.insert(0, HideEnvEmbreex())
-    try:
-        import embreex
-        facts["embreex_before"] = embreex.__file__
-        del sys.modules["embreex"]
-    except ModuleNotFoundError:
-        facts["embreex_before"] = None
+    sys.meta_path.insert(0, HideEnvPackages())
+    facts["env_before"] = {}
+    for name in args["hide_env"]:
+        try:
+            facts["env_before"][name] = __import__(name).__file__
+            del sys.modules[name]
+        except ModuleNotFoundError:
+            facts["env_before"][name] = None
+
+if args["preimport_numba_from"]:
+    # Something (another add-on, a startup script) imported numba before DRT registers:
+    # numba.core.config has already read the environment, without NUMBA_CACHE_DIR.
+    sys.path.insert(0, args["preimport_numba_from"])
+    import numba
+    facts["preimported_numba"] = numba.__file__
+    facts["preimported_cache_dir"] = numba.core.config.CACHE_DIR
+    sys.path.remove(args["preimport_numba_from"])
 
 import bpy
 import numpy as np
@@ -198,6 +285,7 @@ def drt_engine():
 
 facts["user_extensions"] = bpy.utils.user_resource("EXTENSIONS")
 facts["drt_before"] = drt_engine() is not None
+t0 = time.perf_counter()
 if args["install"]:
     result = bpy.ops.extensions.package_install_files(
         filepath=args["zip"], repo="user_default", enable_on_install=True)
@@ -206,6 +294,7 @@ if args["install"]:
 else:
     # What Blender does at start-up: read the preferences, enable the add-ons they list.
     facts["op"] = sorted(bpy.ops.wm.read_userpref())
+facts["enable_seconds"] = time.perf_counter() - t0
 facts["enabled"] = args["pkg"] in bpy.context.preferences.addons
 
 cls = drt_engine()
@@ -242,30 +331,107 @@ facts["min"], facts["max"] = float(rgb.min()), float(rgb.max())
 facts["std"] = float(rgb.std())
 facts["distinct"] = int(np.unique(rgb).size)
 
-emb = sys.modules.get("embreex")
-facts["embreex_file"] = getattr(emb, "__file__", None)
+facts["module_files"] = {name: getattr(sys.modules.get(name), "__file__", None)
+                         for name in ("embreex", "numba", "llvmlite")}
+
+# Numba's view: where the add-on pointed the cache, whether the tracer caches at all, and
+# what each compiled kernel of the tracer did (cache hit: loaded from disk; miss: compiled).
+facts["env_cache_dir"] = os.environ.get("NUMBA_CACHE_DIR")
+config = sys.modules.get("numba.core.config")
+facts["numba_cache_dir"] = getattr(config, "CACHE_DIR", None)
+jit = sys.modules.get(args["pkg"] + ".engine.kernels.jit")
+facts["jit_cache"] = getattr(jit, "CACHE", None)
+kernels = {}
+if "numba" in sys.modules:
+    from numba.core.dispatcher import Dispatcher
+    for name, m in list(sys.modules.items()):
+        if name == args["pkg"] + ".engine" or name.startswith(args["pkg"] + ".engine."):
+            for v in list(vars(m).values()):
+                if isinstance(v, Dispatcher):
+                    kernels[id(v)] = v
+used = [k for k in kernels.values() if k.signatures]
+facts["kernels"], facts["kernels_used"] = len(kernels), len(used)
+facts["cache_hits"] = sum(sum(k.stats.cache_hits.values()) for k in used)
+facts["cache_misses"] = sum(sum(k.stats.cache_misses.values()) for k in used)
+facts["cache_paths"] = sorted({k.stats.cache_path for k in used if k.stats.cache_path})
+if facts["env_cache_dir"]:
+    try:  # is the cache folder writable in this session?
+        probe = os.path.join(facts["env_cache_dir"], ".probe")
+        open(probe, "w").close()
+        os.remove(probe)
+        facts["cache_dir_writable"] = True
+    except OSError:
+        facts["cache_dir_writable"] = False
+
 facts["source_modules"] = sorted(m for m in sys.modules
                                  if m.split(".")[0] in ("drt_addon", "engine"))
 facts["repo_on_path"] = [p for p in sys.path if os.path.realpath(p or ".") ==
                          os.path.realpath(args["repo"])]
 print("FACTS " + json.dumps(facts))
-'''
+"""
+
+# Runs the rest of the command line with the first argument mounted read-only, in a new user
+# and mount namespace (`unshare -rm`): even root cannot write there, unlike after a chmod.
+READ_ONLY = ('mount --bind "$1" "$1" && mount -o remount,bind,ro "$1" "$1" && shift '
+             '&& exec "$@"')
 
 
-def _session(tmp, user_dir, zip_path, *, install, hide_env_embreex) -> dict:
+def _read_only_mounts_work(tmp) -> bool:
+    probe = os.path.join(tmp, "ro_probe")
+    os.makedirs(probe, exist_ok=True)
+    if shutil.which("unshare") is None:
+        return False
+    # Exit status 0 only when the mount worked and a write into it failed.
+    proc = subprocess.run(["unshare", "-rm", "sh", "-c", READ_ONLY, "sh", probe,
+                           "sh", "-c", 'touch "$0/x" 2>/dev/null && exit 3; exit 0', probe],
+                          capture_output=True, text=True, timeout=60)
+    return proc.returncode == 0 and not os.path.exists(os.path.join(probe, "x"))
+
+
+def _session(tmp, user_dir, zip_path, *, install, hide_env=(), preimport_numba_from=None,
+             env_extra=None, read_only=None) -> dict:
     env = {k: v for k, v in os.environ.items()
-           if not k.startswith(("BLENDER_USER_", "PYTHON"))}
+           if not k.startswith(("BLENDER_USER_", "PYTHON", "NUMBA_", "DRT_"))}
     env["BLENDER_USER_RESOURCES"] = user_dir  # never the real ~/.config/blender
+    env.update(env_extra or {})
     args = {"zip": zip_path, "blend": CORNELL, "pkg": PKG, "repo": ROOT, "tmp": str(tmp),
-            "install": install, "hide_env_embreex": hide_env_embreex}
-    proc = subprocess.run([sys.executable, "-I", "-c", SESSION, json.dumps(args)],
-                          cwd=str(tmp), env=env, capture_output=True, text=True, timeout=600)
+            "install": install, "hide_env": list(hide_env),
+            "preimport_numba_from": preimport_numba_from}
+    cmd = [sys.executable, "-I", "-c", SESSION, json.dumps(args)]
+    if read_only:
+        cmd = ["unshare", "-rm", "sh", "-c", READ_ONLY, "sh", read_only, *cmd]
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, cwd=str(tmp), env=env, capture_output=True, text=True,
+                          timeout=900)
     assert proc.returncode == 0, f"Blender session failed:\n{proc.stdout}\n{proc.stderr}"
     lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("FACTS ")]
     assert lines, f"no FACTS line:\n{proc.stdout}\n{proc.stderr}"
     facts = json.loads(lines[-1][len("FACTS "):])
+    facts["process_seconds"] = time.perf_counter() - t0
     print(json.dumps(facts, indent=1))  # shown with -s / on failure
     return facts
+
+
+def _ext_cache_dir(user_dir) -> str:
+    """Where bpy.utils.extension_path_user puts the extension's "numba_cache" folder."""
+    return os.path.join(user_dir, "extensions", ".user", "user_default", "drt", "numba_cache")
+
+
+def _site_packages(user_dir) -> str:
+    """Where Blender unpacks the extensions' wheels."""
+    return os.path.join(user_dir, "extensions", ".local", "lib",
+                        f"python{sys.version_info[0]}.{sys.version_info[1]}", "site-packages")
+
+
+def _cache_files(user_dir) -> dict[str, int]:
+    """{path relative to the cache folder: modification time in ns} of every file there."""
+    root = _ext_cache_dir(user_dir)
+    found = {}
+    for dirpath, _dirs, files in os.walk(root):
+        for f in files:
+            path = os.path.join(dirpath, f)
+            found[os.path.relpath(path, root)] = os.stat(path).st_mtime_ns
+    return found
 
 
 @pytest.fixture(scope="module")
@@ -275,14 +441,53 @@ def user_dir(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def first_session(built, user_dir, tmp_path_factory):
-    return _session(tmp_path_factory.mktemp("session1"), user_dir, built[0],
-                    install=True, hide_env_embreex=True)
+    """Install from Disk in a Blender whose Python has none of the bundled packages, with
+    an empty kernel cache. Returns (facts, the cache files afterwards)."""
+    assert _cache_files(user_dir) == {}
+    facts = _session(tmp_path_factory.mktemp("session1"), user_dir, built[0],
+                     install=True, hide_env=sorted(BUNDLED))
+    return facts, _cache_files(user_dir)
 
 
 @pytest.fixture(scope="module")
 def restart_session(first_session, built, user_dir, tmp_path_factory):
-    return _session(tmp_path_factory.mktemp("session2"), user_dir, built[0],
-                    install=False, hide_env_embreex=False)
+    """A second Blender start with the same user folder, nothing hidden. Returns (facts,
+    the cache files afterwards)."""
+    facts = _session(tmp_path_factory.mktemp("session2"), user_dir, built[0], install=False)
+    return facts, _cache_files(user_dir)
+
+
+@pytest.fixture(scope="module")
+def preimported_session(restart_session, built, user_dir, tmp_path_factory):
+    """A third start in which numba was imported before Blender enabled DRT."""
+    return _session(tmp_path_factory.mktemp("session3"), user_dir, built[0], install=False,
+                    preimport_numba_from=_site_packages(user_dir))
+
+
+@pytest.fixture(scope="module")
+def uncached_session(preimported_session, built, user_dir, tmp_path_factory):
+    """A start with DRT_NUMBA_CACHE=0 (jit.py's switch). Returns (facts, the cache files
+    before, the cache files after)."""
+    before = _cache_files(user_dir)
+    facts = _session(tmp_path_factory.mktemp("session4"), user_dir, built[0], install=False,
+                     env_extra={"DRT_NUMBA_CACHE": "0"})
+    return facts, before, _cache_files(user_dir)
+
+
+@pytest.fixture(scope="module")
+def read_only_session(uncached_session, built, user_dir, tmp_path_factory):
+    """A start in which the whole Blender user folder (the installed extension, its wheels'
+    site-packages and its cache folder) and the home folder are read-only mounts."""
+    tmp = tmp_path_factory.mktemp("session5")
+    if not _read_only_mounts_work(str(tmp)):
+        pytest.skip("no read-only bind mounts here (unshare -rm unavailable); the "
+                    "DRT_NUMBA_CACHE=0 test covers the uncached path")
+    home = os.path.join(user_dir, "home")  # inside the read-only mount
+    os.makedirs(home, exist_ok=True)
+    before = _cache_files(user_dir)
+    facts = _session(tmp, user_dir, built[0], install=False, read_only=user_dir,
+                     env_extra={"HOME": home, "XDG_CACHE_HOME": os.path.join(home, ".cache")})
+    return facts, before, _cache_files(user_dir)
 
 
 def _check_session(facts, user_dir):
@@ -302,22 +507,98 @@ def _check_session(facts, user_dir):
     assert min(facts["size"]) >= 8
     assert facts["finite"]
     assert facts["max"] > 0.01 and facts["std"] > 1e-3 and facts["distinct"] > 10
-    # embreex from the bundled wheel, which Blender unpacked into extensions/.local.
-    assert os.path.realpath(facts["embreex_file"]).startswith(
-        os.path.join(ext_dir, ".local", "lib") + os.sep), facts["embreex_file"]
+    # embreex, numba and llvmlite from the bundled wheels, which Blender unpacked into
+    # extensions/.local, never from the Python environment running this test.
+    site_packages = os.path.realpath(_site_packages(user_dir)) + os.sep
+    for name, path in facts["module_files"].items():
+        assert path and os.path.realpath(path).startswith(site_packages), (name, path)
+    # The tracer's kernels were compiled by that numba (a render that used none would
+    # not test it).
+    assert facts["kernels_used"] > 0
+
+
+def _check_cached_in_extension_folder(facts, user_dir):
+    cache_dir = os.path.realpath(_ext_cache_dir(user_dir))
+    assert os.path.realpath(facts["env_cache_dir"]) == cache_dir
+    assert os.path.realpath(facts["numba_cache_dir"]) == cache_dir
+    assert facts["jit_cache"] is True
+    assert facts["cache_paths"] and all(
+        os.path.realpath(p).startswith(cache_dir + os.sep) for p in facts["cache_paths"])
 
 
 def test_install_from_disk_enables_and_renders(first_session, user_dir):
-    """Install from Disk in a Blender whose Python has no embreex: the wheel alone works."""
-    assert first_session["embreex_before"] is None  # the hiding works: a real check
-    assert not first_session["drt_before"]          # DRT only exists once installed
-    _check_session(first_session, user_dir)
+    """Install from Disk in a Blender whose Python has none of the bundled packages: the
+    wheels alone work, and the kernels compile (nothing cached yet) into the extension's
+    user cache folder."""
+    facts, cache_after = first_session
+    assert facts["env_before"] == {n: None for n in sorted(BUNDLED)}  # the hiding works
+    assert not facts["drt_before"]                                      # DRT only once installed
+    _check_session(facts, user_dir)
+    _check_cached_in_extension_folder(facts, user_dir)
+    assert facts["cache_hits"] == 0 and facts["cache_misses"] > 0
+    # Numba's index (.nbi) and compiled code (.nbc) files, there and only there.
+    assert any(f.endswith(".nbi") for f in cache_after), sorted(cache_after)
+    assert any(f.endswith(".nbc") for f in cache_after), sorted(cache_after)
+    installed = os.path.join(user_dir, "extensions", "user_default", "drt")
+    assert not [os.path.join(d, f) for d, _, fs in os.walk(installed) for f in fs
+                if f.endswith((".nbi", ".nbc"))]
 
 
 def test_after_restart_the_extension_is_enabled_and_prefers_its_wheel(restart_session,
                                                                       user_dir):
     """A second Blender start with the same user folder, nothing hidden: the extension is
-    enabled from the saved preferences and Blender's site-packages order picks the
-    bundled embreex over one installed in the Python environment."""
-    assert not restart_session["drt_before"]
-    _check_session(restart_session, user_dir)
+    enabled from the saved preferences, Blender's site-packages order picks the bundled
+    embreex and numba over the Python environment's, and the kernels come from the cache
+    the first render wrote."""
+    facts, _ = restart_session
+    assert not facts["drt_before"]
+    _check_session(facts, user_dir)
+    _check_cached_in_extension_folder(facts, user_dir)
+    assert facts["cache_hits"] > 0
+
+
+def test_second_render_loads_the_kernels_the_first_one_cached(first_session,
+                                                              restart_session):
+    first, cache_first = first_session
+    second, cache_second = restart_session
+    assert second["cache_hits"] > 0
+    assert second["cache_misses"] < first["cache_misses"]
+    # Loading from the cache compiles nothing new: no cache file changed.
+    changed = {f for f in cache_second if cache_first.get(f) != cache_second[f]}
+    assert second["cache_misses"] > 0 or not changed, sorted(changed)
+    print(f"first render (empty cache) {first['render_seconds']:.1f} s, "
+          f"second render (cached) {second['render_seconds']:.1f} s")
+
+
+def test_numba_imported_before_the_addon_still_uses_the_extension_cache(preimported_session,
+                                                                        user_dir):
+    """numba.core.config reads NUMBA_CACHE_DIR at import; the add-on reloads it when numba
+    was imported first, so the kernels still load from the extension's cache folder."""
+    facts = preimported_session
+    assert os.path.realpath(facts["preimported_numba"]).startswith(
+        os.path.realpath(_site_packages(user_dir)) + os.sep)
+    assert facts["preimported_cache_dir"] == ""  # numba read no cache folder at import
+    _check_session(facts, user_dir)
+    _check_cached_in_extension_folder(facts, user_dir)
+    assert facts["cache_hits"] > 0
+
+
+def test_renders_without_a_kernel_cache(uncached_session, user_dir):
+    """DRT_NUMBA_CACHE=0: kernels compile in memory, nothing is read or written on disk."""
+    facts, before, after = uncached_session
+    _check_session(facts, user_dir)
+    assert facts["jit_cache"] is False
+    assert facts["cache_paths"] == [] and facts["cache_hits"] == 0
+    assert after == before
+
+
+def test_renders_from_a_read_only_user_folder(read_only_session, user_dir):
+    """The installed extension, its cache folder and the home folder all read-only (a
+    read-only bind mount, which binds root too): jit.py finds no writable cache location,
+    kernels compile in memory, and the render works."""
+    facts, before, after = read_only_session
+    assert facts["cache_dir_writable"] is False  # the mount really is read-only
+    _check_session(facts, user_dir)
+    assert facts["jit_cache"] is False
+    assert facts["cache_paths"] == [] and facts["cache_hits"] == 0
+    assert after == before
