@@ -12,6 +12,22 @@ from __future__ import annotations
 
 import numpy as np
 
+from .kernels.jit import kernel
+
+
+@kernel
+def _accumulate(pixel, radiance, alpha, count, total, total_sq, alpha_sum):
+    """Add each sample to its pixel's statistics (alpha empty: coverage 1)."""
+    has_alpha = alpha.shape[0] > 0
+    for i in range(pixel.shape[0]):
+        p = pixel[i]
+        count[p] += 1
+        alpha_sum[p] += alpha[i] if has_alpha else 1.0
+        for c in range(3):
+            v = radiance[i, c]
+            total[p, c] += v
+            total_sq[p, c] += v * v
+
 
 class Film:
     def __init__(self, width: int, height: int):
@@ -23,15 +39,12 @@ class Film:
         self.alpha_sum = np.zeros(n, dtype=np.float64)
 
     def add(self, pixel: np.ndarray, radiance: np.ndarray, alpha: np.ndarray | None = None) -> None:
-        n = self.count.size
-        pixel = np.asarray(pixel, dtype=np.int64)
-        counts = np.bincount(pixel, minlength=n)
-        self.count += counts
-        self.alpha_sum += counts if alpha is None else np.bincount(pixel, weights=alpha, minlength=n)
-        for c in range(3):
-            v = radiance[:, c]
-            self.sum[:, c] += np.bincount(pixel, weights=v, minlength=n)
-            self.sum_sq[:, c] += np.bincount(pixel, weights=v * v, minlength=n)
+        pixel = np.ascontiguousarray(pixel, dtype=np.int64)
+        if len(pixel) and (pixel.min() < 0 or pixel.max() >= self.count.size):
+            raise IndexError("sample pixel outside the film")
+        _accumulate(pixel, np.ascontiguousarray(radiance, dtype=np.float64),
+                    np.zeros(0) if alpha is None else np.ascontiguousarray(alpha, np.float64),
+                    self.count, self.sum, self.sum_sq, self.alpha_sum)
 
     def merge(self, other: "Film") -> "Film":
         if (other.width, other.height) != (self.width, self.height):

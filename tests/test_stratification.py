@@ -43,14 +43,21 @@ def test_stratified_sampling_beats_random(case, sampler):
 
 
 def test_lens_dimension_is_used_only_with_an_aperture():
-    """A pinhole camera never asks the sampler for lens samples (no lens dimension)."""
-    from engine.render import RenderContext, render_unit
+    """A pinhole camera never asks for lens samples (no lens dimension): the NumPy camera
+    never calls the sampler for D.LENS, the compiled camera's lens flag is off, and both
+    give the same rays, so the kernel draws a lens sample exactly when NumPy does."""
+    from engine.kernels.camera_rays import C_LENS
+    from engine.render import RenderContext, camera_rays
     from engine.sampling import dimensions as D
 
+    pixel = np.repeat(np.arange(16), 2)
+    index = np.tile(np.arange(2), 16)
     for aperture, expect in ((0.0, False), (0.03, True)):
         scene = defocus_scene(4)
         scene.camera.aperture_radius = aperture
         ctx = RenderContext(scene, RenderSettings(samples=2))
+        assert (ctx.camera_kernel[0][C_LENS] != 0.0) == expect
+        compiled = camera_rays(ctx, pixel, index)
         asked = []
         original = ctx.sampler.get_2d
 
@@ -59,6 +66,10 @@ def test_lens_dimension_is_used_only_with_an_aperture():
             return original(dim, pixel, index)
 
         ctx.sampler.get_2d = spy
-        render_unit(ctx, np.arange(16), 0, 2)
+        ctx.camera_kernel = None                  # the NumPy twin
+        reference = camera_rays(ctx, pixel, index)
         ctx.close()
         assert (D.LENS in asked) == expect
+        for field in ("origins", "directions", "tmax"):
+            np.testing.assert_allclose(getattr(compiled[0], field),
+                                       getattr(reference[0], field), rtol=0, atol=1e-12)
