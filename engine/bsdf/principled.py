@@ -23,10 +23,7 @@ point, every lobe in the local shading frame):
 
 with m = metallic, t = transmission, GGX alpha = roughness^2 (clamped, see
 `microfacet.ALPHA_MIN`). The weights sum to 1, and each part conserves energy, so the
-whole does. E_spec is tabulated once per process (lazily, thread-safe) over
-(cos theta_o, roughness, F0^(1/4), side of eta; for eta < 1 the cos axis is
-aligned on the critical angle) by stratified visible-normal quadrature
-and interpolated trilinearly.
+whole does. E_spec is tabulated in engine/bsdf/layer_albedo.py.
 
 Not modelled (Cycles has them): subsurface, sheen, coat, specular tint/F82 tint (with
 Blender's default white tint, Cycles' F82-tint metal reduces to Schlick), anisotropy,
@@ -52,14 +49,15 @@ Without it every hit is taken as a front face.
 """
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass
 
 import numpy as np
 
 from . import blinn_phong, dielectric, fresnel, lambert
 from . import microfacet as mf
+from .layer_albedo import specular_albedo
 from .lobes import DIFFUSE, GLOSSY, TRANSMISSION
+from .material_table import MaterialTable  # noqa: F401  (re-exported: engine.render, tests)
 from ..warp import cosine_hemisphere
 
 
@@ -79,116 +77,6 @@ LOBE_NAMES = ("diffuse", "specular", "metal", "glass")
 # Lower bound of a present lobe's selection estimate, relative to its weight, so a lobe
 # that reflects little at this wo (black metal at normal incidence) can still be sampled.
 MIN_SELECTION = 0.02
-
-
-# --- directional albedo of the specular layer ------------------------------------------
-
-_TABLE_T = np.linspace(0.0, 1.0, 33)        # cos theta_o coordinate, see _mu_of_t
-_TABLE_R = np.linspace(0.01, 1.0, 17)       # roughness (alpha = r^2 >= ALPHA_MIN)
-_TABLE_S = np.linspace(0.0, 0.95 ** 0.5, 25)  # F0^(1/4) = sqrt(|eta - 1| / (eta + 1)):
-#                                             dense near eta = 1, where E is steep
-_TABLE_STRATA = 16                          # 16 x 16 stratified visible normals per entry
-_tables = [None, None]                      # eta >= 1, eta < 1; each built on first use
-_table_lock = threading.Lock()
-
-
-def _critical_cos(eta):
-    """cos of the critical angle for relative IOR eta < 1 (0 for eta >= 1)."""
-    return np.sqrt(np.clip(1.0 - np.asarray(eta, dtype=np.float64) ** 2, 0.0, 1.0))
-
-
-def _mu_of_t(t, c):
-    """The cos theta_o of table coordinate t in [0, 1]. For eta >= 1 (c = 0): t^2. For
-    eta < 1 the critical cosine c sits at t = 1/2 with nodes crowding towards it from
-    both sides (c sin^2(pi t) below, quadratic above), so that the steep edge of total
-    internal reflection is resolved even for small roughness."""
-    t = np.asarray(t, dtype=np.float64)
-    lo = c * np.sin(np.pi * np.minimum(t, 0.5)) ** 2
-    hi = c + (1.0 - c) * (2.0 * t - 1.0) ** 2
-    return np.where(c > 0, np.where(t <= 0.5, lo, hi), t * t)
-
-
-def _t_of_mu(mu, c):
-    mu = np.clip(np.asarray(mu, dtype=np.float64), 0.0, 1.0)
-    cs = np.where(c > 0, c, 1.0)
-    lo = np.arcsin(np.sqrt(np.clip(mu / cs, 0.0, 1.0))) / np.pi
-    hi = 0.5 + 0.5 * np.sqrt(np.clip((mu - c) / np.maximum(1.0 - c, 1e-300), 0.0, 1.0))
-    return np.where(c > 0, np.where(mu <= c, lo, hi), np.sqrt(mu))
-
-
-def _eta_of(x, side):
-    eta = (1.0 + x) / (1.0 - x)
-    return 1.0 / eta if side else eta
-
-
-def _build_specular_albedo_table(side):
-    """E[s, r, t] = integral of F D G2 / (4 cos_o) over the reflected hemisphere, by
-    midpoint quadrature of the visible-normal sampling weight F(wo.h) G2/G1, for
-    eta >= 1 (side 0) or eta < 1 (side 1)."""
-    k = _TABLE_STRATA
-    g = (np.arange(k) + 0.5) / k
-    u = np.stack(np.meshgrid(g, g, indexing="ij"), -1).reshape(-1, 2)  # (S, 2)
-    table = np.empty((len(_TABLE_S), len(_TABLE_R), len(_TABLE_T)))
-    cache = {}
-    for j, x in enumerate(_TABLE_S ** 2):
-        eta = _eta_of(x, side)
-        c = float(_critical_cos(eta))
-        if c not in cache:       # eta >= 1: one set of directions serves every eta
-            mu = np.maximum(_mu_of_t(_TABLE_T, c), 1e-6)
-            rr, tt = np.meshgrid(_TABLE_R, mu, indexing="ij")        # (R, T)
-            cos_o = np.repeat(tt.reshape(-1), len(u))
-            alpha = np.repeat(rr.reshape(-1) ** 2, len(u))
-            wo = np.stack([np.sqrt(np.maximum(0.0, 1.0 - cos_o ** 2)), np.zeros_like(cos_o),
-                           cos_o], -1)
-            wi, h, valid = mf.reflection_sample(wo, alpha, np.tile(u, (tt.size, 1)))
-            weight = np.where(valid, mf.G2_over_G1(wo, wi, alpha), 0.0)
-            cache = {c: (weight, np.clip((wo * h).sum(1), 0.0, 1.0), tt.shape)}
-        weight, cos_oh, shape = cache[c]
-        F = fresnel.dielectric(cos_oh, eta)
-        table[j] = (F * weight).reshape(-1, len(u)).mean(1).reshape(shape)
-    return np.clip(table, 0.0, 1.0)
-
-
-def _get_table(side):
-    if _tables[side] is None:
-        with _table_lock:
-            if _tables[side] is None:
-                _tables[side] = _build_specular_albedo_table(side)
-    return _tables[side]
-
-
-def _lerp_coords(grid, v):
-    f = (np.clip(v, grid[0], grid[-1]) - grid[0]) / (grid[1] - grid[0])
-    i0 = np.minimum(f.astype(np.int64), len(grid) - 2)
-    return i0, f - i0
-
-
-def specular_albedo(cos_o, alpha, eta) -> np.ndarray:
-    """Directional albedo (n,) of GGX reflection with exact dielectric Fresnel of
-    relative IOR `eta`, single scattering, interpolated from the tables."""
-    cos_o = np.asarray(cos_o, dtype=np.float64)
-    eta = np.broadcast_to(np.asarray(eta, dtype=np.float64), cos_o.shape)
-    alpha = np.broadcast_to(mf.clamp_alpha(alpha), cos_o.shape)
-    out = np.zeros(cos_o.shape)
-    for side in (0, 1):
-        sel = (eta < 1.0) if side else (eta >= 1.0)
-        if not sel.any():
-            continue
-        table = _get_table(side)
-        e = eta[sel]
-        x = np.abs(e - 1.0) / (e + 1.0)
-        i, fi = _lerp_coords(_TABLE_S, np.sqrt(x))
-        j, fj = _lerp_coords(_TABLE_R, np.sqrt(alpha[sel]))
-        # each eta node has its own cos axis, aligned on its critical angle: the same
-        # coordinate t is the same position relative to the critical angle in every node
-        k, fk = _lerp_coords(_TABLE_T, _t_of_mu(cos_o[sel], _critical_cos(e)))
-        acc = 0.0
-        for di, wi_ in ((0, 1.0 - fi), (1, fi)):
-            for dj, wj in ((0, 1.0 - fj), (1, fj)):
-                for dk, wk in ((0, 1.0 - fk), (1, fk)):
-                    acc = acc + wi_ * wj * wk * table[i + di, j + dj, k + dk]
-        out[sel] = acc
-    return out
 
 
 # --- the mixture -----------------------------------------------------------------------
@@ -554,141 +442,3 @@ class PrincipledBSDF:
         pdf[~ok] = 0.0
         delta &= ok
         return BSDFSample(wi, weight, pdf, kind, delta, ok)
-
-
-class MaterialTable:
-    """Scene materials as arrays, indexed by a hit's material id.
-
-    The plain arrays (base_color, metallic, ...) hold each material's constant value (for
-    a textured parameter: the texture's average, a summary for estimates such as the
-    albedo AOV). What a hit sees comes from `lookup(name, index, uv)`, which evaluates the
-    parameter's texture (engine.textures) at the hit's UV where the material has one.
-
-    `emission` is the table emissive-triangle light sampling uses (engine.mesh_lights):
-    it is zero for materials whose emission is textured, because a light entry has one
-    radiance per triangle. Those surfaces are still found by BSDF-sampled rays, with MIS
-    weight 1 (their light pdf is 0), which is unbiased, only noisier.
-    """
-
-    PARAMS = ("base_color", "metallic", "roughness", "emission", "alpha")
-
-    def __init__(self, materials):
-        materials = list(materials)
-        self.base_color = np.array([m.base_color[:3] for m in materials], dtype=np.float64)
-        self.metallic = np.array([m.metallic for m in materials], dtype=np.float64)
-        self.roughness = np.array([m.roughness for m in materials], dtype=np.float64)
-        self.ior = np.array([m.ior for m in materials], dtype=np.float64)
-        self.transmission = np.array([m.transmission for m in materials], dtype=np.float64)
-        self.specular_ior_level = np.array([m.specular_ior_level for m in materials], np.float64)
-        self.alpha = np.array([getattr(m, "alpha", 1.0) for m in materials], dtype=np.float64)
-        models = [getattr(m, "glossy_model", "GGX") for m in materials]
-        for m, model in zip(materials, models):
-            if model not in ("GGX", "BLINN_PHONG"):
-                raise ValueError(f"material {m.name!r}: glossy_model must be 'GGX' or "
-                                 f"'BLINN_PHONG', not {model!r}")
-        self.blinn_phong = np.array([model == "BLINN_PHONG" for model in models], bool)
-        # Lobe colours: the metal F0 and the glass tint per crossing, when they are not
-        # Principled's own (base colour, sqrt(base colour)).
-        metal = [getattr(m, "metal_color", None) for m in materials]
-        glass = [getattr(m, "glass_color", None) for m in materials]
-        self.has_metal_color = np.array([c is not None for c in metal], bool)
-        self.has_glass_color = np.array([c is not None for c in glass], bool)
-        self.metal_color = np.array([(c if c is not None else b)[:3] for c, b in
-                                     zip(metal, self.base_color)], np.float64).reshape(-1, 3)
-        self.glass_color = np.array([(c if c is not None else (1.0, 1.0, 1.0))[:3]
-                                     for c in glass], np.float64).reshape(-1, 3)
-        self.transparent_color = np.array(
-            [tuple(getattr(m, "transparent_color", (1.0, 1.0, 1.0)))[:3] for m in materials],
-            np.float64).reshape(-1, 3)
-        # Textures: one input per (parameter, material), each distinct Texture indexed once.
-        self.textures = []
-        self.texture_index = {}            # id(Texture) -> index into self.textures
-        self._inputs = {}
-        for name in self.PARAMS:
-            inputs = [getattr(m, name + "_texture", None) for m in materials]
-            if any(t is not None for t in inputs):
-                self._inputs[name] = inputs
-                for t in inputs:
-                    if t is not None and id(t.texture) not in self.texture_index:
-                        self.texture_index[id(t.texture)] = len(self.textures)
-                        self.textures.append(t.texture)
-        self.textured = {name: np.array([t is not None for t in inputs], bool)
-                         for name, inputs in self._inputs.items()}
-        emission = np.array([m.emission[:3] for m in materials], dtype=np.float64)
-        for name, arr in (("base_color", self.base_color), ("metallic", self.metallic),
-                          ("roughness", self.roughness), ("ior", self.ior),
-                          ("transmission", self.transmission),
-                          ("specular_ior_level", self.specular_ior_level),
-                          ("emission", emission), ("alpha", self.alpha),
-                          ("metal_color", self.metal_color), ("glass_color", self.glass_color),
-                          ("transparent_color", self.transparent_color)):
-            if not np.all(np.isfinite(arr)):
-                bad = [m.name for m, row in zip(materials, arr.reshape(len(materials), -1))
-                       if not np.all(np.isfinite(row))]
-                raise ValueError(f"material {bad[0]!r} has a non-finite {name}")
-        self.emission_textured = self.textured.get("emission", np.zeros(len(materials), bool))
-        self.emission = np.where(self.emission_textured[:, None], 0.0, emission)
-        self.any_emission = bool((self.emission > 0).any() or self.emission_textured.any())
-        alpha_tex = self.textured.get("alpha", np.zeros(len(materials), bool))
-        # Materials that may let rays through (stochastic transparency in the integrators)
-        self.maybe_transparent = (self.alpha < 1.0) | alpha_tex
-        self.any_transparent = bool(self.maybe_transparent.any())
-        # Which lobes any material can produce (a scene of plain diffuse materials never
-        # touches the microfacet code; PrincipledBSDF also skips lobes per batch).
-        self.any_glossy = bool(((self.specular_ior_level > 0) | (self.metallic > 0)
-                                | (self.transmission > 0)).any()
-                               or "metallic" in self.textured)
-
-    @property
-    def any_textures(self) -> bool:
-        return bool(self.textures)
-
-    def _constant(self, name):
-        return self.emission if name == "emission" else getattr(self, name)
-
-    def lookup(self, name, index, uv=None) -> np.ndarray:
-        """Parameter `name` (one of PARAMS) at hits of materials `index` (n,) with texture
-        coordinates uv (n, 2) (None: the mesh has no UVs, read as (0, 0) like Cycles'
-        missing UV attribute). Returns (n, 3) for colours, (n,) for scalars; a fresh array."""
-        index = np.asarray(index, dtype=np.int64)
-        if name == "emission":
-            out = np.where(self.emission_textured[index][:, None], 0.0, self.emission[index])
-        else:
-            out = self._constant(name)[index].copy()
-        inputs = self._inputs.get(name)
-        if inputs is None or len(index) == 0:
-            return out
-        rows = np.nonzero(self.textured[name][index])[0]
-        if rows.size == 0:
-            return out
-        if uv is None:
-            uv = np.zeros((len(index), 2))
-        mats = index[rows]
-        for k in np.unique(mats):
-            r = rows[mats == k]
-            out[r] = inputs[k].evaluate(uv[r])
-        return out
-
-    def emission_at(self, index, uv=None) -> np.ndarray:
-        """Emitted radiance (n, 3) of the hits' materials, textures evaluated."""
-        return self.lookup("emission", index, uv)
-
-    def alpha_at(self, index, uv=None) -> np.ndarray:
-        """Coverage (n,) in [0, 1]: 1 - the probability that a ray passes through."""
-        return np.clip(self.lookup("alpha", index, uv), 0.0, 1.0)
-
-    def base_color_at(self, index, uv=None) -> np.ndarray:
-        return self.lookup("base_color", index, uv)
-
-    def metallic_at(self, index, uv=None) -> np.ndarray:
-        return self.lookup("metallic", index, uv)
-
-    def roughness_at(self, index, uv=None) -> np.ndarray:
-        return self.lookup("roughness", index, uv)
-
-    def metal_color_at(self, index, base_color) -> np.ndarray:
-        """The metal lobe's F0 per hit: the explicit metal colour, else the base colour
-        (`base_color`, the per-hit value from `base_color_at`)."""
-        index = np.asarray(index, dtype=np.int64)
-        return np.where(self.has_metal_color[index][:, None], self.metal_color[index],
-                        base_color)

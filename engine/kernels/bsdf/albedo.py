@@ -1,6 +1,6 @@
 """Directional albedo of the Principled specular layer (GGX reflection with exact
-dielectric Fresnel), looked up in the tables of engine/bsdf/principled.py: the compiled
-twin of `principled.specular_albedo` (same coordinates, same trilinear interpolation).
+dielectric Fresnel), looked up in the tables of engine/bsdf/layer_albedo.py: the compiled
+twin of `layer_albedo.specular_albedo` (same coordinates, same trilinear interpolation).
 
 The tables are built by the NumPy module (lazily, once per process, thread-safe) and
 handed to the kernels as one tuple, `kernel_tables()`:
@@ -29,13 +29,13 @@ def kernel_tables() -> tuple:
     the module docstring), built on first use and then shared."""
     global _tables
     if _tables is None:
-        from ...bsdf import principled as npp
+        from ...bsdf import layer_albedo as la
         with _lock:
             if _tables is None:
                 def arr(a):
                     return np.ascontiguousarray(a, dtype=np.float64)
-                _tables = (arr(npp._get_table(0)), arr(npp._get_table(1)),
-                           arr(npp._TABLE_S), arr(npp._TABLE_R), arr(npp._TABLE_T))
+                _tables = (arr(la.get_table(0)), arr(la.get_table(1)),
+                           arr(la.TABLE_S), arr(la.TABLE_R), arr(la.TABLE_T))
     return _tables
 
 

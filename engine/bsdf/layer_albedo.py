@@ -1,0 +1,125 @@
+"""Directional albedo of the Principled specular layer: GGX reflection with exact
+dielectric Fresnel, single scattering, tabulated once per process and interpolated.
+
+E_spec(wo) = integral of F(wo.h) D G2 / (4 cos_o) over the reflected hemisphere, the
+energy the layer reflects for light leaving along wo; the diffuse layer below gets the
+rest (engine/bsdf/principled.py). The tables are built lazily (thread-safe) over
+(cos theta_o, roughness, F0^(1/4), side of eta; for eta < 1 the cos axis is aligned on
+the critical angle) by stratified visible-normal quadrature, and interpolated
+trilinearly; engine/kernels/bsdf/albedo.py is the compiled twin of the lookup.
+"""
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+
+from . import fresnel
+from . import microfacet as mf
+
+TABLE_T = np.linspace(0.0, 1.0, 33)          # cos theta_o coordinate, see _mu_of_t
+TABLE_R = np.linspace(0.01, 1.0, 17)         # roughness (alpha = r^2 >= ALPHA_MIN)
+TABLE_S = np.linspace(0.0, 0.95 ** 0.5, 25)  # F0^(1/4) = sqrt(|eta - 1| / (eta + 1)):
+#                                              dense near eta = 1, where E is steep
+TABLE_STRATA = 16                            # 16 x 16 stratified visible normals per entry
+_tables = [None, None]                       # eta >= 1, eta < 1; each built on first use
+_table_lock = threading.Lock()
+
+
+def _critical_cos(eta):
+    """cos of the critical angle for relative IOR eta < 1 (0 for eta >= 1)."""
+    return np.sqrt(np.clip(1.0 - np.asarray(eta, dtype=np.float64) ** 2, 0.0, 1.0))
+
+
+def _mu_of_t(t, c):
+    """The cos theta_o of table coordinate t in [0, 1]. For eta >= 1 (c = 0): t^2. For
+    eta < 1 the critical cosine c sits at t = 1/2 with nodes crowding towards it from
+    both sides (c sin^2(pi t) below, quadratic above), so that the steep edge of total
+    internal reflection is resolved even for small roughness."""
+    t = np.asarray(t, dtype=np.float64)
+    lo = c * np.sin(np.pi * np.minimum(t, 0.5)) ** 2
+    hi = c + (1.0 - c) * (2.0 * t - 1.0) ** 2
+    return np.where(c > 0, np.where(t <= 0.5, lo, hi), t * t)
+
+
+def _t_of_mu(mu, c):
+    mu = np.clip(np.asarray(mu, dtype=np.float64), 0.0, 1.0)
+    cs = np.where(c > 0, c, 1.0)
+    lo = np.arcsin(np.sqrt(np.clip(mu / cs, 0.0, 1.0))) / np.pi
+    hi = 0.5 + 0.5 * np.sqrt(np.clip((mu - c) / np.maximum(1.0 - c, 1e-300), 0.0, 1.0))
+    return np.where(c > 0, np.where(mu <= c, lo, hi), np.sqrt(mu))
+
+
+def _eta_of(x, side):
+    eta = (1.0 + x) / (1.0 - x)
+    return 1.0 / eta if side else eta
+
+
+def _build_specular_albedo_table(side):
+    """E[s, r, t] = integral of F D G2 / (4 cos_o) over the reflected hemisphere, by
+    midpoint quadrature of the visible-normal sampling weight F(wo.h) G2/G1, for
+    eta >= 1 (side 0) or eta < 1 (side 1)."""
+    k = TABLE_STRATA
+    g = (np.arange(k) + 0.5) / k
+    u = np.stack(np.meshgrid(g, g, indexing="ij"), -1).reshape(-1, 2)  # (S, 2)
+    table = np.empty((len(TABLE_S), len(TABLE_R), len(TABLE_T)))
+    cache = {}
+    for j, x in enumerate(TABLE_S ** 2):
+        eta = _eta_of(x, side)
+        c = float(_critical_cos(eta))
+        if c not in cache:       # eta >= 1: one set of directions serves every eta
+            mu = np.maximum(_mu_of_t(TABLE_T, c), 1e-6)
+            rr, tt = np.meshgrid(TABLE_R, mu, indexing="ij")        # (R, T)
+            cos_o = np.repeat(tt.reshape(-1), len(u))
+            alpha = np.repeat(rr.reshape(-1) ** 2, len(u))
+            wo = np.stack([np.sqrt(np.maximum(0.0, 1.0 - cos_o ** 2)), np.zeros_like(cos_o),
+                           cos_o], -1)
+            wi, h, valid = mf.reflection_sample(wo, alpha, np.tile(u, (tt.size, 1)))
+            weight = np.where(valid, mf.G2_over_G1(wo, wi, alpha), 0.0)
+            cache = {c: (weight, np.clip((wo * h).sum(1), 0.0, 1.0), tt.shape)}
+        weight, cos_oh, shape = cache[c]
+        F = fresnel.dielectric(cos_oh, eta)
+        table[j] = (F * weight).reshape(-1, len(u)).mean(1).reshape(shape)
+    return np.clip(table, 0.0, 1.0)
+
+
+def get_table(side):
+    if _tables[side] is None:
+        with _table_lock:
+            if _tables[side] is None:
+                _tables[side] = _build_specular_albedo_table(side)
+    return _tables[side]
+
+
+def _lerp_coords(grid, v):
+    f = (np.clip(v, grid[0], grid[-1]) - grid[0]) / (grid[1] - grid[0])
+    i0 = np.minimum(f.astype(np.int64), len(grid) - 2)
+    return i0, f - i0
+
+
+def specular_albedo(cos_o, alpha, eta) -> np.ndarray:
+    """Directional albedo (n,) of GGX reflection with exact dielectric Fresnel of
+    relative IOR `eta`, single scattering, interpolated from the tables."""
+    cos_o = np.asarray(cos_o, dtype=np.float64)
+    eta = np.broadcast_to(np.asarray(eta, dtype=np.float64), cos_o.shape)
+    alpha = np.broadcast_to(mf.clamp_alpha(alpha), cos_o.shape)
+    out = np.zeros(cos_o.shape)
+    for side in (0, 1):
+        sel = (eta < 1.0) if side else (eta >= 1.0)
+        if not sel.any():
+            continue
+        table = get_table(side)
+        e = eta[sel]
+        x = np.abs(e - 1.0) / (e + 1.0)
+        i, fi = _lerp_coords(TABLE_S, np.sqrt(x))
+        j, fj = _lerp_coords(TABLE_R, np.sqrt(alpha[sel]))
+        # each eta node has its own cos axis, aligned on its critical angle: the same
+        # coordinate t is the same position relative to the critical angle in every node
+        k, fk = _lerp_coords(TABLE_T, _t_of_mu(cos_o[sel], _critical_cos(e)))
+        acc = 0.0
+        for di, wi_ in ((0, 1.0 - fi), (1, fi)):
+            for dj, wj in ((0, 1.0 - fj), (1, fj)):
+                for dk, wk in ((0, 1.0 - fk), (1, fk)):
+                    acc = acc + wi_ * wj * wk * table[i + di, j + dj, k + dk]
+        out[sel] = acc
+    return out

@@ -1,0 +1,143 @@
+"""Scene materials as arrays (`MaterialTable`), indexed by a hit's material id: the
+Principled parameters of engine/scene.py's `Material`s, with their textures."""
+from __future__ import annotations
+
+import numpy as np
+
+
+class MaterialTable:
+    """Scene materials as arrays, indexed by a hit's material id.
+
+    The plain arrays (base_color, metallic, ...) hold each material's constant value (for
+    a textured parameter: the texture's average, a summary for estimates such as the
+    albedo AOV). What a hit sees comes from `lookup(name, index, uv)`, which evaluates the
+    parameter's texture (engine.textures) at the hit's UV where the material has one.
+
+    `emission` is the table emissive-triangle light sampling uses (engine.mesh_lights):
+    it is zero for materials whose emission is textured, because a light entry has one
+    radiance per triangle. Those surfaces are still found by BSDF-sampled rays, with MIS
+    weight 1 (their light pdf is 0), which is unbiased, only noisier.
+    """
+
+    PARAMS = ("base_color", "metallic", "roughness", "emission", "alpha")
+
+    def __init__(self, materials):
+        materials = list(materials)
+        self.base_color = np.array([m.base_color[:3] for m in materials], dtype=np.float64)
+        self.metallic = np.array([m.metallic for m in materials], dtype=np.float64)
+        self.roughness = np.array([m.roughness for m in materials], dtype=np.float64)
+        self.ior = np.array([m.ior for m in materials], dtype=np.float64)
+        self.transmission = np.array([m.transmission for m in materials], dtype=np.float64)
+        self.specular_ior_level = np.array([m.specular_ior_level for m in materials], np.float64)
+        self.alpha = np.array([getattr(m, "alpha", 1.0) for m in materials], dtype=np.float64)
+        models = [getattr(m, "glossy_model", "GGX") for m in materials]
+        for m, model in zip(materials, models):
+            if model not in ("GGX", "BLINN_PHONG"):
+                raise ValueError(f"material {m.name!r}: glossy_model must be 'GGX' or "
+                                 f"'BLINN_PHONG', not {model!r}")
+        self.blinn_phong = np.array([model == "BLINN_PHONG" for model in models], bool)
+        # Lobe colours: the metal F0 and the glass tint per crossing, when they are not
+        # Principled's own (base colour, sqrt(base colour)).
+        metal = [getattr(m, "metal_color", None) for m in materials]
+        glass = [getattr(m, "glass_color", None) for m in materials]
+        self.has_metal_color = np.array([c is not None for c in metal], bool)
+        self.has_glass_color = np.array([c is not None for c in glass], bool)
+        self.metal_color = np.array([(c if c is not None else b)[:3] for c, b in
+                                     zip(metal, self.base_color)], np.float64).reshape(-1, 3)
+        self.glass_color = np.array([(c if c is not None else (1.0, 1.0, 1.0))[:3]
+                                     for c in glass], np.float64).reshape(-1, 3)
+        self.transparent_color = np.array(
+            [tuple(getattr(m, "transparent_color", (1.0, 1.0, 1.0)))[:3] for m in materials],
+            np.float64).reshape(-1, 3)
+        # Textures: one input per (parameter, material), each distinct Texture indexed once.
+        self.textures = []
+        self.texture_index = {}            # id(Texture) -> index into self.textures
+        self._inputs = {}
+        for name in self.PARAMS:
+            inputs = [getattr(m, name + "_texture", None) for m in materials]
+            if any(t is not None for t in inputs):
+                self._inputs[name] = inputs
+                for t in inputs:
+                    if t is not None and id(t.texture) not in self.texture_index:
+                        self.texture_index[id(t.texture)] = len(self.textures)
+                        self.textures.append(t.texture)
+        self.textured = {name: np.array([t is not None for t in inputs], bool)
+                         for name, inputs in self._inputs.items()}
+        emission = np.array([m.emission[:3] for m in materials], dtype=np.float64)
+        for name, arr in (("base_color", self.base_color), ("metallic", self.metallic),
+                          ("roughness", self.roughness), ("ior", self.ior),
+                          ("transmission", self.transmission),
+                          ("specular_ior_level", self.specular_ior_level),
+                          ("emission", emission), ("alpha", self.alpha),
+                          ("metal_color", self.metal_color), ("glass_color", self.glass_color),
+                          ("transparent_color", self.transparent_color)):
+            if not np.all(np.isfinite(arr)):
+                bad = [m.name for m, row in zip(materials, arr.reshape(len(materials), -1))
+                       if not np.all(np.isfinite(row))]
+                raise ValueError(f"material {bad[0]!r} has a non-finite {name}")
+        self.emission_textured = self.textured.get("emission", np.zeros(len(materials), bool))
+        self.emission = np.where(self.emission_textured[:, None], 0.0, emission)
+        self.any_emission = bool((self.emission > 0).any() or self.emission_textured.any())
+        alpha_tex = self.textured.get("alpha", np.zeros(len(materials), bool))
+        # Materials that may let rays through (stochastic transparency in the integrators)
+        self.maybe_transparent = (self.alpha < 1.0) | alpha_tex
+        self.any_transparent = bool(self.maybe_transparent.any())
+        # Which lobes any material can produce (a scene of plain diffuse materials never
+        # touches the microfacet code; PrincipledBSDF also skips lobes per batch).
+        self.any_glossy = bool(((self.specular_ior_level > 0) | (self.metallic > 0)
+                                | (self.transmission > 0)).any()
+                               or "metallic" in self.textured)
+
+    @property
+    def any_textures(self) -> bool:
+        return bool(self.textures)
+
+    def _constant(self, name):
+        return self.emission if name == "emission" else getattr(self, name)
+
+    def lookup(self, name, index, uv=None) -> np.ndarray:
+        """Parameter `name` (one of PARAMS) at hits of materials `index` (n,) with texture
+        coordinates uv (n, 2) (None: the mesh has no UVs, read as (0, 0) like Cycles'
+        missing UV attribute). Returns (n, 3) for colours, (n,) for scalars; a fresh array."""
+        index = np.asarray(index, dtype=np.int64)
+        if name == "emission":
+            out = np.where(self.emission_textured[index][:, None], 0.0, self.emission[index])
+        else:
+            out = self._constant(name)[index].copy()
+        inputs = self._inputs.get(name)
+        if inputs is None or len(index) == 0:
+            return out
+        rows = np.nonzero(self.textured[name][index])[0]
+        if rows.size == 0:
+            return out
+        if uv is None:
+            uv = np.zeros((len(index), 2))
+        mats = index[rows]
+        for k in np.unique(mats):
+            r = rows[mats == k]
+            out[r] = inputs[k].evaluate(uv[r])
+        return out
+
+    def emission_at(self, index, uv=None) -> np.ndarray:
+        """Emitted radiance (n, 3) of the hits' materials, textures evaluated."""
+        return self.lookup("emission", index, uv)
+
+    def alpha_at(self, index, uv=None) -> np.ndarray:
+        """Coverage (n,) in [0, 1]: 1 - the probability that a ray passes through."""
+        return np.clip(self.lookup("alpha", index, uv), 0.0, 1.0)
+
+    def base_color_at(self, index, uv=None) -> np.ndarray:
+        return self.lookup("base_color", index, uv)
+
+    def metallic_at(self, index, uv=None) -> np.ndarray:
+        return self.lookup("metallic", index, uv)
+
+    def roughness_at(self, index, uv=None) -> np.ndarray:
+        return self.lookup("roughness", index, uv)
+
+    def metal_color_at(self, index, base_color) -> np.ndarray:
+        """The metal lobe's F0 per hit: the explicit metal colour, else the base colour
+        (`base_color`, the per-hit value from `base_color_at`)."""
+        index = np.asarray(index, dtype=np.int64)
+        return np.where(self.has_metal_color[index][:, None], self.metal_color[index],
+                        base_color)
