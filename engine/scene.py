@@ -36,9 +36,13 @@ class Material:
       glass_color  the tint of each refraction through the glass lobe (Principled uses
                    sqrt(base colour); a Glass BSDF node its colour).
 
-    glossy_model: the microfacet distribution of the specular and metal lobes: 'GGX'
-    (Blender's, default) or 'BLINN_PHONG' (the lecture's normalised Blinn-Phong lobe, with
-    the exponent n = 2 / alpha^2 - 2 that matches GGX's alpha, Walter et al. 2007).
+    glossy_model: the microfacet model of the specular, metal and glass lobes: 'GGX'
+    (single scattering, the default here and Blender's "GGX"), 'MULTI_GGX' (Blender's
+    default "Multiscatter GGX": GGX with Cycles' energy compensation for the light the
+    single-scattering lobe loses, engine/bsdf/multiscatter.py) or 'BLINN_PHONG' (the
+    lecture's normalised Blinn-Phong lobe in the specular and metal lobes, with the
+    exponent n = 2 / alpha^2 - 2 that matches GGX's alpha, Walter et al. 2007; glass
+    stays single-scattering GGX).
 
     alpha: coverage, Cycles' Principled Alpha or 1 - the weight of a Transparent BSDF in
     a Mix Shader. Where alpha < 1 the integrators let rays through with probability

@@ -90,6 +90,15 @@ PRINCIPLED = {
     "blinn_phong": dict(base_color=(0.7, 0.6, 0.2), metallic=0.5, transmission=0.0,
                         roughness=0.3, ior=1.5, specular_ior_level=0.5, front_facing=True,
                         blinn_phong=True),
+    # Multiscatter GGX: every lobe compensated, which changes the lobe selection
+    "all_lobes_multiscatter": dict(base_color=(0.8, 0.5, 0.3), metallic=0.3,
+                                   transmission=0.4, roughness=0.7, ior=1.45,
+                                   specular_ior_level=0.7, front_facing=True,
+                                   multiscatter=True),
+    "back_face_glass_multiscatter": dict(base_color=(0.9, 0.7, 0.9), metallic=0.0,
+                                         transmission=0.6, roughness=0.9, ior=1.5,
+                                         specular_ior_level=0.5, front_facing=False,
+                                         multiscatter=True),
 }
 ALLOWED = {
     "all": (True, True, True),
@@ -103,7 +112,8 @@ def make_principled(params, n):
     return PrincipledBSDF(np.tile(p["base_color"], (n, 1)), full(p["metallic"], n),
                           full(p["transmission"], n), full(p["roughness"], n), full(p["ior"], n),
                           full(p["specular_ior_level"], n), np.full(n, p["front_facing"]),
-                          np.full(n, p.get("blinn_phong", False)))
+                          np.full(n, p.get("blinn_phong", False)),
+                          np.full(n, p.get("multiscatter", False)))
 
 
 def case_principled(deg, name, allowed="all"):
@@ -139,7 +149,8 @@ CASES += [("rough_dielectric-from_inside-45deg", case_rough_dielectric, (45.0, 1
            (85.0, 1 / 1.5, 0.3, False, False, True))]
 CASES += [(f"principled-{m}-{d:g}deg", case_principled, (d, m))
           for m in PRINCIPLED for d in ANGLES]
-CASES += [(f"principled-all_lobes-{a}-45deg", case_principled, (45.0, "all_lobes", a))
+CASES += [(f"principled-{m}-{a}-45deg", case_principled, (45.0, m, a))
+          for m in ("all_lobes", "all_lobes_multiscatter")
           for a in ("transmission_only", "no_transmission")]
 
 # every chi-square test run by this file, including the negative controls

@@ -2,10 +2,11 @@
 engine/kernels/) against the NumPy reference integrator (engine/integrators/path.py):
 the same estimator with the same random numbers must give the same image, to rounding,
 on every feature the compiled path handles: lamps of every kind, emissive triangles, the
-world and suns, glossy, metal, glass and Blinn-Phong materials, smooth normals, image
-textures, stochastic transparency with its bounce limit, clamps, Film > Transparent,
-holdouts and the three MIS modes. A perturbed scene must not match (negative control),
-and scenes the compiled path does not handle must fall back to the reference."""
+world and suns, glossy, metal, glass (single- and multiple-scattering GGX) and
+Blinn-Phong materials, smooth normals, image textures, stochastic transparency with its
+bounce limit, clamps, Film > Transparent, holdouts and the three MIS modes. A perturbed
+scene must not match (negative control), and scenes the compiled path does not handle
+must fall back to the reference."""
 from __future__ import annotations
 
 import numpy as np
@@ -45,9 +46,11 @@ def _assert_same(scene, settings, **kw):
 
 def _materials_scene():
     s = cornell_box(40, 40)
-    s.materials += [Material("metal", (0.9, 0.6, 0.3), metallic=1.0, roughness=0.3),
+    s.materials += [Material("metal", (0.9, 0.6, 0.3), metallic=1.0, roughness=0.3,
+                             glossy_model="MULTI_GGX"),
                     Material("glass", (1, 1, 1), transmission=1.0, roughness=0.0, ior=1.45),
-                    Material("rough glass", (0.8, 0.9, 1), transmission=1.0, roughness=0.4),
+                    Material("rough glass", (0.8, 0.9, 1), transmission=1.0, roughness=0.4,
+                             glossy_model="MULTI_GGX"),
                     Material("phong", (0.5, 0.5, 0.8), roughness=0.2, glossy_model="BLINN_PHONG"),
                     Material("glow", (0, 0, 0), emission=(4.0, 3.0, 2.0))]
     for k, c in enumerate([(-0.5, 0.2, 1.5), (0.5, -0.3, 0.9), (0.0, -0.6, 0.3),

@@ -18,7 +18,9 @@ from engine.bsdf import layer_albedo, principled as npp
 from engine.bsdf.lobes import DIFFUSE, GLOSSY, TRANSMISSION
 from engine.bsdf.principled import MaterialTable, PrincipledBSDF
 from engine.kernels import bsdf as kb
+from engine.bsdf import multiscatter as npms
 from engine.kernels.bsdf import albedo, batch
+from engine.kernels.bsdf import multiscatter as kms
 from engine.scene import Material
 
 RTOL = 1e-9
@@ -45,7 +47,8 @@ def random_materials(rng, n):
             ior=float(rng.choice([1.0, 1.01, 1.45, 1.5, 2.4, 0.75])),
             transmission=float(rng.choice([0.0, 0.0, 0.5, 1.0])),
             specular_ior_level=float(rng.choice([0.0, 0.5, 0.5, 1.0, rng.random()])),
-            glossy_model="BLINN_PHONG" if rng.random() < 0.25 else "GGX")
+            glossy_model="BLINN_PHONG" if rng.random() < 0.25 else
+            ("MULTI_GGX" if k % 2 else "GGX"))
         if kind == 0:                                     # plain diffuse
             m.metallic, m.transmission, m.specular_ior_level = 0.0, 0.0, 0.0
         if rng.random() < 0.2:
@@ -124,9 +127,10 @@ def test_pack_materials_columns():
     mats = [Material(base_color=(0.1, 0.2, 0.3), metallic=0.4, roughness=0.6, ior=1.7,
                      transmission=0.8, specular_ior_level=0.9, metal_color=(0.5, 0.6, 0.7),
                      glossy_model="BLINN_PHONG"),
-            Material(glass_color=(0.2, 0.3, 0.4))]
+            Material(glass_color=(0.2, 0.3, 0.4)),
+            Material(glossy_model="MULTI_GGX")]
     rows = kb.pack_materials(MaterialTable(mats))
-    assert rows.shape == (2, kb.NPARAM) and rows.dtype == np.float64
+    assert rows.shape == (3, kb.NPARAM) and rows.dtype == np.float64
     r = rows[0]
     assert tuple(r[kb.P_BASE:kb.P_BASE + 3]) == (0.1, 0.2, 0.3)
     assert (r[kb.P_METALLIC], r[kb.P_ROUGHNESS], r[kb.P_IOR], r[kb.P_TRANSMISSION],
@@ -138,6 +142,7 @@ def test_pack_materials_columns():
     assert r[kb.P_HAS_METAL_COLOR] == 0 and r[kb.P_HAS_GLASS_COLOR] == 1
     assert tuple(r[kb.P_GLASS_COLOR:kb.P_GLASS_COLOR + 3]) == (0.2, 0.3, 0.4)
     assert r[kb.P_GLOSSY_MODEL] == kb.GLOSSY_GGX
+    assert rows[2, kb.P_GLOSSY_MODEL] == kb.GLOSSY_MULTI_GGX
 
 
 def test_constants_match_numpy():
@@ -172,6 +177,44 @@ def test_specular_albedo_matches():
     got = np.array([albedo.specular_albedo(c, a, e, tables)
                     for c, a, e in zip(cos_o, alpha, eta)])
     assert_close(got, ref, "specular albedo")
+
+
+def test_multiscatter_lookups_match():
+    """The compiled multiple-scattering tables' lookups and factor equal NumPy's, on and
+    off the grids, on both sides of eta = 1 and past the grids' ends."""
+    rng = np.random.default_rng(4)
+    n = 3000
+    cos_o = np.concatenate([rng.random(n), [0.0, 1.0, 1e-9, 0.5]])
+    alpha = np.concatenate([rng.random(n) ** 2, [1e-4, 1.0, 0.3, 0.0]])
+    eta = np.concatenate([rng.uniform(0.2, 4.0, n), [1.0, 0.5, 50.0, 1e-3]])
+    tables = kb.kernel_tables()
+    cases = [(npms.ggx_albedo(cos_o, alpha), lambda c, a, e: kms.ggx_albedo(c, a, tables)),
+             (npms.ggx_albedo_avg(alpha), lambda c, a, e: kms.ggx_albedo_avg(a, tables)),
+             (npms.glass_albedo(cos_o, alpha, eta),
+              lambda c, a, e: kms.glass_albedo(c, a, e, tables)),
+             (npms.glass_albedo_avg(alpha, eta),
+              lambda c, a, e: kms.glass_albedo_avg(a, e, tables)),
+             (npms.dielectric_fresnel_avg(eta),
+              lambda c, a, e: kms.dielectric_fresnel_avg(e, tables)),
+             (npms.compensation(cos_o * 0.7 + 0.3, alpha * 0.5 + 0.5, np.minimum(eta / 4, 1)),
+              lambda c, a, e: kms.compensation(c * 0.7 + 0.3, a * 0.5 + 0.5, min(e / 4, 1.0)))]
+    for ref, fn in cases:
+        got = np.array([fn(c, a, e) for c, a, e in zip(cos_o, alpha, eta)])
+        assert np.isfinite(ref).all() and (ref > 0).all()
+        assert_close(got, ref, "multiscatter lookup")
+
+
+def test_case_has_multiscatter_lobes(case):
+    """The random materials include multiple-scattering ones whose factors differ from 1
+    in every lobe (so the comparisons below cover the compensation)."""
+    ref = case["ref"]
+    _, _, comp = ref._wo_state(case["wo"])
+    on = ref.weight > 0
+    for cols, lobe in ((slice(0, 1), npp.L_SPECULAR), (slice(1, 4), npp.L_METAL),
+                       (slice(4, 7), npp.L_GLASS)):
+        rows = ref.multiscatter & on[:, lobe]
+        assert (comp[rows, cols] > 1.01).any(1).sum() > 100, lobe
+        assert (comp[~ref.multiscatter, cols] == 1.0).all()
 
 
 # --- the mixture against NumPy -----------------------------------------------------------

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+# The microfacet models of `Material.glossy_model`
+GLOSSY_MODELS = ("GGX", "MULTI_GGX", "BLINN_PHONG")
+
 
 class MaterialTable:
     """Scene materials as arrays, indexed by a hit's material id.
@@ -32,10 +35,11 @@ class MaterialTable:
         self.alpha = np.array([getattr(m, "alpha", 1.0) for m in materials], dtype=np.float64)
         models = [getattr(m, "glossy_model", "GGX") for m in materials]
         for m, model in zip(materials, models):
-            if model not in ("GGX", "BLINN_PHONG"):
-                raise ValueError(f"material {m.name!r}: glossy_model must be 'GGX' or "
-                                 f"'BLINN_PHONG', not {model!r}")
+            if model not in GLOSSY_MODELS:
+                raise ValueError(f"material {m.name!r}: glossy_model must be one of "
+                                 f"{', '.join(map(repr, GLOSSY_MODELS))}, not {model!r}")
         self.blinn_phong = np.array([model == "BLINN_PHONG" for model in models], bool)
+        self.multiscatter = np.array([model == "MULTI_GGX" for model in models], bool)
         # Lobe colours: the metal F0 and the glass tint per crossing, when they are not
         # Principled's own (base colour, sqrt(base colour)).
         metal = [getattr(m, "metal_color", None) for m in materials]

@@ -25,11 +25,16 @@ with m = metallic, t = transmission, GGX alpha = roughness^2 (clamped, see
 `microfacet.ALPHA_MIN`). The weights sum to 1, and each part conserves energy, so the
 whole does. E_spec is tabulated in engine/bsdf/layer_albedo.py.
 
+Distribution per point: single-scattering GGX (Blender's "GGX"), the same with Cycles'
+multiple-scattering energy compensation (`multiscatter`, Blender's default "Multiscatter
+GGX", multiscatter.py: the metal, specular and rough glass lobes scaled per wo by
+1 + F_ms (1 - E(wo)) / E(wo), so that a white metal or glass keeps all the energy; the
+diffuse then gets 1 - E_spec(wo) x that factor, the compensated layer's albedo), or the
+lecture's Blinn-Phong in the reflection lobes (`blinn_phong`, never compensated).
+
 Not modelled (Cycles has them): subsurface, sheen, coat, specular tint/F82 tint (with
 Blender's default white tint, Cycles' F82-tint metal reduces to Schlick), anisotropy,
-thin film, and multiple-scattering GGX energy compensation (Cycles' default
-"Multiscatter GGX"): rough metals and glass here are single-scattering, so slightly
-darker than Cycles at high roughness.
+thin film.
 
 Sampling: a lobe is chosen per point with probability proportional to an estimate of its
 albedo at wo; the mixture pdf is sum_i q_i pdf_i over the allowed lobes (the delta part
@@ -53,8 +58,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import blinn_phong, dielectric, fresnel, lambert
+from . import dielectric, fresnel, lambert, reflection
 from . import microfacet as mf
+from . import multiscatter as ms
 from .layer_albedo import specular_albedo
 from .lobes import DIFFUSE, GLOSSY, TRANSMISSION
 from .material_table import MaterialTable  # noqa: F401  (re-exported: engine.render, tests)
@@ -89,7 +95,8 @@ class PrincipledBSDF:
     """Diffuse, dielectric specular, metal and glass lobes with Blender's weights."""
 
     def __init__(self, base_color, metallic, transmission, roughness=None, ior=None,
-                 specular_ior_level=None, front_facing=None, blinn_phong=None):
+                 specular_ior_level=None, front_facing=None, blinn_phong=None,
+                 multiscatter=None):
         base_color = np.asarray(base_color, dtype=np.float64).reshape(-1, 3)
         n = self.n = len(base_color)
 
@@ -115,6 +122,11 @@ class PrincipledBSDF:
                       else np.broadcast_to(np.asarray(blinn_phong, bool), (n,)).copy())
         self.any_blinn = bool(self.blinn.any())
         self.exponent = np.maximum(2.0 / (self.alpha * self.alpha) - 2.0, 0.0)
+        # Cycles' "Multiscatter GGX": energy compensation of the GGX lobes (not of
+        # Blinn-Phong ones), see multiscatter.py
+        self.multiscatter = (np.zeros(n, bool) if multiscatter is None else
+                             np.broadcast_to(np.asarray(multiscatter, bool), (n,)) & ~self.blinn)
+        self.any_multiscatter = bool(self.multiscatter.any())
         base_w = (1.0 - m) * (1.0 - t)
         # specular layer: F0 scaled by 2 * level, IOR recomputed from it
         f0 = fresnel.f0_from_ior(ior) * 2.0 * level
@@ -154,7 +166,7 @@ class PrincipledBSDF:
         bsdf = cls(base, table.metallic_at(index, uv), table.transmission[index],
                    table.roughness_at(index, uv), table.ior[index],
                    table.specular_ior_level[index], front_facing,
-                   table.blinn_phong[index])
+                   table.blinn_phong[index], table.multiscatter[index])
         if table.has_metal_color.any():
             own = table.has_metal_color[index]
             if own.any():
@@ -177,27 +189,33 @@ class PrincipledBSDF:
 
     # -- per-wo quantities ---------------------------------------------------------------
     def _wo_state(self, wo):
-        """Albedo-dependent weights at wo: the diffuse colour under the specular layer and
+        """Albedo-dependent weights at wo: the diffuse colour under the specular layer,
         the lobe selection estimates (n, 5): diffuse, specular, metal, glass reflection,
-        glass refraction. Cached for the last wo array seen (the integrator evaluates,
-        computes pdfs and samples with one wo)."""
+        glass refraction, and the multiple-scattering factors (n, 7) (None without
+        multiscatter rows): specular, metal (3), glass (3). Cached for the last wo array
+        seen (the integrator evaluates, computes pdfs and samples with one wo)."""
         if self._state_key is wo:
             return self._state
         n = self.n
         cos_o = np.clip(wo[:, 2], 0.0, 1.0)
+        comp = self._compensation(wo, cos_o) if self.any_multiscatter else None
         est = np.zeros((n, 5))
-        e_spec = np.zeros(n)
+        e_layer = np.zeros(n)         # the specular layer's albedo, compensation included
         if self.active[L_SPECULAR]:
             r = self._rows_on[L_SPECULAR]
-            e_spec[r] = specular_albedo(cos_o[r], self.alpha[r], self.eta_spec[r])
-            est[r, 1] = self.weight[r, L_SPECULAR] * e_spec[r]
-        diffuse = self.diffuse_color * (1.0 - e_spec)[:, None]
+            e_layer[r] = specular_albedo(cos_o[r], self.alpha[r], self.eta_spec[r])
+            if comp is not None:
+                e_layer[r] = e_layer[r] * comp[r, 0]
+            est[r, 1] = self.weight[r, L_SPECULAR] * e_layer[r]
+        diffuse = self.diffuse_color * (1.0 - np.minimum(e_layer, 1.0))[:, None]
         if self.active[L_DIFFUSE]:
             est[:, 0] = diffuse.max(1)
         if self.active[L_METAL]:
             r = self._rows_on[L_METAL]
-            F = fresnel.schlick(self.base_clamped[r], cos_o[r]).max(1)
-            est[r, 2] = self.weight[r, L_METAL] * F
+            F = fresnel.schlick(self.base_clamped[r], cos_o[r])
+            if comp is not None:
+                F = F * comp[r, 1:4]
+            est[r, 2] = self.weight[r, L_METAL] * F.max(1)
         if self.active[L_GLASS]:
             r = self._rows_on[L_GLASS]
             eta = self.eta_glass[r]
@@ -206,13 +224,43 @@ class PrincipledBSDF:
             est[r, 3] = self.weight[r, L_GLASS] * F
             est[r, 4] = (self.weight[r, L_GLASS] * (1.0 - F) * self.tint_t[r].max(1)
                          / (eta_rel * eta_rel))
+            if comp is not None:
+                c = comp[r, 4:7].max(1)
+                est[r, 3] = est[r, 3] * c
+                est[r, 4] = est[r, 4] * c
         # floors so that every present lobe can be sampled
         floor = MIN_SELECTION * self.weight
         est[:, :3] = np.where(self.weight[:, :3] > 0, np.maximum(est[:, :3], floor[:, :3]), 0.0)
         est[:, 3] = np.where(self.weight[:, 3] > 0, np.maximum(est[:, 3], 0.5 * floor[:, 3]), 0.0)
         est[:, 4] = np.where(self.weight[:, 3] > 0, np.maximum(est[:, 4], 0.5 * floor[:, 3]), 0.0)
-        self._state_key, self._state = wo, (diffuse, est)
+        self._state_key, self._state = wo, (diffuse, est, comp)
         return self._state
+
+    def _compensation(self, wo, cos_o):
+        """Multiple-scattering factors (n, 7) at wo (multiscatter.py): specular layer,
+        metal (per channel), rough glass (per channel); 1 elsewhere."""
+        comp = np.ones((self.n, 7))
+        on = self.weight > 0
+        r = np.nonzero(self.multiscatter & (on[:, L_SPECULAR] | on[:, L_METAL]))[0]
+        if len(r):
+            E = ms.ggx_albedo(cos_o[r], self.alpha[r])
+            E_avg = ms.ggx_albedo_avg(self.alpha[r])
+            spec = on[r, L_SPECULAR]
+            comp[r[spec], 0] = ms.compensation(E[spec], E_avg[spec],
+                                               ms.dielectric_fresnel_avg(self.eta_spec[r[spec]]))
+            metal = on[r, L_METAL]
+            comp[r[metal], 1:4] = ms.compensation(
+                E[metal][:, None], E_avg[metal][:, None],
+                ms.schlick_fresnel_avg(self.base_clamped[r[metal]]))
+        r = np.nonzero(self.multiscatter & on[:, L_GLASS] & ~self.glass_smooth)[0]
+        if len(r):
+            eta = self.eta_glass[r]
+            eta_rel = np.where(wo[r, 2] < 0, 1.0 / eta, eta)
+            c = np.minimum(np.abs(wo[r, 2]), 1.0)
+            E = ms.glass_albedo(c, self.alpha[r], eta_rel)
+            E_avg = ms.glass_albedo_avg(self.alpha[r], eta_rel)
+            comp[r, 4:7] = ms.compensation(E[:, None], E_avg[:, None], self.tint_t[r])
+        return comp
 
     def _selection(self, est, allowed):
         """Lobe probabilities (n, 4) and the glass lobe's allow flags."""
@@ -239,47 +287,13 @@ class PrincipledBSDF:
         return idx[loc], loc
 
     # -- the reflection distribution: GGX, or Blinn-Phong where asked ----------------------
-    def _reflection_eval(self, o, i, g):
-        """D G / (4 cos cos) of the reflection lobes at rows g (None = all) and h."""
-        if not self.any_blinn:
-            return mf.reflection_eval(o, i, _sub(self.alpha, g))
-        blinn = _sub(self.blinn, g)
-        h, _ = mf.half_vector(o, i)
-        base = np.zeros(len(o))
-        gg, bb = np.nonzero(~blinn)[0], np.nonzero(blinn)[0]
-        if len(gg):
-            base[gg] = mf.reflection_eval(o[gg], i[gg], _sub(self.alpha, g)[gg])[0]
-        if len(bb):
-            base[bb] = blinn_phong.eval_f(o[bb], i[bb], _sub(self.exponent, g)[bb])
-        return base, h
-
-    def _reflection_pdf(self, o, i, g):
-        if not self.any_blinn:
-            return mf.reflection_pdf(o, i, self.alpha[g])
-        blinn = self.blinn[g]
-        p = np.zeros(len(o))
-        gg, bb = np.nonzero(~blinn)[0], np.nonzero(blinn)[0]
-        if len(gg):
-            p[gg] = mf.reflection_pdf(o[gg], i[gg], self.alpha[g][gg])
-        if len(bb):
-            p[bb] = blinn_phong.pdf(o[bb], i[bb], self.exponent[g][bb])
-        return p
-
-    def _reflection_sample(self, o, u, g):
-        if not self.any_blinn:
-            w, _, v = mf.reflection_sample(o, self.alpha[g], u)
-            return w, v
-        blinn = self.blinn[g]
-        w, v = np.zeros((len(o), 3)), np.zeros(len(o), bool)
-        gg, bb = np.nonzero(~blinn)[0], np.nonzero(blinn)[0]
-        if len(gg):
-            w[gg], _, v[gg] = mf.reflection_sample(o[gg], self.alpha[g][gg], u[gg])
-        if len(bb):
-            w[bb], v[bb] = blinn_phong.sample(o[bb], u[bb], self.exponent[g][bb])
-        return w, v
+    def _reflection(self, g):
+        """(alpha, exponent, blinn or None) of rows g (None = all) for reflection.py."""
+        return (_sub(self.alpha, g), _sub(self.exponent, g),
+                _sub(self.blinn, g) if self.any_blinn else None)
 
     # -- evaluation ----------------------------------------------------------------------
-    def _eval(self, idx, wo, wi, diffuse):
+    def _eval(self, idx, wo, wi, diffuse, comp):
         f = np.zeros((len(wo), 3))
         if self.active[L_DIFFUSE]:
             g, loc = self._lobe_rows(L_DIFFUSE, idx)
@@ -296,13 +310,16 @@ class PrincipledBSDF:
             if g is not None and not len(g):
                 continue
             o, i = _sub(wo, loc), _sub(wi, loc)
-            base, h = self._reflection_eval(o, i, g)
+            base, h = reflection.eval_base(o, i, *self._reflection(g))
             cos_oh = np.clip((o * h).sum(1), 0.0, 1.0)
             if lobe == L_SPECULAR:
                 F = fresnel.dielectric(cos_oh, _sub(self.eta_spec, g))[:, None]
             else:
                 F = fresnel.schlick(_sub(self.base_clamped, g), cos_oh)
             val = F * (base * _sub(self.weight[:, lobe], g))[:, None]
+            if comp is not None:
+                val = val * (_sub(comp[:, 0:1], g) if lobe == L_SPECULAR
+                             else _sub(comp[:, 1:4], g))
             if loc is None:
                 f += val
             else:
@@ -319,6 +336,8 @@ class PrincipledBSDF:
                                                      self.alpha[gr])
                     val = (f_r[:, None] + f_t[:, None] * self.tint_t[gr]) \
                         * self.weight[gr, L_GLASS][:, None]
+                    if comp is not None:
+                        val = val * comp[gr, 4:7]
                     f[lr] += val
         return f
 
@@ -326,8 +345,8 @@ class PrincipledBSDF:
         """The whole BSDF f(wo, wi) (n, 3) in 1/sr (delta parts excluded)."""
         if self.diffuse_only:
             return lambert.eval_f(self.diffuse_color, wo, wi)
-        diffuse, _ = self._wo_state(wo)
-        return self._eval(None, wo, wi, diffuse)
+        diffuse, _, comp = self._wo_state(wo)
+        return self._eval(None, wo, wi, diffuse, comp)
 
     def _pdf(self, idx, wo, wi, q, a_g, a_t):
         """Mixture pdf on the subset idx; q, a_g, a_t already restricted to it."""
@@ -339,7 +358,7 @@ class PrincipledBSDF:
             r = np.nonzero(q_refl > 0)[0]
             if len(r):
                 g = r if idx is None else idx[r]
-                p[r] += q_refl[r] * self._reflection_pdf(wo[r], wi[r], g)
+                p[r] += q_refl[r] * reflection.pdf(wo[r], wi[r], *self._reflection(g))
         if self.active[L_GLASS]:
             gl = q[:, L_GLASS] > 0
             gl &= ~_sub(self.glass_smooth, idx)
@@ -354,7 +373,7 @@ class PrincipledBSDF:
         """Mixture pdf (n,) in 1/sr of `sample` with the same `allowed` mask."""
         if self.diffuse_only:
             return np.where(self._diffuse_allowed(allowed), lambert.pdf(wo, wi), 0.0)
-        _, est = self._wo_state(wo)
+        _, est, _ = self._wo_state(wo)
         q, a_g, a_t = self._selection(est, allowed)
         return self._pdf(None, wo, wi, q, a_g, a_t)
 
@@ -378,7 +397,7 @@ class PrincipledBSDF:
         if self.diffuse_only:
             return self._sample_diffuse_only(wo, u_dir, allowed)
         n = self.n
-        diffuse, est = self._wo_state(wo)
+        diffuse, est, comp = self._wo_state(wo)
         q, a_g, a_t = self._selection(est, allowed)
         cdf = np.cumsum(q, axis=1)
         total = cdf[:, -1]
@@ -401,7 +420,7 @@ class PrincipledBSDF:
             ok[r] &= wo[r, 2] > 0
         r = np.nonzero(ok & ((lobe == L_SPECULAR) | (lobe == L_METAL)))[0]
         if len(r):
-            w, v = self._reflection_sample(wo[r], u_dir[r], r)
+            w, v = reflection.sample(wo[r], u_dir[r], *self._reflection(r))
             wi[r] = w
             kind[r] = GLOSSY
             ok[r] &= v
@@ -431,7 +450,7 @@ class PrincipledBSDF:
         # non-delta choices: one-sample mixture estimator f |cos| / sum_j q_j pdf_j
         r = np.nonzero(ok & ~delta)[0]
         if len(r):
-            f = self._eval(r, wo[r], wi[r], diffuse)
+            f = self._eval(r, wo[r], wi[r], diffuse, comp)
             p = self._pdf(r, wo[r], wi[r], q[r], a_g[r], a_t[r])
             good = (p > 0) & np.isfinite(p)
             weight[r] = np.where(good[:, None],

@@ -1,42 +1,15 @@
 """Directional albedo of the Principled specular layer (GGX reflection with exact
 dielectric Fresnel), looked up in the tables of engine/bsdf/layer_albedo.py: the compiled
 twin of `layer_albedo.specular_albedo` (same coordinates, same trilinear interpolation).
-
-The tables are built by the NumPy module (lazily, once per process, thread-safe) and
-handed to the kernels as one tuple, `kernel_tables()`:
-    (table for eta >= 1, table for eta < 1, grid of F0^(1/4), grid of roughness,
-     grid of the cos theta_o coordinate t)
-each table indexed [F0^(1/4), roughness, t].
+The tables reach the kernels in the tuple of `tables.kernel_tables()`.
 """
 from __future__ import annotations
 
 import math
-import threading
-
-import numpy as np
 
 from ..jit import kernel
 from . import microfacet as mf
-
-T_SIDE0, T_SIDE1, T_GRID_S, T_GRID_R, T_GRID_T = 0, 1, 2, 3, 4
-
-_lock = threading.Lock()
-_tables = None
-
-
-def kernel_tables() -> tuple:
-    """The specular albedo tables and their grids as C-contiguous float64 arrays (see
-    the module docstring), built on first use and then shared."""
-    global _tables
-    if _tables is None:
-        from ...bsdf import layer_albedo as la
-        with _lock:
-            if _tables is None:
-                def arr(a):
-                    return np.ascontiguousarray(a, dtype=np.float64)
-                _tables = (arr(la.get_table(0)), arr(la.get_table(1)),
-                           arr(la.TABLE_S), arr(la.TABLE_R), arr(la.TABLE_T))
-    return _tables
+from .tables import T_GRID_R, T_GRID_S, T_GRID_T, T_SIDE0, T_SIDE1, kernel_tables  # noqa: F401
 
 
 @kernel

@@ -19,11 +19,12 @@ P_METAL_COLOR = 8        # 3 columns: the metal lobe's F0 when P_HAS_METAL_COLOR
 P_HAS_METAL_COLOR = 11   # 0 / 1
 P_GLASS_COLOR = 12       # 3 columns: the refraction tint when P_HAS_GLASS_COLOR is 1
 P_HAS_GLASS_COLOR = 15   # 0 / 1
-P_GLOSSY_MODEL = 16      # GLOSSY_GGX or GLOSSY_BLINN_PHONG
+P_GLOSSY_MODEL = 16      # GLOSSY_GGX, GLOSSY_BLINN_PHONG or GLOSSY_MULTI_GGX
 NPARAM = 17
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
+GLOSSY_MULTI_GGX = 2     # GGX with Cycles' multiple-scattering compensation
 
 
 def pack_materials(table) -> np.ndarray:
@@ -41,5 +42,7 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_HAS_METAL_COLOR] = table.has_metal_color
     rows[:, P_GLASS_COLOR:P_GLASS_COLOR + 3] = table.glass_color
     rows[:, P_HAS_GLASS_COLOR] = table.has_glass_color
-    rows[:, P_GLOSSY_MODEL] = np.where(table.blinn_phong, GLOSSY_BLINN_PHONG, GLOSSY_GGX)
+    rows[:, P_GLOSSY_MODEL] = np.where(table.blinn_phong, GLOSSY_BLINN_PHONG,
+                                       np.where(table.multiscatter, GLOSSY_MULTI_GGX,
+                                                GLOSSY_GGX))
     return rows

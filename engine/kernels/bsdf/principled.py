@@ -1,8 +1,8 @@
 """Blender's Principled BSDF as a mixture of lobes, one hit at a time: the compiled twin
 of `engine.bsdf.principled.PrincipledBSDF` (see that module for the model: diffuse under
-a dielectric specular layer with albedo scaling, Schlick metal, smooth or rough glass;
-the lobe selection by albedo estimates with the MIN_SELECTION floor; the `allowed`
-masks). Same formulas, same order of operations, so the values agree with the NumPy
+a dielectric specular layer with albedo scaling, Schlick metal, smooth or rough glass,
+Cycles' multiple-scattering compensation of the GGX lobes; the lobe selection by albedo
+estimates with the MIN_SELECTION floor; the `allowed` masks). Same formulas, same order of operations, so the values agree with the NumPy
 class to rounding (to the bit where the maths library agrees).
 
 Use, per hit:
@@ -24,11 +24,14 @@ import math
 from ..jit import kernel
 from . import blinn_phong, dielectric, fresnel
 from . import microfacet as mf
-from .albedo import kernel_tables, specular_albedo  # noqa: F401  (re-exported)
-from .params import (GLOSSY_BLINN_PHONG, GLOSSY_GGX, NPARAM, P_BASE,  # noqa: F401
+from . import multiscatter as ms
+from .albedo import specular_albedo
+from .params import (GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
+                     NPARAM, P_BASE,
                      P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
                      P_HAS_METAL_COLOR, P_IOR, P_METAL_COLOR, P_METALLIC, P_ROUGHNESS,
                      P_SPEC_LEVEL, P_TRANSMISSION, pack_materials)
+from .tables import kernel_tables  # noqa: F401  (re-exported)
 from ..warp import INV_PI, cosine_hemisphere
 
 # Constants of the NumPy model, repeated here rather than imported: Numba freezes globals
@@ -53,7 +56,10 @@ S_METAL_F0 = 15      # 3: Schlick F0 of the metal lobe
 S_ETA_GLASS = 18     # relative IOR of the glass lobe (1/ior on back faces)
 S_GLASS_SMOOTH = 19  # 1: the glass lobe is the smooth (delta) interface
 S_TINT = 20          # 3: refraction tint per crossing
-NSTATE = 23
+S_MS_SPEC = 23       # multiple-scattering factor of the specular lobe (1: none)
+S_MS_METAL = 24      # 3: ... of the metal lobe, per channel
+S_MS_GLASS = 27      # 3: ... of the rough glass lobe, per channel
+NSTATE = 30
 
 
 @kernel
@@ -106,20 +112,22 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
 
     # albedo-dependent weights at wo (PrincipledBSDF._wo_state)
     cos_o = min(max(woz, 0.0), 1.0)
+    compensate(row[P_GLOSSY_MODEL] == GLOSSY_MULTI_GGX, woz, cos_o, alpha, eta_spec,
+               eta_glass, w_spec, m, w_glass, tables, state)
     e_spec = 0.0
     est_spec = 0.0
     if w_spec > 0.0:
-        e_spec = specular_albedo(cos_o, alpha, eta_spec, tables)
+        e_spec = specular_albedo(cos_o, alpha, eta_spec, tables) * state[S_MS_SPEC]
         est_spec = w_spec * e_spec
     est_diff = 0.0
     for c in range(3):
-        state[S_DIFFUSE + c] = state[S_DIFFUSE + c] * (1.0 - e_spec)
+        state[S_DIFFUSE + c] = state[S_DIFFUSE + c] * (1.0 - min(e_spec, 1.0))
         est_diff = max(est_diff, state[S_DIFFUSE + c])
     est_metal = 0.0
     if m > 0.0:
         F = 0.0
         for c in range(3):
-            F = max(F, fresnel.schlick(state[S_METAL_F0 + c], cos_o))
+            F = max(F, fresnel.schlick(state[S_METAL_F0 + c], cos_o) * state[S_MS_METAL + c])
         est_metal = m * F
     est_gr = 0.0
     est_gt = 0.0
@@ -127,8 +135,9 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
         F = fresnel.dielectric(woz, eta_glass)
         eta_rel = 1.0 / eta_glass if woz < 0.0 else eta_glass
         tint_max = max(state[S_TINT], max(state[S_TINT + 1], state[S_TINT + 2]))
-        est_gr = w_glass * F
-        est_gt = w_glass * (1.0 - F) * tint_max / (eta_rel * eta_rel)
+        c_max = max(state[S_MS_GLASS], max(state[S_MS_GLASS + 1], state[S_MS_GLASS + 2]))
+        est_gr = w_glass * F * c_max
+        est_gt = w_glass * (1.0 - F) * tint_max / (eta_rel * eta_rel) * c_max
     # floors so that every present lobe can be sampled
     state[S_EST] = max(est_diff, MIN_SELECTION * w_diff) if w_diff > 0.0 else 0.0
     state[S_EST + 1] = max(est_spec, MIN_SELECTION * w_spec) if w_spec > 0.0 else 0.0
@@ -136,6 +145,36 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     half_floor = 0.5 * (MIN_SELECTION * w_glass)
     state[S_EST + 3] = max(est_gr, half_floor) if w_glass > 0.0 else 0.0
     state[S_EST + 4] = max(est_gt, half_floor) if w_glass > 0.0 else 0.0
+
+
+@kernel
+def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, w_glass,
+               tables, state):
+    """The multiple-scattering factors at wo (PrincipledBSDF._compensation): 1 unless
+    `multiscatter`; the lobe weights, metal F0 and tint must be in the state already."""
+    state[S_MS_SPEC] = 1.0
+    for c in range(3):
+        state[S_MS_METAL + c] = 1.0
+        state[S_MS_GLASS + c] = 1.0
+    if not multiscatter:
+        return
+    if w_spec > 0.0 or m > 0.0:
+        E = ms.ggx_albedo(cos_o, alpha, tables)
+        E_avg = ms.ggx_albedo_avg(alpha, tables)
+        if w_spec > 0.0:
+            state[S_MS_SPEC] = ms.compensation(E, E_avg,
+                                               ms.dielectric_fresnel_avg(eta_spec, tables))
+        if m > 0.0:
+            for c in range(3):
+                state[S_MS_METAL + c] = ms.compensation(
+                    E, E_avg, ms.schlick_fresnel_avg(state[S_METAL_F0 + c]))
+    if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0:
+        eta_rel = 1.0 / eta_glass if woz < 0.0 else eta_glass
+        c_o = min(abs(woz), 1.0)
+        E = ms.glass_albedo(c_o, alpha, eta_rel, tables)
+        E_avg = ms.glass_albedo_avg(alpha, eta_rel, tables)
+        for c in range(3):
+            state[S_MS_GLASS + c] = ms.compensation(E, E_avg, state[S_TINT + c])
 
 
 @kernel
@@ -197,22 +236,22 @@ def eval_f(state, wox, woy, woz, wix, wiy, wiz):
         cos_oh = min(max(mf.dot(wox, woy, woz, hx, hy, hz), 0.0), 1.0)
         if w_spec > 0.0:
             F = fresnel.dielectric(cos_oh, state[S_ETA_SPEC])
-            v = F * (base * w_spec)
+            v = F * (base * w_spec) * state[S_MS_SPEC]
             fr += v
             fg += v
             fb += v
         if w_metal > 0.0:
             bw = base * w_metal
-            fr += fresnel.schlick(state[S_METAL_F0], cos_oh) * bw
-            fg += fresnel.schlick(state[S_METAL_F0 + 1], cos_oh) * bw
-            fb += fresnel.schlick(state[S_METAL_F0 + 2], cos_oh) * bw
+            fr += fresnel.schlick(state[S_METAL_F0], cos_oh) * bw * state[S_MS_METAL]
+            fg += fresnel.schlick(state[S_METAL_F0 + 1], cos_oh) * bw * state[S_MS_METAL + 1]
+            fb += fresnel.schlick(state[S_METAL_F0 + 2], cos_oh) * bw * state[S_MS_METAL + 2]
     w_glass = state[S_W_GLASS]
     if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0:
         f_r, f_t = dielectric.rough_eval(wox, woy, woz, wix, wiy, wiz,
                                          state[S_ETA_GLASS], state[S_ALPHA])
-        fr += (f_r + f_t * state[S_TINT]) * w_glass
-        fg += (f_r + f_t * state[S_TINT + 1]) * w_glass
-        fb += (f_r + f_t * state[S_TINT + 2]) * w_glass
+        fr += (f_r + f_t * state[S_TINT]) * w_glass * state[S_MS_GLASS]
+        fg += (f_r + f_t * state[S_TINT + 1]) * w_glass * state[S_MS_GLASS + 1]
+        fb += (f_r + f_t * state[S_TINT + 2]) * w_glass * state[S_MS_GLASS + 2]
     return fr, fg, fb
 
 
