@@ -225,6 +225,45 @@ def test_glossy_and_glass_export_to_the_right_lobes(bpy_drt):
     assert close(bsdf.base_clamped[2], (1, 1, 1))
 
 
+def test_microfacet_distribution_is_exported(bpy_drt):
+    """Each node's distribution reaches Material.glossy_model: Multiscatter GGX (Blender's
+    default for Principled, Glossy and Glass) and GGX as they are, Beckmann as GGX
+    (reported); a Mix takes the distribution of its glossiest closure."""
+    bpy = bpy_drt
+    _reset(bpy)
+    for kind in ("ShaderNodeBsdfPrincipled", "ShaderNodeBsdfGlossy", "ShaderNodeBsdfGlass"):
+        mat, nt, node = _single(bpy, kind)
+        assert node.distribution == "MULTI_GGX"                  # Blender's default
+        m, w = _export(mat)
+        assert m.glossy_model == "MULTI_GGX" and w == [], kind
+        node.distribution = "GGX"
+        m, w = _export(mat)
+        assert m.glossy_model == "GGX" and w == [], kind
+        if kind != "ShaderNodeBsdfPrincipled":
+            node.distribution = "BECKMANN"
+            m, w = _export(mat)
+            assert m.glossy_model == "GGX", kind
+            assert len(w) == 1 and "BECKMANN" in w[0] and "GGX" in w[0]
+    # Diffuse + single-scatter Glossy: the glossy side decides, no report
+    gloss = ("ShaderNodeBsdfGlossy", {"Color": (1, 1, 1, 1), "Roughness": 0.2})
+    mat, nt, mix = _mix(bpy, "DG1", DIFFUSE, gloss, fac=0.25)
+    nt.nodes["Glossy BSDF"].distribution = "GGX"
+    m, w = _export(mat)
+    assert m.glossy_model == "GGX" and w == []
+    # two glossy closures of different distributions: the glossier one's, reported
+    mat, nt, mix = _mix(bpy, "PG", PRINCIPLED, gloss, fac=0.25)
+    nt.nodes["Glossy BSDF"].distribution = "GGX"
+    m, w = _export(mat)
+    assert m.glossy_model == "MULTI_GGX"
+    assert len(w) == 1 and "distributions" in w[0]
+    # the Fresnel-mixed "plastic": the glossy closure's distribution
+    mat, nt, mix = _mix(bpy, "Plastic1", DIFFUSE, gloss)
+    nt.nodes["Glossy BSDF"].distribution = "GGX"
+    nt.links.new(nt.nodes.new("ShaderNodeFresnel").outputs[0], mix.inputs[0])
+    m, _ = _export(mat)
+    assert m.specular_ior_level == 0.5 and m.glossy_model == "GGX"
+
+
 # --------------------------------------------------------------------------- warnings
 def _camera_and_sun(bpy, scene, ortho=2.0, size=(48, 48)):
     cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))

@@ -10,16 +10,20 @@ Principled BSDF
     BSDF gets weight a and a Transparent BSDF the rest (so emission is a x emission on
     average), rendered as stochastic transparency. Coat, sheen, subsurface, anisotropy,
     specular tint, thin film and diffuse roughness are not modelled: reported when used.
-    Cycles' default Multiscatter GGX is rendered single-scatter (slightly darker when rough).
+    The node's distribution is the material's `glossy_model`: 'MULTI_GGX' (Blender's
+    default, Cycles' energy-compensated GGX) or 'GGX' (single scattering).
 Diffuse BSDF
     Lambert with its colour (no specular layer). Roughness > 0 (Oren-Nayar) is reported.
 Glossy BSDF
     GGX reflection of its colour with its roughness: DRT's metal lobe with F0 = colour.
     Cycles' Glossy has no Fresnel (reflectance = colour at every angle); Schlick's F0
     lobe reaches white only at grazing angles, so edges are a little brighter here.
-    Beckmann and Ashikhmin-Shirley are rendered as GGX (reported).
+    Multiscatter GGX (the default) and GGX are kept (Cycles' multiscatter Glossy colours
+    its extra bounces by the colour itself, DRT's by Schlick's average of it); Beckmann
+    and Ashikhmin-Shirley are rendered as GGX (reported).
 Glass BSDF
-    DRT's glass lobe with the node's IOR and roughness; its colour tints each refraction
+    DRT's glass lobe with the node's IOR, roughness and distribution (Multiscatter GGX
+    or GGX; Beckmann is rendered as GGX, reported); its colour tints each refraction
     (`Material.glass_color`), as Cycles' Glass does (Cycles also tints the reflection).
 Refraction BSDF
     Approximated by the glass lobe (which also reflects): reported.
@@ -34,7 +38,9 @@ Mix Shader
     transparent) mix exactly, each lobe's colour is the weighted mean of the colours of
     the closures that contribute to it (a Glossy's colour becomes the metal colour, a
     Diffuse's the base colour), roughness and IOR are means weighted by the lobes that use
-    them. Fac from a Fresnel or Layer Weight node (angle-dependent in Cycles): a Mix of a
+    them; the distribution is that of the closure with the largest glossy weight
+    (reported when they differ). Fac from a Fresnel or Layer Weight node (angle-dependent
+    in Cycles): a Mix of a
     dielectric base with a Glossy BSDF becomes Principled's own Fresnel-weighted specular
     layer with that IOR (the classic "plastic" set-up, which is what that layer models);
     otherwise the factor is replaced by its average over the cosine-weighted hemisphere.
@@ -202,6 +208,12 @@ class _Comp:
     spec: float = 0.5
     metal_color: object = None      # None: the base colour (Principled)
     glass_color: object = None      # None: sqrt(base colour) per crossing (Principled)
+    distribution: str = "MULTI_GGX"  # 'MULTI_GGX' or 'GGX' (engine glossy_model)
+
+    def glossy_weight(self):
+        """Mean weight of the lobes the distribution shapes (metal, glass, specular)."""
+        m, g, b = self.weights()
+        return m + g + (b if self.spec > 0 else 0.0)
 
     def weights(self):
         """Mean lobe weights (metal, glass, dielectric base) of this closure."""
@@ -419,7 +431,8 @@ def _principled(node, ctx) -> _Closure:
     comp = _Comp(base=val("Base Color", (0.8, 0.8, 0.8), True),
                  metallic=val("Metallic", 0.0), transmission=const("Transmission Weight", 0.0),
                  roughness=val("Roughness", 0.5), ior=const("IOR", 1.5),
-                 spec=const("Specular IOR Level", 0.5))
+                 spec=const("Specular IOR Level", 0.5),
+                 distribution=_distribution(node, ctx))
     ignored = []
     for sock, what in (("Coat Weight", "coat"), ("Sheen Weight", "sheen"),
                        ("Subsurface Weight", "subsurface"), ("Anisotropic", "anisotropy"),
@@ -457,23 +470,31 @@ def _diffuse(node, ctx) -> _Closure:
                                  spec=0.0))])
 
 
+def _distribution(node, ctx) -> str:
+    """The engine glossy_model of a node's microfacet distribution."""
+    d = getattr(node, "distribution", "MULTI_GGX")
+    if d in ("MULTI_GGX", "GGX"):
+        return d
+    ctx.issue(f"{node.name!r} uses the {d} distribution; DRT uses GGX")
+    return "GGX"
+
+
 def _glossy(node, ctx) -> _Closure:
-    if node.distribution in ("BECKMANN", "ASHIKHMIN_SHIRLEY"):
-        ctx.issue(f"{node.name!r} uses the {node.distribution} distribution; DRT uses GGX")
+    distribution = _distribution(node, ctx)
     s = node.inputs.get("Anisotropy")
     if s is not None and (s.is_linked or float(s.default_value) != 0.0):
         ctx.issue(f"{node.name!r} is anisotropic; DRT renders it isotropic")
     color = _input(node, "Color", ctx, True, (0.8,) * 3)
     return _Closure([(1.0, _Comp(base=color, metallic=1.0,
-                                 roughness=_input(node, "Roughness", ctx, False, 0.5)))])
+                                 roughness=_input(node, "Roughness", ctx, False, 0.5),
+                                 distribution=distribution))])
 
 
 def _glass(node, ctx, refraction=False) -> _Closure:
     if refraction:
         ctx.issue(f"{node.name!r} (Refraction BSDF) is rendered as glass, which also "
                   f"reflects")
-    if node.distribution == "BECKMANN":
-        ctx.issue(f"{node.name!r} uses the BECKMANN distribution; DRT uses GGX")
+    distribution = _distribution(node, ctx)
     color = _input(node, "Color", ctx, True, WHITE)
     if _is_tex(color):
         ctx.issue(f"the colour of {node.name!r} is textured; DRT tints its refraction "
@@ -484,7 +505,8 @@ def _glass(node, ctx, refraction=False) -> _Closure:
         ctx.issue(f"{node.name!r} uses thin film, which DRT does not render (left out)")
     comp = _Comp(base=color, transmission=1.0,
                  roughness=_input(node, "Roughness", ctx, False, 0.0),
-                 ior=_constant(node, "IOR", ctx, 1.5), glass_color=color)
+                 ior=_constant(node, "IOR", ctx, 1.5), glass_color=color,
+                 distribution=distribution)
     return _Closure([(1.0, comp)])
 
 
@@ -550,7 +572,8 @@ def _plastic(a: _Closure, b: _Closure, ior, fac, ctx):
     if not _same(_mean(mc), WHITE):
         ctx.issue("the glossy side of a Fresnel-mixed shader is tinted; DRT's specular "
                   "layer is white")
-    comp = replace(ca, spec=0.5, ior=float(ior), roughness=cb.roughness)
+    comp = replace(ca, spec=0.5, ior=float(ior), roughness=cb.roughness,
+                   distribution=cb.distribution)
     return _Closure([(1.0, comp)], 0.0, BLACK,
                     _lin([(1.0 - fac, a.emission), (fac, b.emission)], ctx, "emission"))
 
@@ -647,6 +670,7 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
     _set(m, "emission", emission)
     m.ior = float(p["ior"])
     m.transmission = float(p["transmission"])
+    m.glossy_model = p["distribution"]
     m.specular_ior_level = float(p["spec"])
     if p["metal_color"] is not None:
         mc = p["metal_color"]
@@ -682,7 +706,7 @@ def _blend(comps, ctx) -> dict:
                     roughness=c.roughness, ior=c.ior, spec=c.spec,
                     metal_color=None if c.metal_color is None or _same(c.metal_color, c.base)
                     else c.metal_color,
-                    glass_color=c.glass_color)
+                    glass_color=c.glass_color, distribution=c.distribution)
     lw = [(c, comp, *comp.weights()) for c, comp in comps]
     Wm = sum(c * m for c, _, m, _, _ in lw)
     Wg = sum(c * g for c, _, _, g, _ in lw)
@@ -730,9 +754,15 @@ def _blend(comps, ctx) -> dict:
     ior = sum(w * i for w, i in ior_w) / total_i if total_i > 0 else 1.5
     if Wb > 0 and Wm > 0 and not _same(metal_avg, base):
         pass   # exact: the metal lobe keeps its own colour (Material.metal_color)
+    # the microfacet distribution: the one of the closure with the most glossy weight
+    glossy = [(c * comp.glossy_weight(), comp.distribution) for c, comp in comps]
+    distribution = max(glossy, key=lambda x: x[0])[1]
+    if len({d for w, d in glossy if w > 0}) > 1:
+        ctx.issue(f"closures with different microfacet distributions are mixed; DRT uses "
+                  f"{distribution} for all")
     return dict(base=base, metallic=metallic, transmission=float(np.clip(transmission, 0, 1)),
                 roughness=roughness, ior=ior, spec=spec, metal_color=metal_color,
-                glass_color=glass_color)
+                glass_color=glass_color, distribution=distribution)
 
 
 # --------------------------------------------------------------------------- entry points
@@ -756,7 +786,8 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
     name = mat.name
     ctx = _Ctx(mat, reporter)
     fallback = engine.Material(name, tuple(mat.diffuse_color[:3]), metallic=float(mat.metallic),
-                               roughness=float(mat.roughness), specular_ior_level=0.5)
+                               roughness=float(mat.roughness), specular_ior_level=0.5,
+                               glossy_model="MULTI_GGX")
     if not uses_nodes(mat):
         return fallback
     out = _output_node(mat.node_tree)

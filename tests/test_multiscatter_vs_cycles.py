@@ -1,0 +1,179 @@
+"""Multiscatter GGX against Cycles: five metal spheres (roughness 0.05, 0.2, 0.4, 0.6, 0.8;
+copper-like base colour; Principled BSDF at Blender's default distribution, Multiscatter
+GGX) on a grey Lambertian plane under a 4 m square area lamp, 64 x 48 pixels, built here
+with bpy. Cycles renders 2048 samples per pixel, DRT 1024.
+
+Checks (`compare`, in the style of tests/test_scenes_vs_cycles.py): the image means
+agree within MEAN_TOLERANCE = 1 % per channel, and every 8 x 8 block mean within
+BLOCK_TOLERANCE = 3 % of the image mean.
+
+Light paths. Cycles' Filter Glossy (default 1) widens glossy lobes after a bounce whose
+pdf was below 1; DRT does not have it yet, so the comparisons avoid the paths where it
+acts:
+  * `test_metal_spheres_match_cycles`: Cycles' defaults except the bounce limits: two
+    bounces in total, no diffuse bounce, so the light reaches the camera directly or
+    after one or two glossy bounces (the plane seen in the spheres, the spheres in each
+    other); Filter Glossy acts only on sphere-to-sphere paths, which this test measures:
+    Cycles with Filter Glossy 0 differs from Cycles at 1 by 0.2 % (mean) and 1.3 % (worst
+    block). Measured, DRT Multiscatter GGX: mean 0.0 %, worst block 1.2 %. With DRT's
+    previous single-scattering GGX (the same scene with the distribution set to GGX):
+    mean -4.3 % (red; -1.9 % green, -1.3 % blue), worst block 37 % (the rough spheres):
+    it fails both checks (`test_single_scatter_fails_the_comparison`).
+    Why not one bounce: at its last bounce DRT samples only the lamp, not the BSDF (a
+    noisier estimator of the same value), which leaves the lamp's highlight in the
+    smooth spheres seen in their neighbours about 6 % low in a block at these samples,
+    for single and multiple scattering alike; with two bounces that path is not the last.
+  * `test_metal_spheres_match_cycles_without_filter_glossy`: AN INTERMEDIATE TEST, until
+    DRT has Filter Glossy: every light path at Cycles' defaults, but Cycles' Filter
+    Glossy set to 0 (scene.cycles.blur_glossy = 0) on the Cycles side. Measured: mean
+    -0.1 %, worst block 1.1 %. With Filter Glossy at 1 Cycles' own image changes by up
+    to 8 % in a block here (the plane's diffuse bounce into the spheres), which this test
+    does not judge.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from conftest import render_current
+
+MEAN_TOLERANCE = 0.01
+BLOCK_TOLERANCE = 0.03
+BLOCK = 8
+CYCLES_SAMPLES = 2048
+DRT_SAMPLES = 1024
+ROUGHNESS = (0.05, 0.2, 0.4, 0.6, 0.8)
+BASE_COLOR = (0.95, 0.64, 0.54, 1.0)
+FEW_BOUNCES = dict(max_bounces=2, diffuse_bounces=0)
+DEFAULT_BOUNCES = dict(max_bounces=12, diffuse_bounces=4)
+
+_renders = {}
+
+
+def build_scene(bpy, distribution="MULTI_GGX"):
+    """The spheres, plane, lamp and camera in a fresh file; the metals' distribution."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.resolution_x, scene.render.resolution_y = 64, 48
+    scene.render.resolution_percentage = 100
+    scene.world = bpy.data.worlds.new("Black")
+    if bpy.app.version < (5, 0, 0):
+        scene.world.use_nodes = True
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.location = (0.0, -6.5, 2.6)
+    cam.rotation_euler = (math.radians(72.0), 0.0, 0.0)
+    cam.data.lens = 40.0
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    lamp = bpy.data.objects.new("Lamp", bpy.data.lights.new("Lamp", "AREA"))
+    lamp.data.size = 4.0
+    lamp.data.energy = 200.0          # radiance 200 / (pi 16) = 4: no sample reaches a clamp
+    lamp.location = (0.5, -1.5, 4.0)
+    scene.collection.objects.link(lamp)
+    mesh = bpy.data.meshes.new("Plane")
+    mesh.from_pydata([(-8, -8, 0), (8, -8, 0), (8, 8, 0), (-8, 8, 0)], [], [(0, 1, 2, 3)])
+    plane = bpy.data.objects.new("Plane", mesh)
+    scene.collection.objects.link(plane)
+    grey = bpy.data.materials.new("Grey")
+    if bpy.app.version < (5, 0, 0):
+        grey.use_nodes = True
+    p = grey.node_tree.nodes["Principled BSDF"]
+    p.inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1.0)
+    p.inputs["Specular IOR Level"].default_value = 0.0          # Lambertian
+    mesh.materials.append(grey)
+    for k, r in enumerate(ROUGHNESS):
+        bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32, radius=0.5,
+                                             location=(-2.2 + 1.1 * k, 0.0, 0.5))
+        sphere = bpy.context.active_object
+        bpy.ops.object.shade_smooth()
+        mat = bpy.data.materials.new(f"Metal{r}")
+        if bpy.app.version < (5, 0, 0):
+            mat.use_nodes = True
+        q = mat.node_tree.nodes["Principled BSDF"]
+        q.inputs["Base Color"].default_value = BASE_COLOR
+        q.inputs["Metallic"].default_value = 1.0
+        q.inputs["Roughness"].default_value = r
+        q.distribution = distribution
+        sphere.data.materials.append(mat)
+    return scene
+
+
+def _render(bpy, engine, bounces, distribution="MULTI_GGX", blur_glossy=None):
+    key = (engine, tuple(sorted(bounces.items())), distribution, blur_glossy)
+    if key not in _renders:
+        scene = build_scene(bpy, distribution)
+        scene.render.engine = engine
+        c, d = scene.cycles, scene.drt
+        c.samples, d.samples = CYCLES_SAMPLES, DRT_SAMPLES
+        c.use_denoising = False
+        c.use_adaptive_sampling = False
+        c.device = "CPU"
+        for name, value in bounces.items():
+            setattr(c, name, value)
+            setattr(d, name, value)
+        if blur_glossy is not None:
+            c.blur_glossy = blur_glossy
+        _renders[key] = render_current(bpy, scene)
+    return _renders[key]
+
+
+def compare(image, reference):
+    """(relative difference of the means per channel (3,), largest |block mean
+    difference| over the reference's image mean)."""
+    m_img, m_ref = image.mean(axis=(0, 1)), reference.mean(axis=(0, 1))
+    h, w, _ = reference.shape
+
+    def blocks(img):
+        return img.mean(axis=2).reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK).mean(axis=(1, 3))
+    block = np.abs(blocks(image) - blocks(reference)).max() / reference.mean()
+    return (m_img - m_ref) / m_ref, float(block)
+
+
+def within(image, reference):
+    rel, block = compare(image, reference)
+    return bool((np.abs(rel) <= MEAN_TOLERANCE).all() and block <= BLOCK_TOLERANCE)
+
+
+def _report(label, image, reference):
+    rel, block = compare(image, reference)
+    print(f"{label}: mean difference {np.round(100 * rel, 2)} %, worst block "
+          f"{100 * block:.2f} % of the image mean")
+
+
+def test_metal_spheres_match_cycles(bpy_drt):
+    cycles = _render(bpy_drt, "CYCLES", FEW_BOUNCES)
+    drt = _render(bpy_drt, "DRT", FEW_BOUNCES)
+    assert drt.shape == cycles.shape == (48, 64, 3) and np.isfinite(drt).all()
+    assert cycles.mean() > 0.05 and cycles.std() > 0.3 * cycles.mean()   # lit, structured
+    _report("Multiscatter GGX, DRT vs Cycles", drt, cycles)
+    # the premise: Filter Glossy hardly acts on these paths
+    no_blur = _render(bpy_drt, "CYCLES", FEW_BOUNCES, blur_glossy=0.0)
+    _report("Cycles, Filter Glossy 0 vs 1", no_blur, cycles)
+    rel, block = compare(no_blur, cycles)
+    assert np.abs(rel).max() < 0.005 and block < 0.015
+    rel, block = compare(drt, cycles)
+    assert (np.abs(rel) <= MEAN_TOLERANCE).all(), rel
+    assert block <= BLOCK_TOLERANCE, block
+
+
+def test_single_scatter_fails_the_comparison(bpy_drt):
+    """The negative control: DRT's previous model, single-scattering GGX, is too dark in
+    the rough spheres for these checks."""
+    cycles = _render(bpy_drt, "CYCLES", FEW_BOUNCES)
+    single = _render(bpy_drt, "DRT", FEW_BOUNCES, distribution="GGX")
+    _report("single-scatter GGX, DRT vs Cycles", single, cycles)
+    rel, block = compare(single, cycles)
+    assert not within(single, cycles)
+    assert rel[0] < -MEAN_TOLERANCE and block > 3 * BLOCK_TOLERANCE
+
+
+def test_metal_spheres_match_cycles_without_filter_glossy(bpy_drt):
+    """INTERMEDIATE (see the module docstring): all of Cycles' default light paths, with
+    Cycles' Filter Glossy off, until DRT implements it."""
+    cycles = _render(bpy_drt, "CYCLES", DEFAULT_BOUNCES, blur_glossy=0.0)
+    drt = _render(bpy_drt, "DRT", DEFAULT_BOUNCES)
+    _report("Multiscatter GGX, all bounces, DRT vs Cycles without Filter Glossy", drt, cycles)
+    rel, block = compare(drt, cycles)
+    assert (np.abs(rel) <= MEAN_TOLERANCE).all(), rel
+    assert block <= BLOCK_TOLERANCE, block
