@@ -171,8 +171,13 @@ def test_principled_albedo(name):
     for c in range(3):
         mean = check_albedo(f"principled {name} [{c}]", w[:, c], tol=5e-3)
     if name.startswith("white diffuse"):
-        # the diffuse layer takes exactly what the specular layer leaves: white furnace
-        assert np.all(mean > 0.985), mean
+        # the diffuse layer takes what the specular layer leaves by Cycles' estimate of
+        # the layer's albedo (principled.py), which ignores the single-scattering lobe's
+        # masking loss: all of it under a smooth layer, up to 12 % less under a rough one
+        # (measured at IOR 2.4, roughness 1; Multiscatter GGX gives the loss back,
+        # tests/test_multiscatter.py)
+        floor = 0.985 if PRINCIPLED_CASES[name]["r"] == 0.0 else 0.85
+        assert np.all(mean > floor), mean
 
 
 def test_principled_back_face_glass_flux():

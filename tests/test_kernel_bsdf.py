@@ -180,8 +180,8 @@ def test_specular_albedo_matches():
 
 
 def test_multiscatter_lookups_match():
-    """The compiled multiple-scattering tables' lookups and factor equal NumPy's, on and
-    off the grids, on both sides of eta = 1 and past the grids' ends."""
+    """The compiled multiple-scattering and layering tables' lookups and the factor equal
+    NumPy's, on and off the grids, on both sides of eta = 1 and past the grids' ends."""
     rng = np.random.default_rng(4)
     n = 3000
     cos_o = np.concatenate([rng.random(n), [0.0, 1.0, 1e-9, 0.5]])
@@ -196,6 +196,8 @@ def test_multiscatter_lookups_match():
               lambda c, a, e: kms.glass_albedo_avg(a, e, tables)),
              (npms.dielectric_fresnel_avg(eta),
               lambda c, a, e: kms.dielectric_fresnel_avg(e, tables)),
+             (npms.layer_reflectance(cos_o, alpha, eta),
+              lambda c, a, e: kms.layer_reflectance(c, a, e, tables)),
              (npms.compensation(cos_o * 0.7 + 0.3, alpha * 0.5 + 0.5, np.minimum(eta / 4, 1)),
               lambda c, a, e: kms.compensation(c * 0.7 + 0.3, a * 0.5 + 0.5, min(e / 4, 1.0)))]
     for ref, fn in cases:

@@ -82,6 +82,31 @@ def test_cached_tables_are_what_the_code_computes():
         assert abs(fine - tab["glass_E"][s, z, i, j]) < 1e-3, (s, z, i, j)
     np.testing.assert_array_equal(tab["fresnel_avg"][0], et.fresnel_average(
         et.eta_of_z(et.FRESNEL_Z, 0)))
+    for _ in range(4):
+        s, z = rng.integers(2), rng.integers(len(et.GLASS_Z))
+        i, j = rng.integers(len(et.GLASS_ROUGH)), rng.integers(len(et.GLASS_T))
+        args = (et.mu_of_t(et.GLASS_T[j]), et.GLASS_ROUGH[i] ** 2,
+                float(et.eta_of_z(et.GLASS_Z[z], s)))
+        assert abs(et.fresnel_interpolant(*args) - tab["fresnel_s"][s, z, i, j]) < 1e-12
+
+
+def test_layer_reflectance_is_fresnel_for_a_mirror_and_bounds_the_albedo():
+    """Cycles' layering estimate: for a near-mirror layer it is the Fresnel reflectance
+    at wo itself; for IOR > 1 it is at least the layer's actual single-scattering
+    albedo (it ignores the masking loss), by little when smooth away from grazing
+    (measured at most 0.004), by up to 0.12 when rough."""
+    from engine.bsdf.layer_albedo import specular_albedo
+    mu = np.array([1.0, 0.8, 0.5, 0.3])
+    np.testing.assert_allclose(ms.layer_reflectance(mu, 1e-4, 1.5),
+                               fresnel.dielectric(mu, 1.5), atol=2e-3)
+    rng = np.random.default_rng(2)
+    mu, rough = rng.random(300), rng.uniform(0.05, 1.0, 300)
+    eta = rng.choice([1.33, 1.5, 2.4], 300)
+    est = ms.layer_reflectance(mu, rough ** 2, eta)
+    actual = specular_albedo(mu, rough ** 2, eta)
+    assert np.all(est >= actual - 2e-3)
+    assert np.all((est - actual)[(rough < 0.2) & (mu > 0.2)] < 0.01)
+    assert (est - actual).max() > 0.02
 
 
 def test_table_interpolation_error():
@@ -187,10 +212,19 @@ def test_white_multiscatter_glass_keeps_its_energy(roughness, front):
         assert ss[:, 0].min() < 0.9
 
 
-@pytest.mark.parametrize("roughness", [0.3, 1.0])
+@pytest.mark.parametrize("roughness", [0.3, 0.7, 1.0])
 def test_white_multiscatter_dielectric_keeps_its_energy(roughness):
-    """White diffuse under the compensated specular layer (the diffuse gets what the
-    layer's albedo, compensation included, leaves): 1 at every angle."""
+    """White diffuse under the compensated specular layer: the diffuse gets 1 minus
+    Cycles' estimate of the layer's albedo (principled.py), an estimate, so the furnace
+    is white within 1.5 % (measured: within 1.2 %, the worst at 88 degrees); under a
+    single-scattering layer, whose masking loss the estimate ignores, rough plastic
+    loses up to 24 % (IOR 2.4, Specular IOR Level 1, roughness 1)."""
     for ior, level in ((1.5, 0.5), (2.4, 1.0)):
         a = albedo("MULTI_GGX", roughness=roughness, ior=ior, level=level)
-        assert np.all(np.abs(a - 1.0) < 0.01), (ior, a[:, 0])
+        ss = albedo("GGX", roughness=roughness, ior=ior, level=level)
+        print(f"roughness {roughness}, ior {ior}, level {level}: white plastic albedo GGX "
+              f"{ss[:, 0].round(4).tolist()}, MULTI_GGX {a[:, 0].round(4).tolist()}")
+        assert np.all(np.abs(a - 1.0) < 0.015), (ior, a[:, 0])
+        assert np.all(ss <= 1.0 + 1e-3)
+        if roughness >= 0.7:
+            assert ss.min() < 0.985

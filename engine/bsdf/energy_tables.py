@@ -22,7 +22,13 @@ and, for a relative IOR eta, z = sqrt(|e - 1| / (e + 1)) where e = eta on side 0
                           factor 1/eta^2 removed, so that a lossless interface gives 1;
   glass_E_avg[s, z, r]    its cosine-weighted average;
   fresnel_avg[s, z]       2 int_0^1 F(mu) mu dmu of the exact dielectric Fresnel reflectance
-                          (the "Fss" of a dielectric specular layer).
+                          (the "Fss" of a dielectric specular layer);
+  fresnel_s[s, z, r, t]   the mean over the visible normals h of wo of
+                          s(h) = (F(wo.h) - F0) / (1 - F0) (0 where the reflection leaves
+                          below the surface): the dielectric GGX layer's reflectance as
+                          Cycles estimates it for layering, F0 + (1 - F0) s, which assumes
+                          a lobe that loses no energy (Cycles' ggx_gen_schlick_ior_s table,
+                          read in app/cycles_precompute.cpp; on the glass grids).
 
 Quadrature: an entry is an expectation over the visible normals of wo (Heitz 2018), whose
 sampling map takes (u0, u1) in the unit square; with u0 = rho^2 it is a Gauss-Legendre
@@ -56,7 +62,7 @@ QUAD_FRESNEL = 64                        # Gauss-Legendre nodes above the critic
 PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "ggx_energy.npz")
 GRIDS = {"grid_rough": ROUGH, "grid_t": T, "grid_glass_rough": GLASS_ROUGH,
          "grid_glass_t": GLASS_T, "grid_glass_z": GLASS_Z, "grid_fresnel_z": FRESNEL_Z}
-NAMES = ("ggx_E", "ggx_E_avg", "glass_E", "glass_E_avg", "fresnel_avg")
+NAMES = ("ggx_E", "ggx_E_avg", "glass_E", "glass_E_avg", "fresnel_avg", "fresnel_s")
 
 
 # --- coordinates -----------------------------------------------------------------------
@@ -129,6 +135,26 @@ def glass_albedo(mu, alpha, eta, quad=QUAD_GLASS) -> np.ndarray:
     return (g.reshape(-1, k) * w).sum(1).reshape(mu.shape)
 
 
+def fresnel_interpolant(mu, alpha, eta, quad=QUAD_GLASS) -> np.ndarray:
+    """The mean (m,) over the visible normals of wo of s = (F(wo.h) - F0) / (1 - F0)
+    for GGX reflection (0 for a reflection below the surface), exact dielectric F of
+    relative IOR eta; see `fresnel_s` in the module docstring."""
+    u, w = vndf_rule(*quad)
+    mu, alpha, eta = np.broadcast_arrays(np.asarray(mu, float), np.asarray(alpha, float),
+                                         np.asarray(eta, float))
+    k = len(w)
+    wo = _directions(mu.ravel(), k)
+    a = np.repeat(alpha.ravel(), k)
+    e = np.repeat(eta.ravel(), k)
+    wi, h, valid = mf.reflection_sample(wo, a, np.tile(u, (mu.size, 1)))
+    F = fresnel.dielectric(np.clip((wo * h).sum(1), 0.0, 1.0), e)
+    F0 = fresnel.f0_from_ior(e)
+    span = 1.0 - F0
+    s = np.clip((F - F0) / np.where(span > 0, span, 1.0), 0.0, 1.0)
+    g = np.where(valid & (span > 0), s, 0.0)
+    return (g.reshape(-1, k) * w).sum(1).reshape(mu.shape)
+
+
 def fresnel_average(eta) -> np.ndarray:
     """2 int_0^1 F(mu, eta) mu dmu of the exact dielectric Fresnel reflectance (eta (m,)).
     Below the critical cosine c (eta < 1) F = 1, which gives c^2; above it, F has a
@@ -182,7 +208,21 @@ def build(progress=None) -> dict:
     out["glass_E"] = np.clip(G, 0.0, 1.0)
     out["glass_E_avg"] = _average_over_mu(out["glass_E"], GLASS_T)
     out["fresnel_avg"] = np.stack([fresnel_average(eta_of_z(FRESNEL_Z, s)) for s in (0, 1)])
+    out["fresnel_s"] = build_fresnel_s(progress)
     return out
+
+
+def build_fresnel_s(progress=None) -> np.ndarray:
+    rr, tt = np.meshgrid(GLASS_ROUGH, mu_of_t(GLASS_T), indexing="ij")
+    S = np.empty((2, len(GLASS_Z), len(GLASS_ROUGH), len(GLASS_T)))
+    for s in (0, 1):
+        for j, z in enumerate(GLASS_Z):
+            eta = float(eta_of_z(z, s))
+            for i in range(len(GLASS_ROUGH)):
+                S[s, j, i] = fresnel_interpolant(tt[i], rr[i] ** 2, eta)
+            if progress is not None:
+                progress(f"layer Fresnel side {s}, z {z:.3f} (eta {eta:.4g})")
+    return np.clip(S, 0.0, 1.0)
 
 
 def save(tables, path=PATH):

@@ -29,8 +29,10 @@ reciprocal, as in Cycles). F_ss per lobe, as Cycles chooses it:
   glass      the refraction tint ("the transmissive tint makes up most of the overall
              colour"), so white glass gets exactly 1 / E(wo).
 The Principled diffuse base lies under the specular layer and gets what that layer
-leaves: its albedo with the compensation (`closure_layering_weight` in Cycles; see
-principled.py).
+leaves (`closure_layering_weight`): 1 minus the layer's albedo as Cycles estimates it,
+`layer_reflectance` (the Fresnel averaged over the visible normals, as if the lobe lost
+no energy) times, for Multiscatter GGX, the weight E(wo) (1 + F_ms (1 - E) / E) that the
+compensation leaves on the closure (see principled.py).
 
 The tables E, E_avg and the dielectric F_ss are DRT's own, computed from DRT's lobes
 (engine/bsdf/energy_tables.py); lookups interpolate (bi/tri)linearly on uniform grids
@@ -42,6 +44,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import energy_tables as et
+from . import fresnel
 from . import microfacet as mf
 
 
@@ -88,12 +91,17 @@ def _side_z(eta):
 
 def glass_albedo(cos_o, alpha, eta) -> np.ndarray:
     """E(wo) of the rough dielectric interface of relative IOR eta, in flux terms."""
+    return glass_grid_lookup("glass_E", cos_o, alpha, eta)
+
+
+def glass_grid_lookup(name, cos_o, alpha, eta) -> np.ndarray:
+    """Table `name` [side, z, rough, t] on the glass grids, trilinearly interpolated."""
     tab = et.load()
     z, s = _side_z(eta)
     i, fi = _lerp(tab["grid_glass_z"], z)
     j, fj = _lerp(tab["grid_glass_rough"], _rough(alpha))
     k, fk = _lerp(tab["grid_glass_t"], _t(cos_o))
-    table = tab["glass_E"]
+    table = tab[name]
     acc = 0.0
     for di, wi in ((0, 1.0 - fi), (1, fi)):
         for dj, wj in ((0, 1.0 - fj), (1, fj)):
@@ -123,6 +131,15 @@ def dielectric_fresnel_avg(eta) -> np.ndarray:
     i, fi = _lerp(tab["grid_fresnel_z"], z)
     table = tab["fresnel_avg"]
     return (1.0 - fi) * table[s, i] + fi * table[s, i + 1]
+
+
+def layer_reflectance(cos_o, alpha, eta) -> np.ndarray:
+    """The reflectance of a dielectric GGX layer at wo as Cycles estimates it for the
+    layers below (`bsdf_microfacet_estimate_albedo`): F0 + (1 - F0) s, s the mean of
+    (F(wo.h) - F0) / (1 - F0) over the visible normals (energy_tables' `fresnel_s`), the
+    Fresnel averaged as if the lobe lost no energy to masking."""
+    f0 = fresnel.f0_from_ior(eta)
+    return f0 + (1.0 - f0) * glass_grid_lookup("fresnel_s", cos_o, alpha, eta)
 
 
 def schlick_fresnel_avg(f0) -> np.ndarray:

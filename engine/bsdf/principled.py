@@ -17,20 +17,25 @@ point, every lobe in the local shading frame):
                                             no specular, 1 = twice F0), IOR' = IOR(F0')
   diffuse       weight  (1 - m)(1 - t)      Lambert with the base colour, under the specular
                         (1 - E_spec(wo))    layer: it gets only the energy the layer does not
-                                            reflect, E_spec(wo) being that layer's
-                                            directional albedo (Cycles' albedo scaling), so
-                                            diffuse + specular <= 1 for base colour <= 1.
+                                            reflect, E_spec(wo) being that layer's albedo as
+                                            Cycles estimates it (its albedo scaling, see
+                                            `_layer_albedo`), so diffuse + specular <= 1 for
+                                            base colour <= 1.
 
 with m = metallic, t = transmission, GGX alpha = roughness^2 (clamped, see
 `microfacet.ALPHA_MIN`). The weights sum to 1, and each part conserves energy, so the
-whole does. E_spec is tabulated in engine/bsdf/layer_albedo.py.
+whole does. Cycles' E_spec for GGX is the Fresnel reflectance averaged over the visible
+normals, which ignores the energy the single-scattering lobe loses to masking, so a
+rough single-scattering plastic reflects a little less than 1 in a white furnace, as in
+Cycles; with Multiscatter GGX it is that times the compensated lobe's weight, and the
+furnace is white again.
 
 Distribution per point: single-scattering GGX (Blender's "GGX"), the same with Cycles'
 multiple-scattering energy compensation (`multiscatter`, Blender's default "Multiscatter
 GGX", multiscatter.py: the metal, specular and rough glass lobes scaled per wo by
-1 + F_ms (1 - E(wo)) / E(wo), so that a white metal or glass keeps all the energy; the
-diffuse then gets 1 - E_spec(wo) x that factor, the compensated layer's albedo), or the
-lecture's Blinn-Phong in the reflection lobes (`blinn_phong`, never compensated).
+1 + F_ms (1 - E(wo)) / E(wo), so that a white metal or glass keeps all the energy), or
+the lecture's Blinn-Phong in the reflection lobes (`blinn_phong`, never compensated; its
+diffuse gets 1 - DRT's own single-scattering albedo of a GGX layer, layer_albedo.py).
 
 Not modelled (Cycles has them): subsurface, sheen, coat, specular tint/F82 tint (with
 Blender's default white tint, Cycles' F82-tint metal reduces to Schlick), anisotropy,
@@ -191,21 +196,20 @@ class PrincipledBSDF:
     def _wo_state(self, wo):
         """Albedo-dependent weights at wo: the diffuse colour under the specular layer,
         the lobe selection estimates (n, 5): diffuse, specular, metal, glass reflection,
-        glass refraction, and the multiple-scattering factors (n, 7) (None without
-        multiscatter rows): specular, metal (3), glass (3). Cached for the last wo array
-        seen (the integrator evaluates, computes pdfs and samples with one wo)."""
+        glass refraction, and the multiple-scattering factors (n, 8) (None without
+        multiscatter rows): specular, metal (3), glass (3), and the GGX albedo E(wo) they
+        were computed from. Cached for the last wo array seen (the integrator evaluates,
+        computes pdfs and samples with one wo)."""
         if self._state_key is wo:
             return self._state
         n = self.n
         cos_o = np.clip(wo[:, 2], 0.0, 1.0)
         comp = self._compensation(wo, cos_o) if self.any_multiscatter else None
         est = np.zeros((n, 5))
-        e_layer = np.zeros(n)         # the specular layer's albedo, compensation included
+        e_layer = np.zeros(n)         # the specular layer's albedo estimate
         if self.active[L_SPECULAR]:
             r = self._rows_on[L_SPECULAR]
-            e_layer[r] = specular_albedo(cos_o[r], self.alpha[r], self.eta_spec[r])
-            if comp is not None:
-                e_layer[r] = e_layer[r] * comp[r, 0]
+            e_layer[r] = self._layer_albedo(r, cos_o, comp)
             est[r, 1] = self.weight[r, L_SPECULAR] * e_layer[r]
         diffuse = self.diffuse_color * (1.0 - np.minimum(e_layer, 1.0))[:, None]
         if self.active[L_DIFFUSE]:
@@ -236,15 +240,37 @@ class PrincipledBSDF:
         self._state_key, self._state = wo, (diffuse, est, comp)
         return self._state
 
+    def _layer_albedo(self, r, cos_o, comp):
+        """The specular layer's albedo at wo as the diffuse below sees it, rows r: Cycles'
+        estimate per distribution (multiscatter.py), `layer_reflectance` for GGX, that
+        times E(wo) for Multiscatter GGX (with the compensation factor: the weight the
+        compensation leaves on the closure), but never below the layer's actual
+        single-scattering albedo (layer_albedo.py; times the factor), so the layering
+        creates no energy where the estimate falls short (IOR < 1 near the critical
+        angle). Blinn-Phong, which Cycles does not have: that actual albedo."""
+        exact = specular_albedo(cos_o[r], self.alpha[r], self.eta_spec[r])
+        e = ms.layer_reflectance(cos_o[r], self.alpha[r], self.eta_spec[r])
+        if comp is not None:
+            e = e * comp[r, 7]
+        e = np.maximum(e, exact)
+        if comp is not None:
+            e = e * comp[r, 0]
+        if self.any_blinn:
+            b = np.nonzero(self.blinn[r])[0]
+            e[b] = exact[b]
+        return e
+
     def _compensation(self, wo, cos_o):
-        """Multiple-scattering factors (n, 7) at wo (multiscatter.py): specular layer,
-        metal (per channel), rough glass (per channel); 1 elsewhere."""
-        comp = np.ones((self.n, 7))
+        """Multiple-scattering factors (n, 8) at wo (multiscatter.py): specular layer,
+        metal (per channel), rough glass (per channel), and GGX's E(wo) (for the layer
+        albedo); 1 elsewhere."""
+        comp = np.ones((self.n, 8))
         on = self.weight > 0
         r = np.nonzero(self.multiscatter & (on[:, L_SPECULAR] | on[:, L_METAL]))[0]
         if len(r):
             E = ms.ggx_albedo(cos_o[r], self.alpha[r])
             E_avg = ms.ggx_albedo_avg(self.alpha[r])
+            comp[r, 7] = E
             spec = on[r, L_SPECULAR]
             comp[r[spec], 0] = ms.compensation(E[spec], E_avg[spec],
                                                ms.dielectric_fresnel_avg(self.eta_spec[r[spec]]))

@@ -8,11 +8,12 @@ from __future__ import annotations
 import math
 
 from ..jit import kernel
+from . import fresnel
 from . import microfacet as mf
 from .albedo import lerp_coords
-from .tables import (T_FRESNEL_AVG, T_G_FRESNEL_Z, T_G_GLASS_ROUGH, T_G_GLASS_T,
-                     T_G_GLASS_Z, T_G_ROUGH, T_G_T, T_GGX_E, T_GGX_E_AVG, T_GLASS_E,
-                     T_GLASS_E_AVG)
+from .tables import (T_FRESNEL_AVG, T_FRESNEL_S, T_G_FRESNEL_Z, T_G_GLASS_ROUGH,
+                     T_G_GLASS_T, T_G_GLASS_Z, T_G_ROUGH, T_G_T, T_GGX_E, T_GGX_E_AVG,
+                     T_GLASS_E, T_GLASS_E_AVG)
 
 
 @kernel
@@ -58,11 +59,16 @@ def ggx_albedo_avg(alpha, tables):
 @kernel
 def glass_albedo(cos_o, alpha, eta, tables):
     """E(wo) of the rough dielectric interface of relative IOR eta, in flux terms."""
+    return glass_grid_lookup(tables[T_GLASS_E], cos_o, alpha, eta, tables)
+
+
+@kernel
+def glass_grid_lookup(table, cos_o, alpha, eta, tables):
+    """`table` [side, z, rough, t] on the glass grids, trilinearly interpolated."""
     s, z = side_z(eta)
     i, fi = lerp_coords(tables[T_G_GLASS_Z], z)
     j, fj = lerp_coords(tables[T_G_GLASS_ROUGH], math.sqrt(mf.clamp_alpha(alpha)))
     k, fk = lerp_coords(tables[T_G_GLASS_T], t_coord(cos_o))
-    table = tables[T_GLASS_E]
     acc = 0.0
     for di in range(2):
         wi_ = fi if di else 1.0 - fi
@@ -97,6 +103,13 @@ def dielectric_fresnel_avg(eta, tables):
     i, fi = lerp_coords(tables[T_G_FRESNEL_Z], z)
     table = tables[T_FRESNEL_AVG]
     return (1.0 - fi) * table[s, i] + fi * table[s, i + 1]
+
+
+@kernel
+def layer_reflectance(cos_o, alpha, eta, tables):
+    """Cycles' estimate of a dielectric GGX layer's reflectance at wo: F0 + (1 - F0) s."""
+    f0 = fresnel.f0_from_ior(eta)
+    return f0 + (1.0 - f0) * glass_grid_lookup(tables[T_FRESNEL_S], cos_o, alpha, eta, tables)
 
 
 @kernel

@@ -59,7 +59,8 @@ S_TINT = 20          # 3: refraction tint per crossing
 S_MS_SPEC = 23       # multiple-scattering factor of the specular lobe (1: none)
 S_MS_METAL = 24      # 3: ... of the metal lobe, per channel
 S_MS_GLASS = 27      # 3: ... of the rough glass lobe, per channel
-NSTATE = 30
+S_MS_E = 30          # GGX's E(wo) behind the factors (1: none)
+NSTATE = 31
 
 
 @kernel
@@ -117,7 +118,11 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     e_spec = 0.0
     est_spec = 0.0
     if w_spec > 0.0:
-        e_spec = specular_albedo(cos_o, alpha, eta_spec, tables) * state[S_MS_SPEC]
+        # the layer's albedo as the diffuse sees it (PrincipledBSDF._layer_albedo)
+        e_spec = specular_albedo(cos_o, alpha, eta_spec, tables)
+        if state[S_BLINN] == 0.0:
+            e_est = ms.layer_reflectance(cos_o, alpha, eta_spec, tables) * state[S_MS_E]
+            e_spec = max(e_est, e_spec) * state[S_MS_SPEC]
         est_spec = w_spec * e_spec
     est_diff = 0.0
     for c in range(3):
@@ -153,6 +158,7 @@ def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, 
     """The multiple-scattering factors at wo (PrincipledBSDF._compensation): 1 unless
     `multiscatter`; the lobe weights, metal F0 and tint must be in the state already."""
     state[S_MS_SPEC] = 1.0
+    state[S_MS_E] = 1.0
     for c in range(3):
         state[S_MS_METAL + c] = 1.0
         state[S_MS_GLASS + c] = 1.0
@@ -161,6 +167,7 @@ def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, 
     if w_spec > 0.0 or m > 0.0:
         E = ms.ggx_albedo(cos_o, alpha, tables)
         E_avg = ms.ggx_albedo_avg(alpha, tables)
+        state[S_MS_E] = E
         if w_spec > 0.0:
             state[S_MS_SPEC] = ms.compensation(E, E_avg,
                                                ms.dielectric_fresnel_avg(eta_spec, tables))

@@ -4,8 +4,9 @@
   T_SIDE0, T_SIDE1   specular-layer albedo for eta >= 1 and eta < 1, indexed
                      [F0^(1/4), roughness, t] (engine/bsdf/layer_albedo.py), on the
   T_GRID_S, T_GRID_R, T_GRID_T   grids of F0^(1/4), roughness and t;
-  T_GGX_E, T_GGX_E_AVG, T_GLASS_E, T_GLASS_E_AVG, T_FRESNEL_AVG
-                     the multiple-scattering tables (engine/bsdf/energy_tables.py), on the
+  T_GGX_E, T_GGX_E_AVG, T_GLASS_E, T_GLASS_E_AVG, T_FRESNEL_AVG, T_FRESNEL_S
+                     the multiple-scattering and layering tables (engine/bsdf/
+                     energy_tables.py), on the
   T_G_ROUGH, T_G_T, T_G_GLASS_ROUGH, T_G_GLASS_T, T_G_GLASS_Z, T_G_FRESNEL_Z   grids.
 """
 from __future__ import annotations
@@ -18,6 +19,7 @@ T_SIDE0, T_SIDE1, T_GRID_S, T_GRID_R, T_GRID_T = 0, 1, 2, 3, 4
 T_GGX_E, T_GGX_E_AVG, T_GLASS_E, T_GLASS_E_AVG, T_FRESNEL_AVG = 5, 6, 7, 8, 9
 T_G_ROUGH, T_G_T, T_G_GLASS_ROUGH, T_G_GLASS_T, T_G_GLASS_Z, T_G_FRESNEL_Z = (
     10, 11, 12, 13, 14, 15)
+T_FRESNEL_S = 16
 
 _lock = threading.Lock()
 _tables = None
@@ -39,5 +41,5 @@ def kernel_tables() -> tuple:
                            e["ggx_E"], e["ggx_E_avg"], e["glass_E"], e["glass_E_avg"],
                            e["fresnel_avg"], e["grid_rough"], e["grid_t"],
                            e["grid_glass_rough"], e["grid_glass_t"], e["grid_glass_z"],
-                           e["grid_fresnel_z"])
+                           e["grid_fresnel_z"], e["fresnel_s"])
     return _tables
