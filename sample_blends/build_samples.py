@@ -376,8 +376,9 @@ SCENES.update(MOTION_SCENES)
 # 64 x 64 pixels, Principled BSDF only, Cycles' default light paths (full global
 # illumination), compared in tests/test_scenes_vs_cycles.py and docs/comparisons.md.
 # Two Cycles settings are changed so that both engines compute the same thing:
-# - specular materials use single-scattering GGX (`distribution = 'GGX'`): the
-#   Principled default, multiscatter GGX, adds energy that DRT does not model;
+# - specular materials use single-scattering GGX (`distribution = 'GGX'`), as when these
+#   comparisons were first measured; the Principled default, Multiscatter GGX, is
+#   compared with Cycles in tests/test_multiscatter_vs_cycles.py;
 # - Filter Glossy is 0 (`cycles.blur_glossy`, default 1): Cycles' default blurs glossy
 #   surfaces seen after a diffuse or rough bounce, a bias DRT does not have (measured:
 #   with the default, Cycles renders metals 1.4-2.7% and glass 4.6-5.9% darker).
