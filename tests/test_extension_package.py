@@ -144,7 +144,8 @@ def test_zip_holds_the_addon_tracer_and_wheels_only(built):
     assert zipped_manifest == {**_manifest(), "platforms": [PLATFORM], "wheels": wheels}
     for required in ("blender_manifest.toml", "__init__.py", "drt_addon/__init__.py",
                      "drt_addon/render_engine.py", "drt_addon/engine_link.py",
-                     "engine/__init__.py", "engine/accel.py", "engine/render.py"):
+                     "engine/__init__.py", "engine/accel.py", "engine/render.py",
+                     "engine/bsdf/data/ggx_energy.npz"):   # the multiscatter tables
         assert required in names, required
     zipped_wheels = sorted(n for n in names if n.endswith(".whl"))
     assert zipped_wheels == sorted(os.path.normpath(w).replace(os.sep, "/") for w in wheels)
