@@ -80,7 +80,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
             materials.append(export_material(mat, reporter))
         return material_index[key]
 
-    cache = MeshCache()
+    cache = MeshCache(reporter)
     meshes, lights = [], []
     holdouts = 0
     for k, inst in enumerate(depsgraph.object_instances):

@@ -80,6 +80,14 @@ def export_light(obj, matrix_world, reporter: Reporter):
             strength = _scaled(strength, _sun_area(angle))
         return engine.SunLight(tuple(direction), strength, angle=angle, name=obj.name)
     if light.type == "AREA":
+        sx = float(light.size)
+        sy = float(light.size_y) if light.shape in ("RECTANGLE", "ELLIPSE") else sx
+        scale = np.linalg.norm(m[:3, :2], axis=0)
+        if not (sx * scale[0] > 0.0 and sy * scale[1] > 0.0
+                and math.isfinite(sx * sy * scale[0] * scale[1])):
+            reporter.warn(f"DRT: area light {obj.name!r} has zero size; it is skipped, as "
+                          "Cycles does", key=(obj.name, "zero size"))
+            return None
         spread = float(getattr(light, "spread", math.pi))
         if spread < math.pi - 1e-6:
             reporter.warn(f"DRT: area light {obj.name!r} has a spread of "
