@@ -620,8 +620,55 @@ def world_light():
     return scene
 
 
+def ray_visibility():
+    """Blender's defaults throughout (Filter Glossy 1, caustics on): a diffuse floor
+    with three objects under four lamps hidden from the camera although in view: a point
+    lamp (100 W, radius 0.05, Soft Falloff off), a spot, a sun and a disk lamp; the
+    sphere casts no shadow, the block is hidden from the camera (its shadow stays) and
+    the cylinder is invisible to diffuse rays (no light bounces off it)."""
+    scene = reset()
+    render_defaults(scene, size=COMPARISON_SIZE, samples=512)
+    scene.cycles.samples = 1024
+    scene.cycles.use_adaptive_sampling = False
+    _set_world(scene, (0.02, 0.02, 0.02))
+    floor = principled("Floor", (0.6, 0.6, 0.6), specular=0.0)
+    quad("Floor", [(-5, -5, 0), (5, -5, 0), (5, 5, 0), (-5, 5, 0)], floor)
+    orange = principled("Orange", (0.8, 0.35, 0.1), specular=0.0)
+    sphere = uv_sphere("Sphere", (-0.9, 0.3, 0.5), 0.5, orange)
+    sphere.visible_shadow = False
+    white = principled("White", (0.75, 0.75, 0.75), specular=0.0)
+    block = cuboid("Block", (0.3, 0.2, 0.0), (0.9, 0.8, 0.7), white, math.radians(20))
+    block.visible_camera = False
+    green = principled("Green", (0.15, 0.6, 0.15), specular=0.0)
+    post = cuboid("Post", (-0.2, 1.2, 0.0), (0.2, 1.6, 1.4), green)
+    post.visible_diffuse = False
+    lamps = []
+    point = bpy.data.lights.new("Point", "POINT")
+    point.energy, point.shadow_soft_size, point.use_soft_falloff = 100.0, 0.05, False
+    lamps.append((point, (0.2, -0.4, 0.6), None))
+    spot = bpy.data.lights.new("Spot", "SPOT")
+    spot.energy, spot.shadow_soft_size = 150.0, 0.1
+    spot.spot_size, spot.spot_blend = math.radians(50.0), 0.3
+    lamps.append((spot, (-1.5, -0.5, 2.0), (-0.9, 0.3, 0.0)))
+    sun = bpy.data.lights.new("Sun", "SUN")
+    sun.energy = 1.0
+    lamps.append((sun, (2.0, -1.0, 3.0), (0.0, 0.0, 0.0)))
+    disk = bpy.data.lights.new("Disk", "AREA")
+    disk.shape, disk.size, disk.energy = "DISK", 0.5, 40.0
+    lamps.append((disk, (1.3, -0.2, 1.1), (1.3, 0.4, 0.0)))
+    for light, location, target in lamps:
+        obj = bpy.data.objects.new(light.name, light)
+        obj.location = location
+        scene.collection.objects.link(obj)
+        obj.visible_camera = False
+        if target is not None:
+            _aim(obj, target)
+    camera(scene, (0.0, -4.0, 2.2), (math.radians(65.0), 0.0, 0.0), lens=32.0)
+    return scene
+
+
 COMPARISON_SCENES = {f.__name__: f for f in (
-    metals, glossy_dielectric, glass, dof, instances, world_light)}
+    metals, glossy_dielectric, glass, dof, instances, world_light, ray_visibility)}
 SCENES.update(COMPARISON_SCENES)
 
 

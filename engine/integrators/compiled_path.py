@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import visibility
 from ..kernels import lights as klights
 from ..kernels.bsdf import principled as kbsdf
 from ..kernels.path_vertex import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
@@ -62,13 +63,20 @@ class CompiledPathIntegrator:
         self.params = kbsdf.pack_materials(mats)
         self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)
         self.textures = pack_textures(mats)
+        vis = _or_empty(surf.visibility, 0, np.uint8)
         self.materials = (surf.material, np.ascontiguousarray(mats.maybe_transparent),
                           np.ascontiguousarray(mats.alpha, dtype=np.float64),
                           np.ascontiguousarray(mats.transparent_color, dtype=np.float64),
-                          self.textures)
+                          self.textures, vis)
+        # Ray Visibility: closest hits pass through surfaces some ray kind does not see,
+        # shadow rays through objects casting no shadow (engine.visibility)
+        ray_kinds = visibility.CAMERA | visibility.DIFFUSE | visibility.GLOSSY \
+            | visibility.TRANSMISSION
+        self.skips_hits = bool(((vis & ray_kinds) != ray_kinds).any())
+        self.skips_shadows = bool(((vis & visibility.SHADOW) == 0).any())
         self.any_transparent = mats.any_transparent
         self.tables = kbsdf.kernel_tables()
-        self.lights = klights.pack_lights(ctx.lights)
+        self.lights = klights.pack_lights(ctx.lights, surf.visibility)
         self.world = np.ascontiguousarray(ctx.world_radiance, dtype=np.float64)
 
     @property
@@ -82,7 +90,7 @@ class CompiledPathIntegrator:
             self.cfg[8] = _MODE_IDS[mode]
 
     # -- transparency: repeated queries through surfaces with alpha < 1 ----------------
-    def _through_transparent(self, depth, paths, live, used, o, d, tm, hits):
+    def _through_transparent(self, depth, paths, live, used, ray_bits, o, d, tm, hits):
         """Closest hits seen through transparent layers (see path.intersect_alpha):
         returns (t, prim, u, v, throughput factor (m, 3), stopped (m,))."""
         m = len(live)
@@ -97,7 +105,7 @@ class CompiledPathIntegrator:
         layer = 0
         while rows.size:
             k = alpha_pass(depth, layer, self.transparent_limit, int(cfg[0]), int(cfg[1]),
-                           paths[0], paths[1], live, used, rows, d, tm,
+                           paths[0], paths[1], live, used, ray_bits, rows, d, tm,
                            cur.t, cur.prim, cur.u, cur.v, travelled, factor, stopped,
                            self.geometry, self.materials, out_rows, out_org, out_far)
             if k == 0:
@@ -139,6 +147,7 @@ class CompiledPathIntegrator:
         beta = np.ones((n, 3))
         counts = np.zeros((n, 3), dtype=np.int64)
         used = np.zeros(n, dtype=np.int64)         # transparent bounces per path
+        ray_bits = np.full(n, visibility.CAMERA, dtype=np.int64)   # each path's ray kind
         prev_pdf = np.full(n, np.inf)              # camera rays count as specular: weight 1
         prev_pos = np.ascontiguousarray(origins, dtype=np.float64).copy()
         live = np.arange(n, dtype=np.int64)
@@ -156,19 +165,19 @@ class CompiledPathIntegrator:
                 break
             hits = ctx.accel.intersect(o, d, tm)
             t, prim, u, v, stopped = hits.t, hits.prim, hits.u, hits.v, no_stop
-            if self.any_transparent:
+            if self.any_transparent or self.skips_hits:
                 t, prim, u, v, factor, stopped = self._through_transparent(
-                    depth, (pkey, index), live, used, o, d, tm, hits)
+                    depth, (pkey, index), live, used, ray_bits, o, d, tm, hits)
                 beta[live] *= factor
             ns, nn = shade(depth, self.cfg, pkey, index, beta, counts, L, coverage,
-                           prev_pdf, prev_pos, live, o, d, tm, t, prim, u, v, stopped,
+                           prev_pdf, prev_pos, ray_bits, live, o, d, tm, t, prim, u, v, stopped,
                            self.geometry, self.params, self.emission, self.textures,
                            self.tables, self.lights, self.world,
                            sh_path, sh_org, sh_dir, sh_far, sh_contrib,
                            nx_path, nx_org, nx_dir)
             if ns:
                 limit = s.clamp_direct if depth == 0 else s.clamp_indirect
-                if self.any_transparent:
+                if self.any_transparent or self.skips_shadows:
                     trans = self._transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns])
                     add_transmitted(L, sh_path[:ns], sh_contrib[:ns], trans, limit)
                 else:

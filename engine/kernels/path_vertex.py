@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from .. import visibility
 from ..bsdf.lobes import TRANSMISSION
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
@@ -28,6 +29,9 @@ from .surface import hit_uv, offset_origin, rebuild
 from .textures import apply_to_row, emission_at
 
 MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
+# Numba freezes these into its cache; the cache's fingerprint covers every engine file
+DIFFUSE_BIT, GLOSSY_BIT, TRANSMISSION_BIT, SHADOW_BIT = (
+    visibility.DIFFUSE, visibility.GLOSSY, visibility.TRANSMISSION, visibility.SHADOW)
 ROULETTE_START = 3
 _INF = np.inf
 
@@ -88,7 +92,7 @@ def uncovered(br, bg, bb):
 
 
 @kernel
-def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
+def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, ray_bits,
           live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
           geometry, params, emission, textures, tables, lights, world,
           sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir):
@@ -99,7 +103,10 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
     geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout,
     corner_uvs) of the static triangles (the last three may be empty). alpha: each
     path's film coverage, or empty when the film is opaque. stopped: rays that ended at
-    the transparent bounce limit. Writes the shadow rays to sh_* (their contributions
+    the transparent bounce limit. ray_bits: the kind of each path's current ray
+    (engine.visibility: CAMERA, then the bit of the lobe it left by), which decides the
+    lamps it sees; next-event estimation evaluates only the lobes the light is seen by
+    and skips the shadow ray of a light that casts no shadow. Writes the shadow rays to sh_* (their contributions
     before the clamp, which `add_transmitted` applies) and the continuing paths' next
     rays to nx_*; returns (shadow count, next count). beta, counts, L, alpha, prev_pdf,
     prev_pos are per-path state, updated in place."""
@@ -126,8 +133,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
         t_geom = hit_t[j] if hit else rt[j]
         # 1a. area and sphere lamps in front of the geometry; the ray goes on behind them
         if n_lights > 0:
-            t_l, k_l, lr, lg, lb = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_geom)
-            if k_l >= 0 and (depth > 0 or lt.lamp_visible_camera(lights, k_l)):
+            t_l, k_l, lr, lg, lb = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_geom,
+                                                ray_bits[p])
+            if k_l >= 0:
                 lpdf = lt.lamp_pdf(lights, k_l, prev_pos[p, 0], prev_pos[p, 1],
                                    prev_pos[p, 2], dx, dy, dz, t_l)
                 w = hit_weight(mode, prev_pdf[p], lpdf)
@@ -183,7 +191,10 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
             k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
                 lights, px, py, pz, u_pick, u1, u2)
             lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
-            fr, fg, fb = bsdf.eval_f(state, wox, woy, woz, lx, ly, lz)
+            seen = lt.entry_visibility(lights, k)
+            see_d, see_g, see_t = (seen & DIFFUSE_BIT) != 0, (seen & GLOSSY_BIT) != 0, \
+                (seen & TRANSMISSION_BIT) != 0
+            fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, see_d, see_g, see_t)
             front_side = dot(wx, wy, wz, gx, gy, gz) > 0.0
             if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0
                     and (front_side or bsdf.transmits(state))):
@@ -200,16 +211,21 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
                     far = min(seg * (1.0 - 2e-5), seg - margin)
                 else:
                     far = scene_radius * 4.0
-                bpdf = bsdf.pdf(state, wox, woy, woz, lx, ly, lz, ad, ag, at)
+                bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
+                                     see_d, see_g, see_t)
                 w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * abs(lz)
-                sh_path[ns_out] = p
-                sh_org[ns_out, 0], sh_org[ns_out, 1], sh_org[ns_out, 2] = sox, soy, soz
-                sh_dir[ns_out, 0], sh_dir[ns_out, 1], sh_dir[ns_out, 2] = sdx, sdy, sdz
-                sh_far[ns_out] = max(far, 0.0)
-                sh_contrib[ns_out, 0] = br * fr * lr * w
-                sh_contrib[ns_out, 1] = bg * fg * lg * w
-                sh_contrib[ns_out, 2] = bb * fb * lb * w
-                ns_out += 1
+                if not seen & SHADOW_BIT:        # a light casting no shadow: no shadow ray
+                    _add(L, p, br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w,
+                         clamp_direct if depth == 0 else clamp_indirect)
+                else:
+                    sh_path[ns_out] = p
+                    sh_org[ns_out, 0], sh_org[ns_out, 1], sh_org[ns_out, 2] = sox, soy, soz
+                    sh_dir[ns_out, 0], sh_dir[ns_out, 1], sh_dir[ns_out, 2] = sdx, sdy, sdz
+                    sh_far[ns_out] = max(far, 0.0)
+                    sh_contrib[ns_out, 0] = br * fr * lr * w
+                    sh_contrib[ns_out, 1] = bg * fg * lg * w
+                    sh_contrib[ns_out, 2] = bb * fb * lb * w
+                    ns_out += 1
         # 3. continue by BSDF sampling
         if not (ad or ag or at):
             continue
@@ -235,6 +251,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
             continue
         beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
         counts[p, skind] += 1
+        ray_bits[p] = DIFFUSE_BIT << skind     # diffuse, glossy, transmission: 2, 4, 8
         nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
         nx_path[nn_out] = p
         nx_org[nn_out, 0], nx_org[nn_out, 1], nx_org[nn_out, 2] = nox, noy, noz
