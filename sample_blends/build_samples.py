@@ -667,8 +667,61 @@ def ray_visibility():
     return scene
 
 
+def _defaults(scene):
+    """Blender's defaults (Filter Glossy 1, caustics on, clamps), DRT 512 and Cycles
+    1024 samples without adaptive sampling."""
+    render_defaults(scene, size=COMPARISON_SIZE, samples=512)
+    scene.cycles.samples = 1024
+    scene.cycles.use_adaptive_sampling = False
+
+
+def mirror_caustic():
+    """Blender's defaults: a small area lamp lights a tilted metal plate (roughness 0.1,
+    Multiscatter GGX) that throws its reflection onto a diffuse floor and wall (a
+    reflective caustic, which Filter Glossy blurs); the camera sees the plate too."""
+    scene = reset()
+    _defaults(scene)
+    grey = principled("Grey", (0.7, 0.7, 0.7), specular=0.0)
+    quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], grey)
+    quad("Wall", [(-3, 1.5, 0), (3, 1.5, 0), (3, 1.5, 3), (-3, 1.5, 3)], grey)
+    metal = principled("Metal", (0.95, 0.95, 0.95), roughness=0.1, metallic=1.0)
+    quad("Plate", [(-0.8, -0.2, 0.0), (0.8, -0.2, 0.0), (0.8, 0.6, 0.9), (-0.8, 0.6, 0.9)],
+         metal)
+    light = bpy.data.lights.new("Lamp", "AREA")
+    light.size, light.energy = 0.3, 60.0
+    obj = bpy.data.objects.new("Lamp", light)
+    obj.location = (0.0, -1.5, 2.5)
+    scene.collection.objects.link(obj)
+    _aim(obj, (0.0, 0.2, 0.4))
+    camera(scene, (0.0, -4.0, 2.2), (math.radians(70.0), 0.0, 0.0), lens=30.0)
+    return scene
+
+
+def glass_caustics():
+    """Blender's defaults: a clear (roughness 0) and a frosted (0.25) glass sphere, IOR
+    1.45, on a checker floor under a 2 m area lamp, black world: the caustics under the
+    spheres come from lamp light through glass."""
+    scene = reset()
+    _defaults(scene)
+    _checker("Floor", -4, 4, -4, 4, 0.0, [(0.8, 0.8, 0.8), (0.2, 0.2, 0.2)], 8)
+    for x, rough in ((-0.7, 0.0), (0.7, 0.25)):
+        mat = principled(f"Glass{rough}", (1.0, 1.0, 1.0), roughness=rough)
+        node = mat.node_tree.nodes["Principled BSDF"]
+        node.inputs["Transmission Weight"].default_value = 1.0
+        node.inputs["IOR"].default_value = 1.45
+        uv_sphere(f"Sphere{rough}", (x, 0.0, 0.6), 0.6, mat)
+    light = bpy.data.lights.new("Lamp", "AREA")
+    light.size, light.energy = 2.0, 500.0
+    obj = bpy.data.objects.new("Lamp", light)
+    obj.location = (0.0, 0.0, 4.0)
+    scene.collection.objects.link(obj)
+    camera(scene, (0.0, -4.5, 3.0), (math.radians(58.0), 0.0, 0.0), lens=40.0)
+    return scene
+
+
 COMPARISON_SCENES = {f.__name__: f for f in (
-    metals, glossy_dielectric, glass, dof, instances, world_light, ray_visibility)}
+    metals, glossy_dielectric, glass, dof, instances, world_light, ray_visibility,
+    mirror_caustic, glass_caustics)}
 SCENES.update(COMPARISON_SCENES)
 
 

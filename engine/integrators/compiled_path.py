@@ -55,7 +55,9 @@ class CompiledPathIntegrator:
         self.cfg = np.array([ctx.sampler.kind, ctx.sampler.samples_per_pixel, s.max_bounces,
                              s.diffuse_bounces, s.glossy_bounces, s.transmission_bounces,
                              s.clamp_direct, s.clamp_indirect, MIS, ctx.scene_radius,
-                             float(ctx.scene.film_transparent)], dtype=np.float64)
+                             float(ctx.scene.film_transparent), s.filter_glossy,
+                             float(s.caustics_reflective), float(s.caustics_refractive)],
+                            dtype=np.float64)
         self.geometry = (surf.v0, surf.v1, surf.v2, surf.normal, surf.tri_scale, surf.material,
                          _or_empty(surf.corner_normals, (0, 3, 3), np.float32),
                          _or_empty(surf.holdout, 0, bool),
@@ -148,6 +150,7 @@ class CompiledPathIntegrator:
         counts = np.zeros((n, 3), dtype=np.int64)
         used = np.zeros(n, dtype=np.int64)         # transparent bounces per path
         ray_bits = np.full(n, visibility.CAMERA, dtype=np.int64)   # each path's ray kind
+        min_pdf = np.full(n, np.inf)               # smallest BSDF pdf so far per path
         prev_pdf = np.full(n, np.inf)              # camera rays count as specular: weight 1
         prev_pos = np.ascontiguousarray(origins, dtype=np.float64).copy()
         live = np.arange(n, dtype=np.int64)
@@ -170,7 +173,7 @@ class CompiledPathIntegrator:
                     depth, (pkey, index), live, used, ray_bits, o, d, tm, hits)
                 beta[live] *= factor
             ns, nn = shade(depth, self.cfg, pkey, index, beta, counts, L, coverage,
-                           prev_pdf, prev_pos, ray_bits, live, o, d, tm, t, prim, u, v, stopped,
+                           prev_pdf, prev_pos, ray_bits, min_pdf, live, o, d, tm, t, prim, u, v, stopped,
                            self.geometry, self.params, self.emission, self.textures,
                            self.tables, self.lights, self.world,
                            sh_path, sh_org, sh_dir, sh_far, sh_contrib,

@@ -92,21 +92,47 @@ def uncovered(br, bg, bb):
 
 
 @kernel
+def prepare_closures(cfg, row, min_pdf, ray_bit):
+    """Cycles' two changes to a hit's BSDF that depend on the path so far (its
+    surface_shader_prepare_closures), applied to the material row before setup:
+
+    Filter Glossy (cfg[11], Cycles' `blur_glossy`; 0 = off): after bounces that were
+    unlikely (the smallest BSDF pdf along the path, min_pdf, below blur_glossy), every
+    microfacet lobe is widened to at least GGX alpha = 0.5 sqrt(1 - min_pdf /
+    blur_glossy). A bias that trades sharp caustics and fireflies for blur.
+
+    Caustics (cfg[12] reflective, cfg[13] refractive; 1 = on): with one off, a hit of a
+    ray that left a diffuse bounce has no glossy reflection (resp. refraction) lobes.
+
+    Returns (keep glossy lobes, keep transmission lobes)."""
+    blur = cfg[11]
+    if blur > 0.0 and min_pdf < _INF:
+        blur_pdf = min_pdf / blur
+        if blur_pdf < 1.0:
+            alpha = 0.5 * math.sqrt(1.0 - blur_pdf)
+            row[P_ROUGHNESS] = max(row[P_ROUGHNESS], math.sqrt(alpha))   # alpha = r^2
+    after_diffuse = ray_bit == DIFFUSE_BIT
+    return (cfg[12] != 0.0 or not after_diffuse), (cfg[13] != 0.0 or not after_diffuse)
+
+
+@kernel
 def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, ray_bits,
-          live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
+          min_pdf, live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
           geometry, params, emission, textures, tables, lights, world,
           sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
 
     cfg: float64 [sampler kind, spp, max_bounces, diffuse, glossy, transmission limits,
-    clamp_direct, clamp_indirect, mis mode, scene radius, film transparent].
+    clamp_direct, clamp_indirect, mis mode, scene radius, film transparent, filter glossy,
+    reflective caustics, refractive caustics] (see `prepare_closures`).
     geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout,
     corner_uvs) of the static triangles (the last three may be empty). alpha: each
     path's film coverage, or empty when the film is opaque. stopped: rays that ended at
     the transparent bounce limit. ray_bits: the kind of each path's current ray
     (engine.visibility: CAMERA, then the bit of the lobe it left by), which decides the
     lamps it sees; next-event estimation evaluates only the lobes the light is seen by
-    and skips the shadow ray of a light that casts no shadow. Writes the shadow rays to sh_* (their contributions
+    and skips the shadow ray of a light that casts no shadow. min_pdf: the smallest
+    BSDF pdf along each path so far (Filter Glossy, `prepare_closures`). Writes the shadow rays to sh_* (their contributions
     before the clamp, which `add_transmitted` applies) and the continuing paths' next
     rays to nx_*; returns (shadow count, next count). beta, counts, L, alpha, prev_pdf,
     prev_pos are per-path state, updated in place."""
@@ -118,7 +144,10 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     max_bounces = int(cfg[2])
     clamp_direct, clamp_indirect, mode = cfg[6], cfg[7], int(cfg[8])
     scene_radius = cfg[9]
-    clamp_hit = clamp_indirect if depth > 0 else 0.0   # what the camera sees: unclamped
+    # Emission found by this bounce's rays is lit by bounce depth - 1 (Cycles' count): a
+    # lamp hit from the first surface is direct light, as its next-event estimate is;
+    # what the camera sees directly is never clamped.
+    clamp_hit = 0.0 if depth == 0 else (clamp_direct if depth == 1 else clamp_indirect)
     n_lights = lt.n_entries(lights)
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
@@ -179,11 +208,12 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         row[:] = params[m]
         if any_textures:
             apply_to_row(textures, m, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
+        keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
         room = depth < max_bounces
         ad = room and counts[p, 0] < cfg[3]
-        ag = room and counts[p, 1] < cfg[4]
-        at = room and counts[p, 2] < cfg[5]
+        ag = room and counts[p, 1] < cfg[4] and keep_g
+        at = room and counts[p, 2] < cfg[5] and keep_t
         # 2. next-event estimation: one light entry, one point, one shadow ray
         if n_lights > 0:
             u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK)
@@ -192,8 +222,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 lights, px, py, pz, u_pick, u1, u2)
             lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
             seen = lt.entry_visibility(lights, k)
-            see_d, see_g, see_t = (seen & DIFFUSE_BIT) != 0, (seen & GLOSSY_BIT) != 0, \
-                (seen & TRANSMISSION_BIT) != 0
+            see_d = (seen & DIFFUSE_BIT) != 0
+            see_g = (seen & GLOSSY_BIT) != 0 and keep_g
+            see_t = (seen & TRANSMISSION_BIT) != 0 and keep_t
             fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, see_d, see_g, see_t)
             front_side = dot(wx, wy, wz, gx, gy, gz) > 0.0
             if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0
@@ -252,6 +283,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
         counts[p, skind] += 1
         ray_bits[p] = DIFFUSE_BIT << skind     # diffuse, glossy, transmission: 2, 4, 8
+        if not sdelta:
+            min_pdf[p] = min(min_pdf[p], spdf)
         nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
         nx_path[nn_out] = p
         nx_org[nn_out, 0], nx_org[nn_out, 1], nx_org[nn_out, 2] = nox, noy, noz
