@@ -5,12 +5,13 @@ query, one of these kernels, the next query for the rays that go on.
 
 `materials` is the tuple (material of each triangle, maybe_transparent per material,
 alpha per material, transparent colour per material (M, 3), textures T); `geometry` the
-tuple `path_vertex.shade` takes, plus corner UVs."""
+tuple `path_vertex.shade` takes. Hits on moving objects are placed at the time of the
+ray's path (`path_time` per path, `ray_time` per shadow ray)."""
 from __future__ import annotations
 
 from ..sampling.dispatch import sample_1d
 from .jit import kernel
-from .surface import hit_uv, offset_origin, rebuild
+from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import alpha_at
 
 TRANSPARENT_DIM = 1 << 24      # the pass-through numbers' own dimensions (see path.py)
@@ -22,19 +23,19 @@ def alpha_dim(depth, layer):
 
 
 @kernel
-def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz):
-    v0, v1, v2, normal, tri_scale, tri_material, corner_normals, holdout, corner_uvs = geometry
+def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz, time):
+    tri_material, corner_uvs = geometry[5], geometry[8]
     _, _, alpha_table, _, T = materials
-    px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild(
-        v0, v1, v2, normal, tri_scale, corner_normals, prim, u, v, dx, dy, dz)
+    px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild_at_time(
+        geometry, prim, u, v, dx, dy, dz, time)
     uu, vv = hit_uv(corner_uvs, prim, u, v)
     m = tri_material[prim]
     return alpha_at(T, alpha_table, m, uu, vv), m, px, py, pz, gx, gy, gz, scale
 
 
 @kernel
-def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, rows, rd, tmax,
-               cur_t, cur_prim, cur_u, cur_v, travelled, factor, stopped,
+def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, path_time, rows,
+               rd, tmax, cur_t, cur_prim, cur_u, cur_v, travelled, factor, stopped,
                geometry, materials, out_rows, out_org, out_far):
     """One transparent layer for the camera or bounce rays `rows` (indices into the
     wavefront `live`) whose current closest hits are cur_*: each ray whose hit surface
@@ -50,9 +51,9 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, rows, rd
         if prim < 0 or not maybe_transparent[tri_material[prim]]:
             continue
         dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
-        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim,
-                                                         cur_u[i], cur_v[i], dx, dy, dz)
         p = live[r]
+        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim, cur_u[i],
+                                                         cur_v[i], dx, dy, dz, path_time[p])
         if not sample_1d(kind, pkey[p], spp, index[p], alpha_dim(depth, layer)) >= a:
             continue
         if used[p] >= limit:
@@ -72,8 +73,8 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, rows, rd
 
 
 @kernel
-def shadow_pass(layer, limit, rows, sd, remaining, cur_t, cur_prim, cur_u, cur_v, trans,
-                geometry, materials, out_rows, out_org, out_far):
+def shadow_pass(layer, limit, rows, sd, ray_time, remaining, cur_t, cur_prim, cur_u, cur_v,
+                trans, geometry, materials, out_rows, out_org, out_far):
     """One layer of transparent shadows for the shadow rays `rows`: an opaque surface (or
     one past `limit` transparent layers) blocks; a transparent one multiplies the
     transmittance by (1 - alpha) x its transparent colour and the ray goes on."""
@@ -88,8 +89,8 @@ def shadow_pass(layer, limit, rows, sd, remaining, cur_t, cur_prim, cur_u, cur_v
             trans[r, 0] = trans[r, 1] = trans[r, 2] = 0.0
             continue
         dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
-        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim,
-                                                         cur_u[i], cur_v[i], dx, dy, dz)
+        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim, cur_u[i],
+                                                         cur_v[i], dx, dy, dz, ray_time[r])
         trans[r, 0] *= (1.0 - a) * tcolor[m, 0]
         trans[r, 1] *= (1.0 - a) * tcolor[m, 1]
         trans[r, 2] *= (1.0 - a) * tcolor[m, 2]
