@@ -145,7 +145,8 @@ def _moving_scene(turn=np.radians(150.0)):
     c = np.array([0.5, -0.3, 0.9])
     grow = np.eye(4)
     grow[:3, 3] = c
-    spheres["s1"].motion = RigidMotion([0.0, 1.0], [np.eye(4), grow @ stretch @ np.linalg.inv(grow)])
+    spheres["s1"].motion = RigidMotion([0.0, 1.0],
+                                       [np.eye(4), grow @ stretch @ np.linalg.inv(grow)])
     wobble = spheres["s2"]
     end = wobble.positions + np.random.default_rng(7).normal(0, 0.03, wobble.positions.shape)
     wobble.motion = DeformMotion([0.0, 1.0], np.stack([wobble.positions, end + (0, 0.2, 0)]))
@@ -186,9 +187,11 @@ def test_motion_blur_through_transparency_and_textures():
     s.materials[0].base_color_texture = TextureInput(tex)
     tall = s.meshes[5]
     tall.material_indices[:] = 3
-    tall.motion = RigidMotion([0.0, 1.0], [np.eye(4), _turn_about((-0.3, 0.2, 0.6), (0, 0, 1), 2.0)])
+    tall.motion = RigidMotion([0.0, 1.0],
+                              [np.eye(4), _turn_about((-0.3, 0.2, 0.6), (0, 0, 1), 2.0)])
     short = s.meshes[6]
-    short.motion = RigidMotion([0.0, 1.0], [np.eye(4), _turn_about((0.4, -0.3, 0.3), (1, 1, 0), 1.0)])
+    short.motion = RigidMotion([0.0, 1.0],
+                               [np.eye(4), _turn_about((0.4, -0.3, 0.3), (1, 1, 0), 1.0)])
     for mesh in s.meshes:
         mesh.uvs = rng.uniform(0, 1, (len(mesh.triangles), 3, 2)).astype(np.float32)
     s.shutter = Shutter()

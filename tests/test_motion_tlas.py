@@ -53,16 +53,20 @@ def moving_scene(rng, count, scale=1.0, offset=0.0):
     sphere, above KERNEL_TRIANGLES: Embree), the rest 12-triangle boxes (kernel); 1 in 4
     deforming (4 time slices), the rest rigid."""
     s = scale
-    meshes = [quad(np.array([0.0, 0.0, -2.0]) * s + offset, (5 * s, 0, 0), (0, 5 * s, 0), "floor"),
-              box(np.array([-1.0, -1.0, -1.0]) * s + offset, np.array([-0.6, 1.0, 0.0]) * s + offset),
-              box(np.array([0.5, -0.3, 0.0]) * s + offset, np.array([0.9, 0.3, 2.0]) * s + offset)]
+
+    def at(*p):
+        return np.array(p) * s + offset
+
+    meshes = [quad(at(0.0, 0.0, -2.0), (5 * s, 0, 0), (0, 5 * s, 0), "floor"),
+              box(at(-1.0, -1.0, -1.0), at(-0.6, 1.0, 0.0)), box(at(0.5, -0.3, 0.0), at(0.9, 0.3, 2.0))]
     for i in range(count):
         centre = rng.uniform(-2.0, 2.0, 3) * s + offset
         if rng.random() < 0.3:
             mesh = uv_sphere((0, 0, 0), 0.3 * s, 12, 24, f"big{i}")
             assert len(mesh.triangles) > KERNEL_TRIANGLES
         else:
-            mesh = box(np.array([-0.2, -0.1, -0.15]) * s, np.array([0.2, 0.1, 0.15]) * s, f"small{i}")
+            mesh = box(np.array([-0.2, -0.1, -0.15]) * s, np.array([0.2, 0.1, 0.15]) * s,
+                       f"small{i}")
         if rng.random() < 0.25:
             start = mesh.positions + centre
             end = start + rng.normal(0.0, 0.3 * s, start.shape)
