@@ -25,7 +25,7 @@ from .bsdf import principled as bsdf
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from .bsdf.params import P_BASE, P_METALLIC, P_ROUGHNESS
-from .surface import hit_uv, offset_origin, rebuild
+from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import apply_to_row, emission_at
 
 MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
@@ -117,7 +117,7 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
 
 @kernel
 def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, ray_bits,
-          min_pdf, live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
+          min_pdf, path_time, live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
           geometry, params, emission, textures, tables, lights, world,
           sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
@@ -126,18 +126,19 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     clamp_direct, clamp_indirect, mis mode, scene radius, film transparent, filter glossy,
     reflective caustics, refractive caustics] (see `prepare_closures`).
     geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout,
-    corner_uvs) of the static triangles (the last three may be empty). alpha: each
-    path's film coverage, or empty when the film is opaque. stopped: rays that ended at
-    the transparent bounce limit. ray_bits: the kind of each path's current ray
-    (engine.visibility: CAMERA, then the bit of the lobe it left by), which decides the
-    lamps it sees; next-event estimation evaluates only the lobes the light is seen by
-    and skips the shadow ray of a light that casts no shadow. min_pdf: the smallest
-    BSDF pdf along each path so far (Filter Glossy, `prepare_closures`). Writes the shadow rays to sh_* (their contributions
-    before the clamp, which `add_transmitted` applies) and the continuing paths' next
+    corner_uvs, moving objects) of every triangle (corner normals, holdout and UVs may be
+    empty; see `surface.rebuild_at_time`). path_time: each path's shutter time (its
+    moving triangles are placed at that time). alpha: each path's film coverage, or
+    empty when the film is opaque. stopped: rays that ended at the transparent bounce
+    limit. ray_bits: the kind of each path's current ray (engine.visibility: CAMERA,
+    then the bit of the lobe it left by), which decides the lamps it sees; next-event
+    estimation evaluates only the lobes the light is seen by and skips the shadow ray
+    of a light that casts no shadow. min_pdf: the smallest BSDF pdf along each path so
+    far (Filter Glossy, `prepare_closures`). Writes the shadow rays to sh_* (their
+    contributions before the clamp, which `add_transmitted` applies) and the continuing paths' next
     rays to nx_*; returns (shadow count, next count). beta, counts, L, alpha, prev_pdf,
     prev_pos are per-path state, updated in place."""
-    (v0, v1, v2, normal, tri_scale, tri_material, corner_normals, holdout,
-     corner_uvs) = geometry
+    tri_material, holdout, corner_uvs = geometry[5], geometry[7], geometry[8]
     any_textures = textures[1].shape[0] > 0
     film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
     kind, spp = int(cfg[0]), int(cfg[1])
@@ -192,9 +193,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             if alpha.shape[0] > 0:        # Cycles' holdout: a hole, for camera rays only
                 alpha[p] = uncovered(br, bg, bb)
             continue
-        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild(
-            v0, v1, v2, normal, tri_scale, corner_normals, prim, hit_u[j], hit_v[j],
-            dx, dy, dz)
+        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
+            geometry, prim, hit_u[j], hit_v[j], dx, dy, dz, path_time[p])
         m = tri_material[prim]
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
