@@ -234,11 +234,14 @@ def main():
         "|---|---|---|---|---|---|---|---|---|",
         *rows,
         "",
-        "What the blur costs: a rigidly moving object adds one Embree scene and, on every "
-        "ray that queries it, an interpolated transform computed in NumPy (the ray is moved "
-        "into object space at its own time); a deforming object adds one Embree scene per "
-        "time slice, and each ray queries only its slice. A static scene (motion blur off, "
-        "or nothing moving) builds one Embree scene and samples no time.",
+        "What the blur costs: a rigidly moving object adds one Embree scene, a deforming "
+        "object one per time slice. A ray does not query every moving object: a hierarchy "
+        "over their swept bounds (valid at every time of the shutter) lists the objects "
+        "whose bounds it crosses before its nearest hit, in compiled code; small objects "
+        "(at most 256 triangles) are intersected there too, larger ones by their Embree "
+        "scene, the ray moved into object space at its own time (a deforming object: its "
+        "slice). A static scene (motion blur off, or nothing moving) builds one Embree "
+        "scene and samples no time.",
         "",
         "## DRT against Cycles",
         "",

@@ -46,8 +46,14 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
                          default=0, min=0, max=256)
 
     def to_engine_settings(self):
+        """The engine's settings: DRT's own, and the file's Cycles settings DRT shares
+        with Cycles (Filter Glossy, caustics; Blender's defaults without Cycles)."""
         from .engine_link import engine
+        cycles = getattr(self.id_data, "cycles", None)
         return engine.RenderSettings(
+            filter_glossy=float(getattr(cycles, "blur_glossy", 1.0)),
+            caustics_reflective=bool(getattr(cycles, "caustics_reflective", True)),
+            caustics_refractive=bool(getattr(cycles, "caustics_refractive", True)),
             samples=self.samples, seed=self.seed, sampler=self.sampler,
             integrator=self.integrator, max_bounces=self.max_bounces,
             diffuse_bounces=self.diffuse_bounces, glossy_bounces=self.glossy_bounces,

@@ -7,6 +7,7 @@ from .render import RenderContext, RenderStats, render
 from .scene import (AreaLight, Camera, Material, PointLight, Scene, SunLight, TriangleMesh,
                     World)
 from .settings import RenderSettings
+from . import visibility  # noqa: E402  (the Ray Visibility bits, for exporters)
 
 __all__ = ["AreaLight", "Camera", "Film", "Material", "PointLight", "RenderContext",
            "RenderSettings", "RenderStats", "Scene", "SunLight", "TriangleMesh", "World",

@@ -14,6 +14,20 @@ here from plain scenes:
   slice its time falls in (see `engine.motion.DeformMotion` for what that costs).
 The nearest hit across all of them wins. Triangles get global ids in that order.
 
+Many moving objects: a ray does not visit every moving object. A top-level hierarchy
+over the moving objects' swept world bounds (`engine.kernels.motion_tlas`: the bounds
+hold at every time of the shutter, rotation included) is walked by one compiled call per
+batch (`engine.kernels.motion_trace`), which intersects small objects (at most
+KERNEL_TRIANGLES triangles) on the spot in float64 and lists the (ray, object) pairs of
+the large ones, whose bounds the ray crosses before its nearest hit so far; only those
+pairs go to Embree, grouped by object, each ray moved into object space at its own time
+(`engine.kernels.motion_pairs`). `Accelerator(..., motion_tlas=False)` visits every
+moving object with every ray instead: the reference the hierarchy must equal; with
+kernel_triangles=0 as well, every moving object goes through Embree.
+
+All Embree scenes share one Embree device: one device per scene crashes Embree past
+about a thousand scenes.
+
 Precision: Embree takes float32. Triangles are uploaded once in float32; ray origins and
 directions are rounded per query. Hit points are NOT taken from the float32 distance but
 rebuilt in float64 from the hit's barycentrics (`engine.surface`).
@@ -27,18 +41,40 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .motion import DeformMotion, RigidMotion, inverse3
+from .kernels.motion import pack_motion
+from .kernels.motion_pairs import group_pairs, merge_blocked, merge_hits
+from .kernels.motion_tlas import MotionTLAS, build_tlas
+from .kernels.motion_trace import trace_moving
+from .motion import DeformMotion, RigidMotion
 from .scene import TriangleMesh
 
 MISS = -1
+# Moving objects of at most this many triangles are intersected inside the compiled
+# traversal (float64, no Embree call); larger ones by their own Embree scene.
+KERNEL_TRIANGLES = 256
 _BIG = np.float32(1e30)
+_NO_F64, _NO_I64, _NO_BOOL = np.zeros(0), np.zeros(0, np.int64), np.zeros(0, bool)
 _MIN_SPLIT = 4096      # below this many rays, one thread is faster than two
+
+
+_DEVICE = None
+_DEVICE_LOCK = threading.Lock()
+
+
+def _embree_device():
+    """The process's one Embree device (created on first use)."""
+    global _DEVICE
+    with _DEVICE_LOCK:
+        if _DEVICE is None:
+            from embreex import rtcore
+            _DEVICE = rtcore.EmbreeDevice()
+        return _DEVICE
 
 
 def _embree_scene(positions: np.ndarray, triangles: np.ndarray):
     from embreex import rtcore_scene
     from embreex.mesh_construction import TriangleMesh as EmbreeMesh
-    scene = rtcore_scene.EmbreeScene()
+    scene = rtcore_scene.EmbreeScene(_embree_device())
     EmbreeMesh(scene, np.ascontiguousarray(positions, dtype=np.float32),
                np.ascontiguousarray(triangles, dtype=np.int32))
     return scene
@@ -90,7 +126,8 @@ def _static_world_positions(mesh: TriangleMesh) -> np.ndarray:
 class Accelerator:
     """All triangles of a scene: static ones in one Embree scene, moving ones apart."""
 
-    def __init__(self, meshes: list[TriangleMesh], threads: int = 0, time_enabled: bool = False):
+    def __init__(self, meshes: list[TriangleMesh], threads: int = 0, time_enabled: bool = False,
+                 motion_tlas: bool = True, kernel_triangles: int = KERNEL_TRIANGLES):
         for m in meshes:
             if not np.all(np.isfinite(m.positions)):
                 raise ValueError(f"mesh {m.name!r} has non-finite (NaN or Inf) vertex positions")
@@ -124,9 +161,35 @@ class Accelerator:
         # receives (query, origins, dirs, tmax) of every static-scene batch, so that a
         # benchmark can replay exactly the same rays through bare Embree.
         self.rays_traced = {"INTERSECT": 0, "OCCLUDED": 0}
+        # (ray, moving object unit) pairs examined: intersected in the kernel or listed
+        # for Embree (all threads).
+        self.pairs_visited = 0
         self.recorder = None
         self._count_lock = threading.Lock()
         self.scene_count = (self._scene is not None) + sum(len(o.scenes) for o in self.moving)
+        # Moving objects packed for the kernels (engine.kernels.motion), and the
+        # top-level hierarchy over them (motion_tlas=False: brute force, the reference).
+        self.motion = pack_motion(self)
+        self.motion_tlas = motion_tlas
+        self.kernel_triangles = kernel_triangles
+        self.tlas: MotionTLAS | None = None
+        if self.moving:
+            self.build_tlas()
+
+    def build_tlas(self, swept: bool = True):
+        """(Re)build the hierarchy over the moving objects. swept=False is a negative
+        control for tests: rigid bounds at the motion steps only, which misses hits."""
+        n = len(self.moving)
+        lo, hi = np.zeros((n, 3)), np.zeros((n, 3))
+        for i, obj in enumerate(self.moving):
+            if obj.rigid and len(obj.mesh.positions):
+                lo[i] = obj.mesh.positions.min(axis=0)
+                hi[i] = obj.mesh.positions.max(axis=0)
+        self.tlas = build_tlas(self.motion, lo, hi, swept=swept,
+                               kernel_triangles=self.kernel_triangles)
+        self._unit_scene = [self.moving[o].scenes[s]
+                            for o, s in zip(self.tlas.unit_obj, self.tlas.unit_slice)]
+        self._embree_units = bool((self.tlas.unit_root < 0).any())
 
     def close(self):
         if self._pool is not None:
@@ -143,6 +206,11 @@ class Accelerator:
             self.rays_traced[query] += n
             if self.recorder is not None and scene is self._scene:
                 self.recorder.append((query, o, d, dist))
+        return self._run32(scene, o, d, dist, query, output)
+
+    def _run32(self, scene, o, d, dist, query, output):
+        """Embree on float32 contiguous rays, split over the pool for large batches."""
+        n = len(o)
         if self._pool is None or n < _MIN_SPLIT:
             return [scene.run(o, d, dists=dist, query=query, output=output)]
         bounds = np.linspace(0, n, self.threads + 1).astype(int)
@@ -159,21 +227,51 @@ class Accelerator:
         return t, prim, u, v
 
     # -- motion ------------------------------------------------------------------------
-    @staticmethod
-    def to_object_space(obj: MovingObject, origins, dirs, time):
-        """Rays moved into a rigid object's space at each ray's own time."""
-        m = obj.mesh.motion.at(time)
-        inv = inverse3(m[:, :3, :3])
-        o = np.einsum("nij,nj->ni", inv, origins - m[:, :3, 3])
-        d = np.einsum("nij,nj->ni", inv, dirs)
-        return o, d
-
-    def _moving_groups(self, obj: MovingObject, time):
-        """(scene, row indices) pairs: one for a rigid object, one per time slice else."""
-        if obj.rigid:
-            return [(obj.scenes[0], None)]
-        sl = obj.mesh.motion.slice_of(time)
-        return [(scene, np.nonzero(sl == s)[0]) for s, scene in enumerate(obj.scenes)]
+    def _trace_moving(self, origins, dirs, time, best, t, prim, u, v, blocked, occlusion):
+        """The moving objects against the rays (see the module docstring): the kernel
+        objects inside `trace_moving`, then the Embree objects' (ray, object) pairs it
+        lists, grouped by object. Updates (t, prim, u, v, best) or blocked in place."""
+        n = len(origins)
+        o = np.ascontiguousarray(origins, np.float64)
+        d = np.ascontiguousarray(dirs, np.float64)
+        tm = np.ascontiguousarray(np.broadcast_to(time, (n,)), np.float64)
+        hit_unit = np.full(n, -1, np.int64)
+        cap = 2 * n + 256 if self._embree_units else 0
+        while True:
+            pr, pu = np.empty(cap, np.int64), np.empty(cap, np.int64)
+            visits = np.zeros(1, np.int64)
+            count = trace_moving(self.tlas, self.motion, o, d, tm, best, t, prim, u, v,
+                                 hit_unit, blocked, occlusion, self.motion_tlas, pr, pu,
+                                 visits)
+            if count <= cap:
+                break
+            cap = count
+        with self._count_lock:
+            self.pairs_visited += int(visits[0])
+        if count == 0:
+            return
+        s_ray, s_unit = np.empty(count, np.int64), np.empty(count, np.int64)
+        o32, d32 = np.empty((count, 3), np.float32), np.empty((count, 3), np.float32)
+        f32 = np.empty(count, np.float32)
+        unit_start = np.empty(len(self._unit_scene) + 1, np.int64)
+        group_pairs(self.motion, self.tlas, pr, pu, count, o, d, best, tm,
+                    s_ray, s_unit, o32, d32, f32, unit_start)
+        query = "OCCLUDED" if occlusion else "INTERSECT"
+        parts = []
+        for k in np.flatnonzero(unit_start[1:] > unit_start[:-1]):
+            a, b = unit_start[k], unit_start[k + 1]
+            parts += self._run32(self._unit_scene[k], o32[a:b], d32[a:b], f32[a:b], query,
+                                 None if occlusion else 1)
+        with self._count_lock:
+            self.rays_traced[query] += count
+        if occlusion:
+            merge_blocked(s_ray, np.concatenate(parts).astype(np.int64), blocked)
+        else:
+            merge_hits(self.motion, self.tlas, s_ray, s_unit,
+                       np.concatenate([p["primID"] for p in parts]),
+                       np.concatenate([p["tfar"] for p in parts]),
+                       np.concatenate([p["u"] for p in parts]),
+                       np.concatenate([p["v"] for p in parts]), t, prim, u, v, best, hit_unit)
 
     # -- public queries ----------------------------------------------------------------
     def intersect(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
@@ -190,21 +288,10 @@ class Accelerator:
         if self.moving:
             if time is None:
                 raise ValueError("a scene with moving objects needs a time per ray")
-            best = np.minimum(t, tmax)
-            for obj in self.moving:
-                for scene, rows in self._moving_groups(obj, time):
-                    if rows is not None and rows.size == 0:
-                        continue
-                    sel = slice(None) if rows is None else rows
-                    o, d = origins[sel], dirs[sel]
-                    if obj.rigid:
-                        o, d = self.to_object_space(obj, o, d, time[sel])
-                    tt, pp, uu, vv = self._intersect_scene(scene, o, d, best[sel])
-                    closer = (pp >= 0) & (tt < best[sel])
-                    idx = np.arange(n)[sel][closer]
-                    t[idx], prim[idx] = tt[closer], pp[closer] + obj.prim_offset
-                    u[idx], v[idx] = uu[closer], vv[closer]
-                    best[idx] = tt[closer]
+            best = np.array(np.broadcast_to(np.minimum(t, tmax), (n,)), np.float64)
+            t, prim = np.array(t, np.float64), np.array(prim, np.int64)
+            u, v = np.array(u, np.float64), np.array(v, np.float64)
+            self._trace_moving(origins, dirs, time, best, t, prim, u, v, _NO_BOOL, False)
         return Hits(t, prim, u, v)
 
     def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
@@ -220,15 +307,8 @@ class Accelerator:
         if self.moving:
             if time is None:
                 raise ValueError("a scene with moving objects needs a time per ray")
-            for obj in self.moving:
-                for scene, rows in self._moving_groups(obj, time):
-                    open_rows = np.nonzero(~blocked)[0] if rows is None else rows[~blocked[rows]]
-                    if open_rows.size == 0:
-                        continue
-                    o, d = origins[open_rows], dirs[open_rows]
-                    if obj.rigid:
-                        o, d = self.to_object_space(obj, o, d, time[open_rows])
-                    hit = np.concatenate(self._run(scene, o, d, tmax[open_rows], "OCCLUDED",
-                                                   None)) != MISS
-                    blocked[open_rows[hit]] = True
+            blocked = np.array(blocked, bool)
+            far = np.array(np.broadcast_to(tmax, (n,)), np.float64)
+            self._trace_moving(origins, dirs, time, far, _NO_F64, _NO_I64, _NO_F64, _NO_F64,
+                               blocked, True)
         return blocked

@@ -45,6 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import visibility
 from .scene import AreaLight, PointLight, SunLight
 from .warp import concentric_disk, orthonormal_basis, uniform_sphere
 
@@ -120,6 +121,7 @@ class PointLightModel:
             self.delta = True                         # r so small r^2 underflows: a point
             self.disc = False
         self.visible = not self.delta
+        self.visibility = int(getattr(light, "visibility", visibility.ALL))
 
     def power(self, scene_radius):
         p = luminance(self.strength)
@@ -243,6 +245,7 @@ class SunLightModel:
         # Below ~1e-7 rad the disc is a delta (and sin^2 would lose the radiance's digits).
         self.delta = half < 1e-7 or not sin2_half > 0
         self.visible = not self.delta
+        self.visibility = int(getattr(light, "visibility", visibility.ALL))
         if not self.delta:
             self.cos_max = float(np.cos(half))
             self.radiance = self.irradiance / (np.pi * sin2_half)
@@ -403,6 +406,9 @@ class AreaLightModel:
         self.delta = False
         self.visible = True
         self.visible_camera = bool(light.visible_camera)
+        self.visibility = int(getattr(light, "visibility", visibility.ALL))
+        if not self.visible_camera:
+            self.visibility &= ~visibility.CAMERA
         # Inverse of [ax ay normal] maps world offsets to (s, t, z) with s,t in [-1, 1].
         self.inv = np.linalg.inv(np.stack([self.ax, self.ay, self.normal], axis=1))
         # Spherical rectangle frame (rectangles with perpendicular edges only).
@@ -482,6 +488,7 @@ class EnvironmentLightModel:
     delta = False
     visible = False
     visible_camera = False
+    visibility = 30            # engine.visibility.ALL but CAMERA (never hit as a surface)
     is_environment = True
 
     def __init__(self, radiance):
@@ -517,6 +524,7 @@ class TimeSlicedLight:
         first = self.slices[0]
         self.delta, self.visible = first.delta, first.visible
         self.visible_camera = getattr(first, "visible_camera", True)
+        self.visibility = first.visibility
         self.is_sun = isinstance(first, SunLightModel)
         self.k = len(self.slices)
 

@@ -105,6 +105,7 @@ class TriangleMesh:
     uvs: Optional[np.ndarray] = None
     motion: Optional[object] = None
     holdout: bool = False          # Cycles' holdout: a zero-alpha hole for camera rays
+    visibility: int = 31           # the ray kinds that see it (engine.visibility)
 
     def __post_init__(self):
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)
@@ -147,6 +148,7 @@ class PointLight:
     direction: tuple = (0.0, 0.0, -1.0)
     name: str = "point"
     soft_falloff: bool = False
+    visibility: int = 31           # the ray kinds that see it (engine.visibility)
     motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
 
 
@@ -158,6 +160,7 @@ class SunLight:
     strength: tuple
     angle: float = 0.0
     name: str = "sun"
+    visibility: int = 31           # the ray kinds that see it (engine.visibility)
     motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
 
 
@@ -176,6 +179,7 @@ class AreaLight:
     normalize: bool = True
     visible_camera: bool = True
     name: str = "area"
+    visibility: int = 31           # the ray kinds that see it (engine.visibility)
     motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
 
 

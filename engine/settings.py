@@ -21,6 +21,11 @@ class RenderSettings:
     transparent_bounces: int = 8
     clamp_direct: float = 0.0         # 0 = off, as in Cycles
     clamp_indirect: float = 10.0
+    # Cycles' Filter Glossy (`blur_glossy`, 0 = off) and caustics switches
+    # (engine.kernels.path_vertex.prepare_closures)
+    filter_glossy: float = 1.0
+    caustics_reflective: bool = True
+    caustics_refractive: bool = True
     # Film
     filter_type: str = "BLACKMAN_HARRIS"
     filter_width: float = 1.5
@@ -45,6 +50,9 @@ class RenderSettings:
             v = getattr(self, name)
             if not (v >= 0) or v == float("inf"):
                 problems.append(f"{name} must be a finite number >= 0 (0 = off), got {v!r}")
+        if not (0.0 <= self.filter_glossy < float("inf")):
+            problems.append(f"filter_glossy must be a finite number >= 0 (0 = off), got "
+                            f"{self.filter_glossy!r}")
         if not (0 < self.filter_width <= 100):
             problems.append(f"filter_width must be in (0, 100] pixels, got {self.filter_width!r}")
         if self.chunk_paths < 256:

@@ -62,6 +62,10 @@ class SurfaceBuilder:
         # Holdout triangles (None when the scene has none): camera rays end there.
         self.holdout = (np.concatenate([np.full(len(m.triangles), m.holdout) for m in ordered])
                         if any(m.holdout for m in ordered) else None)
+        # The ray kinds that see each triangle (engine.visibility); None when all see all.
+        self.visibility = (np.concatenate([np.full(len(m.triangles), m.visibility, np.uint8)
+                                           for m in ordered])
+                           if any(m.visibility != 31 for m in ordered) else None)
         self.corner_normals = None
         if any(m.corner_normals is not None for m in ordered):
             parts, offset = [], 0

@@ -621,8 +621,108 @@ def world_light():
     return scene
 
 
+def ray_visibility():
+    """Blender's defaults throughout (Filter Glossy 1, caustics on): a diffuse floor
+    with three objects under four lamps hidden from the camera although in view: a point
+    lamp (100 W, radius 0.05, Soft Falloff off), a spot, a sun and a disk lamp; the
+    sphere casts no shadow, the block is hidden from the camera (its shadow stays) and
+    the cylinder is invisible to diffuse rays (no light bounces off it)."""
+    scene = reset()
+    render_defaults(scene, size=COMPARISON_SIZE, samples=512)
+    scene.cycles.samples = 1024
+    scene.cycles.use_adaptive_sampling = False
+    _set_world(scene, (0.02, 0.02, 0.02))
+    floor = principled("Floor", (0.6, 0.6, 0.6), specular=0.0)
+    quad("Floor", [(-5, -5, 0), (5, -5, 0), (5, 5, 0), (-5, 5, 0)], floor)
+    orange = principled("Orange", (0.8, 0.35, 0.1), specular=0.0)
+    sphere = uv_sphere("Sphere", (-0.9, 0.3, 0.5), 0.5, orange)
+    sphere.visible_shadow = False
+    white = principled("White", (0.75, 0.75, 0.75), specular=0.0)
+    block = cuboid("Block", (0.3, 0.2, 0.0), (0.9, 0.8, 0.7), white, math.radians(20))
+    block.visible_camera = False
+    green = principled("Green", (0.15, 0.6, 0.15), specular=0.0)
+    post = cuboid("Post", (-0.2, 1.2, 0.0), (0.2, 1.6, 1.4), green)
+    post.visible_diffuse = False
+    lamps = []
+    point = bpy.data.lights.new("Point", "POINT")
+    point.energy, point.shadow_soft_size, point.use_soft_falloff = 100.0, 0.05, False
+    lamps.append((point, (0.2, -0.4, 0.6), None))
+    spot = bpy.data.lights.new("Spot", "SPOT")
+    spot.energy, spot.shadow_soft_size = 150.0, 0.1
+    spot.spot_size, spot.spot_blend = math.radians(50.0), 0.3
+    lamps.append((spot, (-1.5, -0.5, 2.0), (-0.9, 0.3, 0.0)))
+    sun = bpy.data.lights.new("Sun", "SUN")
+    sun.energy = 1.0
+    lamps.append((sun, (2.0, -1.0, 3.0), (0.0, 0.0, 0.0)))
+    disk = bpy.data.lights.new("Disk", "AREA")
+    disk.shape, disk.size, disk.energy = "DISK", 0.5, 40.0
+    lamps.append((disk, (1.3, -0.2, 1.1), (1.3, 0.4, 0.0)))
+    for light, location, target in lamps:
+        obj = bpy.data.objects.new(light.name, light)
+        obj.location = location
+        scene.collection.objects.link(obj)
+        obj.visible_camera = False
+        if target is not None:
+            _aim(obj, target)
+    camera(scene, (0.0, -4.0, 2.2), (math.radians(65.0), 0.0, 0.0), lens=32.0)
+    return scene
+
+
+def _defaults(scene):
+    """Blender's defaults (Filter Glossy 1, caustics on, clamps), DRT 512 and Cycles
+    1024 samples without adaptive sampling."""
+    render_defaults(scene, size=COMPARISON_SIZE, samples=512)
+    scene.cycles.samples = 1024
+    scene.cycles.use_adaptive_sampling = False
+
+
+def mirror_caustic():
+    """Blender's defaults: a small area lamp lights a tilted metal plate (roughness 0.1,
+    Multiscatter GGX) that throws its reflection onto a diffuse floor and wall (a
+    reflective caustic, which Filter Glossy blurs); the camera sees the plate too."""
+    scene = reset()
+    _defaults(scene)
+    grey = principled("Grey", (0.7, 0.7, 0.7), specular=0.0)
+    quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], grey)
+    quad("Wall", [(-3, 1.5, 0), (3, 1.5, 0), (3, 1.5, 3), (-3, 1.5, 3)], grey)
+    metal = principled("Metal", (0.95, 0.95, 0.95), roughness=0.1, metallic=1.0)
+    quad("Plate", [(-0.8, -0.2, 0.0), (0.8, -0.2, 0.0), (0.8, 0.6, 0.9), (-0.8, 0.6, 0.9)],
+         metal)
+    light = bpy.data.lights.new("Lamp", "AREA")
+    light.size, light.energy = 0.3, 60.0
+    obj = bpy.data.objects.new("Lamp", light)
+    obj.location = (0.0, -1.5, 2.5)
+    scene.collection.objects.link(obj)
+    _aim(obj, (0.0, 0.2, 0.4))
+    camera(scene, (0.0, -4.0, 2.2), (math.radians(70.0), 0.0, 0.0), lens=30.0)
+    return scene
+
+
+def glass_caustics():
+    """Blender's defaults: a clear (roughness 0) and a frosted (0.25) glass sphere, IOR
+    1.45, on a checker floor under a 2 m area lamp, black world: the caustics under the
+    spheres come from lamp light through glass."""
+    scene = reset()
+    _defaults(scene)
+    _checker("Floor", -4, 4, -4, 4, 0.0, [(0.8, 0.8, 0.8), (0.2, 0.2, 0.2)], 8)
+    for x, rough in ((-0.7, 0.0), (0.7, 0.25)):
+        mat = principled(f"Glass{rough}", (1.0, 1.0, 1.0), roughness=rough)
+        node = mat.node_tree.nodes["Principled BSDF"]
+        node.inputs["Transmission Weight"].default_value = 1.0
+        node.inputs["IOR"].default_value = 1.45
+        uv_sphere(f"Sphere{rough}", (x, 0.0, 0.6), 0.6, mat)
+    light = bpy.data.lights.new("Lamp", "AREA")
+    light.size, light.energy = 2.0, 500.0
+    obj = bpy.data.objects.new("Lamp", light)
+    obj.location = (0.0, 0.0, 4.0)
+    scene.collection.objects.link(obj)
+    camera(scene, (0.0, -4.5, 3.0), (math.radians(58.0), 0.0, 0.0), lens=40.0)
+    return scene
+
+
 COMPARISON_SCENES = {f.__name__: f for f in (
-    metals, glossy_dielectric, glass, dof, instances, world_light)}
+    metals, glossy_dielectric, glass, dof, instances, world_light, ray_visibility,
+    mirror_caustic, glass_caustics)}
 SCENES.update(COMPARISON_SCENES)
 
 

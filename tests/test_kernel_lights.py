@@ -34,7 +34,7 @@ import numpy as np
 import pytest
 
 from engine.kernels.lights import (environment_pdf, environment_radiance, hit_lamps,
-                                   lamp_pdf, lamp_visible_camera, mesh_pdf, n_entries,
+                                   lamp_pdf, entry_visibility, mesh_pdf, n_entries,
                                    n_suns, pack_lights, sample, sun_escaped)
 from engine.kernels.lights.batch import (hit_lamps_batch, lamp_pdf_batch, mesh_pdf_batch,
                                          sample_batch, sun_escaped_batch)
@@ -379,8 +379,10 @@ def test_hits_and_their_pdfs_match(name):
     assert name in ("point", "sun", "world", "triangles", "empty") or np.any(k >= 0), \
         "no ray hit a lamp: the test would show nothing"
     compare_pdf(L, ls, k, o3, d, t, "pdf of the lamps hit")
-    vis = [getattr(m, "visible_camera", True) for m in ls.models]
-    assert [lamp_visible_camera(L, j) for j in range(len(vis))] == vis
+    vis = [m.visibility for m in ls.models]
+    assert [entry_visibility(L, j) for j in range(len(vis))] == vis
+    assert all((v & 1 == 1) == getattr(m, "visible_camera", True)
+               for v, m in zip(vis, ls.models))
 
 
 @pytest.mark.parametrize("name", ["triangles", "all", "tiny", "area", "empty"])
@@ -441,7 +443,7 @@ def test_scalar_kernels_equal_batch_rows():
         assert one[1:4] == tuple(rows[1][i]) and one[5:8] == tuple(rows[3][i])
         assert (one[4], one[8], one[10]) == (rows[2][i], rows[4][i], rows[6][i])
         d = rows[1][i]
-        t, k, r, g, b = hit_lamps(L, *p[i], *d, np.inf)
+        t, k, r, g, b = hit_lamps(L, *p[i], *d, np.inf, 31)
         assert (t, k) == tuple(x[0] for x in hit_lamps_batch(L, p[i:i + 1], d[None],
                                                              np.array([np.inf]))[:2])
         assert lamp_pdf(L, k, *p[i], *d, t) == lamp_pdf_batch(
@@ -456,7 +458,7 @@ def test_empty_set():
     s, idx, dl = ls.sample(np.zeros((1, 3)), np.array([0.3]), np.array([[0.5, 0.5]]))
     assert k == idx[0] == -1 and pdf == s.pdf[0] == 0.0 and not delta
     assert (wx, wy, wz) == tuple(s.wi[0]) and (r, g, b) == (0.0, 0.0, 0.0)
-    assert hit_lamps(L, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 7.0) == (7.0, -1, 0.0, 0.0, 0.0)
+    assert hit_lamps(L, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 7.0, 31) == (7.0, -1, 0.0, 0.0, 0.0)
     assert environment_pdf(L) == 0.0 and environment_radiance(L) == (0.0, 0.0, 0.0)
     black = pack_lights(LightSet([], 1.0, world=(0.0, 0.0, 0.0)))   # a black world: no light
     assert n_entries(black) == 0 and environment_radiance(black) == (0.0, 0.0, 0.0)

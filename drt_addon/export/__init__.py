@@ -6,7 +6,7 @@ import time
 from ..engine_link import engine
 from .camera import RenderRegion, export_camera, render_region, window_camera
 from .errors import ExportError, Reporter
-from .lights import export_light
+from .lights import export_light, object_visibility
 from .materials import export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
 from .motion import MotionExport, read_settings
@@ -80,7 +80,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
             materials.append(export_material(mat, reporter))
         return material_index[key]
 
-    cache = MeshCache()
+    cache = MeshCache(reporter)
     meshes, lights = [], []
     holdouts = 0
     for k, inst in enumerate(depsgraph.object_instances):
@@ -97,6 +97,10 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
             name = f"{obj.name}#{k}" if inst.is_instance else obj.name
             meshes.append(instance_mesh(local, inst.matrix_world.copy(), slots, name))
             meshes[-1].holdout = holdout
+            # an instance is seen by the rays that see both it and its instancer (Cycles)
+            meshes[-1].visibility = object_visibility(obj) & (
+                object_visibility(inst.parent) if inst.is_instance and inst.parent is not None
+                else 31)
             if tracker is not None:
                 tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
         elif obj.type == "LIGHT":

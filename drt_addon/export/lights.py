@@ -47,6 +47,28 @@ def _scaled(strength, factor):
     return tuple(c * factor for c in strength)
 
 
+visibility = engine.visibility
+
+
+def object_visibility(obj) -> int:
+    """Object Properties > Visibility > Ray Visibility as an engine.visibility mask."""
+    return visibility.from_flags(
+        camera=bool(getattr(obj, "visible_camera", True)),
+        diffuse=bool(getattr(obj, "visible_diffuse", True)),
+        glossy=bool(getattr(obj, "visible_glossy", True)),
+        transmission=bool(getattr(obj, "visible_transmission", True)),
+        shadow=bool(getattr(obj, "visible_shadow", True)))
+
+
+def lamp_visibility(obj) -> int:
+    """A lamp's mask: its object's ray visibility, with SHADOW from the light's Cast
+    Shadow (`use_shadow`), as Cycles reads them."""
+    mask = object_visibility(obj) | visibility.SHADOW
+    if not getattr(obj.data, "use_shadow", True):
+        mask &= ~visibility.SHADOW
+    return mask
+
+
 def export_light(obj, matrix_world, reporter: Reporter):
     light = obj.data
     m = to_numpy(matrix_world)
@@ -56,15 +78,13 @@ def export_light(obj, matrix_world, reporter: Reporter):
         reporter.warn(f"DRT: light {obj.name!r} uses a shader node tree, which DRT ignores; "
                       "its colour and power are used as set on the light",
                       key=(obj.name, "nodes"))
-    if not getattr(light, "use_shadow", True):
-        reporter.warn(f"DRT: light {obj.name!r} has shadows off, which DRT does not model; "
-                      "it casts shadows", key=(obj.name, "shadow"))
+    vis = lamp_visibility(obj)
     if light.type in ("POINT", "SPOT"):
         radius = max(float(light.shadow_soft_size), 0.0)
         if not _normalize(light):
             strength = _scaled(strength, _point_area(radius))
         kwargs = dict(radius=radius, soft_falloff=bool(getattr(light, "use_soft_falloff", False)),
-                      name=obj.name)
+                      name=obj.name, visibility=vis)
         if light.type == "SPOT":
             sx, sy = np.linalg.norm(m[:3, 0]), np.linalg.norm(m[:3, 1])
             if abs(sx - sy) > 1e-4 * max(sx, sy):
@@ -78,8 +98,17 @@ def export_light(obj, matrix_world, reporter: Reporter):
         angle = float(light.angle)
         if not _normalize(light):
             strength = _scaled(strength, _sun_area(angle))
-        return engine.SunLight(tuple(direction), strength, angle=angle, name=obj.name)
+        return engine.SunLight(tuple(direction), strength, angle=angle, name=obj.name,
+                               visibility=vis)
     if light.type == "AREA":
+        sx = float(light.size)
+        sy = float(light.size_y) if light.shape in ("RECTANGLE", "ELLIPSE") else sx
+        scale = np.linalg.norm(m[:3, :2], axis=0)
+        if not (sx * scale[0] > 0.0 and sy * scale[1] > 0.0
+                and math.isfinite(sx * sy * scale[0] * scale[1])):
+            reporter.warn(f"DRT: area light {obj.name!r} has zero size; it is skipped, as "
+                          "Cycles does", key=(obj.name, "zero size"))
+            return None
         spread = float(getattr(light, "spread", math.pi))
         if spread < math.pi - 1e-6:
             reporter.warn(f"DRT: area light {obj.name!r} has a spread of "
@@ -87,7 +116,7 @@ def export_light(obj, matrix_world, reporter: Reporter):
                           "hemisphere (180 degrees)", key=(obj.name, "spread"))
         return engine.AreaLight(m, strength, shape=light.shape, size_x=float(light.size),
                                 size_y=float(light.size_y), normalize=_normalize(light),
-                                visible_camera=bool(getattr(obj, "visible_camera", True)),
-                                name=obj.name)
+                                visible_camera=bool(vis & visibility.CAMERA),
+                                name=obj.name, visibility=vis)
     reporter.warn(f"DRT: light {obj.name!r} of type {light.type} is not supported; skipped")
     return None

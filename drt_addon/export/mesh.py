@@ -28,6 +28,7 @@ class LocalMesh:
     normals: Optional[np.ndarray] = None   # (T, 3, 3) float32 split normals, None if all flat
     uvs: Optional[np.ndarray] = None       # (T, 3, 2) float32 corner UVs, None if not needed
     uv_request: Optional[str] = None       # the UV map asked for ('' = default), None = none
+    kept: Optional[np.ndarray] = None      # indices of the mesh's triangles kept (None: all)
 
 
 def mesh_arrays(mesh):
@@ -119,8 +120,9 @@ def _cache_key(obj):
 class MeshCache:
     """Object-space arrays per evaluated geometry, for the length of one export."""
 
-    def __init__(self):
+    def __init__(self, reporter=None):
         self._local = {}
+        self.reporter = reporter
         self.evaluations = 0      # to_mesh calls
         self.reuses = 0           # instances served from the cache
 
@@ -133,14 +135,47 @@ class MeshCache:
             if cached is None or want_uv is None or cached.uv_request == want_uv:
                 self.reuses += 1
                 return cached
-        local = _evaluate(obj, want_uv)
+        local = _evaluate(obj, want_uv, self.reporter)
         self.evaluations += 1
         if key is not None:
             self._local[key] = local
         return local
 
 
-def _evaluate(obj, want_uv: Optional[str] = None) -> Optional[LocalMesh]:
+def degenerate_triangles(pos: np.ndarray, tris: np.ndarray) -> np.ndarray:
+    """Triangles Cycles skips: a corner at a non-finite (NaN or infinite) position, or two
+    corners at the same position. Returns a boolean mask (T,)."""
+    finite = np.isfinite(pos).all(axis=1)
+    bad = ~finite[tris].all(axis=1)
+    a, b, c = pos[tris[:, 0]], pos[tris[:, 1]], pos[tris[:, 2]]
+    with np.errstate(invalid="ignore"):
+        bad |= (a == b).all(axis=1) | (b == c).all(axis=1) | (a == c).all(axis=1)
+    return bad
+
+
+def _drop_degenerate(obj, pos, tris, mat, normals, uvs, reporter):
+    """The mesh without its degenerate triangles (see `degenerate_triangles`), with one
+    warning per object; non-finite vertices left unused are moved onto a used one so
+    that every position is finite. Returns (pos, tris, mat, normals, uvs, kept)."""
+    bad = degenerate_triangles(pos, tris)
+    if not bad.any():
+        return pos, tris, mat, normals, uvs, None
+    kept = np.flatnonzero(~bad)
+    if reporter is not None:
+        reporter.warn(f"DRT: object {obj.name!r}: {int(bad.sum())} of {len(tris)} triangles "
+                      "have non-finite (NaN or infinite) or coincident vertices; they are "
+                      "skipped, as Cycles does", key=(obj.name, "degenerate"))
+    tris, mat = tris[kept], mat[kept]
+    normals = normals[kept] if normals is not None else None
+    uvs = uvs[kept] if uvs is not None else None
+    finite = np.isfinite(pos).all(axis=1)
+    if not finite.all():
+        pos = pos.copy()
+        pos[~finite] = pos[tris[0, 0]] if len(tris) else 0.0
+    return pos, tris, mat, normals, uvs, kept
+
+
+def _evaluate(obj, want_uv: Optional[str] = None, reporter=None) -> Optional[LocalMesh]:
     try:
         mesh = obj.to_mesh()
     except RuntimeError as e:
@@ -156,15 +191,15 @@ def _evaluate(obj, want_uv: Optional[str] = None) -> Optional[LocalMesh]:
         obj.to_mesh_clear()
     if len(tris) == 0:
         return None
-    if not np.all(np.isfinite(pos)):
-        bad = int(np.count_nonzero(~np.isfinite(pos).all(axis=1)))
-        raise ExportError(f"object {obj.name!r} has {bad} vertices with non-finite (NaN or "
-                          "infinite) positions; fix or delete them to render")
+    pos, tris, mat, normals, uvs, kept = _drop_degenerate(obj, pos, tris, mat, normals, uvs,
+                                                          reporter)
+    if len(tris) == 0:
+        return None
     if normals is not None and not np.all(np.isfinite(normals)):
         normals = None                        # degenerate faces: fall back to flat shading
     if uvs is not None and not np.all(np.isfinite(uvs)):
         uvs = np.where(np.isfinite(uvs), uvs, 0.0).astype(np.float32)
-    return LocalMesh(pos, tris, mat, normals, uvs, want_uv)
+    return LocalMesh(pos, tris, mat, normals, uvs, want_uv, kept)
 
 
 def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engine.TriangleMesh":

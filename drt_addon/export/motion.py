@@ -386,8 +386,10 @@ class MotionExport:
                 if gkey not in per_geometry:
                     per_geometry[gkey] = _positions(obj)
                 got = per_geometry[gkey]
+                kept = tr.local.kept
                 if (got is None or got[0].shape != tr.local.positions.shape
-                        or not np.array_equal(got[1], tr.local.triangles)):
+                        or not np.array_equal(got[1] if kept is None else got[1][kept],
+                                              tr.local.triangles)):
                     tr.topology_changed = True
                 else:
                     tr.positions[i] = got[0]

@@ -10,12 +10,16 @@ stage releases the GIL, so work units on threads run in parallel.
 
 It computes the same estimator as `engine.integrators.path.PathIntegrator`, which
 remains the reference implementation (tests compare the two) and serves the scenes this
-one does not handle yet (`unsupported` names the reason): motion blur.
+one does not handle yet (`unsupported` names the reason): lamps that move during the
+shutter. Motion blur of objects and cameras is handled: each path keeps the shutter
+time of its camera ray for all its rays, the accelerator places moving objects at that
+time, and hits on them are rebuilt there (`kernels.surface.rebuild_at_time`).
 """
 from __future__ import annotations
 
 import numpy as np
 
+from .. import visibility
 from ..kernels import lights as klights
 from ..kernels.bsdf import principled as kbsdf
 from ..kernels.path_vertex import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
@@ -30,8 +34,6 @@ _MODE_IDS = {"mis": MIS, "light": LIGHT_ONLY, "bsdf": BSDF_ONLY}
 
 def unsupported(ctx) -> str | None:
     """Why the compiled path tracer cannot render this context yet (None: it can)."""
-    if ctx.has_motion:
-        return "motion blur"
     try:
         klights.pack_lights(ctx.lights)
     except NotImplementedError as e:
@@ -54,21 +56,31 @@ class CompiledPathIntegrator:
         self.cfg = np.array([ctx.sampler.kind, ctx.sampler.samples_per_pixel, s.max_bounces,
                              s.diffuse_bounces, s.glossy_bounces, s.transmission_bounces,
                              s.clamp_direct, s.clamp_indirect, MIS, ctx.scene_radius,
-                             float(ctx.scene.film_transparent)], dtype=np.float64)
+                             float(ctx.scene.film_transparent), s.filter_glossy,
+                             float(s.caustics_reflective), float(s.caustics_refractive)],
+                            dtype=np.float64)
         self.geometry = (surf.v0, surf.v1, surf.v2, surf.normal, surf.tri_scale, surf.material,
                          _or_empty(surf.corner_normals, (0, 3, 3), np.float32),
                          _or_empty(surf.holdout, 0, bool),
-                         _or_empty(surf.corner_uvs, (0, 3, 2), np.float32))
+                         _or_empty(surf.corner_uvs, (0, 3, 2), np.float32),
+                         ctx.accel.motion)
         self.params = kbsdf.pack_materials(mats)
         self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)
         self.textures = pack_textures(mats)
+        vis = _or_empty(surf.visibility, 0, np.uint8)
         self.materials = (surf.material, np.ascontiguousarray(mats.maybe_transparent),
                           np.ascontiguousarray(mats.alpha, dtype=np.float64),
                           np.ascontiguousarray(mats.transparent_color, dtype=np.float64),
-                          self.textures)
+                          self.textures, vis)
+        # Ray Visibility: closest hits pass through surfaces some ray kind does not see,
+        # shadow rays through objects casting no shadow (engine.visibility)
+        ray_kinds = visibility.CAMERA | visibility.DIFFUSE | visibility.GLOSSY \
+            | visibility.TRANSMISSION
+        self.skips_hits = bool(((vis & ray_kinds) != ray_kinds).any())
+        self.skips_shadows = bool(((vis & visibility.SHADOW) == 0).any())
         self.any_transparent = mats.any_transparent
         self.tables = kbsdf.kernel_tables()
-        self.lights = klights.pack_lights(ctx.lights)
+        self.lights = klights.pack_lights(ctx.lights, surf.visibility)
         self.world = np.ascontiguousarray(ctx.world_radiance, dtype=np.float64)
 
     @property
@@ -82,9 +94,11 @@ class CompiledPathIntegrator:
             self.cfg[8] = _MODE_IDS[mode]
 
     # -- transparency: repeated queries through surfaces with alpha < 1 ----------------
-    def _through_transparent(self, depth, paths, live, used, o, d, tm, hits):
-        """Closest hits seen through transparent layers (see path.intersect_alpha):
-        returns (t, prim, u, v, throughput factor (m, 3), stopped (m,))."""
+    def _through_transparent(self, depth, paths, live, used, ray_bits, path_time, time, o,
+                             d, tm, hits):
+        """Closest hits seen through transparent layers and surfaces the rays do not see
+        (see path.intersect_alpha); time: the rays' shutter times (None when nothing
+        moves). Returns (t, prim, u, v, throughput factor (m, 3), stopped (m,))."""
         m = len(live)
         t_all, prim_all = hits.t.copy(), hits.prim.copy()
         u_all, v_all = hits.u.copy(), hits.v.copy()
@@ -97,30 +111,34 @@ class CompiledPathIntegrator:
         layer = 0
         while rows.size:
             k = alpha_pass(depth, layer, self.transparent_limit, int(cfg[0]), int(cfg[1]),
-                           paths[0], paths[1], live, used, rows, d, tm,
+                           paths[0], paths[1], live, used, ray_bits, path_time, rows, d, tm,
                            cur.t, cur.prim, cur.u, cur.v, travelled, factor, stopped,
                            self.geometry, self.materials, out_rows, out_org, out_far)
             if k == 0:
                 break
             rows = out_rows[:k].copy()
-            cur = self.ctx.accel.intersect(out_org[:k], d[rows], out_far[:k])
+            cur = self.ctx.accel.intersect(out_org[:k], d[rows], out_far[:k],
+                                           None if time is None else time[rows])
             merge_layer(rows, travelled, cur.t, cur.prim, cur.u, cur.v,
                         t_all, prim_all, u_all, v_all)
             layer += 1
         return t_all, prim_all, u_all, v_all, factor, stopped
 
-    def _transmittance(self, org, dirs, far):
-        """Transmittance (n, 3) of shadow rays through transparent layers."""
+    def _transmittance(self, org, dirs, far, time):
+        """Transmittance (n, 3) of shadow rays through transparent layers; time: their
+        shutter times (None when nothing moves)."""
         n = len(org)
         trans = np.ones((n, 3))
         rows = np.arange(n, dtype=np.int64)
         o, remaining = org, far
         out_rows, out_org, out_far = np.empty(n, np.int64), np.empty((n, 3)), np.empty(n)
+        ray_time = np.zeros(n) if time is None else np.ascontiguousarray(time, np.float64)
         layer = 0
         while rows.size:
-            h = self.ctx.accel.intersect(o, dirs[rows], remaining)
-            k = shadow_pass(layer, self.transparent_limit, rows, dirs, remaining, h.t, h.prim,
-                            h.u, h.v, trans, self.geometry, self.materials,
+            h = self.ctx.accel.intersect(o, dirs[rows], remaining,
+                                         None if time is None else time[rows])
+            k = shadow_pass(layer, self.transparent_limit, rows, dirs, ray_time, remaining,
+                            h.t, h.prim, h.u, h.v, trans, self.geometry, self.materials,
                             out_rows, out_org, out_far)
             rows = out_rows[:k].copy()
             o, remaining = out_org[:k].copy(), out_far[:k].copy()
@@ -139,6 +157,8 @@ class CompiledPathIntegrator:
         beta = np.ones((n, 3))
         counts = np.zeros((n, 3), dtype=np.int64)
         used = np.zeros(n, dtype=np.int64)         # transparent bounces per path
+        ray_bits = np.full(n, visibility.CAMERA, dtype=np.int64)   # each path's ray kind
+        min_pdf = np.full(n, np.inf)               # smallest BSDF pdf so far per path
         prev_pdf = np.full(n, np.inf)              # camera rays count as specular: weight 1
         prev_pos = np.ascontiguousarray(origins, dtype=np.float64).copy()
         live = np.arange(n, dtype=np.int64)
@@ -151,28 +171,36 @@ class CompiledPathIntegrator:
         nx_path = np.empty(n, np.int64)
         nx_org, nx_dir = np.empty((n, 3)), np.empty((n, 3))
         no_stop = np.zeros(n, bool)
+        # each path's shutter time, kept for all its rays (zeros when nothing moves)
+        moving = time is not None
+        path_time = np.ascontiguousarray(time, np.float64) if moving else np.zeros(n)
         for depth in range(self.max_bounces + 1):
             if live.size == 0:
                 break
-            hits = ctx.accel.intersect(o, d, tm)
+            ray_time = path_time[live] if moving else None
+            hits = ctx.accel.intersect(o, d, tm, ray_time)
             t, prim, u, v, stopped = hits.t, hits.prim, hits.u, hits.v, no_stop
-            if self.any_transparent:
+            if self.any_transparent or self.skips_hits:
                 t, prim, u, v, factor, stopped = self._through_transparent(
-                    depth, (pkey, index), live, used, o, d, tm, hits)
+                    depth, (pkey, index), live, used, ray_bits, path_time, ray_time, o, d,
+                    tm, hits)
                 beta[live] *= factor
             ns, nn = shade(depth, self.cfg, pkey, index, beta, counts, L, coverage,
-                           prev_pdf, prev_pos, live, o, d, tm, t, prim, u, v, stopped,
+                           prev_pdf, prev_pos, ray_bits, min_pdf, path_time, live, o, d, tm,
+                           t, prim, u, v, stopped,
                            self.geometry, self.params, self.emission, self.textures,
                            self.tables, self.lights, self.world,
                            sh_path, sh_org, sh_dir, sh_far, sh_contrib,
                            nx_path, nx_org, nx_dir)
             if ns:
                 limit = s.clamp_direct if depth == 0 else s.clamp_indirect
-                if self.any_transparent:
-                    trans = self._transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns])
+                sh_time = path_time[sh_path[:ns]] if moving else None
+                if self.any_transparent or self.skips_shadows:
+                    trans = self._transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns], sh_time)
                     add_transmitted(L, sh_path[:ns], sh_contrib[:ns], trans, limit)
                 else:
-                    blocked = ctx.accel.occluded(sh_org[:ns], sh_dir[:ns], sh_far[:ns])
+                    blocked = ctx.accel.occluded(sh_org[:ns], sh_dir[:ns], sh_far[:ns],
+                                                 sh_time)
                     add_unoccluded(L, sh_path[:ns], sh_contrib[:ns], blocked, limit)
             live = nx_path[:nn].copy()
             o, d = nx_org[:nn].copy(), nx_dir[:nn].copy()

@@ -217,8 +217,9 @@ class PathIntegrator:
         prev_pos = o
 
         def add(rows, contrib, depth, direct=False):
-            # Cycles' clamps: direct light at the first hit, indirect beyond it;
-            # what the camera sees directly is never clamped.
+            # Cycles' clamps: direct light at the first hit (its next-event estimates,
+            # direct=True, and the emission its BSDF rays find at depth 1), indirect
+            # beyond it; what the camera sees directly (depth 0) is never clamped.
             limit = s.clamp_direct if direct else (s.clamp_indirect if depth > 0 else 0.0)
             L[rows] += _clamp(contrib, limit)   # rows are unique: one entry per path
 
@@ -247,7 +248,7 @@ class PathIntegrator:
                     light_pdf = lights.pdf(k_l[sel], prev_pos[sel], d[sel], t_l[sel],
                                            None if tp is None else tp[sel])
                     w = self._hit_weight(prev_pdf[sel], light_pdf)
-                    add(path[sel], b[sel] * le[sel] * w[:, None], depth)
+                    add(path[sel], b[sel] * le[sel] * w[:, None], depth, direct=depth == 1)
                     # Lamps are not surfaces: as in Cycles the ray goes on to what lies
                     # behind the lamp (hit below, or the background).
             # 1b. escaped rays: world background and sun discs
@@ -265,7 +266,7 @@ class PathIntegrator:
                 if background_is_transparent(ctx, alpha_out, depth):
                     alpha_out[path[sel]] = uncovered(b[sel])
                 else:
-                    add(path[sel], b[sel] * env, depth)
+                    add(path[sel], b[sel] * env, depth, direct=depth == 1)
                 alive[sel] = False
             if stopped is not None:
                 alive &= ~stopped               # past the transparent bounce limit
@@ -292,7 +293,7 @@ class PathIntegrator:
                     light_pdf = lights.mesh_pdf(hits.prim[g_live], prev_pos[g_live],
                                                 si.position[glow])
                     w = self._hit_weight(prev_pdf[g_live], light_pdf)
-                    add(rows[glow], b_live[glow] * em[glow] * w[:, None], depth)
+                    add(rows[glow], b_live[glow] * em[glow] * w[:, None], depth, direct=depth == 1)
 
             bsdf = PrincipledBSDF.from_materials(mats, si.material, si.front_facing, si.uv)
             c_live = counts[rows]

@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 
+from .. import visibility
 from ..bsdf.lobes import TRANSMISSION
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
@@ -24,10 +25,13 @@ from .bsdf import principled as bsdf
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from .bsdf.params import P_BASE, P_METALLIC, P_ROUGHNESS
-from .surface import hit_uv, offset_origin, rebuild
+from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import apply_to_row, emission_at
 
 MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
+# Numba freezes these into its cache; the cache's fingerprint covers every engine file
+DIFFUSE_BIT, GLOSSY_BIT, TRANSMISSION_BIT, SHADOW_BIT = (
+    visibility.DIFFUSE, visibility.GLOSSY, visibility.TRANSMISSION, visibility.SHADOW)
 ROULETTE_START = 3
 _INF = np.inf
 
@@ -88,30 +92,63 @@ def uncovered(br, bg, bb):
 
 
 @kernel
-def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
-          live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
+def prepare_closures(cfg, row, min_pdf, ray_bit):
+    """Cycles' two changes to a hit's BSDF that depend on the path so far (its
+    surface_shader_prepare_closures), applied to the material row before setup:
+
+    Filter Glossy (cfg[11], Cycles' `blur_glossy`; 0 = off): after bounces that were
+    unlikely (the smallest BSDF pdf along the path, min_pdf, below blur_glossy), every
+    microfacet lobe is widened to at least GGX alpha = 0.5 sqrt(1 - min_pdf /
+    blur_glossy). A bias that trades sharp caustics and fireflies for blur.
+
+    Caustics (cfg[12] reflective, cfg[13] refractive; 1 = on): with one off, a hit of a
+    ray that left a diffuse bounce has no glossy reflection (resp. refraction) lobes.
+
+    Returns (keep glossy lobes, keep transmission lobes)."""
+    blur = cfg[11]
+    if blur > 0.0 and min_pdf < _INF:
+        blur_pdf = min_pdf / blur
+        if blur_pdf < 1.0:
+            alpha = 0.5 * math.sqrt(1.0 - blur_pdf)
+            row[P_ROUGHNESS] = max(row[P_ROUGHNESS], math.sqrt(alpha))   # alpha = r^2
+    after_diffuse = ray_bit == DIFFUSE_BIT
+    return (cfg[12] != 0.0 or not after_diffuse), (cfg[13] != 0.0 or not after_diffuse)
+
+
+@kernel
+def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, ray_bits,
+          min_pdf, path_time, live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
           geometry, params, emission, textures, tables, lights, world,
           sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
 
     cfg: float64 [sampler kind, spp, max_bounces, diffuse, glossy, transmission limits,
-    clamp_direct, clamp_indirect, mis mode, scene radius, film transparent].
+    clamp_direct, clamp_indirect, mis mode, scene radius, film transparent, filter glossy,
+    reflective caustics, refractive caustics] (see `prepare_closures`).
     geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout,
-    corner_uvs) of the static triangles (the last three may be empty). alpha: each
-    path's film coverage, or empty when the film is opaque. stopped: rays that ended at
-    the transparent bounce limit. Writes the shadow rays to sh_* (their contributions
-    before the clamp, which `add_transmitted` applies) and the continuing paths' next
+    corner_uvs, moving objects) of every triangle (corner normals, holdout and UVs may be
+    empty; see `surface.rebuild_at_time`). path_time: each path's shutter time (its
+    moving triangles are placed at that time). alpha: each path's film coverage, or
+    empty when the film is opaque. stopped: rays that ended at the transparent bounce
+    limit. ray_bits: the kind of each path's current ray (engine.visibility: CAMERA,
+    then the bit of the lobe it left by), which decides the lamps it sees; next-event
+    estimation evaluates only the lobes the light is seen by and skips the shadow ray
+    of a light that casts no shadow. min_pdf: the smallest BSDF pdf along each path so
+    far (Filter Glossy, `prepare_closures`). Writes the shadow rays to sh_* (their
+    contributions before the clamp, which `add_transmitted` applies) and the continuing paths' next
     rays to nx_*; returns (shadow count, next count). beta, counts, L, alpha, prev_pdf,
     prev_pos are per-path state, updated in place."""
-    (v0, v1, v2, normal, tri_scale, tri_material, corner_normals, holdout,
-     corner_uvs) = geometry
+    tri_material, holdout, corner_uvs = geometry[5], geometry[7], geometry[8]
     any_textures = textures[1].shape[0] > 0
     film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
     kind, spp = int(cfg[0]), int(cfg[1])
     max_bounces = int(cfg[2])
     clamp_direct, clamp_indirect, mode = cfg[6], cfg[7], int(cfg[8])
     scene_radius = cfg[9]
-    clamp_hit = clamp_indirect if depth > 0 else 0.0   # what the camera sees: unclamped
+    # Emission found by this bounce's rays is lit by bounce depth - 1 (Cycles' count): a
+    # lamp hit from the first surface is direct light, as its next-event estimate is;
+    # what the camera sees directly is never clamped.
+    clamp_hit = 0.0 if depth == 0 else (clamp_direct if depth == 1 else clamp_indirect)
     n_lights = lt.n_entries(lights)
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
@@ -126,8 +163,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
         t_geom = hit_t[j] if hit else rt[j]
         # 1a. area and sphere lamps in front of the geometry; the ray goes on behind them
         if n_lights > 0:
-            t_l, k_l, lr, lg, lb = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_geom)
-            if k_l >= 0 and (depth > 0 or lt.lamp_visible_camera(lights, k_l)):
+            t_l, k_l, lr, lg, lb = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_geom,
+                                                ray_bits[p])
+            if k_l >= 0:
                 lpdf = lt.lamp_pdf(lights, k_l, prev_pos[p, 0], prev_pos[p, 1],
                                    prev_pos[p, 2], dx, dy, dz, t_l)
                 w = hit_weight(mode, prev_pdf[p], lpdf)
@@ -155,9 +193,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
             if alpha.shape[0] > 0:        # Cycles' holdout: a hole, for camera rays only
                 alpha[p] = uncovered(br, bg, bb)
             continue
-        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild(
-            v0, v1, v2, normal, tri_scale, corner_normals, prim, hit_u[j], hit_v[j],
-            dx, dy, dz)
+        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
+            geometry, prim, hit_u[j], hit_v[j], dx, dy, dz, path_time[p])
         m = tri_material[prim]
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
@@ -171,11 +208,12 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
         row[:] = params[m]
         if any_textures:
             apply_to_row(textures, m, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
+        keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
         room = depth < max_bounces
         ad = room and counts[p, 0] < cfg[3]
-        ag = room and counts[p, 1] < cfg[4]
-        at = room and counts[p, 2] < cfg[5]
+        ag = room and counts[p, 1] < cfg[4] and keep_g
+        at = room and counts[p, 2] < cfg[5] and keep_t
         # 2. next-event estimation: one light entry, one point, one shadow ray
         if n_lights > 0:
             u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK)
@@ -183,7 +221,11 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
             k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
                 lights, px, py, pz, u_pick, u1, u2)
             lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
-            fr, fg, fb = bsdf.eval_f(state, wox, woy, woz, lx, ly, lz)
+            seen = lt.entry_visibility(lights, k)
+            see_d = (seen & DIFFUSE_BIT) != 0
+            see_g = (seen & GLOSSY_BIT) != 0 and keep_g
+            see_t = (seen & TRANSMISSION_BIT) != 0 and keep_t
+            fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, see_d, see_g, see_t)
             front_side = dot(wx, wy, wz, gx, gy, gz) > 0.0
             if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0
                     and (front_side or bsdf.transmits(state))):
@@ -200,16 +242,21 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
                     far = min(seg * (1.0 - 2e-5), seg - margin)
                 else:
                     far = scene_radius * 4.0
-                bpdf = bsdf.pdf(state, wox, woy, woz, lx, ly, lz, ad, ag, at)
+                bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
+                                     see_d, see_g, see_t)
                 w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * abs(lz)
-                sh_path[ns_out] = p
-                sh_org[ns_out, 0], sh_org[ns_out, 1], sh_org[ns_out, 2] = sox, soy, soz
-                sh_dir[ns_out, 0], sh_dir[ns_out, 1], sh_dir[ns_out, 2] = sdx, sdy, sdz
-                sh_far[ns_out] = max(far, 0.0)
-                sh_contrib[ns_out, 0] = br * fr * lr * w
-                sh_contrib[ns_out, 1] = bg * fg * lg * w
-                sh_contrib[ns_out, 2] = bb * fb * lb * w
-                ns_out += 1
+                if not seen & SHADOW_BIT:        # a light casting no shadow: no shadow ray
+                    _add(L, p, br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w,
+                         clamp_direct if depth == 0 else clamp_indirect)
+                else:
+                    sh_path[ns_out] = p
+                    sh_org[ns_out, 0], sh_org[ns_out, 1], sh_org[ns_out, 2] = sox, soy, soz
+                    sh_dir[ns_out, 0], sh_dir[ns_out, 1], sh_dir[ns_out, 2] = sdx, sdy, sdz
+                    sh_far[ns_out] = max(far, 0.0)
+                    sh_contrib[ns_out, 0] = br * fr * lr * w
+                    sh_contrib[ns_out, 1] = bg * fg * lg * w
+                    sh_contrib[ns_out, 2] = bb * fb * lb * w
+                    ns_out += 1
         # 3. continue by BSDF sampling
         if not (ad or ag or at):
             continue
@@ -235,6 +282,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
             continue
         beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
         counts[p, skind] += 1
+        ray_bits[p] = DIFFUSE_BIT << skind     # diffuse, glossy, transmission: 2, 4, 8
+        if not sdelta:
+            min_pdf[p] = min(min_pdf[p], spdf)
         nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
         nx_path[nn_out] = p
         nx_org[nn_out, 0], nx_org[nn_out, 1], nx_org[nn_out, 2] = nox, noy, noz

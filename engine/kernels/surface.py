@@ -1,7 +1,8 @@
 """Surface interactions rebuilt in float64 from Embree's hit, and safe ray origins: the
-compiled form of `engine.surface` for static triangles (same formulas, one hit at a
-time). See that module for why hit points come from barycentrics and why the ray offset
-is relative to the coordinates' magnitude."""
+compiled form of `engine.surface` (same formulas, one hit at a time), for static
+triangles (`rebuild`) and for triangles of moving objects placed at the ray's time
+(`rebuild_at_time`). See that module for why hit points come from barycentrics and why
+the ray offset is relative to the coordinates' magnitude."""
 from __future__ import annotations
 
 import math
@@ -9,8 +10,10 @@ import math
 import numpy as np
 
 from ..surface import RELATIVE_OFFSET
-from .frame import dot
+from .frame import cross, dot
 from .jit import kernel
+from .motion import I_KIND, I_NVERTS, I_SLICES, I_VERT0, RIGID, adjugate_columns, object_of, \
+    rigid_at
 
 
 @kernel
@@ -44,6 +47,101 @@ def rebuild(v0, v1, v2, normal, tri_scale, corner_normals, prim, u, v, dx, dy, d
             sx, sy, sz = nx, ny, nz
     scale = max(max(abs(px), abs(py), abs(pz)), tri_scale[prim])
     return px, py, pz, fx, fy, fz, sx, sy, sz, front, scale
+
+
+@kernel
+def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
+    """`rebuild` for any triangle, static or moving, hit at shutter time `time`.
+    geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout,
+    corner_uvs, M) in the accelerator's triangle order, M its moving objects
+    (engine.kernels.motion.PackedMotion; triangles from M.prim_start[0] on move). A
+    moving triangle is placed as SurfaceBuilder.build places it: a rigid object's
+    vertices by its transform at `time`, its corner normals by that transform's
+    inverse-transpose; a deforming object's vertices from the time slice of `time`."""
+    v0, v1, v2, normal, tri_scale, _, corner_normals, _, _, M = geometry
+    if prim < M.prim_start[0]:
+        return rebuild(v0, v1, v2, normal, tri_scale, corner_normals, prim, u, v, dx, dy, dz)
+    obj = object_of(M, prim)
+    info, verts, tris = M.info, M.verts, M.tris
+    local = prim - M.prim_start[0]
+    i0, i1, i2 = tris[local, 0], tris[local, 1], tris[local, 2]
+    rigid = info[obj, I_KIND] == RIGID
+    base = info[obj, I_VERT0]
+    a00, a01, a02, a10, a11, a12, a20, a21, a22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
+    tx, ty, tz = 0.0, 0.0, 0.0
+    if rigid:
+        a00, a01, a02, a10, a11, a12, a20, a21, a22, tx, ty, tz = rigid_at(
+            info, M.step_time, M.step_trans, M.step_quat, M.step_stretch, M.step_linear,
+            obj, time)
+    else:
+        slices = info[obj, I_SLICES]
+        base += min(max(int(time * slices), 0), slices - 1) * info[obj, I_NVERTS]
+    p0x, p0y, p0z = _place(verts, base + i0, rigid, a00, a01, a02, a10, a11, a12, a20, a21,
+                           a22, tx, ty, tz)
+    p1x, p1y, p1z = _place(verts, base + i1, rigid, a00, a01, a02, a10, a11, a12, a20, a21,
+                           a22, tx, ty, tz)
+    p2x, p2y, p2z = _place(verts, base + i2, rigid, a00, a01, a02, a10, a11, a12, a20, a21,
+                           a22, tx, ty, tz)
+    # the placed triangle's unit geometric normal (engine.surface._unit_normals)
+    gx, gy, gz = cross(p1x - p0x, p1y - p0y, p1z - p0z, p2x - p0x, p2y - p0y, p2z - p0z)
+    ln = math.sqrt(gx * gx + gy * gy + gz * gz)
+    if ln > 0.0:
+        gx, gy, gz = gx / ln, gy / ln, gz / ln
+    else:
+        gx, gy, gz = 0.0, 0.0, 1.0
+    w = 1.0 - u - v
+    px = w * p0x + u * p1x + v * p2x
+    py = w * p0y + u * p1y + v * p2y
+    pz = w * p0z + u * p1z + v * p2z
+    front = dot(gx, gy, gz, dx, dy, dz) < 0.0
+    sign = 1.0 if front else -1.0
+    fx, fy, fz = gx * sign, gy * sign, gz * sign
+    sx, sy, sz = fx, fy, fz
+    if corner_normals.shape[0] > 0:
+        c = corner_normals
+        c0x, c0y, c0z = np.float64(c[prim, 0, 0]), np.float64(c[prim, 0, 1]), np.float64(c[prim, 0, 2])
+        c1x, c1y, c1z = np.float64(c[prim, 1, 0]), np.float64(c[prim, 1, 1]), np.float64(c[prim, 1, 2])
+        c2x, c2y, c2z = np.float64(c[prim, 2, 0]), np.float64(c[prim, 2, 1]), np.float64(c[prim, 2, 2])
+        if rigid:
+            # the normal matrix, the inverse-transpose: columns r_j / det
+            r0x, r0y, r0z, r1x, r1y, r1z, r2x, r2y, r2z, det = adjugate_columns(
+                a00, a01, a02, a10, a11, a12, a20, a21, a22)
+            n00, n10, n20 = r0x / det, r0y / det, r0z / det
+            n01, n11, n21 = r1x / det, r1y / det, r1z / det
+            n02, n12, n22 = r2x / det, r2y / det, r2z / det
+            c0x, c0y, c0z = (n00 * c0x + n01 * c0y + n02 * c0z, n10 * c0x + n11 * c0y + n12 * c0z,
+                             n20 * c0x + n21 * c0y + n22 * c0z)
+            c1x, c1y, c1z = (n00 * c1x + n01 * c1y + n02 * c1z, n10 * c1x + n11 * c1y + n12 * c1z,
+                             n20 * c1x + n21 * c1y + n22 * c1z)
+            c2x, c2y, c2z = (n00 * c2x + n01 * c2y + n02 * c2z, n10 * c2x + n11 * c2y + n12 * c2z,
+                             n20 * c2x + n21 * c2y + n22 * c2z)
+        nx = w * c0x + u * c1x + v * c2x
+        ny = w * c0y + u * c1y + v * c2y
+        nz = w * c0z + u * c1z + v * c2z
+        ln = math.sqrt(nx * nx + ny * ny + nz * nz)
+        if ln > 1e-12:
+            nx, ny, nz = nx / ln, ny / ln, nz / ln
+        else:
+            nx, ny, nz = gx, gy, gz
+        nx, ny, nz = nx * sign, ny * sign, nz * sign
+        # a shading normal bent past the geometric one is replaced by it
+        if dot(nx, ny, nz, fx, fy, fz) > 0.0:
+            sx, sy, sz = nx, ny, nz
+    tri = max(abs(p0x), abs(p0y), abs(p0z), abs(p1x), abs(p1y), abs(p1z),
+              abs(p2x), abs(p2y), abs(p2z))
+    scale = max(max(abs(px), abs(py), abs(pz)), tri)
+    return px, py, pz, fx, fy, fz, sx, sy, sz, front, scale
+
+
+@kernel(inline="always")
+def _place(verts, row, rigid, a00, a01, a02, a10, a11, a12, a20, a21, a22, tx, ty, tz):
+    """Vertex `row` placed in the world: through the affine map for a rigid object, as
+    stored (a time slice's world position) for a deforming one."""
+    x, y, z = verts[row, 0], verts[row, 1], verts[row, 2]
+    if not rigid:
+        return x, y, z
+    return (a00 * x + a01 * y + a02 * z + tx, a10 * x + a11 * y + a12 * z + ty,
+            a20 * x + a21 * y + a22 * z + tz)
 
 
 @kernel

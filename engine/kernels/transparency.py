@@ -4,16 +4,24 @@ per-hit decisions of `engine.integrators.path.intersect_alpha` and
 query, one of these kernels, the next query for the rays that go on.
 
 `materials` is the tuple (material of each triangle, maybe_transparent per material,
-alpha per material, transparent colour per material (M, 3), textures T); `geometry` the
-tuple `path_vertex.shade` takes, plus corner UVs."""
+alpha per material, transparent colour per material (M, 3), textures T, visibility of
+each triangle (engine.visibility masks; empty when every ray sees every triangle));
+`geometry` the tuple `path_vertex.shade` takes. Hits on moving objects are placed at the
+time of the ray's path (`path_time` per path, `ray_time` per shadow ray).
+
+The same passes skip the surfaces a ray does not see (Ray Visibility): a camera or bounce
+ray goes on through a triangle lacking its kind's bit, a shadow ray through one lacking
+SHADOW, untinted and without counting a transparent bounce."""
 from __future__ import annotations
 
+from .. import visibility
 from ..sampling.dispatch import sample_1d
 from .jit import kernel
-from .surface import hit_uv, offset_origin, rebuild
+from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import alpha_at
 
 TRANSPARENT_DIM = 1 << 24      # the pass-through numbers' own dimensions (see path.py)
+SHADOW_BIT = visibility.SHADOW
 
 
 @kernel
@@ -22,37 +30,60 @@ def alpha_dim(depth, layer):
 
 
 @kernel
-def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz):
-    v0, v1, v2, normal, tri_scale, tri_material, corner_normals, holdout, corner_uvs = geometry
-    _, _, alpha_table, _, T = materials
-    px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild(
-        v0, v1, v2, normal, tri_scale, corner_normals, prim, u, v, dx, dy, dz)
+def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz, time):
+    tri_material, corner_uvs = geometry[5], geometry[8]
+    _, _, alpha_table, _, T, _ = materials
+    px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild_at_time(
+        geometry, prim, u, v, dx, dy, dz, time)
     uu, vv = hit_uv(corner_uvs, prim, u, v)
     m = tri_material[prim]
     return alpha_at(T, alpha_table, m, uu, vv), m, px, py, pz, gx, gy, gz, scale
 
 
 @kernel
-def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, rows, rd, tmax,
-               cur_t, cur_prim, cur_u, cur_v, travelled, factor, stopped,
+def _pass_through(geometry, prim, u, v, rd, r, t, time, travelled, tmax, out_rows, out_org,
+                  out_far, n_out):
+    """Ray r goes on beyond the triangle it hit at t, unchanged: entry n_out of out_*."""
+    dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
+    px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild_at_time(geometry, prim, u, v,
+                                                                dx, dy, dz, time)
+    travelled[r] += t
+    ox, oy, oz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
+    out_rows[n_out] = r
+    out_org[n_out, 0], out_org[n_out, 1], out_org[n_out, 2] = ox, oy, oz
+    out_far[n_out] = max(tmax[r] - travelled[r], 0.0)
+
+
+@kernel
+def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits, path_time,
+               rows, rd, tmax, cur_t, cur_prim, cur_u, cur_v, travelled, factor, stopped,
                geometry, materials, out_rows, out_org, out_far):
     """One transparent layer for the camera or bounce rays `rows` (indices into the
     wavefront `live`) whose current closest hits are cur_*: each ray whose hit surface
     lets it through (a sampler number >= alpha) goes on beyond it, tinted, counting one
     transparent bounce of its path (`used`, per path); past `limit` such bounces the
-    path stops. Writes the rays that go on (row, origin, remaining distance); returns
-    their count."""
-    tri_material, maybe_transparent, _, tcolor, _ = materials
+    path stops. A ray whose kind (ray_bits, per path) does not see the hit triangle goes
+    on beyond it as it is. Writes the rays that go on (row, origin, remaining distance);
+    returns their count."""
+    tri_material, maybe_transparent, _, tcolor, _, tri_vis = materials
     n_out = 0
     for i in range(rows.shape[0]):
         r = rows[i]
         prim = cur_prim[i]
-        if prim < 0 or not maybe_transparent[tri_material[prim]]:
+        if prim < 0:
+            continue
+        if tri_vis.shape[0] > 0 and not tri_vis[prim] & ray_bits[live[r]]:
+            _pass_through(geometry, prim, cur_u[i], cur_v[i], rd, r, cur_t[i],
+                          path_time[live[r]], travelled, tmax, out_rows, out_org, out_far,
+                          n_out)
+            n_out += 1
+            continue
+        if not maybe_transparent[tri_material[prim]]:
             continue
         dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
-        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim,
-                                                         cur_u[i], cur_v[i], dx, dy, dz)
         p = live[r]
+        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim, cur_u[i],
+                                                         cur_v[i], dx, dy, dz, path_time[p])
         if not sample_1d(kind, pkey[p], spp, index[p], alpha_dim(depth, layer)) >= a:
             continue
         if used[p] >= limit:
@@ -72,24 +103,35 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, rows, rd
 
 
 @kernel
-def shadow_pass(layer, limit, rows, sd, remaining, cur_t, cur_prim, cur_u, cur_v, trans,
-                geometry, materials, out_rows, out_org, out_far):
+def shadow_pass(layer, limit, rows, sd, ray_time, remaining, cur_t, cur_prim, cur_u, cur_v,
+                trans, geometry, materials, out_rows, out_org, out_far):
     """One layer of transparent shadows for the shadow rays `rows`: an opaque surface (or
     one past `limit` transparent layers) blocks; a transparent one multiplies the
-    transmittance by (1 - alpha) x its transparent colour and the ray goes on."""
-    tri_material, maybe_transparent, _, tcolor, _ = materials
+    transmittance by (1 - alpha) x its transparent colour and the ray goes on; through a
+    surface whose object casts no shadow it goes on unchanged."""
+    tri_material, maybe_transparent, _, tcolor, _, tri_vis = materials
     n_out = 0
     for i in range(rows.shape[0]):
         r = rows[i]
         prim = cur_prim[i]
         if prim < 0 or not cur_t[i] < remaining[i]:
             continue
+        if tri_vis.shape[0] > 0 and not tri_vis[prim] & SHADOW_BIT:
+            dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
+            px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild_at_time(
+                geometry, prim, cur_u[i], cur_v[i], dx, dy, dz, ray_time[r])
+            ox, oy, oz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
+            out_rows[n_out] = r
+            out_org[n_out, 0], out_org[n_out, 1], out_org[n_out, 2] = ox, oy, oz
+            out_far[n_out] = max(remaining[i] - cur_t[i], 0.0)
+            n_out += 1
+            continue
         if not maybe_transparent[tri_material[prim]] or layer >= limit:
             trans[r, 0] = trans[r, 1] = trans[r, 2] = 0.0
             continue
         dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
-        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim,
-                                                         cur_u[i], cur_v[i], dx, dy, dz)
+        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim, cur_u[i],
+                                                         cur_v[i], dx, dy, dz, ray_time[r])
         trans[r, 0] *= (1.0 - a) * tcolor[m, 0]
         trans[r, 1] *= (1.0 - a) * tcolor[m, 1]
         trans[r, 2] *= (1.0 - a) * tcolor[m, 2]

@@ -227,18 +227,20 @@ def reflection_sample(state, ox, oy, oz, u1, u2):
 
 
 @kernel
-def eval_f(state, wox, woy, woz, wix, wiy, wiz):
-    """The whole BSDF f(wo, wi) in 1/sr, every lobe (delta parts excluded)."""
+def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
+    """f(wo, wi) in 1/sr of the lobes of the kinds a light is seen by (see_d: diffuse,
+    see_g: glossy reflection, see_t: transmission; engine.visibility), delta parts
+    excluded."""
     fr = 0.0
     fg = 0.0
     fb = 0.0
-    if woz > 0.0 and wiz > 0.0:                   # Lambert under the specular layer
+    if see_d and woz > 0.0 and wiz > 0.0:         # Lambert under the specular layer
         fr = state[S_DIFFUSE] * INV_PI
         fg = state[S_DIFFUSE + 1] * INV_PI
         fb = state[S_DIFFUSE + 2] * INV_PI
     w_spec = state[S_W_SPEC]
     w_metal = state[S_W_METAL]
-    if w_spec > 0.0 or w_metal > 0.0:
+    if see_g and (w_spec > 0.0 or w_metal > 0.0):
         base, hx, hy, hz = reflection_eval(state, wox, woy, woz, wix, wiy, wiz)
         cos_oh = min(max(mf.dot(wox, woy, woz, hx, hy, hz), 0.0), 1.0)
         if w_spec > 0.0:
@@ -253,13 +255,19 @@ def eval_f(state, wox, woy, woz, wix, wiy, wiz):
             fg += fresnel.schlick(state[S_METAL_F0 + 1], cos_oh) * bw * state[S_MS_METAL + 1]
             fb += fresnel.schlick(state[S_METAL_F0 + 2], cos_oh) * bw * state[S_MS_METAL + 2]
     w_glass = state[S_W_GLASS]
-    if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0:
+    if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0 and (see_g if wiz > 0.0 else see_t):
         f_r, f_t = dielectric.rough_eval(wox, woy, woz, wix, wiy, wiz,
                                          state[S_ETA_GLASS], state[S_ALPHA])
         fr += (f_r + f_t * state[S_TINT]) * w_glass * state[S_MS_GLASS]
         fg += (f_r + f_t * state[S_TINT + 1]) * w_glass * state[S_MS_GLASS + 1]
         fb += (f_r + f_t * state[S_TINT + 2]) * w_glass * state[S_MS_GLASS + 2]
     return fr, fg, fb
+
+
+@kernel
+def eval_f(state, wox, woy, woz, wix, wiy, wiz):
+    """The whole BSDF f(wo, wi) in 1/sr, every lobe (delta parts excluded)."""
+    return eval_seen(state, wox, woy, woz, wix, wiy, wiz, True, True, True)
 
 
 @kernel
@@ -281,6 +289,22 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3, allow_g, al
 def pdf(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t):
     """Mixture pdf (1/sr) of `sample` with the same allow flags."""
     q0, q1, q2, q3 = selection(state, allow_d, allow_g, allow_t)
+    return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3,
+                       allow_g, allow_t)
+
+
+@kernel
+def pdf_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t,
+             see_d, see_g, see_t):
+    """The part of `pdf` (same allow flags) due to the lobes of the kinds a light is seen
+    by: the density with which BSDF sampling reaches that light through wi."""
+    q0, q1, q2, q3 = selection(state, allow_d, allow_g, allow_t)
+    if not see_d:
+        q0 = 0.0
+    if not see_g:
+        q1 = q2 = 0.0
+    if not (see_g if wiz > 0.0 else see_t):
+        q3 = 0.0
     return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3,
                        allow_g, allow_t)
 

@@ -43,7 +43,7 @@ def hit_lamps_batch(L, o, d, tmax):
     rad = np.empty((n, 3))
     for i in range(n):
         t, k, r, g, b = hit_lamps(L, o[i, 0], o[i, 1], o[i, 2], d[i, 0], d[i, 1], d[i, 2],
-                                  tmax[i])
+                                  tmax[i], 31)
         t_out[i] = t
         k_out[i] = k
         rad[i, 0], rad[i, 1], rad[i, 2] = r, g, b

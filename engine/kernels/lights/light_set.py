@@ -7,8 +7,8 @@ from __future__ import annotations
 from ..jit import kernel
 from .area import intersect_area, pdf_area, sample_area
 from .environment import pdf_environment, sample_environment
-from .pack import (C_TYPE, C_VIS_CAMERA, C_VISIBLE, CDF, ENV, LAMPS, SELECT_PDF, SUNS,
-                   T_AREA, T_DISC, T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA)
+from .pack import (C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, ENV, LAMPS, SELECT_PDF, SUNS,
+                   TRI_VISIBILITY, T_AREA, T_DISC, T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA)
 from .point import intersect_point, pdf_point, sample_point
 from .sun import escaped_sun, pdf_sun, sample_sun
 from .triangles import pdf_triangle, sample_triangle, triangle_entry
@@ -79,9 +79,10 @@ def sample(L, px, py, pz, u_pick, u1, u2):
 
 
 @kernel
-def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax):
-    """LightSet.hit_surfaces for one ray: the nearest visible sphere, disc or area lamp
-    closer than tmax: (t, k, r, g, b); (tmax, -1, 0, 0, 0) when there is none."""
+def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit):
+    """LightSet.hit_surfaces for one ray of kind ray_bit (engine.visibility): the nearest
+    sphere, disc or area lamp closer than tmax that this kind of ray sees: (t, k, r, g,
+    b); (tmax, -1, 0, 0, 0) when there is none."""
     lamps = L[LAMPS]
     best_t = tmax
     best_k = -1
@@ -89,6 +90,8 @@ def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax):
     for k in range(lamps.shape[0]):
         kind = lamps[k, C_TYPE]
         if lamps[k, C_VISIBLE] == 0.0 or kind == T_SUN or kind == T_SUN_DELTA:
+            continue
+        if not int(lamps[k, C_VISIBILITY]) & ray_bit:
             continue
         if kind == T_AREA:
             t, r, g, b = intersect_area(lamps, k, ox, oy, oz, dx, dy, dz)
@@ -102,13 +105,15 @@ def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax):
 
 
 @kernel
-def lamp_visible_camera(L, k):
-    """Whether camera rays see lamp k (Blender's visible_camera; True for lamps without
-    that option, and for k outside the lamps)."""
+def entry_visibility(L, k):
+    """The ray kinds that see light entry k (engine.visibility mask): a lamp's own, an
+    emissive triangle's object's; every kind for k < 0."""
     lamps = L[LAMPS]
-    if k < 0 or k >= lamps.shape[0]:
-        return True
-    return lamps[k, C_VIS_CAMERA] != 0.0
+    if k < 0:
+        return 31
+    if k < lamps.shape[0]:
+        return int(lamps[k, C_VISIBILITY])
+    return int(L[TRI_VISIBILITY][k - lamps.shape[0]])
 
 
 @kernel

@@ -19,6 +19,8 @@ every scene):
                  (`EmissiveTriangles.entry`; empty without mesh lights).
   L[ENV]         float64 (5,): [lamp index of the world light or -1, radiance r, g, b,
                  solid-angle pdf 1 / (4 pi)]; radiance 0 when the world is not a light.
+  L[TRI_VISIBILITY]  int64 (n_tri,): the ray kinds that see emissive triangle j (its
+                 object's engine.visibility mask; all 31 when not given).
 """
 from __future__ import annotations
 
@@ -41,6 +43,7 @@ TRI_SCALE = 9
 TRI_RADIANCE = 10
 TRI_ENTRY = 11
 ENV = 12
+TRI_VISIBILITY = 13
 
 # ---------------------------------------------------------------- lamp kinds (C_TYPE)
 T_POINT = 0         # delta point or spot (radius 0)
@@ -54,7 +57,7 @@ T_ENV = 6           # the uniform world
 # ---------------------------------------------------------------- lamp table columns
 C_TYPE = 0
 C_VISIBLE = 1       # 1: BSDF rays can hit it (hit_surfaces), 0: not (delta, sun, world)
-C_VIS_CAMERA = 2    # Blender's visible_camera (1 for lamps without the option)
+C_VISIBILITY = 2    # the ray kinds that see it (engine.visibility mask)
 C_DELTA = 3         # 1 for point and zero-angle sun lights
 C_RAD = 4           # 3: radiance (sphere / disc, sun disc, area, world)
 # point, spot, sphere, disc
@@ -101,7 +104,7 @@ def _lamp_row(model) -> np.ndarray:
         raise NotImplementedError("moving lamps")
     row = np.zeros(N_COLUMNS)
     row[C_VISIBLE] = float(bool(model.visible))
-    row[C_VIS_CAMERA] = float(bool(getattr(model, "visible_camera", True)))
+    row[C_VISIBILITY] = float(int(getattr(model, "visibility", 31)))
     row[C_DELTA] = float(bool(model.delta))
     if isinstance(model, PointLightModel):
         row[C_TYPE] = T_POINT if model.delta else (T_DISC if model.disc else T_SPHERE)
@@ -154,8 +157,10 @@ def _f64(a, shape):
     return np.array(np.asarray(a, dtype=np.float64).reshape(shape), order="C", copy=True)
 
 
-def pack_lights(light_set) -> tuple:
+def pack_lights(light_set, tri_visibility=None) -> tuple:
     """The LightSet as the kernels' tuple L (fields: this module's docstring).
+    tri_visibility: the visibility mask of every global triangle (Surfaces.visibility),
+    or None when every triangle is seen by every ray.
     Raises NotImplementedError("moving lamps") when a lamp moves during the shutter
     (`TimeSlicedLight`): the caller then uses the NumPy LightSet."""
     models = light_set.models
@@ -184,4 +189,10 @@ def pack_lights(light_set) -> tuple:
         env[4] = m.pdf_value
     if len(select_pdf) != len(models) + len(tri[4]):
         raise ValueError("LightSet entries do not match its lamps and triangles")
-    return (lamps, select_pdf, cdf, suns) + tri + (env,)
+    n_tri = len(tri[4])
+    vis = np.full(n_tri, 31, dtype=np.int64)
+    if tri_visibility is not None and n_tri:
+        entry = tri[7]
+        prims = np.flatnonzero(entry >= 0)
+        vis[entry[prims]] = np.asarray(tri_visibility)[prims]
+    return (lamps, select_pdf, cdf, suns) + tri + (env, vis)
