@@ -96,12 +96,17 @@ def case():
     mats = random_materials(rng, N_MATERIALS)
     table = MaterialTable(mats)
     index, front, wo, wi, u_lobe, u_dir, allowed = random_hits(rng, N_HITS, len(mats))
-    ref = PrincipledBSDF.from_materials(table, index, front)
+    # Filter Glossy's lower bound on the lobes' alpha at a fifth of the hits
+    filter_alpha = np.where(np.random.default_rng(8).random(N_HITS) < 0.2,
+                            np.random.default_rng(9).uniform(0.0, 0.5, N_HITS), 0.0)
+    ref = PrincipledBSDF.from_materials(table, index, front, filter_alpha=filter_alpha)
     assert not ref.diffuse_only          # the mixed batch takes the general code path
+    assert (ref.alpha > ref.material_alpha).mean() > 0.1
     rows = kb.pack_materials(table)[index]
+    rows[:, kb.P_FILTER_ALPHA] = filter_alpha
     return dict(mats=mats, table=table, index=index, front=front, wo=wo, wi=wi,
                 u_lobe=u_lobe, u_dir=u_dir, allowed=allowed, ref=ref, rows=rows,
-                tables=kb.kernel_tables())
+                filter_alpha=filter_alpha, tables=kb.kernel_tables())
 
 
 def close(a, b, rtol=RTOL, atol=ATOL):
@@ -143,6 +148,7 @@ def test_pack_materials_columns():
     assert tuple(r[kb.P_GLASS_COLOR:kb.P_GLASS_COLOR + 3]) == (0.2, 0.3, 0.4)
     assert r[kb.P_GLOSSY_MODEL] == kb.GLOSSY_GGX
     assert rows[2, kb.P_GLOSSY_MODEL] == kb.GLOSSY_MULTI_GGX
+    assert (rows[:, kb.P_FILTER_ALPHA] == 0).all()            # a per-hit value, none packed
 
 
 def test_constants_match_numpy():
@@ -275,7 +281,8 @@ def test_eval_and_pdf_at_sampled_directions(case):
     ref = c["ref"].sample(c["wo"], c["u_lobe"], c["u_dir"], c["allowed"])
     ok = ref.valid & ~ref.delta
     idx = np.nonzero(ok)[0]
-    sub = PrincipledBSDF.from_materials(c["table"], c["index"][idx], c["front"][idx])
+    sub = PrincipledBSDF.from_materials(c["table"], c["index"][idx], c["front"][idx],
+                                        filter_alpha=c["filter_alpha"][idx])
     wo, wi, allowed = c["wo"][idx], ref.wi[idx], c["allowed"][idx]
     rows, front = c["rows"][idx], c["front"][idx]
     f_ref = sub.eval_f(wo, wi)

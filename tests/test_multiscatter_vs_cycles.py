@@ -8,27 +8,28 @@ agree within MEAN_TOLERANCE = 1 % per channel, and every 8 x 8 block mean within
 BLOCK_TOLERANCE = 3 % of the image mean.
 
 Light paths. Cycles' Filter Glossy (default 1) widens glossy lobes after a bounce whose
-pdf was below 1; DRT does not have it yet, so the comparisons avoid the paths where it
-acts:
+pdf was below 1; DRT has it too, but applies it before the BSDF setup (see
+FILTER_GLOSSY_ORDER), which matters to the energy compensation, so the comparisons
+avoid the paths where it acts or turn it off:
   * `test_metal_spheres_match_cycles`: Cycles' defaults except the bounce limits: two
     bounces in total, no diffuse bounce, so the light reaches the camera directly or
     after one or two glossy bounces (the plane seen in the spheres, the spheres in each
     other); Filter Glossy acts only on sphere-to-sphere paths, which this test measures:
     Cycles with Filter Glossy 0 differs from Cycles at 1 by 0.2 % (mean) and 1.3 % (worst
-    block). Measured, DRT Multiscatter GGX: mean 0.0 %, worst block 1.2 %. With DRT's
+    block). Measured, DRT Multiscatter GGX: mean 0.04 %, worst block 1.1 %. With DRT's
     previous single-scattering GGX (the same scene with the distribution set to GGX):
-    mean -4.3 % (red; -1.9 % green, -1.3 % blue), worst block 37 % (the rough spheres):
+    mean -4.4 % (red; -1.9 % green, -1.4 % blue), worst block 38 % (the rough spheres):
     it fails both checks (`test_single_scatter_fails_the_comparison`).
     Why not one bounce: at its last bounce DRT samples only the lamp, not the BSDF (a
     noisier estimator of the same value), which leaves the lamp's highlight in the
     smooth spheres seen in their neighbours about 6 % low in a block at these samples,
     for single and multiple scattering alike; with two bounces that path is not the last.
-  * `test_metal_spheres_match_cycles_without_filter_glossy`: AN INTERMEDIATE TEST, until
-    DRT has Filter Glossy: every light path at Cycles' defaults, but Cycles' Filter
-    Glossy set to 0 (scene.cycles.blur_glossy = 0) on the Cycles side. Measured: mean
-    -0.1 %, worst block 1.1 %. With Filter Glossy at 1 Cycles' own image changes by up
-    to 8 % in a block here (the plane's diffuse bounce into the spheres), which this test
-    does not judge.
+  * `test_metal_spheres_match_cycles_without_filter_glossy`: every light path at
+    Cycles' defaults, with Filter Glossy 0 in both engines (scene.cycles.blur_glossy,
+    which DRT reads). Measured: mean -0.1 %, worst block 1.1 %.
+  * `test_metal_spheres_match_cycles_at_the_defaults` (Filter Glossy 1 in both): an
+    expected failure (strict) until DRT's Filter Glossy widens the lobes after the BSDF
+    setup as Cycles does (FILTER_GLOSSY_ORDER below); it passes with that change.
 
 The Principled layering per distribution (`test_plastic_layering_matches_cycles`): a
 plastic sphere (base colour 0.8, default specular) in a white world, the mean over the
@@ -47,6 +48,14 @@ import pytest
 
 from conftest import render_current
 
+FILTER_GLOSSY_ORDER = (
+    "DRT's Filter Glossy (engine/kernels/path_vertex.prepare_closures) raises the "
+    "material's roughness before the BSDF setup, so the energy compensation and the "
+    "layering use the widened alpha, where Cycles widens the closure after its setup "
+    "(surface_shader_prepare_closures after the closures' preserve_energy). Measured: "
+    "mean +0.97 % (red), worst block 3.3 %. With prepare_closures writing the widened "
+    "alpha to row[P_FILTER_ALPHA] (principled.setup keeps the material's alpha for the "
+    "compensation) instead of row[P_ROUGHNESS]: mean -0.07 %, worst block 1.05 %.")
 MEAN_TOLERANCE = 0.01
 PLASTIC_TOLERANCE = 0.005
 BLOCK_TOLERANCE = 0.03
@@ -180,11 +189,22 @@ def test_single_scatter_fails_the_comparison(bpy_drt):
 
 
 def test_metal_spheres_match_cycles_without_filter_glossy(bpy_drt):
-    """INTERMEDIATE (see the module docstring): all of Cycles' default light paths, with
-    Cycles' Filter Glossy off, until DRT implements it."""
+    """Every light path at Cycles' defaults, with Filter Glossy off in both engines
+    (scene.cycles.blur_glossy = 0, which DRT reads too)."""
     cycles = _render(bpy_drt, "CYCLES", DEFAULT_BOUNCES, blur_glossy=0.0)
+    drt = _render(bpy_drt, "DRT", DEFAULT_BOUNCES, blur_glossy=0.0)
+    _report("Multiscatter GGX, all bounces, Filter Glossy 0, DRT vs Cycles", drt, cycles)
+    rel, block = compare(drt, cycles)
+    assert (np.abs(rel) <= MEAN_TOLERANCE).all(), rel
+    assert block <= BLOCK_TOLERANCE, block
+
+
+@pytest.mark.xfail(strict=True, reason=FILTER_GLOSSY_ORDER)
+def test_metal_spheres_match_cycles_at_the_defaults(bpy_drt):
+    """Every light path at Blender's defaults, Filter Glossy 1 in both engines."""
+    cycles = _render(bpy_drt, "CYCLES", DEFAULT_BOUNCES)
     drt = _render(bpy_drt, "DRT", DEFAULT_BOUNCES)
-    _report("Multiscatter GGX, all bounces, DRT vs Cycles without Filter Glossy", drt, cycles)
+    _report("Multiscatter GGX, Blender's defaults, DRT vs Cycles", drt, cycles)
     rel, block = compare(drt, cycles)
     assert (np.abs(rel) <= MEAN_TOLERANCE).all(), rel
     assert block <= BLOCK_TOLERANCE, block

@@ -101,7 +101,7 @@ class PrincipledBSDF:
 
     def __init__(self, base_color, metallic, transmission, roughness=None, ior=None,
                  specular_ior_level=None, front_facing=None, blinn_phong=None,
-                 multiscatter=None):
+                 multiscatter=None, filter_alpha=None):
         base_color = np.asarray(base_color, dtype=np.float64).reshape(-1, 3)
         n = self.n = len(base_color)
 
@@ -120,7 +120,12 @@ class PrincipledBSDF:
 
         self.base = np.maximum(base_color, 0.0)         # Cycles: diffuse is not clamped
         self.base_clamped = np.minimum(self.base, 1.0)  # ... metal F0 and glass tint are
-        self.alpha = mf.clamp_alpha(rough * rough)
+        # GGX alpha of the material, from which the energy compensation and the layering
+        # are computed, and of the lobes, which Filter Glossy may widen afterwards as
+        # Cycles' closure blur does (`filter_alpha`: a per-point lower bound, 0 = none)
+        self.material_alpha = mf.clamp_alpha(rough * rough)
+        self.alpha = (self.material_alpha if filter_alpha is None else
+                      mf.clamp_alpha(np.maximum(self.material_alpha, param(filter_alpha, 0.0))))
         # Reflection lobes with the lecture's Blinn-Phong distribution instead of GGX, at
         # the exponent matching alpha (Walter et al. 2007: n = 2 / alpha^2 - 2).
         self.blinn = (np.zeros(n, bool) if blinn_phong is None
@@ -160,18 +165,19 @@ class PrincipledBSDF:
 
     @classmethod
     def from_materials(cls, table: "MaterialTable", index: np.ndarray,
-                       front_facing=None, uv=None) -> "PrincipledBSDF":
+                       front_facing=None, uv=None, filter_alpha=None) -> "PrincipledBSDF":
         """The BSDFs of hits on materials `index` (n,); uv (n, 2) are the hits' texture
         coordinates (`SurfaceHit.uv`), used where a material's base colour, metallic or
         roughness is textured. Lobe colours that are not Principled's own (a Glossy BSDF's
         colour as the metal F0, a Glass BSDF's colour as the refraction tint) replace the
-        ones derived from the base colour; the lobe maths is unchanged."""
+        ones derived from the base colour; the lobe maths is unchanged. filter_alpha (n,):
+        Filter Glossy's lower bound on the lobes' GGX alpha at each hit (None: none)."""
         index = np.asarray(index, dtype=np.int64)
         base = table.base_color_at(index, uv)
         bsdf = cls(base, table.metallic_at(index, uv), table.transmission[index],
                    table.roughness_at(index, uv), table.ior[index],
                    table.specular_ior_level[index], front_facing,
-                   table.blinn_phong[index], table.multiscatter[index])
+                   table.blinn_phong[index], table.multiscatter[index], filter_alpha)
         if table.has_metal_color.any():
             own = table.has_metal_color[index]
             if own.any():
@@ -248,8 +254,9 @@ class PrincipledBSDF:
         single-scattering albedo (layer_albedo.py; times the factor), so the layering
         creates no energy where the estimate falls short (IOR < 1 near the critical
         angle). Blinn-Phong, which Cycles does not have: that actual albedo."""
-        exact = specular_albedo(cos_o[r], self.alpha[r], self.eta_spec[r])
-        e = ms.layer_reflectance(cos_o[r], self.alpha[r], self.eta_spec[r])
+        a = self.material_alpha[r]
+        exact = specular_albedo(cos_o[r], a, self.eta_spec[r])
+        e = ms.layer_reflectance(cos_o[r], a, self.eta_spec[r])
         if comp is not None:
             e = e * comp[r, 7]
         e = np.maximum(e, exact)
@@ -268,8 +275,8 @@ class PrincipledBSDF:
         on = self.weight > 0
         r = np.nonzero(self.multiscatter & (on[:, L_SPECULAR] | on[:, L_METAL]))[0]
         if len(r):
-            E = ms.ggx_albedo(cos_o[r], self.alpha[r])
-            E_avg = ms.ggx_albedo_avg(self.alpha[r])
+            E = ms.ggx_albedo(cos_o[r], self.material_alpha[r])
+            E_avg = ms.ggx_albedo_avg(self.material_alpha[r])
             comp[r, 7] = E
             spec = on[r, L_SPECULAR]
             comp[r[spec], 0] = ms.compensation(E[spec], E_avg[spec],
@@ -283,8 +290,8 @@ class PrincipledBSDF:
             eta = self.eta_glass[r]
             eta_rel = np.where(wo[r, 2] < 0, 1.0 / eta, eta)
             c = np.minimum(np.abs(wo[r, 2]), 1.0)
-            E = ms.glass_albedo(c, self.alpha[r], eta_rel)
-            E_avg = ms.glass_albedo_avg(self.alpha[r], eta_rel)
+            E = ms.glass_albedo(c, self.material_alpha[r], eta_rel)
+            E_avg = ms.glass_albedo_avg(self.material_alpha[r], eta_rel)
             comp[r, 4:7] = ms.compensation(E[:, None], E_avg[:, None], self.tint_t[r])
         return comp
 

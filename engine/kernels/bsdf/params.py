@@ -2,8 +2,9 @@
 `pack_materials`, which turns a `MaterialTable` into one float64 row per material.
 
 A row holds each material's plain (un-textured) values; where a material is textured the
-integrator overwrites P_BASE / P_METALLIC / P_ROUGHNESS in a per-hit copy of the row, so
-`principled.setup` reads everything from the row and nothing from the table.
+integrator overwrites P_BASE / P_METALLIC / P_ROUGHNESS in a per-hit copy of the row, and
+Filter Glossy may set P_FILTER_ALPHA there (0 in the packed rows), so `principled.setup`
+reads everything from the row and nothing from the table.
 """
 from __future__ import annotations
 
@@ -20,7 +21,9 @@ P_HAS_METAL_COLOR = 11   # 0 / 1
 P_GLASS_COLOR = 12       # 3 columns: the refraction tint when P_HAS_GLASS_COLOR is 1
 P_HAS_GLASS_COLOR = 15   # 0 / 1
 P_GLOSSY_MODEL = 16      # GLOSSY_GGX, GLOSSY_BLINN_PHONG or GLOSSY_MULTI_GGX
-NPARAM = 17
+P_FILTER_ALPHA = 17      # per hit, 0 in the material rows: Filter Glossy's smallest GGX
+#                          alpha for the microfacet lobes (see principled.setup)
+NPARAM = 18
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1

@@ -29,7 +29,8 @@ from .albedo import specular_albedo
 from .params import (GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
                      NPARAM, P_BASE,
                      P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
-                     P_HAS_METAL_COLOR, P_IOR, P_METAL_COLOR, P_METALLIC, P_ROUGHNESS,
+                     P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR, P_METAL_COLOR, P_METALLIC,
+                     P_ROUGHNESS,
                      P_SPEC_LEVEL, P_TRANSMISSION, pack_materials)
 from .tables import kernel_tables  # noqa: F401  (re-exported)
 from ..warp import INV_PI, cosine_hemisphere
@@ -73,9 +74,12 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     ior = max(row[P_IOR], 1e-5)
     level = max(row[P_SPEC_LEVEL], 0.0)
     alpha = mf.clamp_alpha(rough * rough)
-    state[S_ALPHA] = alpha
+    # Filter Glossy widens the lobes after setup, as Cycles' closure blur does: the energy
+    # compensation and the layering below keep the material's own alpha
+    lobe_alpha = mf.clamp_alpha(max(alpha, row[P_FILTER_ALPHA]))
+    state[S_ALPHA] = lobe_alpha
     state[S_BLINN] = 1.0 if row[P_GLOSSY_MODEL] == GLOSSY_BLINN_PHONG else 0.0
-    state[S_EXPONENT] = max(2.0 / (alpha * alpha) - 2.0, 0.0)
+    state[S_EXPONENT] = max(2.0 / (lobe_alpha * lobe_alpha) - 2.0, 0.0)
     base_w = (1.0 - m) * (1.0 - t)
     # specular layer: F0 scaled by 2 * level, IOR recomputed from it
     f0 = fresnel.f0_from_ior(ior) * 2.0 * level
@@ -87,7 +91,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     spec_on = f0 > 0.0 and abs(eta_spec - 1.0) > 1e-7
     eta_glass = ior if front_facing else 1.0 / ior
     state[S_ETA_GLASS] = eta_glass
-    state[S_GLASS_SMOOTH] = 1.0 if dielectric.is_smooth(alpha, eta_glass) else 0.0
+    state[S_GLASS_SMOOTH] = 1.0 if dielectric.is_smooth(lobe_alpha, eta_glass) else 0.0
     has_metal = row[P_HAS_METAL_COLOR] != 0.0
     has_glass = row[P_HAS_GLASS_COLOR] != 0.0
     diffuse_max = 0.0
