@@ -7,29 +7,29 @@ Checks (`compare`, in the style of tests/test_scenes_vs_cycles.py): the image me
 agree within MEAN_TOLERANCE = 1 % per channel, and every 8 x 8 block mean within
 BLOCK_TOLERANCE = 3 % of the image mean.
 
-Light paths. Cycles' Filter Glossy (default 1) widens glossy lobes after a bounce whose
-pdf was below 1; DRT has it too, but applies it before the BSDF setup (see
-FILTER_GLOSSY_ORDER), which matters to the energy compensation, so the comparisons
-avoid the paths where it acts or turn it off:
-  * `test_metal_spheres_match_cycles`: Cycles' defaults except the bounce limits: two
-    bounces in total, no diffuse bounce, so the light reaches the camera directly or
-    after one or two glossy bounces (the plane seen in the spheres, the spheres in each
-    other); Filter Glossy acts only on sphere-to-sphere paths, which this test measures:
-    Cycles with Filter Glossy 0 differs from Cycles at 1 by 0.2 % (mean) and 1.3 % (worst
-    block). Measured, DRT Multiscatter GGX: mean 0.04 %, worst block 1.1 %. With DRT's
-    previous single-scattering GGX (the same scene with the distribution set to GGX):
-    mean -4.4 % (red; -1.9 % green, -1.4 % blue), worst block 38 % (the rough spheres):
-    it fails both checks (`test_single_scatter_fails_the_comparison`).
-    Why not one bounce: at its last bounce DRT samples only the lamp, not the BSDF (a
-    noisier estimator of the same value), which leaves the lamp's highlight in the
-    smooth spheres seen in their neighbours about 6 % low in a block at these samples,
-    for single and multiple scattering alike; with two bounces that path is not the last.
-  * `test_metal_spheres_match_cycles_without_filter_glossy`: every light path at
-    Cycles' defaults, with Filter Glossy 0 in both engines (scene.cycles.blur_glossy,
-    which DRT reads). Measured: mean -0.1 %, worst block 1.1 %.
-  * `test_metal_spheres_match_cycles_at_the_defaults` (Filter Glossy 1 in both): an
-    expected failure (strict) until DRT's Filter Glossy widens the lobes after the BSDF
-    setup as Cycles does (FILTER_GLOSSY_ORDER below); it passes with that change.
+Light paths:
+  * `test_metal_spheres_match_cycles_at_the_defaults`: everything at Blender's defaults
+    (12 bounces, 4 diffuse, Filter Glossy 1, caustics, clamps). Measured: mean -0.07 %,
+    worst block 1.05 %. This needs Filter Glossy to widen only the lobes, after the BSDF
+    setup, as Cycles' closure blur does (its energy compensation and layering keep the
+    material's roughness): widening the material's roughness before the setup, as DRT
+    did at first, gave +0.97 % (red) and 3.3 %.
+  * `test_metal_spheres_match_cycles_without_filter_glossy`: the same with Filter Glossy
+    0 in both engines (scene.cycles.blur_glossy, which DRT reads). Measured: mean
+    -0.1 %, worst block 1.1 %.
+  * `test_metal_spheres_match_cycles`: direct light and the light one or two glossy
+    bounces carry (two bounces in total, no diffuse bounce: the plane seen in the
+    spheres, the spheres in each other), where Filter Glossy hardly acts: Cycles with
+    Filter Glossy 0 differs from Cycles at 1 by 0.2 % (mean) and 1.3 % (worst block),
+    which this test checks. Measured, DRT Multiscatter GGX: mean 0.04 %, worst block
+    1.1 %. With DRT's previous single-scattering GGX (the same scene with the
+    distribution set to GGX): mean -4.4 % (red; -1.9 % green, -1.4 % blue), worst block
+    38 % (the rough spheres): it fails both checks
+    (`test_single_scatter_fails_the_comparison`). Why not one bounce: at its last bounce
+    DRT samples only the lamp, not the BSDF (a noisier estimator of the same value),
+    which leaves the lamp's highlight in the smooth spheres seen in their neighbours
+    about 6 % low in a block at these samples, for single and multiple scattering
+    alike; with two bounces that path is not the last.
 
 The Principled layering per distribution (`test_plastic_layering_matches_cycles`): a
 plastic sphere (base colour 0.8, default specular) in a white world, the mean over the
@@ -48,14 +48,6 @@ import pytest
 
 from conftest import render_current
 
-FILTER_GLOSSY_ORDER = (
-    "DRT's Filter Glossy (engine/kernels/path_vertex.prepare_closures) raises the "
-    "material's roughness before the BSDF setup, so the energy compensation and the "
-    "layering use the widened alpha, where Cycles widens the closure after its setup "
-    "(surface_shader_prepare_closures after the closures' preserve_energy). Measured: "
-    "mean +0.97 % (red), worst block 3.3 %. With prepare_closures writing the widened "
-    "alpha to row[P_FILTER_ALPHA] (principled.setup keeps the material's alpha for the "
-    "compensation) instead of row[P_ROUGHNESS]: mean -0.07 %, worst block 1.05 %.")
 MEAN_TOLERANCE = 0.01
 PLASTIC_TOLERANCE = 0.005
 BLOCK_TOLERANCE = 0.03
@@ -199,7 +191,6 @@ def test_metal_spheres_match_cycles_without_filter_glossy(bpy_drt):
     assert block <= BLOCK_TOLERANCE, block
 
 
-@pytest.mark.xfail(strict=True, reason=FILTER_GLOSSY_ORDER)
 def test_metal_spheres_match_cycles_at_the_defaults(bpy_drt):
     """Every light path at Blender's defaults, Filter Glossy 1 in both engines."""
     cycles = _render(bpy_drt, "CYCLES", DEFAULT_BOUNCES)

@@ -24,7 +24,7 @@ from . import lights as lt
 from .bsdf import principled as bsdf
 from .frame import dot, to_local, to_world
 from .jit import kernel
-from .bsdf.params import P_BASE, P_METALLIC, P_ROUGHNESS
+from .bsdf.params import P_BASE, P_FILTER_ALPHA, P_METALLIC, P_ROUGHNESS
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import apply_to_row, emission_at
 
@@ -99,7 +99,9 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
     Filter Glossy (cfg[11], Cycles' `blur_glossy`; 0 = off): after bounces that were
     unlikely (the smallest BSDF pdf along the path, min_pdf, below blur_glossy), every
     microfacet lobe is widened to at least GGX alpha = 0.5 sqrt(1 - min_pdf /
-    blur_glossy). A bias that trades sharp caustics and fireflies for blur.
+    blur_glossy). A bias that trades sharp caustics and fireflies for blur. As in Cycles,
+    whose closure blur follows the closures' setup, only the lobes widen: the energy
+    compensation and the layering keep the material's alpha (row[P_FILTER_ALPHA]).
 
     Caustics (cfg[12] reflective, cfg[13] refractive; 1 = on): with one off, a hit of a
     ray that left a diffuse bounce has no glossy reflection (resp. refraction) lobes.
@@ -110,7 +112,7 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
         blur_pdf = min_pdf / blur
         if blur_pdf < 1.0:
             alpha = 0.5 * math.sqrt(1.0 - blur_pdf)
-            row[P_ROUGHNESS] = max(row[P_ROUGHNESS], math.sqrt(alpha))   # alpha = r^2
+            row[P_FILTER_ALPHA] = alpha     # the lobes only (principled.setup)
     after_diffuse = ray_bit == DIFFUSE_BIT
     return (cfg[12] != 0.0 or not after_diffuse), (cfg[13] != 0.0 or not after_diffuse)
 
