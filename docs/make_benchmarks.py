@@ -229,9 +229,12 @@ def main():
     skip = set(args.skip.split(",")) - {""}
     q = args.quick
     cores = os.cpu_count() or 1
+    load = os.getloadavg()[0]
     lines = ["# Benchmarks", "",
              "Written by `docs/make_benchmarks.py`; rerun it to reproduce. Machine: "
-             f"{platform.machine()}, {cores} cores, Python {platform.python_version()}.", ""]
+             f"{platform.machine()}, {cores} cores, Python {platform.python_version()}; "
+             f"load average {load:.2f} when it started (above 0.5, other work shared the "
+             "cores and the figures are pessimistic).", ""]
     targets = []
 
     if "1" not in skip:
