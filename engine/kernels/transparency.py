@@ -41,17 +41,24 @@ def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz, time):
 
 
 @kernel
-def _pass_through(geometry, prim, u, v, rd, r, t, time, travelled, tmax, out_rows, out_org,
-                  out_far, n_out):
-    """Ray r goes on beyond the triangle it hit at t, unchanged: entry n_out of out_*."""
-    dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
-    px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild_at_time(geometry, prim, u, v,
-                                                                dx, dy, dz, time)
-    travelled[r] += t
+def _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, dx, dy, dz,
+          far):
+    """Entry n_out of out_*: ray r goes on from just beyond the surface point p (geometric
+    normal g), for a remaining distance `far`."""
     ox, oy, oz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
     out_rows[n_out] = r
     out_org[n_out, 0], out_org[n_out, 1], out_org[n_out, 2] = ox, oy, oz
-    out_far[n_out] = max(tmax[r] - travelled[r], 0.0)
+    out_far[n_out] = max(far, 0.0)
+
+
+@kernel
+def _pass_through(geometry, prim, u, v, d, r, time, far, out_rows, out_org, out_far, n_out):
+    """Ray r (direction d[r]) goes on, unchanged, beyond the triangle it hit."""
+    dx, dy, dz = d[r, 0], d[r, 1], d[r, 2]
+    px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild_at_time(geometry, prim, u, v,
+                                                                dx, dy, dz, time)
+    _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, dx, dy, dz,
+          far)
 
 
 @kernel
@@ -73,9 +80,9 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
         if prim < 0:
             continue
         if tri_vis.shape[0] > 0 and not tri_vis[prim] & ray_bits[live[r]]:
-            _pass_through(geometry, prim, cur_u[i], cur_v[i], rd, r, cur_t[i],
-                          path_time[live[r]], travelled, tmax, out_rows, out_org, out_far,
-                          n_out)
+            travelled[r] += cur_t[i]
+            _pass_through(geometry, prim, cur_u[i], cur_v[i], rd, r, path_time[live[r]],
+                          tmax[r] - travelled[r], out_rows, out_org, out_far, n_out)
             n_out += 1
             continue
         if not maybe_transparent[tri_material[prim]]:
@@ -94,10 +101,8 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
         factor[r, 2] *= tcolor[m, 2]
         used[p] += 1
         travelled[r] += cur_t[i]
-        ox, oy, oz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
-        out_rows[n_out] = r
-        out_org[n_out, 0], out_org[n_out, 1], out_org[n_out, 2] = ox, oy, oz
-        out_far[n_out] = max(tmax[r] - travelled[r], 0.0)
+        _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale,
+              dx, dy, dz, tmax[r] - travelled[r])
         n_out += 1
     return n_out
 
@@ -117,13 +122,8 @@ def shadow_pass(layer, limit, rows, sd, ray_time, remaining, cur_t, cur_prim, cu
         if prim < 0 or not cur_t[i] < remaining[i]:
             continue
         if tri_vis.shape[0] > 0 and not tri_vis[prim] & SHADOW_BIT:
-            dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
-            px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild_at_time(
-                geometry, prim, cur_u[i], cur_v[i], dx, dy, dz, ray_time[r])
-            ox, oy, oz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
-            out_rows[n_out] = r
-            out_org[n_out, 0], out_org[n_out, 1], out_org[n_out, 2] = ox, oy, oz
-            out_far[n_out] = max(remaining[i] - cur_t[i], 0.0)
+            _pass_through(geometry, prim, cur_u[i], cur_v[i], sd, r, ray_time[r],
+                          remaining[i] - cur_t[i], out_rows, out_org, out_far, n_out)
             n_out += 1
             continue
         if not maybe_transparent[tri_material[prim]] or layer >= limit:
@@ -137,10 +137,8 @@ def shadow_pass(layer, limit, rows, sd, ray_time, remaining, cur_t, cur_prim, cu
         trans[r, 2] *= (1.0 - a) * tcolor[m, 2]
         if not max(trans[r, 0], trans[r, 1], trans[r, 2]) > 0.0:
             continue
-        ox, oy, oz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
-        out_rows[n_out] = r
-        out_org[n_out, 0], out_org[n_out, 1], out_org[n_out, 2] = ox, oy, oz
-        out_far[n_out] = max(remaining[i] - cur_t[i], 0.0)
+        _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale,
+              dx, dy, dz, remaining[i] - cur_t[i])
         n_out += 1
     return n_out
 
