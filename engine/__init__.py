@@ -4,11 +4,12 @@ Never imports bpy. The input is an `engine.scene.Scene`, the output an `engine.f
 """
 from .film import Film
 from .render import RenderContext, RenderStats, render
-from .scene import (AreaLight, Camera, Material, PointLight, Scene, SunLight, TriangleMesh,
-                    World)
+from .scene import (AreaLight, Camera, Material, ObjectInfo, PointLight, Scene, SunLight,
+                    TriangleMesh, World)
 from .settings import RenderSettings
 from . import visibility  # noqa: E402  (the Ray Visibility bits, for exporters)
 
-__all__ = ["AreaLight", "Camera", "Film", "Material", "PointLight", "RenderContext",
+__all__ = ["AreaLight", "Camera", "Film", "Material", "ObjectInfo", "PointLight",
+           "RenderContext",
            "RenderSettings", "RenderStats", "Scene", "SunLight", "TriangleMesh", "World",
            "render"]

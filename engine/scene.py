@@ -67,19 +67,44 @@ class Material:
     roughness_texture: Optional[object] = None
     emission_texture: Optional[object] = None
     alpha_texture: Optional[object] = None
+    shader: Optional[object] = None
 
     TEXTURED = ("base_color", "metallic", "roughness", "emission", "alpha")
+
+    # shader: an engine.nodes.program.ShaderProgram whose outputs (OUTPUTS) replace the
+    # parameters they name at every hit (their plain values above are then summaries);
+    # it takes precedence over a *_texture of the same parameter.
 
     def textures(self) -> dict:
         """{parameter name: TextureInput} of the textured parameters."""
         return {k: getattr(self, k + "_texture") for k in self.TEXTURED
                 if getattr(self, k + "_texture") is not None}
 
+    def driven(self, name) -> bool:
+        """Whether parameter `name` varies per hit (a texture or a program output)."""
+        return (getattr(self, name + "_texture", None) is not None
+                or (self.shader is not None and name in self.shader.outputs))
+
     def is_emissive(self) -> bool:
-        return max(self.emission) > 0.0 or self.emission_texture is not None
+        return max(self.emission) > 0.0 or self.driven("emission")
 
     def uses_uv(self) -> bool:
-        return bool(self.textures())
+        return bool(self.textures()) or self.shader is not None
+
+
+@dataclass
+class ObjectInfo:
+    """What shader nodes read of the object a mesh instance belongs to: its transform at
+    the frame (object coordinates, the Texture Coordinate node's Normal), Object Info's
+    Color, Random and pass index, and the texture space Generated coordinates map to
+    [0, 1]^3 (centre and half-size, in object space; Blender's auto texture space is
+    the mesh's bounding box)."""
+    matrix_world: np.ndarray
+    color: tuple = (1.0, 1.0, 1.0)
+    random: float = 0.0
+    pass_index: int = 0
+    texspace_location: tuple = (0.0, 0.0, 0.0)
+    texspace_size: tuple = (1.0, 1.0, 1.0)
 
 
 @dataclass
@@ -106,6 +131,7 @@ class TriangleMesh:
     motion: Optional[object] = None
     holdout: bool = False          # Cycles' holdout: a zero-alpha hole for camera rays
     visibility: int = 31           # the ray kinds that see it (engine.visibility)
+    object_info: Optional[object] = None   # ObjectInfo, what shader nodes read of it
 
     def __post_init__(self):
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)

@@ -32,6 +32,8 @@ class SurfaceHit:
     material: np.ndarray         # (n,) int64 index into Scene.materials
     scale: np.ndarray            # (n,) float64 magnitude used for ray offsets
     uv: np.ndarray | None = None   # (n, 2) texture coordinates, None if no mesh has UVs
+    prim: np.ndarray | None = None       # (n,) the triangles hit
+    direction: np.ndarray | None = None  # (n, 3) the rays' directions
 
 
 class SurfaceBuilder:
@@ -66,6 +68,7 @@ class SurfaceBuilder:
         self.visibility = (np.concatenate([np.full(len(m.triangles), m.visibility, np.uint8)
                                            for m in ordered])
                            if any(m.visibility != 31 for m in ordered) else None)
+        self.tri_object, self.objects = _object_table(ordered)
         self.corner_normals = None
         if any(m.corner_normals is not None for m in ordered):
             parts, offset = [], 0
@@ -90,6 +93,13 @@ class SurfaceBuilder:
                 else:
                     parts.append(np.zeros((t, 3, 2), np.float32))
             self.corner_uvs = np.concatenate(parts)
+
+    def shader_rows(self, si: SurfaceHit, ray=1, depth=0) -> np.ndarray:
+        """The hit rows shader programs read (engine.nodes.context) for the hits si."""
+        from .nodes.context import hit_rows
+        obj = self.tri_object[si.prim] if self.tri_object is not None else None
+        return hit_rows(si.position, si.shading_normal, si.geometric_normal, si.direction,
+                        si.uv, si.front_facing, ray, depth, None, self.objects, obj)
 
     def _moving_vertices(self, prim, time):
         """World vertices, normal matrices (or None) of hit triangles at the rays' times."""
@@ -161,7 +171,32 @@ class SurfaceBuilder:
             # the same barycentric weights as the position: w vertex 0, u vertex 1, v vertex 2
             cu = self.corner_uvs[prim].astype(np.float64)
             uv = w * cu[:, 0] + u * cu[:, 1] + v * cu[:, 2]
-        return SurfaceHit(pos, ng_f, ns, front, self.material[prim], scale, uv)
+        return SurfaceHit(pos, ng_f, ns, front, self.material[prim], scale, uv, prim,
+                          np.asarray(ray_dirs)[index])
+
+
+def _object_table(ordered):
+    """(each triangle's object (int32), the object table (engine.nodes.context O_* rows))
+    when some mesh carries ObjectInfo (its materials run shader programs), else (None,
+    None). A mesh without it is the identity object with its bounding box as texture
+    space."""
+    if not any(getattr(m, "object_info", None) is not None for m in ordered):
+        return None, None
+    from .nodes.context import N_OBJ, object_row
+    rows = np.zeros((len(ordered), N_OBJ))
+    for k, m in enumerate(ordered):
+        info = m.object_info
+        if info is None:
+            lo, hi = (m.positions.min(0), m.positions.max(0)) if len(m.positions) else \
+                (np.zeros(3), np.ones(3))
+            rows[k] = object_row(np.eye(4), texspace_location=(lo + hi) / 2,
+                                 texspace_size=(hi - lo) / 2)
+        else:
+            rows[k] = object_row(info.matrix_world, info.color, info.random,
+                                 info.pass_index, info.texspace_location,
+                                 info.texspace_size)
+    counts = [len(m.triangles) for m in ordered]
+    return np.repeat(np.arange(len(ordered), dtype=np.int32), counts), rows
 
 
 def _unit_normals(v0, v1, v2):

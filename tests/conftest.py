@@ -40,19 +40,25 @@ def read_image_linear(bpy, path) -> np.ndarray:
     return px.reshape(h, w, 4)[::-1, :, :3].astype(np.float64)
 
 
+def use_engine(scene, engine, samples):
+    """Render `scene` with `engine` at `samples` per pixel, Cycles on the CPU without
+    denoising or adaptive sampling (so both engines take every sample)."""
+    scene.render.engine = engine
+    scene.cycles.samples = samples
+    scene.cycles.use_denoising = False
+    scene.cycles.use_adaptive_sampling = False
+    scene.cycles.device = "CPU"
+    scene.drt.samples = samples
+
+
 def render_blend(bpy, path, engine, samples, percentage=50, setup=None) -> np.ndarray:
     """Open `path`, render it with `engine` ('DRT' or 'CYCLES') and return the Combined
     pass as scene-linear float64 (h, w, 3), read back through an OpenEXR file exactly as
     Blender wrote it (so row order and the write-back path are tested too)."""
     bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
     scene = bpy.context.scene
-    scene.render.engine = engine
     scene.render.resolution_percentage = percentage
-    scene.cycles.samples = samples
-    scene.cycles.use_denoising = False
-    scene.cycles.use_adaptive_sampling = False
-    scene.cycles.device = "CPU"
-    scene.drt.samples = samples
+    use_engine(scene, engine, samples)
     if setup is not None:
         setup(scene)
     return render_current(bpy, scene)

@@ -367,25 +367,33 @@ def test_image_texture_export(bpy_drt):
     reporter = Reporter()
     m = export_material(mat, reporter)
     assert reporter.warnings == []
-    tb, te, tr = m.base_color_texture, m.emission_texture, m.roughness_texture
-    assert tb is not None and te is not None and tr is not None
-    assert tb.texture is te.texture                          # exported once
-    t = tb.texture
+    # the textured inputs are outputs of the material's program (engine.nodes)
+    prog = m.shader
+    assert set(prog.outputs) == {"base_color", "emission", "roughness"}
+    assert len(prog.images) == 2                    # the two same nodes: one Texture
+    t, tr = prog.images
     assert (t.interpolation, t.extension, t.srgb) == ("Closest", "CLIP", True)
-    assert tb.channel == "rgb" and te.scale == pytest.approx(2.0)
     # pixels as Blender stores them (8-bit: quantised to 1/255), rows bottom-up
     assert np.allclose(t.pixels[:, :, :3], CHECKER, atol=0.5 / 255)
     uv = np.array([[0.125 + 0.25 * i, 0.125 + 0.25 * j] for j in range(4) for i in range(4)])
     looked = t.lookup(uv)[:, :3].reshape(4, 4, 3)
-    assert np.allclose(looked, srgb_to_linear(np.floor(CHECKER * 255 + 0.5) / 255), atol=1e-5)
-    assert (tr.texture.srgb, tr.texture.interpolation, tr.texture.extension, tr.channel) \
-        == (False, "Linear", "EXTEND", "luminance")
-    assert tr.evaluate(np.array([[0.3, 0.7]]))[0] == pytest.approx(0.25, abs=2 / 255)
+    expected = srgb_to_linear(np.floor(CHECKER * 255 + 0.5) / 255)
+    assert np.allclose(looked, expected, atol=1e-5)
+    from engine.nodes.context import hit_rows
+    hits = hit_rows(np.zeros((16, 3)), np.tile([0.0, 0.0, 1.0], (16, 1)), uv=uv)
+    base = prog.evaluate(prog.outputs["base_color"], hits).reshape(4, 4, 3)
+    assert np.allclose(base, expected, atol=1e-5)
+    emission = prog.evaluate(prog.outputs["emission"], hits).reshape(4, 4, 3)
+    assert np.allclose(emission, 2.0 * expected, atol=1e-5)      # x Emission Strength
+    assert (tr.srgb, tr.interpolation, tr.extension) == (False, "Linear", "EXTEND")
+    rough = prog.evaluate(prog.outputs["roughness"], hit_rows(
+        np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), uv=np.array([[0.3, 0.7]])))
+    assert rough[0] == pytest.approx(0.25, abs=2 / 255)         # colour -> luminance
     # a second material with the same image, other settings: pixels still read once
     mat2, nt2 = _material(bpy, "Tex2", keep_principled=True)
     d = _image_node(nt2, img, "Linear", "REPEAT")
     nt2.links.new(d.outputs["Color"], nt2.nodes["Principled BSDF"].inputs["Base Color"])
-    t2 = export_material(mat2, reporter).base_color_texture.texture
+    t2 = export_material(mat2, reporter).shader.images[0]
     assert t2 is not t and np.shares_memory(t2.pixels, t.pixels)
 
 
@@ -520,8 +528,8 @@ def test_texture_comparison_rejects_wrong_texture_readings(texture_renders):
     def rerender(mutate):
         s = copy.deepcopy(scene)
         for m in s.materials:
-            for ti in m.textures().values():
-                ti.texture = mutate(ti.texture)
+            if m.shader is not None:
+                m.shader.images = [mutate(t) for t in m.shader.images]
         film, _ = render(s, RenderSettings(samples=16, diffuse_bounces=0))
         return film.mean()                  # row 0 at the top, like the EXR read back
 

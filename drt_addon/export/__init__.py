@@ -10,6 +10,7 @@ from .lights import export_light, object_visibility
 from .materials import export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
 from .motion import MotionExport, read_settings
+from .object_info import object_info
 from .world import export_world
 
 __all__ = ["ExportError", "RenderRegion", "Reporter", "export_scene", "render_region",
@@ -97,6 +98,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
             name = f"{obj.name}#{k}" if inst.is_instance else obj.name
             meshes.append(instance_mesh(local, inst.matrix_world.copy(), slots, name))
             meshes[-1].holdout = holdout
+            if any(materials[i].shader is not None for i in slots):
+                meshes[-1].object_info = object_info(inst, obj, inst.matrix_world)
             # an instance is seen by the rays that see both it and its instancer (Cycles)
             meshes[-1].visibility = object_visibility(obj) & (
                 object_visibility(inst.parent) if inst.is_instance and inst.parent is not None

@@ -48,18 +48,19 @@ Mix Shader
 Add Shader
     Emission + BSDF is exact (the emissions add, the BSDF stays). Two BSDFs are summed
     as a mix at 1/2 with their colours doubled (exact for the lobe colours, reported).
-Image Texture (on Base Color, Metallic, Roughness, Emission Color, Alpha, and the Color
-    of Diffuse / Glossy / Emission)
-    The image's pixels are read once per image and export (`Image.pixels`), sampled at
-    the hit's UV (the mesh's active render UV map, or the map a UV Map node names;
-    a Texture Coordinate node's UV output is the default map) with the node's
-    interpolation and extension; see `engine.textures`. 8-bit sRGB images are decoded
-    after interpolation like Cycles; float images and Non-Color data are read as they are.
-    A colour output into a scalar socket is converted with Rec.709 luminance, as Cycles
-    does. Straight-alpha images have their colour premultiplied when the Alpha output is
-    not used (Cycles associates alpha on load). Anything else linked into a socket
-    (Mapping, colour ramps, normal maps, procedural textures...) is not evaluated: the
-    socket's own value is used and the material reported.
+Linked inputs (any node graph, engine/nodes and export/nodes)
+    The graph linked to an input is compiled into the material's shader program, which
+    the engine runs at every hit (`engine.nodes`): Image, Checker and Gradient textures,
+    the colour, converter, vector and input nodes, node groups and reroutes. A graph
+    that does not depend on the hit is folded into a constant at export. Base Color,
+    Metallic, Roughness, Emission Color and Strength and Alpha (and the Color of
+    Diffuse, Glossy and Emission) vary per hit; other inputs (IOR, Transmission, the
+    Mix Shader's Fac...) take the graph's average over the unit square of UV and
+    generated coordinates when it varies (reported). A node no family translates is
+    reported and its socket keeps its own value. Images: 8-bit sRGB images are decoded
+    after interpolation like Cycles; float images and Non-Color data are read as they
+    are; straight-alpha images have their colour premultiplied when the Alpha output is
+    not used (Cycles associates alpha on load).
 
 Anything else falls back to a diffuse surface of the material's viewport colour. Every
 approximation is reported once per material, in one warning naming the material.
@@ -76,10 +77,13 @@ import numpy as np
 
 from ..engine_link import engine
 from .errors import Reporter
+from .images import image_texture as _texture, read_pixels as _read_pixels  # noqa: F401
+from .nodes import NodeCompiler
 
 textures = importlib.import_module(engine.__name__ + ".textures")
 fresnel = importlib.import_module(engine.__name__ + ".bsdf.fresnel")
-TextureInput = textures.TextureInput
+cv = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
+ve = importlib.import_module(engine.__name__ + ".nodes.vector_nodes")
 
 WHITE = (1.0, 1.0, 1.0)
 BLACK = (0.0, 0.0, 0.0)
@@ -132,10 +136,49 @@ def _linked_node(socket):
 
 
 # --------------------------------------------------------------------------- parameters
-# A parameter ("Param") is a plain value (float, or an RGB 3-tuple) or a TextureInput.
+# A parameter ("Param") is a plain value (float, or an RGB 3-tuple) or a NodeParam: a
+# value of the material's shader program, evaluated per hit.
+
+class NodeParam:
+    """A per-hit parameter: a register of the material's program (NodeCompiler)."""
+
+    def __init__(self, value, nodes):
+        self.value = value
+        self.nodes = nodes
+        self._mean = None
+
+    @property
+    def is_color(self) -> bool:
+        return self.value.width == 3
+
+    def mean(self):
+        """A summary: the average over the unit square of UV and generated coordinates."""
+        if self._mean is None:
+            self._mean = self.nodes.mean(self.value)
+        return self._mean
+
+    def scaled(self, factor, add=0.0) -> "NodeParam":
+        """factor x this + add (factor: a float or a NodeParam; add: float or triple)."""
+        return NodeParam(_affine(self.nodes, self.value, factor, add), self.nodes)
+
+
+def _affine(nodes, value, factor, add):
+    f = factor.value if isinstance(factor, NodeParam) else nodes.const(float(factor))
+    if value.width == 1 and f.width == 1:
+        return nodes.emit(cv.CV_MATH, "float", [value, f, nodes.const(float(np.mean(add))),
+                                                cv.MATH_OPS.index("MULTIPLY_ADD"), 0])
+    if value.width == 1:
+        value, f = f, value
+    out = nodes.emit(ve.VEC_MATH, "vector", [value, value, value, nodes.convert(f, "float"),
+                                             ve.VECTOR_OPS.index("SCALE")])
+    if np.any(np.asarray(add, np.float64) != 0.0):
+        a = nodes.const(tuple(np.broadcast_to(np.asarray(add, np.float64), (3,))), "vector")
+        out = nodes.emit(ve.VEC_MATH, "vector", [out, a, a, a, ve.VECTOR_OPS.index("ADD")])
+    return nodes.convert(out, "color")
+
 
 def _is_tex(p) -> bool:
-    return isinstance(p, TextureInput)
+    return isinstance(p, NodeParam)
 
 
 def _mean(p):
@@ -151,49 +194,58 @@ def _same(a, b) -> bool:
     if a is None or b is None:
         return a is b
     if _is_tex(a) or _is_tex(b):
-        return (_is_tex(a) and _is_tex(b) and a.texture is b.texture
-                and a.channel == b.channel
-                and np.allclose(a.scale, b.scale, atol=TOL)
-                and np.allclose(a.offset, b.offset, atol=TOL))
+        return _is_tex(a) and _is_tex(b) and a.value.reg == b.value.reg
     return bool(np.allclose(np.asarray(a, float), np.asarray(b, float), atol=TOL))
 
 
 def _scale(p, f):
+    """p x f; f a float or a NodeParam (then p must be a Param of the same program)."""
+    if _is_tex(f):
+        if _is_tex(p):
+            return p.scaled(f)
+        if not np.any(np.asarray(p, np.float64)):
+            return p
+        if np.ndim(p) == 0:
+            return f.scaled(float(p))
+        c = f.nodes.const(tuple(p), "color")
+        return NodeParam(_affine(f.nodes, c, f, 0.0), f.nodes)
     if _is_tex(p):
         if f == 0:
-            m = p.mean()
-            return _plain(np.zeros(len(m))) if isinstance(m, tuple) else 0.0
+            return _plain(np.zeros(3)) if p.is_color else 0.0
         return p.scaled(f)
     return _plain(np.asarray(p, np.float64) * f)
 
 
 def _lin(terms, ctx, what):
-    """sum_i w_i p_i of Params: exact while at most one texture is involved (the result
-    is then that texture scaled and offset); a second, different texture is replaced by
-    its average (reported)."""
+    """sum_i w_i p_i of Params, exact: NodeParams are summed by the program."""
     const = None
-    tex = None
+    node = None
     for w, p in terms:
-        if w == 0:
+        if w == 0 or p is None:
             continue
         if _is_tex(p):
-            if tex is None:
-                tex = p.scaled(w)
-                continue
-            if tex.texture is p.texture and tex.channel == p.channel:
-                tex = TextureInput(tex.texture, tex.channel,
-                                   _plain(np.asarray(tex.scale) + w * np.asarray(p.scale)),
-                                   _plain(np.asarray(tex.offset) + w * np.asarray(p.offset)),
-                                   tex.uv_map)
-                continue
-            ctx.issue(f"two different textures are blended into the {what}; the second "
-                      f"({p.texture.name!r}) is replaced by its average")
-            p = p.mean()
+            term = p.scaled(w)
+            if node is None:
+                node = term
+            else:
+                kind = "float" if node.value.width == 1 else "vector"
+                a = ctx.nodes.convert(node.value, kind)
+                b = ctx.nodes.convert(term.value, kind)
+                if kind == "float":
+                    s = ctx.nodes.emit(cv.CV_MATH, "float", [a, b, b, cv.MATH_OPS.index("ADD"),
+                                                             0])
+                else:
+                    s = ctx.nodes.convert(ctx.nodes.emit(ve.VEC_MATH, "vector",
+                                                         [a, b, b, b,
+                                                          ve.VECTOR_OPS.index("ADD")]),
+                                          "color")
+                node = NodeParam(s, ctx.nodes)
+            continue
         v = np.asarray(p, np.float64) * w
         const = v if const is None else const + v
-    if tex is None:
+    if node is None:
         return _plain(const) if const is not None else None
-    return tex.scaled(1.0, add=const if const is not None else 0.0)
+    return node.scaled(1.0, add=const if const is not None else 0.0)
 
 
 # --------------------------------------------------------------------------- closures
@@ -272,6 +324,7 @@ class _Ctx:
         self.name = mat.name
         self.issues = []
         self.cache = _image_caches.setdefault(reporter, {}) if reporter is not None else {}
+        self.nodes = NodeCompiler(self)
 
     def issue(self, text):
         if text not in self.issues:
@@ -295,129 +348,29 @@ def _default(sock, color):
 
 
 def _input(node, name, ctx, color, default, texturable=True):
-    """The value of input `name` of `node`: its own value, or an Image Texture's output
-    when one is linked (texturable inputs only)."""
+    """The value of input `name` of `node`: its own value when unlinked; else the node
+    graph linked to it, compiled into the material's program (engine.nodes): a constant
+    when the graph does not depend on the hit (folded now), otherwise a NodeParam that
+    the program evaluates at every hit (texturable inputs), or its average (reported)."""
     sock = node.inputs.get(name)
     if sock is None:
         return default
-    found = _link(sock)
-    if found is None:
+    if _link(sock) is None:
         return _default(sock, color)
-    src, out = found
-    if texturable and src.bl_idname == "ShaderNodeTexImage":
-        tex = _image_texture(src, out, ctx, color)
-        if tex is not None:
-            return tex
-    elif src.bl_idname in ("ShaderNodeRGB", "ShaderNodeValue"):
-        v = out.default_value
-        if color:
-            return tuple(float(x) for x in tuple(v)[:3]) if hasattr(v, "__len__") \
-                else (float(v),) * 3
-        return float(v) if not hasattr(v, "__len__") else float(
-            np.dot(np.asarray(tuple(v)[:3]), textures.LUMINANCE))
-    ctx.issue(f"the input '{name}' of {node.name!r} is connected to {src.bl_label!r}, "
-              f"which DRT does not evaluate; using the input's own value")
-    return _default(sock, color)
+    value = ctx.nodes.socket(sock, "color" if color else "float")
+    folded = ctx.nodes.fold(value)
+    if folded is not None:
+        return folded
+    param = NodeParam(value, ctx.nodes)
+    if not texturable:
+        ctx.issue(f"the input '{name}' of {node.name!r} varies per hit, which DRT does not "
+                  f"render there; using its average")
+        return param.mean()
+    return param
 
 
 def _constant(node, name, ctx, default, color=False):
     return _input(node, name, ctx, color, default, texturable=False)
-
-
-def _uv_map_of(img_node, ctx) -> str:
-    """The UV map an Image Texture reads: '' for the mesh's default (active render) map."""
-    sock = img_node.inputs.get("Vector")
-    found = _link(sock) if sock is not None else None
-    if found is None:
-        return ""
-    src, out = found
-    if src.bl_idname == "ShaderNodeUVMap":
-        return src.uv_map or ""
-    if src.bl_idname == "ShaderNodeTexCoord" and out.identifier == "UV":
-        return ""
-    ctx.issue(f"the Vector of {img_node.name!r} comes from {src.bl_label!r} "
-              f"({out.name}), which DRT does not evaluate; using the default UV map")
-    return ""
-
-
-def _image_texture(node, out, ctx, color):
-    """A TextureInput for the output `out` of Image Texture node `node` (None: use the
-    socket's own value)."""
-    if node.projection != "FLAT":
-        ctx.issue(f"{node.name!r} uses {node.projection} projection; DRT reads it as FLAT")
-    if node.interpolation not in ("Linear", "Closest"):
-        ctx.issue(f"{node.name!r} uses {node.interpolation} interpolation; DRT uses Linear")
-    alpha_out = out.identifier == "Alpha"
-    channel = ("alpha_rgb" if color else "alpha") if alpha_out else \
-        ("rgb" if color else "luminance")
-    uv_map = _uv_map_of(node, ctx)
-    image = node.image
-    if image is None:
-        # Cycles' colour for a node without a (loadable) image
-        if alpha_out:
-            return WHITE if color else 1.0
-        return MISSING if color else float(np.dot(MISSING, textures.LUMINANCE))
-    alpha_linked = any(o.is_linked for o in node.outputs if o.identifier == "Alpha")
-    tex = _texture(image, node, ctx, premultiply=not alpha_linked)
-    if tex is None:
-        if alpha_out:
-            return WHITE if color else 1.0
-        return MISSING if color else float(np.dot(MISSING, textures.LUMINANCE))
-    return TextureInput(tex, channel, 1.0, 0.0, uv_map)
-
-
-def _read_pixels(image, ctx):
-    """(H, W, 4) float32 RGBA as Blender stores them, rows bottom-up, or None."""
-    key = ("pixels", image.name_full)
-    if key in ctx.cache:
-        return ctx.cache[key]
-    px = None
-    try:
-        if image.source == "TILED":
-            ctx.issue(f"image {image.name!r} is a UDIM tiled image; DRT reads its first "
-                      f"tile only")
-        elif image.source in ("SEQUENCE", "MOVIE"):
-            ctx.issue(f"image {image.name!r} is a {image.source.lower()}; DRT reads the "
-                      f"frame Blender has loaded")
-        w, h = image.size[0], image.size[1]
-        c = image.channels
-        if w > 0 and h > 0 and c > 0:
-            flat = np.empty(w * h * c, dtype=np.float32)
-            image.pixels.foreach_get(flat)
-            px = flat.reshape(h, w, c)
-    except (RuntimeError, ValueError, AttributeError):
-        px = None
-    if px is None:
-        ctx.issue(f"image {image.name!r} has no pixels (missing file?); rendered pink "
-                  f"like Cycles")
-    ctx.cache[key] = px
-    return px
-
-
-def _texture(image, node, ctx, premultiply):
-    """One engine Texture per (image, interpolation, extension, premultiplied) per export;
-    the pixel array is read once per image and shared."""
-    cs = image.colorspace_settings
-    is_data = bool(getattr(cs, "is_data", False)) or cs.name == "Non-Color"
-    srgb = (not image.is_float) and cs.name == "sRGB" and not is_data
-    if not is_data and not srgb and not image.is_float and cs.name not in (
-            "Linear Rec.709", "Working Space", "Linear", "Raw"):
-        ctx.issue(f"image {image.name!r} is in the colour space {cs.name!r}, which DRT "
-                  f"reads as scene-linear")
-    premultiply = premultiply and not is_data and image.alpha_mode in ("STRAIGHT",)
-    interp = node.interpolation if node.interpolation in ("Linear", "Closest") else "Linear"
-    key = ("texture", image.name_full, interp, node.extension, srgb, premultiply)
-    if key in ctx.cache:
-        return ctx.cache[key]
-    px = _read_pixels(image, ctx)
-    tex = None
-    if px is not None:
-        if premultiply and px.shape[2] == 4 and (px[:, :, 3] < 1.0).any():
-            px = px.copy()
-            px[:, :, :3] *= px[:, :, 3:4]
-        tex = textures.Texture(px, interp, node.extension, srgb=srgb, name=image.name)
-    ctx.cache[key] = tex
-    return tex
 
 
 # --------------------------------------------------------------------------- nodes
@@ -547,11 +500,14 @@ def _mix_factor(node, ctx):
         ctx.issue(f"the Fac of {node.name!r} is Layer Weight's Facing, which depends on the "
                   f"view angle; DRT uses its hemispherical average")
         return 1.0 - 2.0 / (b + 2.0), None
-    if src.bl_idname == "ShaderNodeValue":
-        return float(np.clip(out.default_value, 0.0, 1.0)), None
-    ctx.issue(f"the Fac of {node.name!r} comes from {src.bl_label!r}, which DRT does not "
-              f"evaluate; using the Fac's own value")
-    return float(np.clip(sock.default_value, 0.0, 1.0)), None
+    value = ctx.nodes.socket(sock, "float")
+    folded = ctx.nodes.fold(value)
+    if folded is not None:
+        return float(np.clip(folded, 0.0, 1.0)), None
+    mean = float(np.clip(ctx.nodes.mean(value), 0.0, 1.0))
+    ctx.issue(f"the Fac of {node.name!r} varies per hit ({src.bl_label!r}); DRT mixes the "
+              f"shaders by its average {mean:.3f}")
+    return mean, None
 
 
 def _plastic(a: _Closure, b: _Closure, ior, fac, ctx):
@@ -691,7 +647,7 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
 
 def _set(m, attr, value):
     if _is_tex(value):
-        setattr(m, attr + "_texture", value)
+        value.nodes.b.output(attr, value.value)
         mean = value.mean()
         setattr(m, attr, tuple(mean) if isinstance(mean, tuple) else float(mean))
     else:
@@ -766,13 +722,27 @@ def _blend(comps, ctx) -> dict:
 
 
 # --------------------------------------------------------------------------- entry points
+def _all_nodes(tree, seen=None):
+    """The nodes of a tree and of the node groups in it (each group once)."""
+    seen = set() if seen is None else seen
+    for n in tree.nodes:
+        yield n
+        sub = getattr(n, "node_tree", None) if n.bl_idname == "ShaderNodeGroup" else None
+        if sub is not None and sub.name_full not in seen:
+            seen.add(sub.name_full)
+            yield from _all_nodes(sub, seen)
+
+
+UV_READERS = {"ShaderNodeTexImage", "ShaderNodeUVMap", "ShaderNodeTexCoord"}
+
+
 def material_uv_maps(mat) -> Optional[set]:
-    """The UV maps a material's image textures read ('' = the mesh's default map), or None
-    when it has no image texture (its meshes then need no UVs)."""
+    """The UV maps a material's nodes may read ('' = the mesh's default map), or None
+    when no node reads UVs (its meshes then need no UVs)."""
     if mat is None or not uses_nodes(mat):
         return None
-    nodes = mat.node_tree.nodes
-    if not any(n.bl_idname == "ShaderNodeTexImage" for n in nodes):
+    nodes = list(_all_nodes(mat.node_tree))
+    if not any(n.bl_idname in UV_READERS for n in nodes):
         return None
     names = {n.uv_map for n in nodes if n.bl_idname == "ShaderNodeUVMap" and n.uv_map}
     return names or {""}
@@ -802,6 +772,8 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
         if disp is not None and _link(disp) is not None:
             ctx.issue("its displacement is not rendered")
         result = _reduce(_closure(out.inputs["Surface"], ctx), ctx, name)
+        if ctx.nodes.b.outputs:
+            result.shader = ctx.nodes.build()
     if ctx.issues and reporter is not None:
         reporter.warn(f"DRT: material {name!r}: " + "; ".join(ctx.issues),
                       key=(name, "material"))

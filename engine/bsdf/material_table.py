@@ -65,8 +65,23 @@ class MaterialTable:
                     if t is not None and id(t.texture) not in self.texture_index:
                         self.texture_index[id(t.texture)] = len(self.textures)
                         self.textures.append(t.texture)
+        # Shader programs (engine.nodes): their images join the texture list; a program
+        # output makes its parameter per-hit for that material.
+        self.programs = [getattr(m, "shader", None) for m in materials]
+        for p in self.programs:
+            for t in (p.images if p is not None else ()):
+                if id(t) not in self.texture_index:
+                    self.texture_index[id(t)] = len(self.textures)
+                    self.textures.append(t)
+        self.programmed = {name: np.array([p is not None and name in p.outputs
+                                           for p in self.programs], bool)
+                           for name in self.PARAMS}
+        self.programmed = {k: v for k, v in self.programmed.items() if v.any()}
+        self._shading = None
         self.textured = {name: np.array([t is not None for t in inputs], bool)
                          for name, inputs in self._inputs.items()}
+        for name, flags in self.programmed.items():
+            self.textured[name] = self.textured.get(name, np.zeros(len(materials), bool)) | flags
         emission = np.array([m.emission[:3] for m in materials], dtype=np.float64)
         for name, arr in (("base_color", self.base_color), ("metallic", self.metallic),
                           ("roughness", self.roughness), ("ior", self.ior),
@@ -96,14 +111,29 @@ class MaterialTable:
     def any_textures(self) -> bool:
         return bool(self.textures)
 
+    @property
+    def any_programs(self) -> bool:
+        return any(p is not None for p in self.programs)
+
+    def shading(self) -> tuple:
+        """The packed textures and programs (engine.nodes.pack.pack_shading), once."""
+        if self._shading is None:
+            from ..nodes.pack import pack_shading
+            self._shading = pack_shading(self)
+        return self._shading
+
     def _constant(self, name):
         return self.emission if name == "emission" else getattr(self, name)
 
-    def lookup(self, name, index, uv=None) -> np.ndarray:
+    def lookup(self, name, index, uv=None, hits=None) -> np.ndarray:
         """Parameter `name` (one of PARAMS) at hits of materials `index` (n,) with texture
         coordinates uv (n, 2) (None: the mesh has no UVs, read as (0, 0) like Cycles'
-        missing UV attribute). Returns (n, 3) for colours, (n,) for scalars; a fresh array."""
+        missing UV attribute). hits: the (n, engine.nodes.context.N_HIT) rows shader
+        programs read (None: built from uv alone, the rest neutral). Returns (n, 3) for
+        colours, (n,) for scalars; a fresh array."""
         index = np.asarray(index, dtype=np.int64)
+        if name in self.programmed and len(index):
+            return self._programmed_lookup(name, index, uv, hits)
         if name == "emission":
             out = np.where(self.emission_textured[index][:, None], 0.0, self.emission[index])
         else:
@@ -122,22 +152,55 @@ class MaterialTable:
             out[r] = inputs[k].evaluate(uv[r])
         return out
 
-    def emission_at(self, index, uv=None) -> np.ndarray:
+    def _programmed_lookup(self, name, index, uv, hits):
+        from ..nodes.context import hit_rows
+        from ..nodes.interpreter import evaluate_materials
+        from ..nodes.pack import OUTS
+        from ..nodes.program import OUTPUTS
+        rows = np.nonzero(self.programmed[name][index])[0]
+        rest = np.nonzero(~self.programmed[name][index])[0]
+        colour = name in ("base_color", "emission")
+        out = np.zeros((len(index), 3)) if colour else np.zeros(len(index))
+        if rest.size:
+            out[rest] = self.lookup_plain(name, index[rest], None if uv is None else uv[rest])
+        if hits is None:
+            n = len(index)
+            uv2 = np.zeros((n, 2)) if uv is None else uv
+            hits = hit_rows(np.zeros((n, 3)), np.tile([0.0, 0.0, 1.0], (n, 1)), uv=uv2)
+        T = self.shading()
+        regs = evaluate_materials(T, index[rows], hits[rows])
+        reg = T[OUTS][index[rows], OUTPUTS.index(name)]
+        if colour:
+            out[rows] = np.stack([regs[np.arange(len(rows)), reg + k] for k in range(3)], 1)
+        else:
+            out[rows] = regs[np.arange(len(rows)), reg]
+        return out
+
+    def lookup_plain(self, name, index, uv=None) -> np.ndarray:
+        """`lookup` without programs (their plain values and textures)."""
+        programmed = self.programmed.pop(name, None)
+        try:
+            return self.lookup(name, index, uv)
+        finally:
+            if programmed is not None:
+                self.programmed[name] = programmed
+
+    def emission_at(self, index, uv=None, hits=None) -> np.ndarray:
         """Emitted radiance (n, 3) of the hits' materials, textures evaluated."""
-        return self.lookup("emission", index, uv)
+        return self.lookup("emission", index, uv, hits)
 
-    def alpha_at(self, index, uv=None) -> np.ndarray:
+    def alpha_at(self, index, uv=None, hits=None) -> np.ndarray:
         """Coverage (n,) in [0, 1]: 1 - the probability that a ray passes through."""
-        return np.clip(self.lookup("alpha", index, uv), 0.0, 1.0)
+        return np.clip(self.lookup("alpha", index, uv, hits), 0.0, 1.0)
 
-    def base_color_at(self, index, uv=None) -> np.ndarray:
-        return self.lookup("base_color", index, uv)
+    def base_color_at(self, index, uv=None, hits=None) -> np.ndarray:
+        return self.lookup("base_color", index, uv, hits)
 
-    def metallic_at(self, index, uv=None) -> np.ndarray:
-        return self.lookup("metallic", index, uv)
+    def metallic_at(self, index, uv=None, hits=None) -> np.ndarray:
+        return self.lookup("metallic", index, uv, hits)
 
-    def roughness_at(self, index, uv=None) -> np.ndarray:
-        return self.lookup("roughness", index, uv)
+    def roughness_at(self, index, uv=None, hits=None) -> np.ndarray:
+        return self.lookup("roughness", index, uv, hits)
 
     def metal_color_at(self, index, base_color) -> np.ndarray:
         """The metal lobe's F0 per hit: the explicit metal colour, else the base colour

@@ -165,17 +165,18 @@ class PrincipledBSDF:
 
     @classmethod
     def from_materials(cls, table: "MaterialTable", index: np.ndarray,
-                       front_facing=None, uv=None, filter_alpha=None) -> "PrincipledBSDF":
+                       front_facing=None, uv=None, filter_alpha=None,
+                       hits=None) -> "PrincipledBSDF":
         """The BSDFs of hits on materials `index` (n,); uv (n, 2) are the hits' texture
         coordinates (`SurfaceHit.uv`), used where a material's base colour, metallic or
-        roughness is textured. Lobe colours that are not Principled's own (a Glossy BSDF's
+        roughness is textured; hits: the rows its shader programs read (None: from uv). Lobe colours that are not Principled's own (a Glossy BSDF's
         colour as the metal F0, a Glass BSDF's colour as the refraction tint) replace the
         ones derived from the base colour; the lobe maths is unchanged. filter_alpha (n,):
         Filter Glossy's lower bound on the lobes' GGX alpha at each hit (None: none)."""
         index = np.asarray(index, dtype=np.int64)
-        base = table.base_color_at(index, uv)
-        bsdf = cls(base, table.metallic_at(index, uv), table.transmission[index],
-                   table.roughness_at(index, uv), table.ior[index],
+        base = table.base_color_at(index, uv, hits)
+        bsdf = cls(base, table.metallic_at(index, uv, hits), table.transmission[index],
+                   table.roughness_at(index, uv, hits), table.ior[index],
                    table.specular_ior_level[index], front_facing,
                    table.blinn_phong[index], table.multiscatter[index], filter_alpha)
         if table.has_metal_color.any():

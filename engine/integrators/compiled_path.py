@@ -24,7 +24,7 @@ from ..kernels import lights as klights
 from ..kernels.bsdf import principled as kbsdf
 from ..kernels.path_vertex import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
                                    add_unoccluded, shade)
-from ..kernels.textures import pack_textures
+from ..nodes.context import N_OBJ
 from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
 from ..sampling.dispatch import pixel_keys
 from .path import MIS_MODES
@@ -63,10 +63,12 @@ class CompiledPathIntegrator:
                          _or_empty(surf.corner_normals, (0, 3, 3), np.float32),
                          _or_empty(surf.holdout, 0, bool),
                          _or_empty(surf.corner_uvs, (0, 3, 2), np.float32),
-                         ctx.accel.motion)
+                         ctx.accel.motion,
+                         _or_empty(surf.tri_object, 0, np.int32),
+                         _or_empty(surf.objects, (0, N_OBJ), np.float64))
         self.params = kbsdf.pack_materials(mats)
         self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)
-        self.textures = pack_textures(mats)
+        self.textures = mats.shading()
         vis = _or_empty(surf.visibility, 0, np.uint8)
         self.materials = (surf.material, np.ascontiguousarray(mats.maybe_transparent),
                           np.ascontiguousarray(mats.alpha, dtype=np.float64),

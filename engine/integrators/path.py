@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import visibility
 from ..bsdf.lobes import TRANSMISSION
 from ..bsdf.principled import PrincipledBSDF
 from ..sampling import dimensions as D
@@ -56,6 +57,17 @@ def _clamp(values, limit):
 # Sampler dimensions of the pass-through decisions at transparent surfaces: outside the
 # per-bounce layout of engine.sampling.dimensions (so no other effect's numbers shift),
 # one per (path vertex, transparent layer).
+def _rows(mats, surfaces, si, depth, ray=None):
+    """The rows shader programs read for hits si, or None when no material has one.
+    The NumPy reference knows a ray's kind only as camera (depth 0) or not (reported as
+    a diffuse ray), unless given."""
+    if not mats.any_programs:
+        return None
+    if ray is None:
+        ray = visibility.CAMERA if depth == 0 else visibility.DIFFUSE
+    return surfaces.shader_rows(si, ray, depth)
+
+
 TRANSPARENT_DIM = 1 << 24
 
 
@@ -100,7 +112,7 @@ def intersect_alpha(ctx, o, d, tm, tp, px, ix, depth, used):
         if c.size == 0:
             break
         si = surfaces.build(cur, c, d[rows], None if tp is None else tp[rows])
-        alpha = mats.alpha_at(si.material, si.uv)
+        alpha = mats.alpha_at(si.material, si.uv, _rows(mats, surfaces, si, depth))
         u_t = ctx.sampler.get_1d(_alpha_dim(depth, layer), px[rows[c]], ix[rows[c]])
         through = u_t >= alpha
         over = through & (used[rows[c]] >= limit)
@@ -154,7 +166,8 @@ def shadow_transmittance(ctx, org, dirs, far, time=None):
             T[rows[tr]] = 0.0
             break
         si = surfaces.build(h, tr, dirs[rows], None if time is None else time[rows])
-        alpha = mats.alpha_at(si.material, si.uv)
+        alpha = mats.alpha_at(si.material, si.uv,
+                              _rows(mats, surfaces, si, 0, visibility.SHADOW))
         T[rows[tr]] *= (1.0 - alpha)[:, None] * mats.transparent_color[si.material]
         still = T[rows[tr]].max(1) > 0
         tr = tr[still]
@@ -285,8 +298,9 @@ class PathIntegrator:
             px_l, ix_l = px[live], ix[live]
             # 1c. emissive surfaces (two-sided, like Cycles' Emission shader), weighted
             # against next-event estimation of the emissive triangle that was hit
+            shader_rows = _rows(mats, ctx.surfaces, si, depth)
             if mats.any_emission:
-                em = mats.emission_at(si.material, si.uv)
+                em = mats.emission_at(si.material, si.uv, shader_rows)
                 glow = np.nonzero((em != 0).any(axis=1))[0]
                 if glow.size:
                     g_live = live[glow]
@@ -295,7 +309,8 @@ class PathIntegrator:
                     w = self._hit_weight(prev_pdf[g_live], light_pdf)
                     add(rows[glow], b_live[glow] * em[glow] * w[:, None], depth, direct=depth == 1)
 
-            bsdf = PrincipledBSDF.from_materials(mats, si.material, si.front_facing, si.uv)
+            bsdf = PrincipledBSDF.from_materials(mats, si.material, si.front_facing, si.uv,
+                                                 hits=shader_rows)
             c_live = counts[rows]
             allowed = (c_live < self.limits[None, :]) & (depth < self.max_bounces)
 

@@ -27,6 +27,10 @@ from .jit import kernel
 from .bsdf.params import P_BASE, P_FILTER_ALPHA, P_METALLIC, P_ROUGHNESS
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import apply_to_row, emission_at
+from ..nodes.context import N_HIT
+from ..nodes.interpreter import has_program
+from ..nodes.pack import NREGS
+from ..nodes.shading import apply_rows, program_emission, program_hit
 
 MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
 # Numba freezes these into its cache; the cache's fingerprint covers every engine file
@@ -128,8 +132,11 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     clamp_direct, clamp_indirect, mis mode, scene radius, film transparent, filter glossy,
     reflective caustics, refractive caustics] (see `prepare_closures`).
     geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout,
-    corner_uvs, moving objects) of every triangle (corner normals, holdout and UVs may be
-    empty; see `surface.rebuild_at_time`). path_time: each path's shutter time (its
+    corner_uvs, moving objects, triangle objects, object table) of every triangle
+    (corner normals, holdout, UVs and objects may be empty; see
+    `surface.rebuild_at_time` and engine.nodes.shading). textures: the packed textures
+    and shader programs (engine.nodes.pack.pack_shading); a material with a program
+    runs it at each hit, and its outputs replace the parameters they drive. path_time: each path's shutter time (its
     moving triangles are placed at that time). alpha: each path's film coverage, or
     empty when the film is opaque. stopped: rays that ended at the transparent bounce
     limit. ray_bits: the kind of each path's current ray (engine.visibility: CAMERA,
@@ -154,6 +161,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     n_lights = lt.n_entries(lights)
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
+    hit_row = np.zeros(N_HIT)
+    regs = np.zeros(max(textures[NREGS][0], 1))
     ns_out, nn_out = 0, 0
     base = D.FIRST_BOUNCE + depth * D.PER_BOUNCE
     for j in range(live.shape[0]):
@@ -199,8 +208,14 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             geometry, prim, hit_u[j], hit_v[j], dx, dy, dz, path_time[p])
         m = tri_material[prim]
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
+        programmed = has_program(textures, m)
+        if programmed:
+            program_hit(textures, geometry, m, prim, uu, vv, px, py, pz, gx, gy, gz, nx, ny,
+                        nz, dx, dy, dz, front, ray_bits[p], depth, t_geom, hit_row, regs)
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
         er, eg, eb = emission_at(textures, emission, m, uu, vv)
+        if programmed:
+            er, eg, eb = program_emission(textures, m, regs, er, eg, eb)
         if er != 0.0 or eg != 0.0 or eb != 0.0:
             lpdf = lt.mesh_pdf(lights, prim, prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2],
                                px, py, pz)
@@ -210,6 +225,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         row[:] = params[m]
         if any_textures:
             apply_to_row(textures, m, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
+        if programmed:
+            apply_rows(textures, m, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
         room = depth < max_bounces

@@ -58,7 +58,9 @@ def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
     moving triangle is placed as SurfaceBuilder.build places it: a rigid object's
     vertices by its transform at `time`, its corner normals by that transform's
     inverse-transpose; a deforming object's vertices from the time slice of `time`."""
-    v0, v1, v2, normal, tri_scale, _, corner_normals, _, _, M = geometry
+    v0, v1, v2, normal, tri_scale, corner_normals, M = (geometry[0], geometry[1], geometry[2],
+                                                       geometry[3], geometry[4], geometry[6],
+                                                       geometry[9])
     if prim < M.prim_start[0]:
         return rebuild(v0, v1, v2, normal, tri_scale, corner_normals, prim, u, v, dx, dy, dz)
     obj = object_of(M, prim)

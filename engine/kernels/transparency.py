@@ -14,11 +14,17 @@ ray goes on through a triangle lacking its kind's bit, a shadow ray through one 
 SHADOW, untinted and without counting a transparent bounce."""
 from __future__ import annotations
 
+import numpy as np
+
 from .. import visibility
 from ..sampling.dispatch import sample_1d
 from .jit import kernel
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import alpha_at
+from ..nodes.context import N_HIT
+from ..nodes.interpreter import has_program
+from ..nodes.pack import NREGS
+from ..nodes.shading import program_alpha, program_hit
 
 TRANSPARENT_DIM = 1 << 24      # the pass-through numbers' own dimensions (see path.py)
 SHADOW_BIT = visibility.SHADOW
@@ -30,14 +36,23 @@ def alpha_dim(depth, layer):
 
 
 @kernel
-def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz, time):
+def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz, time, ray, depth, length):
+    """Alpha of the hit (a material program's, run for a ray of kind `ray`, the path's
+    bounce depth and the hit's distance), its material and its surface point."""
     tri_material, corner_uvs = geometry[5], geometry[8]
     _, _, alpha_table, _, T, _ = materials
-    px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild_at_time(
+    px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
         geometry, prim, u, v, dx, dy, dz, time)
     uu, vv = hit_uv(corner_uvs, prim, u, v)
     m = tri_material[prim]
-    return alpha_at(T, alpha_table, m, uu, vv), m, px, py, pz, gx, gy, gz, scale
+    a = alpha_at(T, alpha_table, m, uu, vv)
+    if has_program(T, m):
+        hit = np.zeros(N_HIT)
+        regs = np.zeros(max(T[NREGS][0], 1))
+        program_hit(T, geometry, m, prim, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
+                    dx, dy, dz, front, ray, depth, length, hit, regs)
+        a = program_alpha(T, m, regs, a)
+    return a, m, px, py, pz, gx, gy, gz, scale
 
 
 @kernel
@@ -89,8 +104,9 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
             continue
         dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
         p = live[r]
-        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim, cur_u[i],
-                                                         cur_v[i], dx, dy, dz, path_time[p])
+        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(
+            geometry, materials, prim, cur_u[i], cur_v[i], dx, dy, dz, path_time[p],
+            ray_bits[p], depth, travelled[r] + cur_t[i])
         if not sample_1d(kind, pkey[p], spp, index[p], alpha_dim(depth, layer)) >= a:
             continue
         if used[p] >= limit:
@@ -130,8 +146,9 @@ def shadow_pass(layer, limit, rows, sd, ray_time, remaining, cur_t, cur_prim, cu
             trans[r, 0] = trans[r, 1] = trans[r, 2] = 0.0
             continue
         dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
-        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(geometry, materials, prim, cur_u[i],
-                                                         cur_v[i], dx, dy, dz, ray_time[r])
+        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(
+            geometry, materials, prim, cur_u[i], cur_v[i], dx, dy, dz, ray_time[r],
+            SHADOW_BIT, 0, cur_t[i])
         trans[r, 0] *= (1.0 - a) * tcolor[m, 0]
         trans[r, 1] *= (1.0 - a) * tcolor[m, 1]
         trans[r, 2] *= (1.0 - a) * tcolor[m, 2]

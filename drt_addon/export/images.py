@@ -1,0 +1,66 @@
+"""Blender images as engine Textures, once per export: the pixels of an image are read
+once (`Image.pixels`) and shared by every Texture made of it (one per interpolation,
+extension, colour space and premultiplication)."""
+from __future__ import annotations
+
+import importlib
+
+import numpy as np
+
+from ..engine_link import engine
+
+textures = importlib.import_module(engine.__name__ + ".textures")
+
+
+def read_pixels(image, ctx):
+    """(H, W, 4) float32 RGBA as Blender stores them, rows bottom-up, or None."""
+    key = ("pixels", image.name_full)
+    if key in ctx.cache:
+        return ctx.cache[key]
+    px = None
+    try:
+        if image.source == "TILED":
+            ctx.issue(f"image {image.name!r} is a UDIM tiled image; DRT reads its first "
+                      f"tile only")
+        elif image.source in ("SEQUENCE", "MOVIE"):
+            ctx.issue(f"image {image.name!r} is a {image.source.lower()}; DRT reads the "
+                      f"frame Blender has loaded")
+        w, h = image.size[0], image.size[1]
+        c = image.channels
+        if w > 0 and h > 0 and c > 0:
+            flat = np.empty(w * h * c, dtype=np.float32)
+            image.pixels.foreach_get(flat)
+            px = flat.reshape(h, w, c)
+    except (RuntimeError, ValueError, AttributeError):
+        px = None
+    if px is None:
+        ctx.issue(f"image {image.name!r} has no pixels (missing file?); rendered pink "
+                  f"like Cycles")
+    ctx.cache[key] = px
+    return px
+
+
+def image_texture(image, node, ctx, premultiply):
+    """One engine Texture per (image, interpolation, extension, premultiplied) per export;
+    the pixel array is read once per image and shared."""
+    cs = image.colorspace_settings
+    is_data = bool(getattr(cs, "is_data", False)) or cs.name == "Non-Color"
+    srgb = (not image.is_float) and cs.name == "sRGB" and not is_data
+    if not is_data and not srgb and not image.is_float and cs.name not in (
+            "Linear Rec.709", "Working Space", "Linear", "Raw"):
+        ctx.issue(f"image {image.name!r} is in the colour space {cs.name!r}, which DRT "
+                  f"reads as scene-linear")
+    premultiply = premultiply and not is_data and image.alpha_mode in ("STRAIGHT",)
+    interp = node.interpolation if node.interpolation in ("Linear", "Closest") else "Linear"
+    key = ("texture", image.name_full, interp, node.extension, srgb, premultiply)
+    if key in ctx.cache:
+        return ctx.cache[key]
+    px = read_pixels(image, ctx)
+    tex = None
+    if px is not None:
+        if premultiply and px.shape[2] == 4 and (px[:, :, 3] < 1.0).any():
+            px = px.copy()
+            px[:, :, :3] *= px[:, :, 3:4]
+        tex = textures.Texture(px, interp, node.extension, srgb=srgb, name=image.name)
+    ctx.cache[key] = tex
+    return tex

@@ -1,0 +1,131 @@
+"""Input nodes to program operations (engine.nodes.input_nodes): Texture Coordinate,
+UV Map, Geometry, Object Info, Value, RGB, Fresnel, Layer Weight, Light Path."""
+from __future__ import annotations
+
+import importlib
+
+from ...engine_link import engine
+from .errors import Unsupported
+
+I = importlib.import_module(engine.__name__ + ".nodes.input_nodes")
+C = importlib.import_module(engine.__name__ + ".nodes.context")
+V = importlib.import_module(engine.__name__ + ".nodes.vector_nodes")
+vis = importlib.import_module(engine.__name__ + ".visibility")
+
+
+def hit3(c, field):
+    return c.emit(I.IN_HIT3, "vector", [field], varying=True)
+
+
+def hit1(c, field):
+    return c.emit(I.IN_HIT1, "float", [field], varying=True)
+
+
+def normal_input(c, node):
+    """A node's Normal input: the hit's shading normal when unlinked (Cycles' sd->N)."""
+    sock = node.inputs.get("Normal")
+    if sock is not None and sock.is_linked:
+        return c.socket(sock, "vector")
+    return hit3(c, C.H_N)
+
+
+def _tex_coord(c, node, out):
+    name = out.identifier
+    if name in ("Generated", "Normal", "Object") and getattr(node, "object", None) is not None:
+        raise Unsupported(f"the {name} coordinates of another object are not evaluated")
+    if name == "Generated":
+        return hit3(c, C.H_GENERATED)
+    if name == "Normal":
+        return hit3(c, C.H_OBJ_NORMAL)
+    if name == "UV":
+        return hit3(c, C.H_UV)
+    if name == "Object":
+        return hit3(c, C.H_OBJECT)
+    if name == "Reflection":
+        incoming = hit3(c, C.H_I)
+        minus = c.emit(V.VEC_MATH, "vector", [incoming, incoming, incoming, c.const(-1.0),
+                                              V.VECTOR_OPS.index("SCALE")])
+        return c.emit(V.VEC_MATH, "vector", [minus, hit3(c, C.H_N), minus, c.const(1.0),
+                                             V.VECTOR_OPS.index("REFLECT")])
+    raise Unsupported(f"the Texture Coordinate output {name} is not evaluated")
+
+
+def _uv_map(c, node, out):
+    return hit3(c, C.H_UV)
+
+
+GEOMETRY = {"Position": C.H_P, "Normal": C.H_N, "True Normal": C.H_NG,
+            "Incoming": C.H_I}
+
+
+def _geometry(c, node, out):
+    name = out.identifier
+    if name in GEOMETRY:
+        return hit3(c, GEOMETRY[name])
+    if name == "Backfacing":
+        return hit1(c, C.H_BACKFACING)
+    raise Unsupported(f"the Geometry output {name} is not evaluated")
+
+
+def _object_info(c, node, out):
+    name = out.identifier
+    if name == "Location":
+        return hit3(c, C.H_OBJ_LOCATION)
+    if name == "Color":
+        return c.convert(hit3(c, C.H_OBJ_COLOR), "color")
+    if name == "Random":
+        return hit1(c, C.H_OBJ_RANDOM)
+    if name == "Object Index":
+        return hit1(c, C.H_OBJ_INDEX)
+    if name == "Alpha":
+        return c.const(1.0)
+    raise Unsupported(f"the Object Info output {name} is not evaluated")
+
+
+def _value(c, node, out):
+    return c.const(float(out.default_value))
+
+
+def _rgb(c, node, out):
+    return c.const(tuple(out.default_value)[:3], "color")
+
+
+def _fresnel(c, node, out):
+    return c.emit(I.IN_FRESNEL, "float", [c.input(node, "IOR", "float"),
+                                         normal_input(c, node)], varying=True)
+
+
+def _layer_weight(c, node, out):
+    op = I.IN_LAYER_FRESNEL if out.identifier == "Fresnel" else I.IN_LAYER_FACING
+    return c.emit(op, "float", [c.input(node, "Blend", "float"), normal_input(c, node)],
+                  varying=True)
+
+
+RAY_MASKS = {"Is Camera Ray": vis.CAMERA, "Is Shadow Ray": vis.SHADOW,
+             "Is Diffuse Ray": vis.DIFFUSE, "Is Glossy Ray": vis.GLOSSY,
+             "Is Reflection Ray": vis.DIFFUSE | vis.GLOSSY,
+             "Is Transmission Ray": vis.TRANSMISSION}
+
+
+def _light_path(c, node, out):
+    name = out.identifier
+    if name in RAY_MASKS:
+        return c.emit(I.IN_RAY_IS, "float", [RAY_MASKS[name]], varying=True)
+    if name == "Ray Length":
+        return hit1(c, C.H_RAY_LENGTH)
+    if name == "Ray Depth":
+        return hit1(c, C.H_DEPTH)
+    raise Unsupported(f"the Light Path output {name} is not evaluated")
+
+
+TRANSLATORS = {
+    "ShaderNodeTexCoord": _tex_coord,
+    "ShaderNodeUVMap": _uv_map,
+    "ShaderNodeNewGeometry": _geometry,
+    "ShaderNodeObjectInfo": _object_info,
+    "ShaderNodeValue": _value,
+    "ShaderNodeRGB": _rgb,
+    "ShaderNodeFresnel": _fresnel,
+    "ShaderNodeLayerWeight": _layer_weight,
+    "ShaderNodeLightPath": _light_path,
+}

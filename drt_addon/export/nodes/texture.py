@@ -1,0 +1,66 @@
+"""Texture nodes to program operations (engine.nodes.texture_nodes): Image, Checker,
+Gradient. An unlinked Vector reads the node's default coordinates, as in Cycles: the
+UV map for Image, Generated for the procedural textures."""
+from __future__ import annotations
+
+import importlib
+
+from ...engine_link import engine
+from ..images import image_texture
+from .errors import Unsupported
+from .input import hit3
+
+X = importlib.import_module(engine.__name__ + ".nodes.texture_nodes")
+C = importlib.import_module(engine.__name__ + ".nodes.context")
+textures = importlib.import_module(engine.__name__ + ".textures")
+
+MISSING = tuple(textures.MISSING_RGBA[:3])
+
+
+def coordinates(c, node, default_field):
+    sock = node.inputs.get("Vector")
+    if sock is not None and sock.is_linked:
+        return c.socket(sock, "vector")
+    return hit3(c, default_field)
+
+
+def _image(c, node, out):
+    alpha_out = out.identifier == "Alpha"
+    if node.projection != "FLAT":
+        c.ctx.issue(f"{node.name!r} uses {node.projection} projection; DRT reads it as FLAT")
+    if node.interpolation not in ("Linear", "Closest"):
+        c.ctx.issue(f"{node.name!r} uses {node.interpolation} interpolation; DRT uses Linear")
+    image = node.image
+    alpha_linked = any(o.is_linked for o in node.outputs if o.identifier == "Alpha")
+    tex = image_texture(image, node, c.ctx, premultiply=not alpha_linked) \
+        if image is not None else None
+    if tex is None:                       # Cycles' colour for a missing image
+        return c.const(1.0) if alpha_out else c.const(MISSING, "color")
+    uv = coordinates(c, node, C.H_UV)
+    op = X.TEX_IMAGE_ALPHA if alpha_out else X.TEX_IMAGE_COLOR
+    return c.emit(op, "float" if alpha_out else "color", [uv], varying=True, image=tex)
+
+
+def _checker(c, node, out):
+    co = coordinates(c, node, C.H_GENERATED)
+    scale = c.input(node, "Scale", "float")
+    if out.identifier == "Fac":
+        return c.emit(X.TEX_CHECKER_FAC, "float", [co, scale])
+    return c.emit(X.TEX_CHECKER_COLOR, "color",
+                  [co, c.input(node, "Color1", "color"), c.input(node, "Color2", "color"),
+                   scale])
+
+
+def _gradient(c, node, out):
+    if node.gradient_type not in X.GRADIENT_TYPES:
+        raise Unsupported(f"gradient type {node.gradient_type}")
+    co = coordinates(c, node, C.H_GENERATED)
+    fac = c.emit(X.TEX_GRADIENT, "float", [co, X.GRADIENT_TYPES.index(node.gradient_type)])
+    return fac if out.identifier == "Fac" else c.convert(fac, "color")
+
+
+TRANSLATORS = {
+    "ShaderNodeTexImage": _image,
+    "ShaderNodeTexChecker": _checker,
+    "ShaderNodeTexGradient": _gradient,
+}

@@ -1,0 +1,41 @@
+"""Vector nodes to program operations (engine.nodes.vector_nodes): Vector Math and
+Mapping."""
+from __future__ import annotations
+
+import importlib
+
+from ...engine_link import engine
+from .errors import Unsupported
+
+VE = importlib.import_module(engine.__name__ + ".nodes.vector_nodes")
+
+
+def _vector_math(c, node, out):
+    op = node.operation
+    if op not in VE.VECTOR_OPS:
+        raise Unsupported(f"the Vector Math operation {op}")
+    a, b, d = (c.input(node, k, "vector") for k in range(3))
+    scale = c.input(node, 3, "float") if len(node.inputs) > 3 else c.const(1.0)
+    code = VE.VEC_MATH_VALUE if op in VE.VALUE_OPS else VE.VEC_MATH
+    kind = "float" if op in VE.VALUE_OPS else "vector"
+    value = c.emit(code, kind, [a, b, d, scale, VE.VECTOR_OPS.index(op)])
+    if out.identifier == "Value" and kind == "vector":
+        return c.const(0.0)
+    if out.identifier == "Vector" and kind == "float":
+        return c.const((0.0, 0.0, 0.0), "vector")
+    return value
+
+
+def _mapping(c, node, out):
+    kind = VE.MAPPING_TYPES.index(node.vector_type)
+    location = c.input(node, "Location", "vector") if node.inputs.get("Location") else \
+        c.const((0.0, 0.0, 0.0), "vector")
+    return c.emit(VE.VEC_MAPPING, "vector", [c.input(node, "Vector", "vector"), location,
+                                             c.input(node, "Rotation", "vector"),
+                                             c.input(node, "Scale", "vector"), kind])
+
+
+TRANSLATORS = {
+    "ShaderNodeVectorMath": _vector_math,
+    "ShaderNodeMapping": _mapping,
+}

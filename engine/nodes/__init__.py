@@ -1,0 +1,31 @@
+"""Shader node programs: a material's node graph as a small program evaluated at every hit.
+
+The exporter (drt_addon/export/nodes/) translates the node tree behind a material's
+output into a `ShaderProgram`: one typed operation per node, sockets as registers, the
+unlinked sockets' values as constant registers. The engine runs the program over each
+hit (`interpreter.run`, a compiled loop with a switch per node family, as Cycles' SVM
+interprets its node stack) and reads the program's outputs: per-hit Principled
+parameters (base colour, metallic, roughness), emission and alpha.
+
+One module per node family on each side, so a node is found by its family:
+
+  context.py          the hit a program reads (position, normals, incoming direction,
+                      UV, the object's coordinates and info, the ray kind)
+  program.py          ShaderProgram and its builder; the outputs a program can drive
+  interpreter.py      the compiled interpreter and its array driver
+  pack.py             every material's program as the arrays the kernels take
+  input_nodes.py      Texture Coordinate, Geometry, Object Info, Fresnel, Layer Weight,
+                      Light Path
+  texture_nodes.py    Image, Checker, Gradient
+  color_nodes.py      Mix (every blend mode), Color Ramp, Invert, Gamma,
+                      Bright/Contrast, Hue/Saturation/Value
+  converter_nodes.py  Math (every operation), Map Range, Clamp, Separate / Combine,
+                      RGB to BW
+  vector_nodes.py     Vector Math, Mapping
+
+Registers are float64; a colour or vector takes three consecutive registers (colours
+carry no alpha: an Image's Alpha is its own output). An instruction is eight int32:
+opcode, output register, then operands (input registers or immediate codes, as each
+family documents). Opcode ranges: input 0-99, texture 100-199, colour 200-299,
+converter 300-399, vector 400-499.
+"""

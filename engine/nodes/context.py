@@ -1,0 +1,154 @@
+"""What a shader program reads of a hit: one float64 row per hit (the H_* layout), and the
+object table (the O_* layout) its object columns come from.
+
+Normals follow Cycles' shader setup: on a back-facing hit N and Ng are flipped to face
+the incoming ray, and Backfacing is 1. I points back along the ray (Cycles' wi).
+Object coordinates are the hit in the object's space (its matrix_world at the frame);
+Generated coordinates map the object's texture space (Blender's auto texture space:
+the mesh's bounding box) to [0, 1]^3; the Texture Coordinate node's Normal is N in
+object space. Moving objects read them at the frame, not at the ray's shutter time.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..kernels.jit import kernel
+
+# ---------------------------------------------------------------- hit row
+H_P = 0              # position (3)
+H_N = 3              # shading normal, facing the ray (3)
+H_NG = 6             # geometric normal, facing the ray (3)
+H_I = 9              # towards the ray's origin (3)
+H_UV = 12            # UV map (3; w = 0)
+H_GENERATED = 15     # generated coordinates (3)
+H_OBJECT = 18        # object-space position (3)
+H_OBJ_NORMAL = 21    # object-space normal (3)
+H_BACKFACING = 24
+H_RAY = 25           # engine.visibility bit of the ray (CAMERA, DIFFUSE, ...; SHADOW)
+H_DEPTH = 26         # bounces before this hit
+H_RAY_LENGTH = 27
+H_OBJ_LOCATION = 28  # the object's location (3)
+H_OBJ_COLOR = 31     # the object's colour (3)
+H_OBJ_RANDOM = 34
+H_OBJ_INDEX = 35     # pass index
+N_HIT = 36
+
+# ---------------------------------------------------------------- object table columns
+O_TO_OBJECT = 0      # 3 x 4 world -> object, row-major (12)
+O_NORMAL = 12        # 3 x 3 row-major: object-space normal = this x world normal (M^T)
+O_LOCATION = 21
+O_COLOR = 24
+O_RANDOM = 27
+O_INDEX = 28
+O_TEX_LOCATION = 29  # texture space centre (3)
+O_TEX_SIZE = 32      # texture space half-size (3)
+N_OBJ = 35
+
+
+def object_row(matrix_world, color=(1.0, 1.0, 1.0), random=0.0, pass_index=0,
+               texspace_location=(0.0, 0.0, 0.0), texspace_size=(1.0, 1.0, 1.0)):
+    """The O_* row of one object (matrix_world: its 4 x 4 object -> world matrix)."""
+    m = np.asarray(matrix_world, np.float64).reshape(4, 4)
+    row = np.zeros(N_OBJ)
+    a = m[:3, :3]
+    try:
+        inv = np.linalg.inv(a)
+    except np.linalg.LinAlgError:
+        inv = np.linalg.pinv(a)
+    row[O_TO_OBJECT:O_TO_OBJECT + 12] = np.hstack([inv, (-inv @ m[:3, 3])[:, None]]).ravel()
+    row[O_NORMAL:O_NORMAL + 9] = a.T.ravel()
+    row[O_LOCATION:O_LOCATION + 3] = m[:3, 3]
+    row[O_COLOR:O_COLOR + 3] = np.asarray(color, np.float64)[:3]
+    row[O_RANDOM] = random
+    row[O_INDEX] = pass_index
+    row[O_TEX_LOCATION:O_TEX_LOCATION + 3] = texspace_location
+    size = np.asarray(texspace_size, np.float64)
+    row[O_TEX_SIZE:O_TEX_SIZE + 3] = np.where(np.abs(size) > 1e-12, size, 1.0)
+    return row
+
+
+IDENTITY_OBJECT = object_row(np.eye(4))
+
+
+@kernel
+def fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, u, v, front, ray, depth,
+         length, objects, obj):
+    """Write one hit row. (n, g): shading and geometric normals facing the ray; d: the
+    ray's direction; (u, v): its UV; obj: its row in `objects` (-1: the identity
+    object, texture space the unit cube around the origin)."""
+    hit[H_P], hit[H_P + 1], hit[H_P + 2] = px, py, pz
+    hit[H_N], hit[H_N + 1], hit[H_N + 2] = nx, ny, nz
+    hit[H_NG], hit[H_NG + 1], hit[H_NG + 2] = gx, gy, gz
+    hit[H_I], hit[H_I + 1], hit[H_I + 2] = -dx, -dy, -dz
+    hit[H_UV], hit[H_UV + 1], hit[H_UV + 2] = u, v, 0.0
+    hit[H_BACKFACING] = 0.0 if front else 1.0
+    hit[H_RAY] = ray
+    hit[H_DEPTH] = depth
+    hit[H_RAY_LENGTH] = length
+    if obj >= 0 and obj < objects.shape[0]:
+        o = objects[obj]
+        for k in range(3):
+            hit[H_OBJECT + k] = (o[O_TO_OBJECT + 4 * k] * px + o[O_TO_OBJECT + 4 * k + 1] * py
+                                 + o[O_TO_OBJECT + 4 * k + 2] * pz + o[O_TO_OBJECT + 4 * k + 3])
+            hit[H_OBJ_NORMAL + k] = (o[O_NORMAL + 3 * k] * nx + o[O_NORMAL + 3 * k + 1] * ny
+                                     + o[O_NORMAL + 3 * k + 2] * nz)
+            hit[H_GENERATED + k] = ((hit[H_OBJECT + k] - o[O_TEX_LOCATION + k])
+                                    / (2.0 * o[O_TEX_SIZE + k]) + 0.5)
+            hit[H_OBJ_LOCATION + k] = o[O_LOCATION + k]
+            hit[H_OBJ_COLOR + k] = o[O_COLOR + k]
+        hit[H_OBJ_RANDOM] = o[O_RANDOM]
+        hit[H_OBJ_INDEX] = o[O_INDEX]
+        ln = math.sqrt(hit[H_OBJ_NORMAL] ** 2 + hit[H_OBJ_NORMAL + 1] ** 2
+                       + hit[H_OBJ_NORMAL + 2] ** 2)
+        if ln > 0.0:
+            for k in range(3):
+                hit[H_OBJ_NORMAL + k] /= ln
+    else:
+        for k, c in enumerate((px, py, pz)):
+            hit[H_OBJECT + k] = c
+            hit[H_GENERATED + k] = 0.5 * c + 0.5
+            hit[H_OBJ_LOCATION + k] = 0.0
+            hit[H_OBJ_COLOR + k] = 1.0
+        hit[H_OBJ_NORMAL], hit[H_OBJ_NORMAL + 1], hit[H_OBJ_NORMAL + 2] = nx, ny, nz
+        hit[H_OBJ_RANDOM] = 0.0
+        hit[H_OBJ_INDEX] = 0.0
+
+
+@kernel
+def fill_rows(position, normal, geometric_normal, direction, uv, front, ray, depth, length,
+              objects, obj):
+    """`fill` for n hits given as arrays: an (n, N_HIT) array of hit rows."""
+    n = position.shape[0]
+    out = np.zeros((n, N_HIT))
+    for i in range(n):
+        fill(out[i], position[i, 0], position[i, 1], position[i, 2], normal[i, 0],
+             normal[i, 1], normal[i, 2], geometric_normal[i, 0], geometric_normal[i, 1],
+             geometric_normal[i, 2], direction[i, 0], direction[i, 1], direction[i, 2],
+             uv[i, 0], uv[i, 1], front[i], ray[i], depth[i], length[i], objects, obj[i])
+    return out
+
+
+def hit_rows(position, normal, geometric_normal=None, direction=None, uv=None, front=None,
+             ray=1, depth=0, length=None, objects=None, obj=None) -> np.ndarray:
+    """(n, N_HIT) hit rows from arrays (NumPy callers; anything left out takes a neutral
+    value: Ng = N, the ray arriving along -N, UV (0, 0), front-facing, a camera ray at
+    depth 0 of length 1, the identity object)."""
+    position = np.ascontiguousarray(position, np.float64).reshape(-1, 3)
+    n = len(position)
+    normal = np.ascontiguousarray(normal, np.float64).reshape(n, 3)
+
+    def arr(a, default, shape, dtype=np.float64):
+        if a is None:
+            return np.ascontiguousarray(np.broadcast_to(default, shape), dtype)
+        return np.ascontiguousarray(np.broadcast_to(np.asarray(a, dtype), shape))
+
+    ng = arr(geometric_normal, normal, (n, 3))
+    d = arr(direction, -normal, (n, 3))
+    uv2 = arr(uv, 0.0, (n, 2))
+    return fill_rows(position, normal, ng, d, uv2, arr(front, True, (n,), np.bool_),
+                     arr(ray, ray, (n,)), arr(depth, depth, (n,)), arr(length, 1.0, (n,)),
+                     np.ascontiguousarray(objects if objects is not None
+                                          else np.zeros((0, N_OBJ)), np.float64),
+                     arr(obj, -1, (n,), np.int64))

@@ -1,0 +1,69 @@
+"""Every material's shader program as the arrays the kernels read, appended to the
+texture tuple T of engine.kernels.textures (one Numba argument; always the same array
+types, so one compilation serves every scene):
+
+  T[OPS]    int32 (n_ops, WIDTH): the instructions of every program, concatenated;
+            image operations name global texture ids (T[TEXTURES] rows), table
+            operations global offsets into T[DATA]
+  T[INIT]   float64: every program's initial registers, concatenated
+  T[DATA]   float64: every program's tables, concatenated
+  T[PROG]   int64 (n_mat, 4): first instruction, instruction count, first initial
+            register, register count (0 instructions: no program)
+  T[OUTS]   int64 (n_mat, N_OUT): the register of each program output, -1 where the
+            program does not drive that parameter
+  T[NREGS]  int64 (1,): the largest register count (the size of a register file)
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..kernels.textures import pack_textures
+from .color_nodes import DATA_OPS
+from .program import N_OUT, OUTPUTS, WIDTH
+from .texture_nodes import IMAGE_OPS
+
+OPS = 5
+INIT = 6
+DATA = 7
+PROG = 8
+OUTS = 9
+NREGS = 10
+
+
+def pack_programs(table) -> tuple:
+    """The program fields (OPS .. NREGS) of a MaterialTable with `programs` and
+    `texture_index` (id(Texture) -> global texture id)."""
+    programs = list(getattr(table, "programs", None) or [])
+    n_mat = len(table.metallic)
+    prog = np.zeros((n_mat, 4), np.int64)
+    outs = np.full((n_mat, N_OUT), -1, np.int64)
+    ops, init, data = [], [], []
+    n_ops = n_init = n_data = 0
+    for m, p in enumerate(programs):
+        if p is None or len(p.ops) == 0:
+            continue
+        o = np.array(p.ops, np.int32, copy=True).reshape(-1, WIDTH)
+        for k in range(len(o)):
+            if o[k, 0] in IMAGE_OPS:
+                o[k, 7] = table.texture_index[id(p.images[o[k, 7]])]
+            if o[k, 0] in DATA_OPS:
+                o[k, 6] += n_data
+        prog[m] = (n_ops, len(o), n_init, p.n_regs)
+        for j, name in enumerate(OUTPUTS):
+            if name in p.outputs:
+                outs[m, j] = p.outputs[name].reg
+        ops.append(o)
+        init.append(p.init)
+        data.append(p.data)
+        n_ops += len(o)
+        n_init += p.n_regs
+        n_data += len(p.data)
+    return (np.concatenate(ops) if ops else np.zeros((0, WIDTH), np.int32),
+            np.concatenate(init) if init else np.zeros(0),
+            np.concatenate(data) if data else np.zeros(0),
+            prog, outs, np.array([int(prog[:, 3].max()) if n_mat else 0], np.int64))
+
+
+def pack_shading(table) -> tuple:
+    """T: the textures (engine.kernels.textures.pack_textures) and the programs."""
+    return pack_textures(table) + pack_programs(table)

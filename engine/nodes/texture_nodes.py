@@ -1,0 +1,85 @@
+"""Texture nodes. Opcodes 100-199. Vectors are registers of the texture coordinates (the
+compiler feeds the node's default, UV for Image and Generated for the procedural ones,
+when its Vector is unlinked).
+
+  TEX_IMAGE_COLOR out, vector | image     the image's colour at (x, y)
+  TEX_IMAGE_ALPHA out, vector | image     its alpha
+  TEX_CHECKER_COLOR out, vector, color1, color2, scale
+  TEX_CHECKER_FAC out, vector, scale
+  TEX_GRADIENT out, vector, type          Fac of the Gradient Texture (GRADIENT_* types)
+
+Image lookups are engine.kernels.textures.texture_rgba (the node's interpolation,
+extension and colour space, baked into the packed texture); field 7 holds the image.
+"""
+from __future__ import annotations
+
+import math
+
+from ..kernels.jit import kernel
+from ..kernels.textures import texture_rgba
+
+TEX_IMAGE_COLOR = 100
+TEX_IMAGE_ALPHA = 101
+TEX_CHECKER_COLOR = 102
+TEX_CHECKER_FAC = 103
+TEX_GRADIENT = 104
+IMAGE_OPS = (TEX_IMAGE_COLOR, TEX_IMAGE_ALPHA)
+
+GRADIENT_TYPES = ("LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "SPHERICAL",
+                  "QUADRATIC_SPHERE", "RADIAL")
+
+
+@kernel
+def checker(x, y, z, scale):
+    """1 on the first colour's squares, 0 on the second's (Cycles' svm_checker)."""
+    x = (x * scale + 0.000001) * 0.999999
+    y = (y * scale + 0.000001) * 0.999999
+    z = (z * scale + 0.000001) * 0.999999
+    xi = abs(int(math.floor(x)))
+    yi = abs(int(math.floor(y)))
+    zi = abs(int(math.floor(z)))
+    return 1.0 if (xi % 2 == yi % 2) == (zi % 2 == 1) else 0.0
+
+
+@kernel
+def gradient(x, y, z, kind):
+    if kind == 0:                      # LINEAR
+        r = x
+    elif kind == 1:                    # QUADRATIC
+        r = max(x, 0.0)
+        r = r * r
+    elif kind == 2:                    # EASING
+        r = min(max(x, 0.0), 1.0)
+        t = r * r
+        r = 3.0 * t - 2.0 * t * r
+    elif kind == 3:                    # DIAGONAL
+        r = (x + y) * 0.5
+    elif kind == 4:                    # SPHERICAL
+        r = max(0.999999 - math.sqrt(x * x + y * y + z * z), 0.0)
+    elif kind == 5:                    # QUADRATIC_SPHERE
+        r = max(0.999999 - math.sqrt(x * x + y * y + z * z), 0.0)
+        r = r * r
+    else:                              # RADIAL
+        r = math.atan2(y, x) / (2.0 * math.pi) + 0.5
+    return min(max(r, 0.0), 1.0)
+
+
+@kernel
+def execute(ins, regs, T):
+    code, out = ins[0], ins[1]
+    v = ins[2]
+    if code == TEX_IMAGE_COLOR or code == TEX_IMAGE_ALPHA:
+        r, g, b, a = texture_rgba(T, ins[7], regs[v], regs[v + 1])
+        if code == TEX_IMAGE_COLOR:
+            regs[out], regs[out + 1], regs[out + 2] = r, g, b
+        else:
+            regs[out] = a
+    elif code == TEX_CHECKER_COLOR:
+        f = checker(regs[v], regs[v + 1], regs[v + 2], regs[ins[5]])
+        c1, c2 = ins[3], ins[4]
+        for k in range(3):
+            regs[out + k] = regs[c1 + k] if f > 0.5 else regs[c2 + k]
+    elif code == TEX_CHECKER_FAC:
+        regs[out] = checker(regs[v], regs[v + 1], regs[v + 2], regs[ins[3]])
+    elif code == TEX_GRADIENT:
+        regs[out] = gradient(regs[v], regs[v + 1], regs[v + 2], ins[3])

@@ -1,0 +1,127 @@
+"""A harness that compares shader nodes with Cycles pixel by pixel.
+
+Each case is a small node graph feeding the Color of an Emission shader (strength 1) on
+its own object, one tile of a grid seen from above by an orthographic camera; the world
+is black. Emission seen directly has no light-transport noise, so what differs between
+DRT and Cycles is the node's value (and antialiasing at sharp edges, the same pixel
+filter in both). One render per engine serves every case; `tile_errors` measures each
+tile.
+
+A case is `(name, build)`: build(nt, probe) adds nodes to the material's tree `nt` and
+returns the output socket to show. `probe.obj` is the tile's object (set its
+colour, rotation...); `probe.coords(nt)` gives a Texture Coordinate node.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from conftest import render_current, use_engine
+
+TILE = 16                  # pixels per tile
+
+
+class Probe:
+    def __init__(self, obj):
+        self.obj = obj
+
+    @staticmethod
+    def coords(nt):
+        return nt.nodes.new("ShaderNodeTexCoord")
+
+    @staticmethod
+    def node(nt, kind, **settings):
+        n = nt.nodes.new(kind)
+        for k, v in settings.items():
+            setattr(n, k, v)
+        return n
+
+
+def build_scene(bpy, cases, columns=None, shape="plane"):
+    """A new scene holding one tile per case; returns (scene, columns, rows)."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    n = len(cases)
+    columns = columns or int(math.ceil(math.sqrt(n)))
+    rows = int(math.ceil(n / columns))
+    for k, (name, build) in enumerate(cases):
+        i, j = k % columns, k // columns
+        x, y = 2.0 * i - (columns - 1), (rows - 1) - 2.0 * j
+        if shape == "sphere":
+            bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, location=(x, y, 0.0),
+                                                 segments=48, ring_count=24)
+            bpy.ops.object.shade_smooth()
+        else:
+            bpy.ops.mesh.primitive_plane_add(size=2.0, location=(x, y, 0.0))
+        obj = bpy.context.object
+        obj.name = name
+        mat = bpy.data.materials.new(name)
+        mat.use_nodes = True
+        nt = mat.node_tree
+        for node in list(nt.nodes):
+            nt.nodes.remove(node)
+        out = nt.nodes.new("ShaderNodeOutputMaterial")
+        emission = nt.nodes.new("ShaderNodeEmission")
+        emission.inputs["Strength"].default_value = 1.0
+        emission.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+        nt.links.new(emission.outputs[0], out.inputs["Surface"])
+        socket = build(nt, Probe(obj))
+        nt.links.new(socket, emission.inputs["Color"])
+        obj.data.materials.append(mat)
+    cam_data = bpy.data.cameras.new("Camera")
+    cam_data.type = "ORTHO"
+    cam_data.ortho_scale = 2.0 * max(columns, rows)
+    cam = bpy.data.objects.new("Camera", cam_data)
+    scene.collection.objects.link(cam)
+    cam.location = (0.0, 0.0, 10.0)
+    scene.camera = cam
+    scene.render.resolution_x = TILE * columns
+    scene.render.resolution_y = TILE * rows
+    if columns != rows:
+        cam_data.sensor_fit = "HORIZONTAL" if columns >= rows else "VERTICAL"
+    scene.render.resolution_percentage = 100
+    world = bpy.data.worlds.new("World")
+    if bpy.app.version < (5, 0, 0):
+        world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    scene.world = world
+    return scene, columns, rows
+
+
+def render(bpy, scene, engine, samples):
+    use_engine(scene, engine, samples)
+    return render_current(bpy, scene)
+
+
+def unlink_probes(bpy):
+    """The fallback DRT had before node programs: every Emission Color unlinked."""
+    for mat in bpy.data.materials:
+        for node in mat.node_tree.nodes:
+            if node.bl_idname == "ShaderNodeEmission":
+                for link in list(node.inputs["Color"].links):
+                    mat.node_tree.links.remove(link)
+
+
+def tiles(img, columns, rows):
+    """{index: (TILE, TILE, 3)} of an image rendered by build_scene (inner pixels only
+    would hide edge errors, so the whole tile)."""
+    out = {}
+    for k in range(columns * rows):
+        i, j = k % columns, k // columns
+        out[k] = img[j * TILE:(j + 1) * TILE, i * TILE:(i + 1) * TILE]
+    return out
+
+
+def tile_errors(drt, cycles):
+    """(mean difference over Cycles' mean, per-pixel mean absolute difference over
+    Cycles' mean, largest difference of the 8 x 8 block means over Cycles' mean) of one
+    tile; Cycles' mean is floored at 0.02 so that a black tile is judged in absolute
+    terms."""
+    ref = max(float(cycles.mean()), 0.02)
+    mean = abs(float(drt.mean() - cycles.mean())) / ref
+    mad = float(np.abs(drt - cycles).mean()) / ref
+    h, w, _ = cycles.shape
+    diff = (drt - cycles).mean(axis=2)[:h // 8 * 8, :w // 8 * 8]
+    blocks = np.abs(diff.reshape(h // 8, 8, w // 8, 8).mean(axis=(1, 3)))
+    return mean, mad, float(blocks.max()) / ref
