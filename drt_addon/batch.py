@@ -97,6 +97,18 @@ def run_package(args) -> int:
     return EXIT_OK
 
 
+def set_still_format(settings, file_format: str) -> None:
+    """Point the scene's output settings (in memory only; the file on disk is not
+    written) at a still image format. Since Blender 5.0 a file whose output is a video
+    has `media_type` VIDEO, which offers only FFMPEG as file format (and MULTI_LAYER_IMAGE
+    only multilayer EXR): switch it to IMAGE first."""
+    if getattr(settings, "media_type", "IMAGE") != "IMAGE":
+        settings.media_type = "IMAGE"
+    settings.file_format = file_format
+    if file_format == "OPEN_EXR":
+        settings.color_depth = "32"
+
+
 def run(argv) -> int:
     args = build_parser().parse_args(argv)
     if args.command == "package":
@@ -151,10 +163,7 @@ def run(argv) -> int:
     if args.engine == "DRT" and not render_engine.last_render.get("ok"):
         raise CliError(EXIT_RENDER, f"drt: error: render failed: "
                                     f"{render_engine.last_render.get('error') or 'unknown error'}")
-    settings = scene.render.image_settings
-    settings.file_format = FORMATS[ext]
-    if FORMATS[ext] == "OPEN_EXR":
-        settings.color_depth = "32"
+    set_still_format(scene.render.image_settings, FORMATS[ext])
     image = bpy.data.images.get("Render Result")
     if image is None:
         raise CliError(EXIT_RENDER, "drt: error: render failed: Blender produced no image")

@@ -47,10 +47,13 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
 
     def to_engine_settings(self):
         """The engine's settings: DRT's own, and the file's Cycles settings DRT shares
-        with Cycles (Filter Glossy, caustics; Blender's defaults without Cycles)."""
+        with Cycles (Filter Glossy, caustics, Film > Exposure; Blender's defaults without
+        Cycles). export/file_settings.py lists every setting of the file and what DRT
+        does with it."""
         from .engine_link import engine
         cycles = getattr(self.id_data, "cycles", None)
         return engine.RenderSettings(
+            film_exposure=float(getattr(cycles, "film_exposure", 1.0)),
             filter_glossy=float(getattr(cycles, "blur_glossy", 1.0)),
             caustics_reflective=bool(getattr(cycles, "caustics_reflective", True)),
             caustics_refractive=bool(getattr(cycles, "caustics_refractive", True)),

@@ -53,6 +53,9 @@ class DRT_PT_film(DRTPanel, bpy.types.Panel):
         s = context.scene.drt
         col = self.layout.column()
         col.use_property_split = True
+        cycles = getattr(context.scene, "cycles", None)
+        if cycles is not None:                 # the file's Film > Exposure, as in Cycles
+            col.prop(cycles, "film_exposure")
         col.prop(s, "filter_type")
         col.prop(s, "filter_width")
 

@@ -181,6 +181,8 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
         bad = ~np.isfinite(rad).all(axis=1)
         if bad.any():
             rad[bad] = 0.0
+        if settings.film_exposure != 1.0:
+            rad *= settings.film_exposure      # Film > Exposure, on the way into the film
         with lock:
             film.add(pix, rad, alpha)
             stats.paths += len(pix)

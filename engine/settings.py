@@ -29,6 +29,11 @@ class RenderSettings:
     # Film
     filter_type: str = "BLACKMAN_HARRIS"
     filter_width: float = 1.5
+    # Cycles' Film > Exposure (`cycles.film_exposure`): every radiance sample is
+    # multiplied by it as it enters the film, so the Combined image and the noise
+    # estimate scale by it and the first-hit passes (depth, normal, albedo) do not, as
+    # Cycles applies it to its light passes only. Clamps act before it, as in Cycles.
+    film_exposure: float = 1.0
     # Execution: paths per work unit bounds memory (about 1 KB of state per path).
     chunk_paths: int = 1 << 15
     threads: int = 0                   # 0 = all cores
@@ -53,6 +58,9 @@ class RenderSettings:
         if not (0.0 <= self.filter_glossy < float("inf")):
             problems.append(f"filter_glossy must be a finite number >= 0 (0 = off), got "
                             f"{self.filter_glossy!r}")
+        if not (0.0 <= self.film_exposure < float("inf")):
+            problems.append(f"film_exposure must be a finite number >= 0, got "
+                            f"{self.film_exposure!r}")
         if not (0 < self.filter_width <= 100):
             problems.append(f"filter_width must be in (0, 100] pixels, got {self.filter_width!r}")
         if self.chunk_paths < 256:

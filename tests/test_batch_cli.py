@@ -87,3 +87,38 @@ def test_render_failure_exits_4(tmp_path):
     assert_one_clear_error_line(proc)
     assert "camera" in proc.stderr
     assert not (tmp_path / "x.png").exists()
+
+
+_MAGIC = {".png": b"\x89PNG\r\n\x1a\n", ".exr": b"\x76\x2f\x31\x01"}
+
+
+@pytest.fixture(scope="module", params=[("VIDEO", "FFMPEG"),
+                                        ("MULTI_LAYER_IMAGE", "OPEN_EXR_MULTILAYER")])
+def movie_output_blend(request, tmp_path_factory):
+    """The Cornell box saved with its output set to a video (or a multilayer EXR): Blender
+    5 then offers no still format in image_settings.file_format until media_type is
+    IMAGE again."""
+    media, file_format = request.param
+    blend = tmp_path_factory.mktemp(media.lower()) / f"{media.lower()}_output.blend"
+    script = (f"import bpy; bpy.ops.wm.open_mainfile(filepath={CORNELL!r}); "
+              "s = bpy.context.scene.render.image_settings; "
+              f"s.media_type = {media!r}; s.file_format = {file_format!r}; "
+              f"bpy.ops.wm.save_as_mainfile(filepath={str(blend)!r}); "
+              "print('saved', s.media_type, s.file_format)")
+    made = subprocess.run([sys.executable, "-c", script], check=True, capture_output=True,
+                          text=True)
+    assert f"saved {media} {file_format}" in made.stdout, made.stdout + made.stderr
+    return blend
+
+
+@pytest.mark.parametrize("ext", [".png", ".exr"])
+def test_a_file_with_video_output_renders_stills(tmp_path, movie_output_blend, ext):
+    """The extension of -o decides the format, whatever the file's output is; the .blend
+    on disk is not changed."""
+    before = movie_output_blend.read_bytes()
+    out = tmp_path / f"still{ext}"
+    proc = drt("render", str(movie_output_blend), "-o", str(out), "--samples", "1",
+               "--percentage", "10")
+    assert proc.returncode == 0, proc.stderr
+    assert out.read_bytes().startswith(_MAGIC[ext])
+    assert movie_output_blend.read_bytes() == before

@@ -6,6 +6,7 @@ import time
 from ..engine_link import engine
 from .camera import RenderRegion, export_camera, render_region, window_camera
 from .errors import ExportError, Reporter
+from .settings_check import check as check_file_settings
 from .lights import export_light, object_visibility
 from .materials import export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
@@ -49,9 +50,13 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
     Motion blur (see `export.motion`): with it on, the scene is exported at the shutter's
     middle and sampled at the motion steps with `render_engine.frame_set` (the
     RenderEngine rendering; without one, as in export tests, Scene.frame_set); the frame
-    is restored afterwards."""
+    is restored afterwards.
+
+    The file's render settings DRT does not honour are warned about through `reporter`
+    (export.file_settings)."""
     reporter = reporter or Reporter()
-    blur = read_settings(depsgraph.scene, reporter)
+    check_file_settings(depsgraph.scene, depsgraph.view_layer, reporter)
+    blur = read_settings(depsgraph.scene)
     if blur is None:
         return _export_scene(depsgraph, reporter, size, region, stats, None)
     with MotionExport(depsgraph, blur, reporter, render_engine) as tracker:

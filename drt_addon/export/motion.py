@@ -93,8 +93,9 @@ class MotionSettings:
         return self.open + t * self.length
 
 
-def read_settings(scene, reporter=None) -> Optional[MotionSettings]:
-    """Blender's motion-blur settings, or None when the render has no motion blur."""
+def read_settings(scene) -> Optional[MotionSettings]:
+    """Blender's motion-blur settings, or None when the render has no motion blur.
+    (Cycles' rolling shutter is not modelled: export.file_settings warns about it.)"""
     r = scene.render
     if not getattr(r, "use_motion_blur", False):
         return None
@@ -104,10 +105,6 @@ def read_settings(scene, reporter=None) -> Optional[MotionSettings]:
     position = getattr(r, "motion_blur_position", None)
     if position is None:                                  # before 4.2: Cycles' setting
         position = getattr(getattr(scene, "cycles", None), "motion_blur_position", "CENTER")
-    rolling = getattr(getattr(scene, "cycles", None), "rolling_shutter_type", "NONE")
-    if rolling != "NONE" and reporter is not None:
-        reporter.warn("DRT: rolling shutter is not supported; the whole image is exposed "
-                      "over the same shutter", key="rolling shutter")
     return MotionSettings(int(scene.frame_current), float(scene.frame_subframe), length,
                           str(position), shutter_curve(r.motion_blur_shutter_curve))
 

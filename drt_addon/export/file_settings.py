@@ -1,0 +1,364 @@
+"""The file's render settings (Cycles', Blender's render and view-layer settings): which
+DRT reads, which it replaces by its own, which Blender applies for it, and which it
+ignores, with one warning per ignored setting the file changed.
+
+SETTINGS is the one table: export.settings_check warns from it when a scene is exported,
+and docs/make_settings_docs.py writes docs/settings.md from it. Each row is a setting by
+its path from the scene (`scene.cycles.film_exposure`) or from the view layer being
+rendered (`view_layer.samples`), its place in Blender's interface, what DRT does with it
+(`kind`, `how`) and, for the settings DRT does not honour, the value at which ignoring it
+changes nothing (`quiet`). That value is Blender's default except for Denoise and
+Adaptive Sampling, which Blender turns on by default and DRT does not do.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+READ = "read"              # DRT renders with the file's value, as Cycles does
+OWN = "own"                # DRT has a setting of its own (scene.drt) in its panels
+BLENDER = "blender"        # Blender applies it, to DRT's result or to the depsgraph
+IGNORED = "ignored"        # not honoured: a warning when the file changes it
+NO_EFFECT = "no effect"    # speed, memory, the viewport, baking: not the F12 image
+KINDS = (READ, OWN, BLENDER, IGNORED, NO_EFFECT)
+
+NOISE_ONLY = "only the noise differs, not the image it converges to"
+
+
+@dataclass(frozen=True)
+class FileSetting:
+    path: str                       # from "scene." or "view_layer."
+    label: str                      # where it is in Blender's interface
+    kind: str
+    how: str                        # what DRT does (docs and warnings)
+    quiet: object = None            # IGNORED/OWN: value(s) that need no warning
+    drt: Optional[str] = None       # OWN: DRT's own setting, a path from "scene."
+    when: Optional[tuple] = None    # (path, values): matters only when path is in values
+    warns: bool = True              # False: covered by another row's warning
+    group: Optional[str] = None     # rows warned together in one message
+
+    def __post_init__(self):
+        assert self.kind in KINDS, self.kind
+
+
+def _s(path, label, kind, how, **kw):
+    return FileSetting(path, label, kind, how, **kw)
+
+
+def _own(name, label, drt, drt_label, default):
+    return _s(f"scene.cycles.{name}", label, OWN, f"DRT renders with its own {drt_label}",
+              quiet=default, drt=f"scene.drt.{drt}")
+
+
+def _ignored(path, label, how, quiet, **kw):
+    return _s(path, label, IGNORED, how, quiet=quiet, **kw)
+
+
+def _part_of(parent, names, prefix="scene.cycles"):
+    """Rows that only matter with `parent` on, which warns for them."""
+    return [_s(f"{prefix}.{name}", f"{parent} > {name}", IGNORED,
+               f"part of {parent} (warned there)", warns=False) for name in names]
+
+
+def _no_effect(names, how, prefix="scene.cycles"):
+    return [_s(f"{prefix}.{name}", name, NO_EFFECT, how) for name in names]
+
+
+_NO_VOLUMES = "DRT renders no volumes (volume shaders are skipped with a warning)"
+_SIMPLIFY = ("scene.render.use_simplify", (True,))
+WRITTEN_PASSES = "Combined, Depth, Normal, Denoising Data and DRT Noise"
+_PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
+
+# Render passes DRT does not write, as (path, label).
+_UNWRITTEN_PASSES = [
+    ("view_layer.use_pass_mist", "Mist"),
+    ("view_layer.use_pass_position", "Position"),
+    ("view_layer.use_pass_vector", "Vector"),
+    ("view_layer.use_pass_uv", "UV"),
+    ("view_layer.use_pass_object_index", "Object Index"),
+    ("view_layer.use_pass_material_index", "Material Index"),
+    ("view_layer.use_pass_diffuse_direct", "Diffuse Direct"),
+    ("view_layer.use_pass_diffuse_indirect", "Diffuse Indirect"),
+    ("view_layer.use_pass_diffuse_color", "Diffuse Color"),
+    ("view_layer.use_pass_glossy_direct", "Glossy Direct"),
+    ("view_layer.use_pass_glossy_indirect", "Glossy Indirect"),
+    ("view_layer.use_pass_glossy_color", "Glossy Color"),
+    ("view_layer.use_pass_transmission_direct", "Transmission Direct"),
+    ("view_layer.use_pass_transmission_indirect", "Transmission Indirect"),
+    ("view_layer.use_pass_transmission_color", "Transmission Color"),
+    ("view_layer.use_pass_subsurface_direct", "Subsurface Direct"),
+    ("view_layer.use_pass_subsurface_indirect", "Subsurface Indirect"),
+    ("view_layer.use_pass_subsurface_color", "Subsurface Color"),
+    ("view_layer.cycles.use_pass_volume_direct", "Volume Direct"),
+    ("view_layer.cycles.use_pass_volume_indirect", "Volume Indirect"),
+    ("view_layer.cycles.use_pass_volume_scatter", "Volume Scatter"),
+    ("view_layer.cycles.use_pass_volume_transmit", "Volume Transmit"),
+    ("view_layer.cycles.use_pass_volume_majorant", "Volume Majorant"),
+    ("view_layer.use_pass_emit", "Emission"),
+    ("view_layer.use_pass_environment", "Environment"),
+    ("view_layer.use_pass_ambient_occlusion", "Ambient Occlusion"),
+    ("view_layer.use_pass_shadow", "Shadow"),
+    ("view_layer.cycles.use_pass_shadow_catcher", "Shadow Catcher"),
+    ("view_layer.use_pass_cryptomatte_object", "Cryptomatte Object"),
+    ("view_layer.use_pass_cryptomatte_material", "Cryptomatte Material"),
+    ("view_layer.use_pass_cryptomatte_asset", "Cryptomatte Asset"),
+    ("view_layer.cycles.denoising_store_passes", "Denoising Data (Cycles')"),
+    ("view_layer.cycles.pass_debug_sample_count", "Sample Count"),
+    ("view_layer.cycles.pass_render_time", "Render Time"),
+]
+
+SETTINGS: list[FileSetting] = [
+    # -- read from the file, as Cycles reads them
+    _s("scene.render.resolution_x", "Output > Resolution X", READ, "the image's width"),
+    _s("scene.render.resolution_y", "Output > Resolution Y", READ, "the image's height"),
+    _s("scene.render.resolution_percentage", "Output > Resolution %", READ,
+       "scales the resolution with Blender's integer arithmetic"),
+    _s("scene.render.pixel_aspect_x", "Output > Aspect X", READ,
+       "pixel aspect, as Cycles' camera"),
+    _s("scene.render.pixel_aspect_y", "Output > Aspect Y", READ,
+       "pixel aspect, as Cycles' camera"),
+    _s("scene.render.use_border", "Output > Render Region", READ,
+       "only the region's pixels are traced"),
+    *[_s(f"scene.render.border_{e}", f"Output > Render Region > {e}", READ,
+         "the region's edge, with Blender's float32 arithmetic")
+      for e in ("min_x", "min_y", "max_x", "max_y")],
+    _s("scene.render.engine", "Render Engine", READ, "DRT renders when it is DRT"),
+    _s("scene.render.film_transparent", "Film > Transparent", READ,
+       "the background has alpha 0, holdouts cut holes, as in Cycles"),
+    _s("scene.cycles.film_exposure", "Film > Exposure", READ,
+       "every radiance sample is multiplied by it as it enters the film: the Combined "
+       "pass and DRT Noise scale by it, Depth, Normal and Denoising Data do not, as in "
+       "Cycles; clamping acts before it"),
+    _s("scene.cycles.blur_glossy", "Light Paths > Caustics > Filter Glossy", READ,
+       "widens glossy lobes after a diffuse or rough bounce, as Cycles"),
+    _s("scene.cycles.caustics_reflective", "Light Paths > Caustics > Reflective", READ,
+       "off: no glossy reflection at hits after a diffuse bounce, as Cycles"),
+    _s("scene.cycles.caustics_refractive", "Light Paths > Caustics > Refractive", READ,
+       "off: no refraction at hits after a diffuse bounce, as Cycles"),
+    _s("scene.render.use_motion_blur", "Motion Blur", READ,
+       "the scene is sampled over the shutter (docs/motion_blur.md)"),
+    _s("scene.render.motion_blur_shutter", "Motion Blur > Shutter", READ,
+       "the shutter's length in frames"),
+    _s("scene.render.motion_blur_position", "Motion Blur > Position", READ,
+       "start, centre or end on the frame"),
+    _s("scene.render.motion_blur_shutter_curve", "Motion Blur > Shutter Curve", READ,
+       "the shutter's openness over time, sampled as Cycles samples it"),
+    _s("view_layer.use_pass_combined", "Passes > Combined", READ, "written"),
+    _s("view_layer.use_pass_z", "Passes > Z", READ, "written: camera-space depth"),
+    _s("view_layer.use_pass_normal", "Passes > Normal", READ, "written: world-space normal"),
+    # -- DRT's own settings (Render Properties with DRT selected) replace these
+    _own("samples", "Sampling > Render > Max Samples", "samples",
+         "Samples (DRT's Sampling panel)", 4096),
+    _own("seed", "Sampling > Advanced > Seed", "seed", "Seed (DRT's Sampling panel)", 0),
+    _own("max_bounces", "Light Paths > Max Bounces > Total", "max_bounces",
+         "Total bounces (DRT's Light Paths panel)", 12),
+    _own("diffuse_bounces", "Light Paths > Max Bounces > Diffuse", "diffuse_bounces",
+         "Diffuse bounces (DRT's Light Paths panel)", 4),
+    _own("glossy_bounces", "Light Paths > Max Bounces > Glossy", "glossy_bounces",
+         "Glossy bounces (DRT's Light Paths panel)", 4),
+    _own("transmission_bounces", "Light Paths > Max Bounces > Transmission",
+         "transmission_bounces", "Transmission bounces (DRT's Light Paths panel)", 12),
+    _own("transparent_max_bounces", "Light Paths > Max Bounces > Transparent",
+         "transparent_bounces", "Transparent bounces (DRT's Light Paths panel)", 8),
+    _own("sample_clamp_direct", "Light Paths > Clamping > Direct Light", "clamp_direct",
+         "Direct Light clamp (DRT's Light Paths panel)", 0.0),
+    _own("sample_clamp_indirect", "Light Paths > Clamping > Indirect Light",
+         "clamp_indirect", "Indirect Light clamp (DRT's Light Paths panel)", 10.0),
+    _own("pixel_filter_type", "Film > Pixel Filter > Type", "filter_type",
+         "Filter (DRT's Film panel: Blackman-Harris or Box, no Gaussian)", "BLACKMAN_HARRIS"),
+    _own("filter_width", "Film > Pixel Filter > Width", "filter_width",
+         "Width (DRT's Film panel)", 1.5),
+    # -- applied by Blender, to DRT's result as to Cycles'
+    _s("scene.view_settings", "Color Management (view transform, look, exposure, gamma, "
+       "curves)", BLENDER, "Blender maps DRT's scene-linear result for display and for "
+       "8/16-bit files, as it does Cycles'"),
+    _s("scene.display_settings.display_device", "Color Management > Display", BLENDER,
+       "applied by Blender"),
+    _s("scene.render.dither_intensity", "Post Processing > Dither", BLENDER,
+       "applied by Blender"),
+    _s("scene.render.use_compositing", "Post Processing > Compositing", BLENDER,
+       "Blender composites DRT's passes"),
+    _s("scene.render.use_sequencer", "Post Processing > Sequencer", BLENDER,
+       "applied by Blender"),
+    _s("scene.render.use_crop_to_border", "Output > Crop to Render Region", BLENDER,
+       "Blender crops or places the region DRT renders"),
+    _s("scene.render.simplify_subdivision_render", "Simplify > Render > Max Subdivision",
+       BLENDER, "Blender's modifiers apply it to the meshes DRT exports"),
+    _s("scene.render.simplify_child_particles_render", "Simplify > Render > Max Child "
+       "Particles", BLENDER, "Blender applies it to the evaluated objects"),
+    _s("view_layer.use", "View Layer > Use for Rendering", BLENDER,
+       "Blender asks DRT for each enabled view layer"),
+    _s("view_layer.use_grease_pencil", "View Layer > Filter > Grease Pencil", BLENDER,
+       "Blender's render pipeline draws Grease Pencil over DRT's result, as over Cycles'"),
+    _s("view_layer.use_pass_grease_pencil", "Passes > Grease Pencil", BLENDER,
+       "written by Blender's Grease Pencil renderer"),
+    _s("scene.render.use_single_layer", "View Layer > Render Single Layer", BLENDER,
+       "Blender asks DRT for the active view layer only"),
+    _s("scene.render.use_simplify", "Simplify", BLENDER, "Blender applies its render "
+       "limits (subdivision, child particles); Cycles' own Simplify settings are warned"),
+    # -- ignored: a warning when the file changes them
+    _ignored("scene.cycles.use_denoising", "Sampling > Render > Denoise",
+             "DRT does not denoise; it renders without (the compositor's Denoise node "
+             "can use DRT's Denoising Data passes)", False),
+    _ignored("scene.cycles.use_adaptive_sampling", "Sampling > Render > Noise Threshold "
+             "(adaptive sampling)", "DRT does not sample adaptively: every pixel gets DRT's Samples",
+             False),
+    *_part_of("Sampling > Render > Denoise", ["denoiser", "denoising_prefilter",
+              "denoising_quality", "denoising_input_passes", "denoising_use_gpu"]),
+    *_part_of("Sampling > Render > Noise Threshold", ["adaptive_threshold",
+              "adaptive_min_samples"]),
+    _ignored("scene.cycles.time_limit", "Sampling > Render > Time Limit",
+             "DRT renders all its samples, however long they take", 0.0),
+    _ignored("scene.cycles.use_sample_subset", "Sampling > Advanced > Sample Subset",
+             "DRT renders all its samples (the engine can render a sample range, "
+             "engine.render(sample_start, sample_end), but the add-on does not)", False),
+    *_part_of("Sampling > Advanced > Sample Subset", ["sample_offset",
+              "sample_subset_length"]),
+    _ignored("scene.cycles.use_layer_samples", "Sampling > Advanced > Layer Samples",
+             "DRT renders every view layer with its own Samples (warned with View Layer "
+             "> Samples)", ("USE", "BOUNDED", "IGNORE"), warns=False),
+    _ignored("view_layer.samples", "View Layer > Override > Samples",
+             "DRT renders every view layer with its own Samples", 0,
+             when=("scene.cycles.use_layer_samples", ("USE", "BOUNDED"))),
+    _ignored("scene.cycles.use_animated_seed", "Sampling > Advanced > Use Animated Seed",
+             "DRT uses the same Seed on every frame, so the noise pattern does not change "
+             "from frame to frame", False),
+    _ignored("scene.cycles.sampling_pattern", "Sampling > Advanced > Pattern",
+             f"DRT uses its own Sampler; {NOISE_ONLY}", ("AUTOMATIC", "TABULATED_SOBOL")),
+    _ignored("scene.cycles.scrambling_distance", "Sampling > Advanced > Scrambling "
+             "Distance", f"DRT never correlates pixels' samples; {NOISE_ONLY}", 1.0),
+    _ignored("scene.cycles.auto_scrambling_distance", "Sampling > Advanced > Automatic "
+             "Scrambling Distance", f"DRT never correlates pixels' samples; {NOISE_ONLY}",
+             False),
+    _ignored("scene.cycles.min_light_bounces", "Sampling > Advanced > Min Light Bounces",
+             f"DRT's Russian roulette starts after three bounces; {NOISE_ONLY}", 0),
+    _ignored("scene.cycles.min_transparent_bounces", "Sampling > Advanced > Min "
+             "Transparent Bounces", f"DRT does not play Russian roulette on transparent "
+             f"bounces; {NOISE_ONLY}", 0),
+    _ignored("scene.cycles.light_sampling_threshold", "Sampling > Advanced > Light "
+             "Threshold", f"DRT never skips a light sample; {NOISE_ONLY}", 0.01),
+    _ignored("scene.cycles.use_light_tree", "Sampling > Lights > Light Tree",
+             f"DRT picks lights in proportion to their power either way; {NOISE_ONLY}",
+             True),
+    _ignored("scene.cycles.direct_light_sampling_type", "Sampling > Advanced > Direct Light "
+             "Sampling", f"DRT combines light and BSDF sampling with multiple importance "
+             f"sampling; {NOISE_ONLY}", "MULTIPLE_IMPORTANCE_SAMPLING"),
+    _ignored("scene.cycles.use_guiding", "Sampling > Path Guiding",
+             f"DRT does not guide paths; {NOISE_ONLY}", False),
+    *_part_of("Sampling > Path Guiding", [
+        "use_deterministic_guiding", "guiding_distribution_type",
+        "guiding_directional_sampling_type", "use_surface_guiding",
+        "surface_guiding_probability", "use_volume_guiding", "guiding_training_samples",
+        "volume_guiding_probability", "use_guiding_direct_light", "use_guiding_mis_weights",
+        "guiding_roughness_threshold"]),
+    _ignored("scene.cycles.volume_bounces", "Light Paths > Max Bounces > Volume",
+             _NO_VOLUMES, 0),
+    _ignored("scene.cycles.volume_step_rate", "Volumes > Step Rate Render", _NO_VOLUMES, 1.0),
+    _ignored("scene.cycles.volume_max_steps", "Volumes > Max Steps", _NO_VOLUMES, 1024),
+    _ignored("scene.cycles.volume_biased", "Volumes > Biased", _NO_VOLUMES, False),
+    _ignored("scene.render.simplify_volumes", "Simplify > Volume Resolution", _NO_VOLUMES,
+             1.0, when=_SIMPLIFY),
+    _ignored("scene.cycles.use_fast_gi", "Light Paths > Fast GI Approximation",
+             "DRT traces full global illumination", False),
+    *_part_of("Light Paths > Fast GI Approximation", ["fast_gi_method",
+              "ao_bounces_render"]),
+    *_part_of("Light Paths > Fast GI Approximation", ["use_ao"], prefix="view_layer"),
+    _ignored("scene.cycles.film_transparent_glass", "Film > Transparent > Transparent Glass",
+             "DRT keeps glass opaque over the transparent background", False,
+             when=("scene.render.film_transparent", (True,))),
+    _ignored("scene.cycles.film_transparent_roughness", "Film > Transparent > Roughness "
+             "Threshold", "part of Transparent Glass (warned there)", 0.1, warns=False),
+    _ignored("scene.cycles.rolling_shutter_type", "Motion Blur > Rolling Shutter",
+             "DRT exposes the whole image over the same shutter", "NONE",
+             when=("scene.render.use_motion_blur", (True,))),
+    _ignored("scene.cycles.rolling_shutter_duration", "Motion Blur > Rolling Shutter "
+             "Duration", "part of Rolling Shutter (warned there)", 0.1, warns=False),
+    _ignored("scene.cycles.texture_limit_render", "Simplify > Render > Texture Limit",
+             "DRT reads textures at their full resolution", "OFF", when=_SIMPLIFY),
+    _ignored("scene.cycles.use_camera_cull", "Simplify > Culling > Camera Culling",
+             "DRT keeps every object", False, when=_SIMPLIFY),
+    _ignored("scene.cycles.use_distance_cull", "Simplify > Culling > Distance Culling",
+             "DRT keeps every object", False, when=_SIMPLIFY),
+    *_part_of("Simplify > Culling", ["camera_cull_margin", "distance_cull_margin"]),
+    _ignored("scene.cycles.dicing_rate", "Subdivision > Dicing Rate Render",
+             "DRT renders meshes as Blender's modifiers evaluate them, without adaptive "
+             "subdivision", 1.0),
+    _ignored("scene.cycles.max_subdivisions", "Subdivision > Max Subdivisions",
+             "DRT does no adaptive subdivision", 12),
+    _ignored("scene.cycles.offscreen_dicing_scale", "Subdivision > Offscreen Scale",
+             "DRT does no adaptive subdivision", 4.0),
+    _ignored("scene.cycles.dicing_camera", "Subdivision > Dicing Camera",
+             "DRT does no adaptive subdivision", None),
+    _ignored("scene.cycles.shading_system", "Render > Open Shading Language",
+             "DRT runs no OSL: Script nodes are skipped", False),
+    _ignored("scene.render.hair_type", "Curves > Shape",
+             "DRT renders curves only as Blender converts them to meshes", "STRAND"),
+    _ignored("scene.render.hair_subdiv", "Curves > Curve Subdivisions",
+             "DRT renders curves only as Blender converts them to meshes", 0),
+    _ignored("scene.render.use_freestyle", "Freestyle", "DRT draws no Freestyle lines", False),
+    _ignored("scene.render.use_multiview", "Stereoscopy",
+             "DRT renders the active camera's single view for every view", False),
+    *_part_of("Stereoscopy", ["views_format", "use_spherical_stereo"],
+              prefix="scene.render"),
+    *_part_of("Freestyle", ["use_freestyle"], prefix="view_layer"),
+    *_part_of("Passes > Cryptomatte", ["use_pass_cryptomatte_accurate",
+              "pass_cryptomatte_depth"], prefix="view_layer"),
+    _ignored("view_layer.material_override", "View Layer > Override > Material",
+             "DRT renders each object's own materials", None),
+    _ignored("view_layer.world_override", "View Layer > Override > World",
+             "DRT renders the scene's World", None),
+    _ignored("view_layer.use_solid", "View Layer > Filter > Surfaces",
+             "DRT renders the surfaces anyway", True),
+    _ignored("view_layer.use_sky", "View Layer > Filter > Environment",
+             "DRT renders the World anyway", True),
+    _ignored("view_layer.use_strand", "View Layer > Filter > Curves",
+             "DRT renders curves as meshes anyway", True),
+    _ignored("view_layer.use_volumes", "View Layer > Filter > Volumes", _NO_VOLUMES, True,
+             warns=False),
+    _ignored("view_layer.use_motion_blur", "View Layer > Filter > Motion Blur",
+             "DRT blurs this view layer as the scene's Motion Blur says", True,
+             when=("scene.render.use_motion_blur", (True,))),
+    _ignored("view_layer.pass_alpha_threshold", "View Layer > Filter > Alpha Threshold",
+             "DRT's Depth and Normal passes take the first surface hit, whatever its alpha",
+             0.5, when=("view_layer.use_pass_z", (True,))),
+    _ignored("view_layer.cycles.use_denoising", "View Layer > Denoising",
+             "part of Denoise (warned there)", True, warns=False),
+    _ignored("view_layer.aovs", "View Layer > Shader AOV",
+             "DRT writes no shader AOVs (count shown)", 0),
+    _ignored("view_layer.lightgroups", "View Layer > Light Groups",
+             "DRT writes no light group passes (count shown)", 0),
+    *[_ignored(path, f"Passes > {label}", _PASSES_HOW, False, group="passes")
+      for path, label in _UNWRITTEN_PASSES],
+    # -- speed, memory, the viewport or baking: never the final image
+    *[_s(f"scene.cycles.{name}", label, NO_EFFECT, how) for name, label, how in [
+        ("device", "Device", "DRT runs on the CPU"),
+        ("use_auto_tile", "Performance > Memory > Use Tiling", "DRT's memory is bounded by "
+         "its work units"),
+        ("tile_size", "Performance > Memory > Tile Size", "not read"),
+        ("debug_use_spatial_splits", "Performance > Acceleration Structure", "DRT uses "
+         "Embree with its own settings"),
+        ("preview_samples", "Sampling > Viewport", "DRT's viewport is EEVEE's"),
+        ("use_preview_denoising", "Sampling > Viewport > Denoise", "DRT's viewport is EEVEE's"),
+        ("texture_limit", "Simplify > Viewport > Texture Limit", "DRT's viewport is EEVEE's"),
+        ("bake_type", "Bake", "DRT does not bake"),
+    ]],
+    *_no_effect(["preview_pause", "preview_denoiser", "preview_denoising_prefilter",
+                 "preview_denoising_quality", "preview_denoising_input_passes",
+                 "preview_denoising_start_sample", "preview_denoising_use_gpu",
+                 "preview_scrambling_distance", "use_preview_adaptive_sampling",
+                 "preview_adaptive_threshold", "preview_adaptive_min_samples",
+                 "volume_preview_step_rate", "preview_dicing_rate", "ao_bounces"],
+                "viewport only (DRT's viewport is EEVEE's)"),
+    *_no_effect(["debug_bvh_type", "debug_use_hair_bvh", "debug_use_compact_bvh",
+                 "debug_bvh_time_steps", "debug_use_cpu_avx2", "debug_use_cpu_sse42",
+                 "debug_bvh_layout", "debug_use_cuda_adaptive_compile",
+                 "debug_use_optix_debug", "debug_use_hip_adaptive_compile",
+                 "debug_use_metal_adaptive_compile"],
+                "Cycles' debugging and devices; DRT uses Embree on the CPU"),
+    _s("scene.render.threads_mode", "Performance > Threads", NO_EFFECT,
+       "DRT's own Threads setting (Sampling) decides"),
+    _s("scene.render.use_persistent_data", "Performance > Final Render > Persistent Data",
+       NO_EFFECT, "DRT exports the scene for every render"),
+    _s("scene.render.filter_size", "Film > Filter Size (EEVEE, Workbench)", NO_EFFECT,
+       "not Cycles' setting; DRT's own Width decides"),
+]
