@@ -117,6 +117,8 @@ class TriangleMesh:
     corner_normals: optional (T, 3, 3) float32 shading normals per triangle corner
         (Blender's split normals); None means flat shading.
     uvs: optional (T, 3, 2) float32 texture coordinates per corner.
+    tangents: optional (T, 3, 4) float32 tangent space per corner (world-space tangent
+        and bitangent sign, Blender's MikkTSpace), for tangent-space Normal Maps.
     motion: None for a static mesh (positions in world space); an
         `engine.motion.RigidMotion` (positions then in OBJECT space, placed in the world by
         the motion's transform at each ray's time); or an `engine.motion.DeformMotion`
@@ -132,6 +134,7 @@ class TriangleMesh:
     holdout: bool = False          # Cycles' holdout: a zero-alpha hole for camera rays
     visibility: int = 31           # the ray kinds that see it (engine.visibility)
     object_info: Optional[object] = None   # ObjectInfo, what shader nodes read of it
+    tangents: Optional[np.ndarray] = None  # (T, 3, 4) float32: tangent, bitangent sign
 
     def __post_init__(self):
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)

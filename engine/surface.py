@@ -34,6 +34,7 @@ class SurfaceHit:
     uv: np.ndarray | None = None   # (n, 2) texture coordinates, None if no mesh has UVs
     prim: np.ndarray | None = None       # (n,) the triangles hit
     direction: np.ndarray | None = None  # (n, 3) the rays' directions
+    bary: np.ndarray | None = None       # (n, 2) barycentrics (u, v) in the triangle
 
 
 class SurfaceBuilder:
@@ -69,6 +70,13 @@ class SurfaceBuilder:
                                            for m in ordered])
                            if any(m.visibility != 31 for m in ordered) else None)
         self.tri_object, self.objects = _object_table(ordered)
+        # Tangent space per corner for Normal Maps (sign 0 where a mesh has none)
+        self.corner_tangents = None
+        if any(getattr(m, "tangents", None) is not None for m in ordered):
+            self.corner_tangents = np.concatenate([
+                np.asarray(m.tangents, np.float32).reshape(-1, 3, 4)
+                if getattr(m, "tangents", None) is not None
+                else np.zeros((len(m.triangles), 3, 4), np.float32) for m in ordered])
         self.corner_normals = None
         if any(m.corner_normals is not None for m in ordered):
             parts, offset = [], 0
@@ -98,8 +106,16 @@ class SurfaceBuilder:
         """The hit rows shader programs read (engine.nodes.context) for the hits si."""
         from .nodes.context import hit_rows
         obj = self.tri_object[si.prim] if self.tri_object is not None else None
+        tangent = None
+        if self.corner_tangents is not None:
+            c = self.corner_tangents[si.prim].astype(np.float64)
+            u, v = si.bary[:, :1], si.bary[:, 1:]
+            tangent = (1.0 - u - v) * c[:, 0] + u * c[:, 1] + v * c[:, 2]
+            t = tangent[:, :3]
+            tangent[:, :3] = t / np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-300)
+            tangent[:, 3] = np.sign(tangent[:, 3])
         return hit_rows(si.position, si.shading_normal, si.geometric_normal, si.direction,
-                        si.uv, si.front_facing, ray, depth, None, self.objects, obj)
+                        si.uv, si.front_facing, ray, depth, None, self.objects, obj, tangent)
 
     def _moving_vertices(self, prim, time):
         """World vertices, normal matrices (or None) of hit triangles at the rays' times."""
@@ -172,7 +188,7 @@ class SurfaceBuilder:
             cu = self.corner_uvs[prim].astype(np.float64)
             uv = w * cu[:, 0] + u * cu[:, 1] + v * cu[:, 2]
         return SurfaceHit(pos, ng_f, ns, front, self.material[prim], scale, uv, prim,
-                          np.asarray(ray_dirs)[index])
+                          np.asarray(ray_dirs)[index], np.hstack([u, v]))
 
 
 def _object_table(ordered):

@@ -113,6 +113,24 @@ def _light_path(nt, p):
     return ident(mix.outputs, "Result_Color")
 
 
+def _normal_map(strength):
+    def build(nt, p):
+        c = p.node(nt, "ShaderNodeTexChecker")
+        c.inputs["Scale"].default_value = 4.0
+        c.inputs["Color1"].default_value = (0.5, 0.5, 1.0, 1.0)
+        c.inputs["Color2"].default_value = (0.8, 0.3, 0.85, 1.0)
+        nt.links.new(p.coords(nt).outputs["UV"], c.inputs["Vector"])
+        nm = p.node(nt, "ShaderNodeNormalMap")
+        nm.inputs["Strength"].default_value = strength
+        nt.links.new(c.outputs["Color"], nm.inputs["Color"])
+        vm = p.node(nt, "ShaderNodeVectorMath", operation="MULTIPLY_ADD")
+        nt.links.new(nm.outputs[0], vm.inputs[0])
+        vm.inputs[1].default_value = (0.5, 0.5, 0.5)
+        vm.inputs[2].default_value = (0.5, 0.5, 0.5)
+        return vm.outputs[0]
+    return build
+
+
 INPUT = [("tc_generated", _tex_coord("Generated")), ("tc_uv", _tex_coord("UV")),
          ("tc_object", _tex_coord("Object")),
          ("oi_color", _object_info("Color")), ("oi_location", _object_info("Location")),
@@ -120,7 +138,8 @@ INPUT = [("tc_generated", _tex_coord("Generated")), ("tc_uv", _tex_coord("UV")),
 INPUT_SPHERES = [("tc_normal", _tex_coord("Normal")), ("geo_normal", _geometry("Normal")),
                  ("geo_position", _geometry("Position")),
                  ("geo_true_normal", _geometry("True Normal")), ("fresnel", _fresnel),
-                 ("lw_fresnel", _layer("Fresnel")), ("lw_facing", _layer("Facing"))]
+                 ("lw_fresnel", _layer("Fresnel")), ("lw_facing", _layer("Facing")),
+                 ("normal_map", _normal_map(1.0)), ("normal_map_half", _normal_map(0.5))]
 
 
 # ---------------------------------------------------------------- textures

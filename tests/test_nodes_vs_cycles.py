@@ -95,3 +95,4 @@ def test_unsupported_node_warns_and_falls_back(bpy_drt):
         (0.75 * 0.9 + 0.25 * 0.2, 0.75 * 0.1 + 0.25 * 0.4, 0.75 * 0.1 + 0.25 * 0.6))
     img = node_probe.render(bpy, scene, "DRT", 4)
     assert np.isfinite(img).all() and img.mean() > 0.1
+

@@ -325,6 +325,7 @@ class _Ctx:
         self.issues = []
         self.cache = _image_caches.setdefault(reporter, {}) if reporter is not None else {}
         self.nodes = NodeCompiler(self)
+        self.normal = None          # the per-hit shading normal (a program Value), if any
 
     def issue(self, text):
         if text not in self.issues:
@@ -397,10 +398,10 @@ def _principled(node, ctx) -> _Closure:
     s = node.inputs.get("Specular Tint")
     if s is not None and (s.is_linked or any(abs(x - 1.0) > TOL for x in s.default_value[:3])):
         ignored.append("specular tint")
-    for sock in ("Normal", "Tangent"):
-        s = node.inputs.get(sock)
-        if s is not None and s.is_linked:
-            ignored.append(f"the {sock.lower()} input")
+    s = node.inputs.get("Tangent")
+    if s is not None and s.is_linked:
+        ignored.append("the tangent input")
+    _normal(node, ctx)
     if ignored:
         ctx.issue(f"{node.name!r} uses {', '.join(ignored)}, which DRT does not render "
                   f"(left out)")
@@ -415,7 +416,26 @@ def _principled(node, ctx) -> _Closure:
     return _Closure([(a, comp)], 1.0 - a, (1.0 - a,) * 3, _scale(emission, a))
 
 
+def _normal(node, ctx):
+    """A BSDF's linked Normal input: the material's per-hit shading normal (one per
+    material: a second, different one in a mix is reported and left out)."""
+    sock = node.inputs.get("Normal")
+    if sock is None or _link(sock) is None:
+        return
+    value = ctx.nodes.socket(sock, "vector")
+    if not value.varying:
+        ctx.issue(f"the Normal of {node.name!r} is a constant direction; DRT keeps the "
+                  f"surface's normal")
+        return
+    if ctx.normal is None:
+        ctx.normal = value
+    elif ctx.normal.reg != value.reg:
+        ctx.issue(f"mixed shaders have different normals; DRT uses the first one's for "
+                  f"all ({node.name!r} left out)")
+
+
 def _diffuse(node, ctx) -> _Closure:
+    _normal(node, ctx)
     r = _constant(node, "Roughness", ctx, 0.0)
     if r > 0.0:
         ctx.issue(f"{node.name!r} has roughness {r:g} (Oren-Nayar); DRT renders it Lambertian")
@@ -433,6 +453,7 @@ def _distribution(node, ctx) -> str:
 
 
 def _glossy(node, ctx) -> _Closure:
+    _normal(node, ctx)
     distribution = _distribution(node, ctx)
     s = node.inputs.get("Anisotropy")
     if s is not None and (s.is_linked or float(s.default_value) != 0.0):
@@ -447,6 +468,7 @@ def _glass(node, ctx, refraction=False) -> _Closure:
     if refraction:
         ctx.issue(f"{node.name!r} (Refraction BSDF) is rendered as glass, which also "
                   f"reflects")
+    _normal(node, ctx)
     distribution = _distribution(node, ctx)
     color = _input(node, "Color", ctx, True, WHITE)
     if _is_tex(color):
@@ -772,6 +794,8 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
         if disp is not None and _link(disp) is not None:
             ctx.issue("its displacement is not rendered")
         result = _reduce(_closure(out.inputs["Surface"], ctx), ctx, name)
+        if ctx.normal is not None:
+            ctx.nodes.b.output("normal", ctx.normal)
         if ctx.nodes.b.outputs:
             result.shader = ctx.nodes.build()
     if ctx.issues and reporter is not None:

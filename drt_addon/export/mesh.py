@@ -14,7 +14,9 @@ import numpy as np
 
 from ..engine_link import engine
 from .errors import ExportError
+from . import tangents as tangent_space
 from .matrices import to_numpy
+from .tangents import mesh_tangents, wants_tangents
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT", "CURVES"}
 
@@ -29,6 +31,7 @@ class LocalMesh:
     uvs: Optional[np.ndarray] = None       # (T, 3, 2) float32 corner UVs, None if not needed
     uv_request: Optional[str] = None       # the UV map asked for ('' = default), None = none
     kept: Optional[np.ndarray] = None      # indices of the mesh's triangles kept (None: all)
+    tangents: Optional[np.ndarray] = None  # (T, 3, 4) float32 tangent + sign, if wanted
 
 
 def mesh_arrays(mesh):
@@ -129,13 +132,15 @@ class MeshCache:
     def local(self, obj) -> Optional[LocalMesh]:
         key = _cache_key(obj)
         want_uv = uv_request(obj)
+        want_tangents = wants_tangents(obj)
         if key is not None and key in self._local:
             cached = self._local[key]
             # a shared mesh whose other user needed no UVs (object-linked materials)
-            if cached is None or want_uv is None or cached.uv_request == want_uv:
+            if cached is None or ((want_uv is None or cached.uv_request == want_uv)
+                                  and (not want_tangents or cached.tangents is not None)):
                 self.reuses += 1
                 return cached
-        local = _evaluate(obj, want_uv, self.reporter)
+        local = _evaluate(obj, want_uv, self.reporter, want_tangents)
         self.evaluations += 1
         if key is not None:
             self._local[key] = local
@@ -175,18 +180,25 @@ def _drop_degenerate(obj, pos, tris, mat, normals, uvs, reporter):
     return pos, tris, mat, normals, uvs, kept
 
 
-def _evaluate(obj, want_uv: Optional[str] = None, reporter=None) -> Optional[LocalMesh]:
+def _evaluate(obj, want_uv: Optional[str] = None, reporter=None,
+              want_tangents=False) -> Optional[LocalMesh]:
     try:
         mesh = obj.to_mesh()
     except RuntimeError as e:
         raise ExportError(f"object {obj.name!r}: cannot evaluate its mesh ({e})") from e
-    uvs = None
+    uvs = tangents = None
     try:
         if mesh is None:
             return None
         pos, tris, mat, normals = mesh_arrays(mesh)
         if want_uv is not None and len(tris):
             uvs = mesh_uvs(mesh, want_uv)
+        if want_tangents and len(tris):
+            tangents = mesh_tangents(mesh, want_uv or "")
+            if tangents is None and reporter is not None:
+                reporter.warn(f"DRT: object {obj.name!r}: no tangents for its Normal Map (no "
+                              "UV map, or faces of more than four corners); the map is not "
+                              "applied", key=(obj.name, "tangents"))
     finally:
         obj.to_mesh_clear()
     if len(tris) == 0:
@@ -199,7 +211,10 @@ def _evaluate(obj, want_uv: Optional[str] = None, reporter=None) -> Optional[Loc
         normals = None                        # degenerate faces: fall back to flat shading
     if uvs is not None and not np.all(np.isfinite(uvs)):
         uvs = np.where(np.isfinite(uvs), uvs, 0.0).astype(np.float32)
-    return LocalMesh(pos, tris, mat, normals, uvs, want_uv, kept)
+    if tangents is not None:
+        tangents = tangents[kept] if kept is not None else tangents
+        tangents = np.where(np.isfinite(tangents), tangents, 0.0).astype(np.float32)
+    return LocalMesh(pos, tris, mat, normals, uvs, want_uv, kept, tangents)
 
 
 def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engine.TriangleMesh":
@@ -214,6 +229,7 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
     tris = local.triangles
     normals = local.normals
     uvs = local.uvs
+    tangents = tangent_space.to_world(local.tangents, m3)
     det = float(np.linalg.det(m3))
     if normals is not None:
         normal_matrix = np.linalg.inv(m3).T if abs(det) > 1e-300 else m3
@@ -228,9 +244,12 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
             normals = normals[:, [0, 2, 1]]
         if uvs is not None:
             uvs = uvs[:, [0, 2, 1]]
+        if tangents is not None:
+            tangents = tangents[:, [0, 2, 1]]
     slots = np.asarray(material_slots if len(material_slots) else [0], dtype=np.int32)
     global_mat = slots[np.clip(local.material, 0, len(slots) - 1)]
-    return engine.TriangleMesh(name, world, tris, global_mat, corner_normals=normals, uvs=uvs)
+    return engine.TriangleMesh(name, world, tris, global_mat, corner_normals=normals, uvs=uvs,
+                               tangents=tangents)
 
 
 def export_mesh_instance(obj, matrix_world, material_slots, name,

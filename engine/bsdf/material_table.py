@@ -176,6 +176,34 @@ class MaterialTable:
             out[rows] = regs[np.arange(len(rows)), reg]
         return out
 
+    def shading_normal(self, index, hits, ns, ng) -> np.ndarray:
+        """The shading normals (n, 3) of hits whose materials' programs set one (a Normal
+        Map), else ns; as in the kernels (engine.nodes.shading.program_normal), made a
+        valid specular reflector for the hit's view direction as Cycles does."""
+        from ..nodes.interpreter import evaluate_materials
+        from ..nodes.pack import OUTS
+        from ..nodes.program import OUTPUTS
+        index = np.asarray(index, np.int64)
+        has = np.array([p is not None and "normal" in p.outputs for p in self.programs],
+                       bool)
+        rows = np.nonzero(has[index])[0] if len(index) else np.zeros(0, np.int64)
+        if rows.size == 0:
+            return ns
+        T = self.shading()
+        regs = evaluate_materials(T, index[rows], hits[rows])
+        reg = T[OUTS][index[rows], OUTPUTS.index("normal")]
+        n = np.stack([regs[np.arange(len(rows)), reg + k] for k in range(3)], 1)
+        from ..nodes.context import H_I
+        from ..nodes.shading import valid_reflection_normal
+        out = ns.copy()
+        for j, r in enumerate(rows):
+            x, y, z = n[j]
+            length = float(np.sqrt(x * x + y * y + z * z))
+            if length > 0 and np.isfinite(length):
+                out[r] = valid_reflection_normal(*ng[r], *hits[r, H_I:H_I + 3], x / length,
+                                                 y / length, z / length)
+        return out
+
     def lookup_plain(self, name, index, uv=None) -> np.ndarray:
         """`lookup` without programs (their plain values and textures)."""
         programmed = self.programmed.pop(name, None)

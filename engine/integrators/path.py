@@ -291,14 +291,16 @@ class PathIntegrator:
             # The surfaces hit
             si = ctx.surfaces.build(hits, live, d, tp)
             t_live = None if tp is None else tp[live]
+            shader_rows = _rows(mats, ctx.surfaces, si, depth)
             ns, ng = si.shading_normal, si.geometric_normal
+            if shader_rows is not None:
+                ns = mats.shading_normal(si.material, shader_rows, ns, ng)
             wo = to_local(-d[live], ns)
             rows = path[live]
             b_live = b[live]
             px_l, ix_l = px[live], ix[live]
             # 1c. emissive surfaces (two-sided, like Cycles' Emission shader), weighted
             # against next-event estimation of the emissive triangle that was hit
-            shader_rows = _rows(mats, ctx.surfaces, si, depth)
             if mats.any_emission:
                 em = mats.emission_at(si.material, si.uv, shader_rows)
                 glow = np.nonzero((em != 0).any(axis=1))[0]

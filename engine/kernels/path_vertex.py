@@ -30,7 +30,7 @@ from .textures import apply_to_row, emission_at
 from ..nodes.context import N_HIT
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import apply_rows, program_emission, program_hit
+from ..nodes.shading import apply_rows, program_emission, program_hit, program_normal
 
 MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
 # Numba freezes these into its cache; the cache's fingerprint covers every engine file
@@ -132,8 +132,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     clamp_direct, clamp_indirect, mis mode, scene radius, film transparent, filter glossy,
     reflective caustics, refractive caustics] (see `prepare_closures`).
     geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout,
-    corner_uvs, moving objects, triangle objects, object table) of every triangle
-    (corner normals, holdout, UVs and objects may be empty; see
+    corner_uvs, moving objects, triangle objects, object table, corner tangents) of every
+    triangle (corner normals, holdout, UVs, objects and tangents may be empty; see
     `surface.rebuild_at_time` and engine.nodes.shading). textures: the packed textures
     and shader programs (engine.nodes.pack.pack_shading); a material with a program
     runs it at each hit, and its outputs replace the parameters they drive. path_time: each path's shutter time (its
@@ -210,8 +210,11 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         programmed = has_program(textures, m)
         if programmed:
-            program_hit(textures, geometry, m, prim, uu, vv, px, py, pz, gx, gy, gz, nx, ny,
-                        nz, dx, dy, dz, front, ray_bits[p], depth, t_geom, hit_row, regs)
+            program_hit(textures, geometry, m, prim, hit_u[j], hit_v[j], uu, vv, px, py, pz,
+                        gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bits[p], depth, t_geom,
+                        hit_row, regs)
+            nx, ny, nz = program_normal(textures, m, regs, nx, ny, nz, gx, gy, gz, -dx, -dy,
+                                        -dz)
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
         er, eg, eb = emission_at(textures, emission, m, uu, vv)
         if programmed:

@@ -49,7 +49,7 @@ def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz, time, ray, depth, le
     if has_program(T, m):
         hit = np.zeros(N_HIT)
         regs = np.zeros(max(T[NREGS][0], 1))
-        program_hit(T, geometry, m, prim, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
+        program_hit(T, geometry, m, prim, u, v, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
                     dx, dy, dz, front, ray, depth, length, hit, regs)
         a = program_alpha(T, m, regs, a)
     return a, m, px, py, pz, gx, gy, gz, scale

@@ -38,7 +38,7 @@ def run(T, m, hit, regs):
         elif code < 400:
             converter_nodes.execute(ins, regs)
         else:
-            vector_nodes.execute(ins, regs)
+            vector_nodes.execute(ins, regs, hit)
 
 
 @kernel

@@ -18,8 +18,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-OUTPUTS = ("base_color", "metallic", "roughness", "emission", "alpha")  # MaterialTable.PARAMS
-OUTPUT_WIDTH = {"base_color": 3, "metallic": 1, "roughness": 1, "emission": 3, "alpha": 1}
+# MaterialTable.PARAMS, then the shading normal (a Normal Map's)
+OUTPUTS = ("base_color", "metallic", "roughness", "emission", "alpha", "normal")
+OUTPUT_WIDTH = {"base_color": 3, "metallic": 1, "roughness": 1, "emission": 3, "alpha": 1,
+                "normal": 3}
 N_OUT = len(OUTPUTS)
 WIDTH = 8            # int32 per instruction: opcode, output register, six operands
 

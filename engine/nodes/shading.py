@@ -1,27 +1,42 @@
 """The kernels' side of shader programs: run a hit's material program and read its
 outputs into the Principled parameter row, emission and alpha.
 
-geometry is the compiled path tracer's triangle tuple; its fields 10 and 11 are each
-triangle's object (int32, empty when no mesh carries ObjectInfo) and the object table
-(context.O_* rows)."""
+geometry is the compiled path tracer's triangle tuple; its fields 10, 11 and 12 are each
+triangle's object (int32, empty when no mesh carries ObjectInfo), the object table
+(context.O_* rows) and the corner tangents ((T, 3, 4) float32, empty without)."""
 from __future__ import annotations
+
+import math
 
 from ..kernels.jit import kernel
 from .context import fill
 from .interpreter import run
 from .pack import OUTS
 
-OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA = 0, 1, 2, 3, 4
+OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL = range(6)
 
 
 @kernel
-def program_hit(T, geometry, m, prim, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy,
-                dz, front, ray, depth, length, hit, regs):
-    """Fill the hit row of a hit on triangle prim (material m) and run m's program."""
-    tri_object, objects = geometry[10], geometry[11]
+def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
+                dx, dy, dz, front, ray, depth, length, hit, regs):
+    """Fill the hit row of a hit on triangle prim (material m) at barycentrics (bu, bv)
+    and run m's program."""
+    tri_object, objects, corner_tangents = geometry[10], geometry[11], geometry[12]
     obj = tri_object[prim] if tri_object.shape[0] > 0 else -1
+    tx = ty = tz = ts = 0.0
+    if corner_tangents.shape[0] > 0:
+        c = corner_tangents
+        b0 = 1.0 - bu - bv
+        tx = b0 * c[prim, 0, 0] + bu * c[prim, 1, 0] + bv * c[prim, 2, 0]
+        ty = b0 * c[prim, 0, 1] + bu * c[prim, 1, 1] + bv * c[prim, 2, 1]
+        tz = b0 * c[prim, 0, 2] + bu * c[prim, 1, 2] + bv * c[prim, 2, 2]
+        ts = b0 * c[prim, 0, 3] + bu * c[prim, 1, 3] + bv * c[prim, 2, 3]
+        ln = math.sqrt(tx * tx + ty * ty + tz * tz)
+        if ln > 0.0:
+            tx, ty, tz = tx / ln, ty / ln, tz / ln
+        ts = 1.0 if ts > 0.0 else (-1.0 if ts < 0.0 else 0.0)
     fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, uu, vv, front, ray, depth,
-         length, objects, obj)
+         length, objects, obj, tx, ty, tz, ts)
     run(T, m, hit, regs)
 
 
@@ -58,3 +73,49 @@ def program_alpha(T, m, regs, a):
     if k < 0:
         return a
     return min(max(regs[k], 0.0), 1.0)
+
+
+@kernel
+def valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z):
+    """Cycles' ensure_valid_specular_reflection: the normal n (unit) tilted towards the
+    geometric normal g (facing the viewer I) just enough that I mirrored about it leaves
+    above the surface (at least min(0.9 I.g, 0.01)); n itself when it already does."""
+    ndi = x * ix + y * iy + z * iz
+    iz_ = ix * gx + iy * gy + iz * gz
+    rz = 2.0 * ndi * (x * gx + y * gy + z * gz) - iz_
+    threshold = min(0.9 * iz_, 0.01)
+    if rz >= threshold:
+        return x, y, z
+    ndg = x * gx + y * gy + z * gz
+    ax, ay, az = x - ndg * gx, y - ndg * gy, z - ndg * gz
+    ln = math.sqrt(ax * ax + ay * ay + az * az)
+    if ln > 0.0:
+        ax, ay, az = ax / ln, ay / ln, az / ln
+    else:
+        ax, ay, az = x, y, z
+    i_x = ix * ax + iy * ay + iz * az
+    a = i_x * i_x + iz_ * iz_
+    if not a > 0.0:
+        return gx, gy, gz
+    b = 2.0 * (a + iz_ * threshold)
+    c = (threshold + iz_) ** 2
+    root = math.sqrt(max(b * b - 4.0 * a * c, 0.0))
+    nz2 = 0.25 * (b + root) / a if i_x < 0.0 else 0.25 * (b - root) / a
+    nz2 = min(max(nz2, 0.0), 1.0)
+    nx_, nz_ = math.sqrt(1.0 - nz2), math.sqrt(nz2)
+    return nx_ * ax + nz_ * gx, nx_ * ay + nz_ * gy, nx_ * az + nz_ * gz
+
+
+@kernel
+def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz):
+    """The program's shading normal (a Normal Map's), normalised and made a valid
+    specular reflector for the view direction I as Cycles makes any normal other than
+    the surface's own (valid_reflection_normal); n when the program does not set one."""
+    k = T[OUTS][m, OUT_NORMAL]
+    if k < 0:
+        return nx, ny, nz
+    x, y, z = regs[k], regs[k + 1], regs[k + 2]
+    ln = math.sqrt(x * x + y * y + z * z)
+    if not ln > 0.0 or not math.isfinite(ln):
+        return nx, ny, nz
+    return valid_reflection_normal(gx, gy, gz, ix, iy, iz, x / ln, y / ln, z / ln)

@@ -5,6 +5,9 @@
                                                  Distance, Length)
   VEC_MAPPING out, vector, location, rotation, scale, type   Mapping (MAPPING_TYPES;
                                                  rotation as Euler XYZ)
+  VEC_NORMAL_MAP out, color, strength            Normal Map in tangent space (the hit's
+                                                 tangent and bitangent sign, Cycles'
+                                                 svm_node_normal_map)
 """
 from __future__ import annotations
 
@@ -13,11 +16,13 @@ import math
 import numpy as np
 
 from ..kernels.jit import kernel
+from .context import H_BACKFACING, H_N, H_TANGENT, H_TANGENT_SIGN
 from .converter_nodes import MATH_OPS, math_op, safe_divide
 
 VEC_MATH = 400
 VEC_MATH_VALUE = 401
 VEC_MAPPING = 402
+VEC_NORMAL_MAP = 403
 
 VECTOR_OPS = ("ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "CROSS_PRODUCT",
               "PROJECT", "REFLECT", "REFRACT", "FACEFORWARD", "DOT_PRODUCT", "DISTANCE",
@@ -123,7 +128,36 @@ def mapping(kind, x, y, z, lx, ly, lz, rx, ry, rz, sx, sy, sz):
 
 
 @kernel
-def execute(ins, regs):
+def normal_map(hit, cr, cg, cb, strength):
+    """Cycles' tangent-space normal map: the colour (2c - 1) in the frame of the tangent,
+    sign x N x T and the interpolated normal N (un-flipped for the maths, flipped back on
+    a back-facing hit); blended towards N by strength != 1; N where the mesh has no
+    tangents."""
+    nx, ny, nz = hit[H_N], hit[H_N + 1], hit[H_N + 2]
+    sign = hit[H_TANGENT_SIGN]
+    if sign == 0.0:
+        return nx, ny, nz
+    back = hit[H_BACKFACING] > 0.0
+    ox, oy, oz = (-nx, -ny, -nz) if back else (nx, ny, nz)
+    tx, ty, tz = hit[H_TANGENT], hit[H_TANGENT + 1], hit[H_TANGENT + 2]
+    bx = sign * (oy * tz - oz * ty)
+    by = sign * (oz * tx - ox * tz)
+    bz = sign * (ox * ty - oy * tx)
+    cx, cy, cz = 2.0 * (cr - 0.5), 2.0 * (cg - 0.5), 2.0 * (cb - 0.5)
+    x, y, z = _normalize(cx * tx + cy * bx + cz * ox, cx * ty + cy * by + cz * oy,
+                         cx * tz + cy * bz + cz * oz)
+    if back:
+        x, y, z = -x, -y, -z
+    if strength != 1.0:
+        s = max(strength, 0.0)
+        x, y, z = _normalize(nx + (x - nx) * s, ny + (y - ny) * s, nz + (z - nz) * s)
+    if x == 0.0 and y == 0.0 and z == 0.0:
+        return nx, ny, nz
+    return x, y, z
+
+
+@kernel
+def execute(ins, regs, hit):
     code, out = ins[0], ins[1]
     if code == VEC_MATH or code == VEC_MATH_VALUE:
         a, b, c = ins[2], ins[3], ins[4]
@@ -139,3 +173,7 @@ def execute(ins, regs):
         regs[out], regs[out + 1], regs[out + 2] = mapping(
             ins[6], regs[v], regs[v + 1], regs[v + 2], regs[lo], regs[lo + 1], regs[lo + 2],
             regs[ro], regs[ro + 1], regs[ro + 2], regs[so], regs[so + 1], regs[so + 2])
+    elif code == VEC_NORMAL_MAP:
+        c = ins[2]
+        regs[out], regs[out + 1], regs[out + 2] = normal_map(hit, regs[c], regs[c + 1],
+                                                             regs[c + 2], regs[ins[3]])

@@ -1,5 +1,5 @@
-"""Vector nodes to program operations (engine.nodes.vector_nodes): Vector Math and
-Mapping."""
+"""Vector nodes to program operations (engine.nodes.vector_nodes): Vector Math, Mapping
+and Normal Map (tangent space, from the tangents of the mesh's UV map)."""
 from __future__ import annotations
 
 import importlib
@@ -35,7 +35,16 @@ def _mapping(c, node, out):
                                              c.input(node, "Scale", "vector"), kind])
 
 
+def _normal_map(c, node, out):
+    if node.space != "TANGENT":
+        raise Unsupported(f"a Normal Map in {node.space} space is not evaluated")
+    return c.emit(VE.VEC_NORMAL_MAP, "vector", [c.input(node, "Color", "color"),
+                                                c.input(node, "Strength", "float")],
+                  varying=True)
+
+
 TRANSLATORS = {
+    "ShaderNodeNormalMap": _normal_map,
     "ShaderNodeVectorMath": _vector_math,
     "ShaderNodeMapping": _mapping,
 }
