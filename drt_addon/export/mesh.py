@@ -16,7 +16,7 @@ from ..engine_link import engine
 from .errors import ExportError
 from . import tangents as tangent_space
 from .matrices import to_numpy
-from .tangents import mesh_tangents, wants_tangents
+from .tangents import mesh_tangents, uv_layer, wants_tangents
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT", "CURVES"}
 
@@ -60,12 +60,9 @@ def mesh_uvs(mesh, name: str = "") -> Optional[np.ndarray]:
     mesh lacks) the map Cycles uses by default: the active render UV map (Blender's camera
     icon in the UV Maps list), else the active one. None when the mesh has no UV map:
     Cycles then reads (0, 0, 0) as UV, which the tracer does for a mesh without UVs."""
-    layers = mesh.uv_layers
-    if len(layers) == 0:
-        return None
-    layer = layers.get(name) if name else None
+    layer = uv_layer(mesh, name)
     if layer is None:
-        layer = next((l for l in layers if l.active_render), None) or layers.active or layers[0]
+        return None
     nt = len(mesh.loop_triangles)
     loops = np.empty(nt * 3, dtype=np.int32)
     mesh.loop_triangles.foreach_get("loops", loops)

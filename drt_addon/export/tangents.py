@@ -20,16 +20,25 @@ def wants_tangents(obj) -> bool:
     return False
 
 
+def uv_layer(mesh, name: str = ""):
+    """The UV map `name`, or for '' (or a name the mesh lacks) the one Cycles uses by
+    default: the active render map, else the active one; None without UV maps."""
+    layers = mesh.uv_layers
+    if len(layers) == 0:
+        return None
+    layer = layers.get(name) if name else None
+    if layer is None:
+        layer = next((l for l in layers if l.active_render), None) or layers.active or layers[0]
+    return layer
+
+
 def mesh_tangents(mesh, uv_name: str = "") -> Optional[np.ndarray]:
     """(T, 3, 4) float32: tangent xyz and bitangent sign per loop-triangle corner, in
     object space, from UV map `uv_name` ('' or a missing name: the active render map);
     None when the mesh has no UV map or Blender cannot compute them (n-gons)."""
-    layers = mesh.uv_layers
-    if len(layers) == 0:
-        return None
-    layer = layers.get(uv_name) if uv_name else None
+    layer = uv_layer(mesh, uv_name)
     if layer is None:
-        layer = next((l for l in layers if l.active_render), None) or layers.active or layers[0]
+        return None
     try:
         mesh.calc_tangents(uvmap=layer.name)
     except RuntimeError:
