@@ -30,7 +30,8 @@ from .textures import apply_to_row, emission_at
 from ..nodes.context import N_HIT
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import apply_rows, program_emission, program_hit, program_normal
+from ..nodes.shading import (apply_rows, bent_diffuse, program_emission, program_hit,
+                             program_normal)
 
 MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
 # Numba freezes these into its cache; the cache's fingerprint covers every engine file
@@ -209,12 +210,16 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         m = tri_material[prim]
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         programmed = has_program(textures, m)
+        bent = False
+        rx, ry, rz = nx, ny, nz
         if programmed:
             program_hit(textures, geometry, m, prim, hit_u[j], hit_v[j], uu, vv, px, py, pz,
                         gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bits[p], depth, t_geom,
                         hit_row, regs)
-            nx, ny, nz = program_normal(textures, m, regs, nx, ny, nz, gx, gy, gz, -dx, -dy,
-                                        -dz)
+            sx, sy, sz, rx, ry, rz = program_normal(textures, m, regs, nx, ny, nz, gx, gy,
+                                                    gz, -dx, -dy, -dz)
+            bent = sx != nx or sy != ny or sz != nz or rx != nx or ry != ny or rz != nz
+            nx, ny, nz = sx, sy, sz
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
         er, eg, eb = emission_at(textures, emission, m, uu, vv)
         if programmed:
@@ -247,7 +252,21 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             see_d = (seen & DIFFUSE_BIT) != 0
             see_g = (seen & GLOSSY_BIT) != 0 and keep_g
             see_t = (seen & TRANSMISSION_BIT) != 0 and keep_t
-            fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, see_d, see_g, see_t)
+            cosine = abs(lz)
+            if bent:
+                # a Normal Map's normal: specular lobes on its valid-reflection frame,
+                # the diffuse lobe on the raw normal with bump shadowing (Cycles)
+                fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, False, see_g,
+                                            see_t)
+                fr, fg, fb = fr * cosine, fg * cosine, fb * cosine
+                if see_d:
+                    dr, dg, db = bent_diffuse(state, wox, woy, woz, gx, gy, gz, rx, ry, rz,
+                                              wx, wy, wz)
+                    fr, fg, fb = fr + dr, fg + dg, fb + db
+                cosine = 1.0
+            else:
+                fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, see_d, see_g,
+                                            see_t)
             front_side = dot(wx, wy, wz, gx, gy, gz) > 0.0
             if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0
                     and (front_side or bsdf.transmits(state))):
@@ -266,7 +285,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                     far = scene_radius * 4.0
                 bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
                                      see_d, see_g, see_t)
-                w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * abs(lz)
+                w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine
                 if not seen & SHADOW_BIT:        # a light casting no shadow: no shadow ray
                     _add(L, p, br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w,
                          clamp_direct if depth == 0 else clamp_indirect)
@@ -289,6 +308,16 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         if not valid:
             continue
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
+        if bent and ad and not sdelta and spdf > 0.0:
+            # the diffuse lobe's share of the weight, moved from the sampling frame's
+            # cosine to the raw normal's (with bump shadowing)
+            fd_r, fd_g, fd_b = bsdf.eval_seen(state, wox, woy, woz, 0.0, 0.0, 1.0, True,
+                                              False, False)
+            dr, dg, db = bent_diffuse(state, wox, woy, woz, gx, gy, gz, rx, ry, rz, wx, wy, wz)
+            c = abs(iz)
+            wr = max(wr + (dr - fd_r * c) / spdf, 0.0)
+            wg = max(wg + (dg - fd_g * c) / spdf, 0.0)
+            wb = max(wb + (db - fd_b * c) / spdf, 0.0)
         side = dot(wx, wy, wz, gx, gy, gz)
         if (side >= 0.0) if skind == TRANSMISSION else (side <= 0.0):
             continue       # reflection leaves on the geometric normal's side, refraction through

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 
+from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
 from .context import fill
 from .interpreter import run
@@ -108,14 +109,48 @@ def valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z):
 
 @kernel
 def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz):
-    """The program's shading normal (a Normal Map's), normalised and made a valid
-    specular reflector for the view direction I as Cycles makes any normal other than
-    the surface's own (valid_reflection_normal); n when the program does not set one."""
+    """The program's shading normal (a Normal Map's), normalised, twice: as Cycles'
+    Principled BSDF uses it for its specular lobes, made a valid specular reflector for
+    the view direction I (valid_reflection_normal), then as its diffuse lobe uses it,
+    unchanged. Both are n when the program does not set one."""
     k = T[OUTS][m, OUT_NORMAL]
     if k < 0:
-        return nx, ny, nz
+        return nx, ny, nz, nx, ny, nz
     x, y, z = regs[k], regs[k + 1], regs[k + 2]
     ln = math.sqrt(x * x + y * y + z * z)
     if not ln > 0.0 or not math.isfinite(ln):
-        return nx, ny, nz
-    return valid_reflection_normal(gx, gy, gz, ix, iy, iz, x / ln, y / ln, z / ln)
+        return nx, ny, nz, nx, ny, nz
+    x, y, z = x / ln, y / ln, z / ln
+    vx, vy, vz = valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z)
+    return vx, vy, vz, x, y, z
+
+
+@kernel
+def bent_diffuse(state, wox, woy, woz, gx, gy, gz, rx, ry, rz, lx, ly, lz):
+    """The diffuse lobe's f x cos towards world direction l under the raw bent normal r
+    (Cycles: Lambert on the node's normal, times bump_shadowing), with the lobe's
+    (direction-independent) value read from the BSDF set up on the specular frame."""
+    cos_d = rx * lx + ry * ly + rz * lz
+    if not cos_d > 0.0:
+        return 0.0, 0.0, 0.0
+    fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, 0.0, 0.0, 1.0, True, False, False)
+    k = cos_d * bump_shadowing(gx, gy, gz, rx, ry, rz, lx, ly, lz)
+    return fr * k, fg * k, fb * k
+
+
+@kernel
+def bump_shadowing(gx, gy, gz, nx, ny, nz, lx, ly, lz):
+    """Cycles' bump_shadowing_term (after appleseed) for a diffuse lobe whose normal n
+    is not the surface's: fades light towards the geometric terminator instead of the
+    bent normal's, g = (Ng.L) / ((N.L)(Ng.N)); 1 for g >= 1, 0 for g < 0, smoothed
+    between."""
+    ndl = nx * lx + ny * ly + nz * lz
+    gdn = gx * nx + gy * ny + gz * nz
+    den = ndl * gdn
+    g = (gx * lx + gy * ly + gz * lz) / den if den != 0.0 else 0.0
+    if g >= 1.0:
+        return 1.0
+    if g < 0.0:
+        return 0.0
+    g2 = g * g
+    return -g2 * g + g2 + g
