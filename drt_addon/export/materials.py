@@ -271,7 +271,7 @@ class _Ctx:
         self.mat = mat
         self.name = mat.name
         self.issues = []
-        self.cache = _image_caches.setdefault(reporter, {}) if reporter is not None else {}
+        self.cache = image_cache(reporter)
 
     def issue(self, text):
         if text not in self.issues:
@@ -358,7 +358,8 @@ def _image_texture(node, out, ctx, color):
             return WHITE if color else 1.0
         return MISSING if color else float(np.dot(MISSING, textures.LUMINANCE))
     alpha_linked = any(o.is_linked for o in node.outputs if o.identifier == "Alpha")
-    tex = _texture(image, node, ctx, premultiply=not alpha_linked)
+    tex = image_texture(image, node.interpolation, node.extension, ctx,
+                        premultiply=not alpha_linked)
     if tex is None:
         if alpha_out:
             return WHITE if color else 1.0
@@ -394,9 +395,15 @@ def _read_pixels(image, ctx):
     return px
 
 
-def _texture(image, node, ctx, premultiply):
+def image_cache(reporter) -> dict:
+    """The export's cache of image pixels and Textures (one per Reporter, i.e. export)."""
+    return _image_caches.setdefault(reporter, {}) if reporter is not None else {}
+
+
+def image_texture(image, interpolation, extension, ctx, premultiply):
     """One engine Texture per (image, interpolation, extension, premultiplied) per export;
-    the pixel array is read once per image and shared."""
+    the pixel array is read once per image and shared. ctx: anything with `cache` (an
+    `image_cache`) and `issue(text)` (the approximations to report)."""
     cs = image.colorspace_settings
     is_data = bool(getattr(cs, "is_data", False)) or cs.name == "Non-Color"
     srgb = (not image.is_float) and cs.name == "sRGB" and not is_data
@@ -405,8 +412,8 @@ def _texture(image, node, ctx, premultiply):
         ctx.issue(f"image {image.name!r} is in the colour space {cs.name!r}, which DRT "
                   f"reads as scene-linear")
     premultiply = premultiply and not is_data and image.alpha_mode in ("STRAIGHT",)
-    interp = node.interpolation if node.interpolation in ("Linear", "Closest") else "Linear"
-    key = ("texture", image.name_full, interp, node.extension, srgb, premultiply)
+    interp = interpolation if interpolation in ("Linear", "Closest") else "Linear"
+    key = ("texture", image.name_full, interp, extension, srgb, premultiply)
     if key in ctx.cache:
         return ctx.cache[key]
     px = _read_pixels(image, ctx)
@@ -415,7 +422,7 @@ def _texture(image, node, ctx, premultiply):
         if premultiply and px.shape[2] == 4 and (px[:, :, 3] < 1.0).any():
             px = px.copy()
             px[:, :, :3] *= px[:, :, 3:4]
-        tex = textures.Texture(px, interp, node.extension, srgb=srgb, name=image.name)
+        tex = textures.Texture(px, interp, extension, srgb=srgb, name=image.name)
     ctx.cache[key] = tex
     return tex
 
