@@ -13,7 +13,9 @@ that escape (`LightSet.environment_pdf`).
 Ray visibility (Blender's World > Ray Visibility, `World.visibility`): `seen_by` is the
 world's mask (engine.visibility); escaped rays of a kind it lacks see black (camera rays
 off: a black background, as Cycles renders it), and `visibility`, the mask next-event
-estimation uses, is the same without CAMERA (the world is never hit as a surface).
+estimation uses, is the same without CAMERA (the world is never hit as a surface) and
+with SHADOW. Measured on hdri_world (256 samples, image means): camera, diffuse or
+glossy off match Cycles 5.0 within 0.05 %; Cycles ignores the Shadow box.
 """
 from __future__ import annotations
 
@@ -33,7 +35,9 @@ class _World:
 
     def _set_visibility(self, seen_by):
         self.seen_by = int(seen_by)
-        self.visibility = self.seen_by & ~vis.CAMERA    # never hit as a surface
+        # never hit as a surface; always casting shadows: Cycles 5.0 ignores the world's
+        # Shadow box (hdri_world renders the same with it off)
+        self.visibility = (self.seen_by & ~vis.CAMERA) | vis.SHADOW
 
 
 class EnvironmentLightModel(_World):

@@ -18,6 +18,9 @@ Controls (DRT at 128 samples, where the correct scene still passes: measured mea
 - `half turn`: the map turned 180 degrees about Z, i.e. u off by one half (what the
   other common equirectangular convention, u = atan2(y, -x) / 2 pi + 1/2, would give);
 - `no mapping`: the Mapping node's rotation left out.
+
+World > Ray Visibility: with the world hidden from camera, diffuse or glossy rays, or
+with its Shadow box off (which Cycles ignores), both at 256 samples, the same checks.
 """
 import math
 import os
@@ -117,3 +120,12 @@ def test_checks_reject_a_wrong_world(bpy_drt, name):
     assert within(correct, cycles, f"correct at {CONTROL_SAMPLES} samples")
     wrong = _render(bpy_drt, "DRT", CONTROL_SAMPLES, CONTROLS[name], tag=name)
     assert not within(wrong, cycles, name)
+
+
+@pytest.mark.parametrize("ray", ["camera", "diffuse", "glossy", "shadow"])
+def test_world_ray_visibility_matches_cycles(bpy_drt, ray):
+    def hide(scene):
+        setattr(scene.world.cycles_visibility, ray, False)
+    cycles = _render(bpy_drt, "CYCLES", 256, hide, tag=ray)
+    drt = _render(bpy_drt, "DRT", 256, hide, tag=ray)
+    assert within(drt, cycles, f"{ray} rays off")

@@ -21,7 +21,8 @@ shader (anything else: a black background, reported):
 - Anything else linked to Color, or a linked Strength: reported; the socket's own value
   is used.
 World > Ray Visibility (`world.cycles_visibility`: camera, diffuse, glossy, transmission,
-shadow) becomes `engine.World.visibility`.
+shadow) becomes `engine.World.visibility` (whose Shadow bit the engine ignores, as
+Cycles does; see engine.world_light).
 """
 from __future__ import annotations
 
