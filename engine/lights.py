@@ -41,13 +41,13 @@ Strategies (all pdfs in solid angle, omega = solid angle subtended, A = area):
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from . import visibility
+from .light_sample import LightSample, luminance  # noqa: F401 (re-exported)
 from .scene import AreaLight, PointLight, SunLight
 from .warp import concentric_disk, orthonormal_basis, uniform_sphere
+from .world_light import world_model
 
 INF = np.inf
 TWO_PI = 2.0 * np.pi
@@ -57,11 +57,6 @@ SOLID_ANGLE_MIN = 1e-4
 # ... and when the point is farther from the light's plane than this fraction of the
 # rectangle's edge sum (closer, the spherical rectangle degenerates to 0 or 2 pi).
 IN_PLANE_REL = 1e-7
-
-
-def luminance(rgb) -> float:
-    r, g, b = np.asarray(rgb, dtype=np.float64)[..., :3].T
-    return 0.2126 * r + 0.7152 * g + 0.0722 * b
 
 
 def _smoothstep01(x):
@@ -85,18 +80,6 @@ def _safe_unit(v):
     ok = n > 0
     out = np.where(ok[:, None], v / np.where(ok, n, 1.0)[:, None], np.array([0.0, 0.0, 1.0]))
     return out, n
-
-
-@dataclass
-class LightSample:
-    wi: np.ndarray        # (n, 3) unit direction towards the light
-    dist: np.ndarray      # (n,) distance to the sampled point (inf for the sun)
-    radiance: np.ndarray  # (n, 3) radiance arriving along -wi (0 where it cannot)
-    pdf: np.ndarray       # (n,) solid-angle pdf (1 for delta lights; 0 = no sample)
-    delta: bool           # a point or a zero-angle sun: no MIS, BSDF rays never hit it
-    # (n,) how far before `dist` a shadow ray must stop so as not to hit the light
-    # itself (emissive triangles are scene geometry); None = no such need
-    margin: np.ndarray | None = None
 
 
 class PointLightModel:
@@ -481,34 +464,6 @@ class AreaLightModel:
         return out
 
 
-class EnvironmentLightModel:
-    """The world's uniform background as a light, as Cycles samples it: next-event
-    estimation from every vertex (uniform directions over the sphere, pdf 1 / (4 pi)),
-    weighted by MIS against BSDF rays that escape. Never hit as a surface."""
-    delta = False
-    visible = False
-    visible_camera = False
-    visibility = 30            # engine.visibility.ALL but CAMERA (never hit as a surface)
-    is_environment = True
-
-    def __init__(self, radiance):
-        self.radiance = np.asarray(radiance, dtype=np.float64)[:3]
-        self.pdf_value = 1.0 / (4.0 * np.pi)
-
-    def power(self, scene_radius):
-        # irradiance pi L on a scene of cross-section pi R^2 (as for the sun)
-        return luminance(self.radiance) * np.pi * np.pi * scene_radius ** 2
-
-    def sample(self, p, u, time=None):
-        n = len(p)
-        wi = uniform_sphere(u)
-        rad = np.broadcast_to(self.radiance, (n, 3)).copy()
-        return LightSample(wi, np.full(n, INF), rad, np.full(n, self.pdf_value), False)
-
-    def pdf(self, p, wi, t, time=None):
-        return np.full(len(wi), self.pdf_value)
-
-
 class TimeSlicedLight:
     """A lamp that moves during the shutter: the exporter gives the lamp at the middles of
     K equal slices of the shutter (`light.motion_slices`), and each ray uses the lamp of
@@ -598,8 +553,12 @@ class LightSet:
 
     def __init__(self, lights, scene_radius: float, mesh_lights=None, world=None):
         self.models = [make_light(l) for l in lights]
-        if world is not None and luminance(world) > 0:
-            self.models.append(EnvironmentLightModel(world))
+        # the world: a model (engine.world_light), a World or an RGB triple; kept even
+        # when it is too dark to be a light, for what escaped rays see
+        self.world = None if world is None else (
+            world if getattr(world, "is_environment", False) else world_model(world))
+        if self.world is not None:
+            self.models.append(self.world)
         power = np.array([max(m.power(scene_radius), 0.0) for m in self.models], dtype=np.float64)
         power = np.where(np.isfinite(power), power, 0.0)
         keep = power > 0
@@ -692,12 +651,12 @@ class LightSet:
         pdf = self.mesh.pdf_area_to_solid_angle(sel, p, q)
         return np.where(is_light, pdf * self.select_pdf[self.n_lamps + sel], 0.0)
 
-    def environment_pdf(self, n):
-        """Pick probability x solid-angle pdf of the world light for n escaped rays
-        (zeros when the world is not a light)."""
+    def environment_pdf(self, d):
+        """Pick probability x solid-angle pdf of the world light for escaped rays along
+        d (n, 3) (zeros when the world is not a light)."""
         if self.env_index is None:
-            return np.zeros(n)
-        return np.full(n, self.models[self.env_index].pdf_value * self.select_pdf[self.env_index])
+            return np.zeros(len(d))
+        return self.models[self.env_index].pdf(None, d, None) * self.select_pdf[self.env_index]
 
     def suns(self):
         return [(k, m) for k, m in enumerate(self.models)

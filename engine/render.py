@@ -38,6 +38,7 @@ from .sampling.dispatch import pixel_keys
 from .scene import Scene
 from .settings import RenderSettings
 from .surface import SurfaceBuilder
+from .world_light import world_model
 
 
 @dataclass
@@ -69,11 +70,15 @@ class RenderContext:
         self.surfaces = SurfaceBuilder(self.accel, scene.meshes)
         self.materials = MaterialTable(scene.materials)
         self.scene_radius = _scene_radius(scene, self.accel)
-        self.world_radiance = np.asarray(scene.world.color, dtype=np.float64)[:3]
+        # the uniform world's radiance (zeros under an environment map), and the world
+        # model (engine.world_light) escaped rays read
+        self.world = world_model(scene.world)
+        self.world_radiance = np.asarray(getattr(self.world, "radiance", np.zeros(3)),
+                                         dtype=np.float64)[:3]
         self.lights = LightSet(scene.lights, self.scene_radius,
                                mesh_lights=EmissiveTriangles.from_scene(
                                    scene, self.accel, self.materials.emission),
-                               world=self.world_radiance)
+                               world=self.world)
         self.light_visible_camera = np.array(
             [getattr(m, "visible_camera", True) for m in self.lights.models] or [True])
         self.integrator = make_integrator(settings.integrator, self)

@@ -245,8 +245,20 @@ class Camera:
 
 @dataclass
 class World:
-    """Uniform background radiance (colour x strength)."""
+    """The background seen by escaped rays, which also lights the scene.
+
+    Without a texture: uniform radiance `color` (Blender's colour x strength). With one:
+    an equirectangular environment map (`engine.textures.Texture`, REPEAT extension, as
+    Cycles' Environment Texture reads it) times `strength` (RGB), looked up along
+    `mapping` @ direction (a 3x3 matrix, Blender's Mapping node; None = identity); see
+    `engine.environment_map` for the projection. `color` is then not used.
+    visibility: the ray kinds that see it (engine.visibility; Blender's World > Ray
+    Visibility); see `engine.world_light`."""
     color: tuple = (0.0, 0.0, 0.0)
+    texture: Optional[object] = None
+    strength: tuple = (1.0, 1.0, 1.0)
+    mapping: Optional[np.ndarray] = None
+    visibility: int = 31
 
 
 @dataclass

@@ -726,6 +726,90 @@ COMPARISON_SCENES = {f.__name__: f for f in (
 SCENES.update(COMPARISON_SCENES)
 
 
+HDRI_SIZE = (256, 128)
+SUN_AZIMUTH, SUN_ELEVATION, SUN_RADIUS = 40.0, 35.0, 2.0      # degrees, in the image
+SUN_RADIANCE = (2000.0, 1900.0, 1700.0)
+
+
+def sky_pixels(width, height):
+    """A procedural sky as an equirectangular RGBA float image (height, width, 4), rows
+    bottom-up as Blender stores them: a horizon-to-zenith gradient warmer towards the
+    sun, a dark ground below the horizon and a small, very bright sun disc (radius
+    SUN_RADIUS degrees, about three texels across) at (SUN_AZIMUTH, SUN_ELEVATION).
+    Directions follow Blender's equirectangular mapping: phi = pi - 2 pi u from +X
+    towards +Y, elevation (v - 1/2) pi."""
+    import numpy as np
+    u = (np.arange(width) + 0.5) / width
+    v = (np.arange(height) + 0.5) / height
+    phi = np.pi - 2.0 * np.pi * u[None, :]
+    el = (v[:, None] - 0.5) * np.pi
+    d = np.stack(np.broadcast_arrays(np.cos(el) * np.cos(phi), np.cos(el) * np.sin(phi),
+                                     np.sin(el)), axis=-1)
+    az, alt = math.radians(SUN_AZIMUTH), math.radians(SUN_ELEVATION)
+    sun = np.array([math.cos(alt) * math.cos(az), math.cos(alt) * math.sin(az), math.sin(alt)])
+    cos_sun = d @ sun
+    t = np.sqrt(np.clip(np.sin(el), 0.0, 1.0))[..., None]
+    zenith, horizon = np.array([0.15, 0.3, 0.8]), np.array([0.8, 0.75, 0.7])
+    rgb = horizon * (1.0 - t) + zenith * t
+    rgb = rgb + np.array([0.6, 0.35, 0.1]) * (((1.0 + cos_sun) / 2.0) ** 6)[..., None]
+    rgb = np.where((el < 0.0)[..., None], np.array([0.12, 0.1, 0.08]), rgb)
+    rgb = np.where((cos_sun > math.cos(math.radians(SUN_RADIUS)))[..., None],
+                   np.array(SUN_RADIANCE), rgb)
+    out = np.ones((height, width, 4), dtype=np.float32)
+    out[..., :3] = rgb
+    return out
+
+
+def _packed_sky(name):
+    """The sky as an OpenEXR image packed into the .blend (its path '//NAME.exr')."""
+    import tempfile
+    w, h = HDRI_SIZE
+    img = bpy.data.images.new(name, w, h, float_buffer=True)
+    img.pixels.foreach_set(sky_pixels(w, h).ravel())
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, f"{name}.exr")
+        img.filepath_raw = path
+        img.file_format = "OPEN_EXR"
+        img.save()
+        bpy.data.images.remove(img)
+        img = bpy.data.images.load(path)
+        img.pack()
+    img.filepath_raw = f"//{name}.exr"
+    img.colorspace_settings.name = "Linear Rec.709"
+    return img
+
+
+def hdri_world():
+    """Blender's defaults: a diffuse sphere and a glossy metal sphere (roughness 0.25)
+    on a diffuse floor, lit only by an environment map (a procedural sky with a small,
+    very bright sun, `sky_pixels`, packed as OpenEXR) through a Mapping node that turns
+    it 60 degrees about Z."""
+    scene = reset()
+    _defaults(scene)
+    grey = principled("Floor", (0.6, 0.6, 0.6), specular=0.0)
+    quad("Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)], grey)
+    clay = principled("Clay", (0.8, 0.45, 0.25), specular=0.0)
+    uv_sphere("Diffuse", (-0.6, 0.0, 0.5), 0.5, clay)
+    metal = principled("Metal", (0.9, 0.9, 0.9), roughness=0.25, metallic=1.0)
+    uv_sphere("Glossy", (0.6, 0.0, 0.5), 0.5, metal)
+    camera(scene, (0.0, -4.0, 1.6), (math.radians(75.0), 0.0, 0.0), lens=35.0)
+    tree = scene.world.node_tree
+    bg = tree.nodes["Background"]
+    env = tree.nodes.new("ShaderNodeTexEnvironment")
+    env.image = _packed_sky("hdri_world_sky")
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(60.0))
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
+    tree.links.new(env.outputs["Color"], bg.inputs["Color"])
+    bg.inputs["Strength"].default_value = 1.0
+    return scene
+
+
+SCENES["hdri_world"] = hdri_world
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("names", nargs="*", help=f"scenes to build (default all: {', '.join(SCENES)})")

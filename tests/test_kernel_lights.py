@@ -424,10 +424,11 @@ def test_suns_and_world_match(name):
         close(pdf, sun.pdf(None, d, None) * ls.select_pdf[k], f"sun {j} pdf")
         assert 0 < np.count_nonzero(pdf) < len(d)          # inside and outside the disc
         assert sun_escaped(L, j, *d[-1])[:3] == tuple(sun.radiance)
-    close(environment_pdf(L), ls.environment_pdf(1)[0], "world pdf")
+    up = np.array([[0.0, 0.0, 1.0]])
+    close(environment_pdf(L, *up[0]), ls.environment_pdf(up)[0], "world pdf")
     world = (ls.models[ls.env_index].radiance if ls.env_index is not None else np.zeros(3))
     assert environment_radiance(L) == tuple(world)
-    assert (environment_pdf(L) > 0) == (name in ("world", "all"))
+    assert (environment_pdf(L, *up[0]) > 0) == (name in ("world", "all"))
 
 
 def test_scalar_kernels_equal_batch_rows():
@@ -459,7 +460,8 @@ def test_empty_set():
     assert k == idx[0] == -1 and pdf == s.pdf[0] == 0.0 and not delta
     assert (wx, wy, wz) == tuple(s.wi[0]) and (r, g, b) == (0.0, 0.0, 0.0)
     assert hit_lamps(L, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 7.0, 31) == (7.0, -1, 0.0, 0.0, 0.0)
-    assert environment_pdf(L) == 0.0 and environment_radiance(L) == (0.0, 0.0, 0.0)
+    assert environment_pdf(L, 0.0, 0.0, 1.0) == 0.0
+    assert environment_radiance(L) == (0.0, 0.0, 0.0)
     black = pack_lights(LightSet([], 1.0, world=(0.0, 0.0, 0.0)))   # a black world: no light
     assert n_entries(black) == 0 and environment_radiance(black) == (0.0, 0.0, 0.0)
 

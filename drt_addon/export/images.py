@@ -4,12 +4,17 @@ extension, colour space and premultiplication)."""
 from __future__ import annotations
 
 import importlib
+import weakref
 
 import numpy as np
 
 from ..engine_link import engine
 
 textures = importlib.import_module(engine.__name__ + ".textures")
+
+# Image pixels and Textures, once per export: keyed by the export's Reporter (a new one
+# per export), so an edited image is read again at the next render.
+_image_caches: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 def read_pixels(image, ctx):
@@ -40,9 +45,15 @@ def read_pixels(image, ctx):
     return px
 
 
-def image_texture(image, node, ctx, premultiply):
+def image_cache(reporter) -> dict:
+    """The export's cache of image pixels and Textures (one per Reporter, i.e. export)."""
+    return _image_caches.setdefault(reporter, {}) if reporter is not None else {}
+
+
+def image_texture(image, interpolation, extension, ctx, premultiply):
     """One engine Texture per (image, interpolation, extension, premultiplied) per export;
-    the pixel array is read once per image and shared."""
+    the pixel array is read once per image and shared. ctx: anything with `cache` (an
+    `image_cache`) and `issue(text)` (the approximations to report)."""
     cs = image.colorspace_settings
     is_data = bool(getattr(cs, "is_data", False)) or cs.name == "Non-Color"
     srgb = (not image.is_float) and cs.name == "sRGB" and not is_data
@@ -51,8 +62,8 @@ def image_texture(image, node, ctx, premultiply):
         ctx.issue(f"image {image.name!r} is in the colour space {cs.name!r}, which DRT "
                   f"reads as scene-linear")
     premultiply = premultiply and not is_data and image.alpha_mode in ("STRAIGHT",)
-    interp = node.interpolation if node.interpolation in ("Linear", "Closest") else "Linear"
-    key = ("texture", image.name_full, interp, node.extension, srgb, premultiply)
+    interp = interpolation if interpolation in ("Linear", "Closest") else "Linear"
+    key = ("texture", image.name_full, interp, extension, srgb, premultiply)
     if key in ctx.cache:
         return ctx.cache[key]
     px = read_pixels(image, ctx)
@@ -61,6 +72,6 @@ def image_texture(image, node, ctx, premultiply):
         if premultiply and px.shape[2] == 4 and (px[:, :, 3] < 1.0).any():
             px = px.copy()
             px[:, :, :3] *= px[:, :, 3:4]
-        tex = textures.Texture(px, interp, node.extension, srgb=srgb, name=image.name)
+        tex = textures.Texture(px, interp, extension, srgb=srgb, name=image.name)
     ctx.cache[key] = tex
     return tex

@@ -68,7 +68,6 @@ approximation is reported once per material, in one warning naming the material.
 from __future__ import annotations
 
 import importlib
-import weakref
 from dataclasses import dataclass, field, replace
 from typing import Optional
 
@@ -77,7 +76,7 @@ import numpy as np
 
 from ..engine_link import engine
 from .errors import Reporter
-from .images import image_texture as _texture, read_pixels as _read_pixels  # noqa: F401
+from .images import image_cache
 from .nodes import NodeCompiler
 
 textures = importlib.import_module(engine.__name__ + ".textures")
@@ -89,10 +88,6 @@ WHITE = (1.0, 1.0, 1.0)
 BLACK = (0.0, 0.0, 0.0)
 MISSING = tuple(textures.MISSING_RGBA[:3])
 TOL = 1e-6
-
-# Image pixels and Textures, once per export: keyed by the export's Reporter (a new one
-# per export), so an edited image is read again at the next render.
-_image_caches: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 def uses_nodes(datablock) -> bool:
@@ -323,7 +318,7 @@ class _Ctx:
         self.mat = mat
         self.name = mat.name
         self.issues = []
-        self.cache = _image_caches.setdefault(reporter, {}) if reporter is not None else {}
+        self.cache = image_cache(reporter)
         self.nodes = NodeCompiler(self)
         self.normal = None          # the per-hit shading normal (a program Value), if any
 

@@ -1,29 +1,181 @@
-"""The world's background as uniform radiance (colour x strength)."""
+"""The world's background: uniform radiance (colour x strength), or an environment map.
+
+Read from the active World Output's Surface socket, which must come from a Background
+shader (anything else: a black background, reported):
+- Color unlinked: uniform radiance colour x strength (`engine.World.color`).
+- Color from an Environment Texture node (its Color output) with an image, equirectangular
+  projection: `engine.World.texture`, the image read once per export (pixels and colour
+  space as for material textures, `images.image_texture`: 8-bit sRGB decoded after
+  interpolation as Cycles does, float images such as .hdr / .exr and Non-Color data as
+  they are), REPEAT extension (Cycles' Environment Texture wraps both ways),
+  Linear or Closest interpolation (Cubic and Smart are read as Linear, reported), times
+  the Strength. No image: Cycles' missing-image pink. Mirror-ball projection is not
+  modelled: reported, and the unconnected colour is used.
+- The texture's Vector: unlinked, or a Texture Coordinate node's Generated or Object
+  output (for the world both are the ray direction), optionally through a Mapping node
+  whose Location, Rotation and Scale are constants: the Mapping becomes the 3x3 matrix
+  `engine.World.mapping` (Blender's Point and Vector types R diag(S), Texture
+  diag(1/S) R^T, Normal R diag(1/S); R the XYZ Euler rotation). A translation is ignored
+  (the lookup direction is normalised and Cycles adds it before: reported), as is a
+  singular scale (reported). Any other vector source is reported and ignored.
+- Anything else linked to Color, or a linked Strength: reported; the socket's own value
+  is used.
+World > Ray Visibility (`world.cycles_visibility`: camera, diffuse, glossy, transmission,
+shadow) becomes `engine.World.visibility` (whose Shadow bit the engine ignores, as
+Cycles does; see engine.world_light).
+"""
 from __future__ import annotations
+
+import numpy as np
 
 from ..engine_link import engine
 from .errors import Reporter
-from .materials import uses_nodes
+from .images import image_cache, image_texture, textures
+from .materials import _link, uses_nodes
+
+BLACK = (0.0, 0.0, 0.0)
+MISSING = tuple(textures.MISSING_RGBA[:3])
+
+
+class _WorldCtx:
+    """What `images.image_texture` needs: the export's image cache and a list of the
+    approximations to report."""
+
+    def __init__(self, world, reporter):
+        self.name = world.name
+        self.cache = image_cache(reporter)
+        self.issues = []
+
+    def issue(self, text):
+        if text not in self.issues:
+            self.issues.append(text)
+
+
+def _visibility(world) -> int:
+    v = getattr(world, "cycles_visibility", None)
+    if v is None:
+        return engine.visibility.ALL
+    return engine.visibility.from_flags(v.camera, v.diffuse, v.glossy, v.transmission,
+                                        v.shadow)
 
 
 def export_world(world, reporter: Reporter) -> "engine.World":
     if world is None:
-        return engine.World((0.0, 0.0, 0.0))
+        return engine.World(BLACK)
+    vis = _visibility(world)
     if not uses_nodes(world):
-        return engine.World(tuple(world.color[:3]))
+        return engine.World(tuple(world.color[:3]), visibility=vis)
     tree = world.node_tree
     out = next((n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputWorld"
                 and getattr(n, "is_active_output", True)), None)
-    if out is None or not out.inputs["Surface"].is_linked:
-        return engine.World((0.0, 0.0, 0.0))
-    node = out.inputs["Surface"].links[0].from_node
+    found = _link(out.inputs["Surface"]) if out is not None else None
+    if found is None:
+        return engine.World(BLACK, visibility=vis)
+    node = found[0]
     if node.bl_idname != "ShaderNodeBackground":
         reporter.warn(f"DRT: world {world.name!r} uses {node.bl_label!r}, not supported yet; "
                       "using a black background", key=("world", "node"))
-        return engine.World((0.0, 0.0, 0.0))
+        return engine.World(BLACK, visibility=vis)
     color, strength = node.inputs["Color"], node.inputs["Strength"]
-    if color.is_linked or strength.is_linked:
-        reporter.warn(f"DRT: world {world.name!r}: textured backgrounds are not supported yet; "
-                      "using the unconnected colour", key=("world", "linked"))
+    if strength.is_linked:
+        reporter.warn(f"DRT: world {world.name!r}: the Background's Strength is connected, "
+                      "which DRT does not evaluate; using its own value",
+                      key=("world", "strength"))
     s = float(strength.default_value)
-    return engine.World(tuple(c * s for c in color.default_value[:3]))
+    plain = tuple(c * s for c in color.default_value[:3])
+    source = _link(color)
+    if source is None:
+        return engine.World(plain, visibility=vis)
+    src, socket = source
+    ctx = _WorldCtx(world, reporter)
+    world_out = None
+    if src.bl_idname == "ShaderNodeTexEnvironment" and socket.identifier == "Color":
+        world_out = _environment(src, s, vis, ctx)
+    else:
+        ctx.issue(f"the Background's Color comes from {src.bl_label!r}, which DRT does not "
+                  f"evaluate; using the Background's own colour")
+    for text in ctx.issues:
+        reporter.warn(f"DRT: world {world.name!r}: {text}", key=("world", text))
+    return world_out if world_out is not None else engine.World(plain, visibility=vis)
+
+
+def _environment(node, strength, vis, ctx):
+    """engine.World of an Environment Texture node times `strength` (None: not modelled,
+    the caller uses the unconnected colour)."""
+    if node.projection != "EQUIRECTANGULAR":
+        ctx.issue(f"{node.name!r} uses {node.projection} projection, which DRT does not "
+                  f"model; using the Background's own colour")
+        return None
+    if node.interpolation not in ("Linear", "Closest"):
+        ctx.issue(f"{node.name!r} uses {node.interpolation} interpolation; DRT uses Linear")
+    rgb = (strength,) * 3
+    if node.image is None:
+        return engine.World(tuple(c * strength for c in MISSING), visibility=vis)
+    alpha_linked = any(o.is_linked for o in node.outputs if o.identifier == "Alpha")
+    tex = image_texture(node.image, node.interpolation, "REPEAT", ctx,
+                        premultiply=not alpha_linked)
+    if tex is None:                       # no pixels (reported): Cycles' pink
+        return engine.World(tuple(c * strength for c in MISSING), visibility=vis)
+    mapping = _mapping(node, ctx)
+    mean = tuple(float(c) * strength for c in tex.mean_rgba()[:3])
+    return engine.World(mean, texture=tex, strength=rgb, mapping=mapping, visibility=vis)
+
+
+def _mapping(env_node, ctx):
+    """The 3x3 matrix of the Environment Texture's Vector input (None = identity)."""
+    found = _link(env_node.inputs["Vector"])
+    if found is None:
+        return None
+    src, out = found
+    matrix = None
+    if src.bl_idname == "ShaderNodeMapping":
+        matrix = _mapping_matrix(src, ctx)
+        vec = _link(src.inputs["Vector"])
+        if vec is None:
+            return matrix
+        src, out = vec
+    if src.bl_idname == "ShaderNodeTexCoord" and out.identifier in ("Generated", "Object"):
+        if out.identifier == "Object" and getattr(src, "object", None) is not None:
+            ctx.issue(f"{src.name!r} takes Object coordinates of {src.object.name!r}, "
+                      f"which DRT does not model; using the world's directions")
+        return matrix
+    ctx.issue(f"the Vector of {env_node.name!r} comes from {src.bl_label!r} "
+              f"({out.name}), which DRT does not evaluate; using the world's directions")
+    return matrix
+
+
+def _mapping_matrix(node, ctx):
+    """The Mapping node as a 3x3 matrix acting on directions (None if not usable)."""
+    import mathutils
+    kind = node.vector_type
+    if kind not in ("POINT", "TEXTURE", "VECTOR", "NORMAL"):
+        ctx.issue(f"{node.name!r} is of type {kind}; DRT ignores it")
+        return None
+    values = {}
+    for name in ("Location", "Rotation", "Scale"):
+        sock = node.inputs.get(name)
+        if sock is None or not sock.enabled:
+            continue
+        if _link(sock) is not None:
+            ctx.issue(f"the {name} of {node.name!r} is connected, which DRT does not "
+                      f"evaluate; using its own value")
+        values[name] = np.array(sock.default_value[:3], dtype=np.float64)
+    rot = np.array(mathutils.Euler(values.get("Rotation", np.zeros(3)), "XYZ").to_matrix(),
+                   dtype=np.float64)
+    scale = values.get("Scale", np.ones(3))
+    if kind in ("POINT", "TEXTURE") and np.any(values.get("Location", np.zeros(3)) != 0):
+        ctx.issue(f"the Location of {node.name!r} moves the lookup off the world's "
+                  f"directions, which DRT does not model; ignored")
+    if kind in ("TEXTURE", "NORMAL") and np.any(scale == 0):
+        m = None
+    elif kind == "POINT" or kind == "VECTOR":
+        m = rot @ np.diag(scale)
+    elif kind == "TEXTURE":
+        m = np.diag(1.0 / scale) @ rot.T
+    else:
+        m = rot @ np.diag(1.0 / scale)
+    if m is None or not np.isfinite(m).all() or abs(np.linalg.det(m)) <= 1e-12 * max(
+            np.abs(m).max(), 1e-300) ** 3:
+        ctx.issue(f"{node.name!r} has a zero scale, which DRT does not model; ignored")
+        return None
+    return m

@@ -269,8 +269,11 @@ class PathIntegrator:
             if escaped.any():
                 sel = np.nonzero(escaped)[0]
                 # the world, weighted against its own next-event estimation
-                w_env = self._hit_weight(prev_pdf[sel], lights.environment_pdf(sel.size))
-                env = ctx.world_radiance[None, :] * w_env[:, None]
+                w_env = self._hit_weight(prev_pdf[sel], lights.environment_pdf(d[sel]))
+                # (Ray Visibility: camera rays may not see the world; the NumPy
+                # reference models no other ray kind, see engine.visibility)
+                seen = float(depth > 0 or bool(ctx.world.seen_by & visibility.CAMERA))
+                env = ctx.world.escaped(d[sel]) * (w_env * seen)[:, None]
                 t_sel = None if tp is None else tp[sel]
                 for k, sun in lights.suns():
                     w = self._hit_weight(prev_pdf[sel], sun.pdf(None, d[sel], None, t_sel)

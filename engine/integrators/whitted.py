@@ -109,7 +109,7 @@ class WhittedIntegrator:
             if background_is_transparent(ctx, alpha_out, depth):
                 alpha_out[path[escaped]] = uncovered(b[escaped])
             else:
-                L[path[escaped]] += b[escaped] * ctx.world_radiance
+                L[path[escaped]] += b[escaped] * ctx.world.escaped(d[escaped])
             alive &= ~escaped
             if stopped is not None:
                 alive &= ~stopped               # past the transparent bounce limit

@@ -188,8 +188,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             if depth == 0 and film_transparent:
                 alpha[p] = uncovered(br, bg, bb)
                 continue
-            w = hit_weight(mode, prev_pdf[p], lt.environment_pdf(lights))
-            er, eg, eb = world[0] * w, world[1] * w, world[2] * w
+            er, eg, eb, epdf = lt.world_escaped(lights, world, ray_bits[p], dx, dy, dz)
+            w = hit_weight(mode, prev_pdf[p], epdf)
+            er, eg, eb = er * w, eg * w, eb * w
             for s in range(lt.n_suns(lights)):
                 sr, sg, sb, spdf = lt.sun_escaped(lights, s, dx, dy, dz)
                 w = hit_weight(mode, prev_pdf[p], spdf)

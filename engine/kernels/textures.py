@@ -110,9 +110,7 @@ def pack_textures(table) -> tuple:
             start[key] = pos
             blocks.append(px.reshape(-1))
             pos += px.size
-        interp = INTERP_CLOSEST if t.interpolation == "Closest" else INTERP_LINEAR
-        info[k] = (start[key], t.width, t.height, interp, EXTENSIONS.index(t.extension),
-                   int(bool(t.srgb)))
+        info[k] = texture_info(t, start[key])
     pixels = np.concatenate(blocks) if blocks else np.zeros(0, np.float32)
 
     m = len(table.metallic)
@@ -146,6 +144,14 @@ def pack_textures(table) -> tuple:
             scale_offset[i, p, :3] = scale
             scale_offset[i, p, 3:] = offset
     return (pixels, info, inputs, scale_offset, plain)
+
+
+def texture_info(t, offset) -> tuple:
+    """The T[TEXTURES] row of `engine.textures.Texture` t whose texels start at
+    T[PIXELS][offset]."""
+    interp = INTERP_CLOSEST if t.interpolation == "Closest" else INTERP_LINEAR
+    return (offset, t.width, t.height, interp, EXTENSIONS.index(t.extension),
+            int(bool(t.srgb)))
 
 
 # ---------------------------------------------------------------- texel lookup

@@ -5,7 +5,8 @@
     k, wix, wiy, wiz, dist, r, g, b, pdf, delta, margin = sample(L, px, py, pz, u_pick, u1, u2)
     t, k, r, g, b = hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit)
     lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t);  mesh_pdf(L, prim, px, py, pz, qx, qy, qz)
-    environment_pdf(L);  environment_radiance(L) -> (r, g, b)
+    environment_pdf(L, dx, dy, dz);  environment_radiance(L) -> (r, g, b)
+    world_escaped(L, world, ray_bit, dx, dy, dz) -> (r, g, b, pdf)   # escaped rays
     n_suns(L);  sun_escaped(L, j, dx, dy, dz) -> (r, g, b, pdf)
     n_entries(L);  entry_visibility(L, k)
 
@@ -15,9 +16,9 @@ caller keeps the NumPy path. Array drivers for tests: `batch`.
 """
 from .light_set import (environment_pdf, environment_radiance, hit_lamps,
                         lamp_pdf, entry_visibility, mesh_pdf, n_entries, n_suns, sample,
-                        sun_escaped)
+                        sun_escaped, world_escaped)
 from .pack import pack_lights
 
 __all__ = ["pack_lights", "n_entries", "sample", "hit_lamps", "entry_visibility",
            "lamp_pdf", "mesh_pdf", "environment_pdf", "environment_radiance", "n_suns",
-           "sun_escaped"]
+           "sun_escaped", "world_escaped"]

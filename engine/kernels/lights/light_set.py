@@ -7,8 +7,10 @@ from __future__ import annotations
 from ..jit import kernel
 from .area import intersect_area, pdf_area, sample_area
 from .environment import pdf_environment, sample_environment
+from .environment_map import has_map, map_radiance, pdf_map, sample_environment_map
 from .pack import (C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, ENV, LAMPS, SELECT_PDF, SUNS,
-                   TRI_VISIBILITY, T_AREA, T_DISC, T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA)
+                   TRI_VISIBILITY, T_AREA, T_DISC, T_ENV_MAP, T_POINT, T_SPHERE, T_SUN,
+                   T_SUN_DELTA)
 from .point import intersect_point, pdf_point, sample_point
 from .sun import escaped_sun, pdf_sun, sample_sun
 from .triangles import pdf_triangle, sample_triangle, triangle_entry
@@ -71,7 +73,10 @@ def sample(L, px, py, pz, u_pick, u1, u2):
     select = L[SELECT_PDF][k]
     lamps = L[LAMPS]
     if k < lamps.shape[0]:
-        wx, wy, wz, dist, r, g, b, pdf, delta = sample_lamp(lamps, k, px, py, pz, u1, u2)
+        if lamps[k, C_TYPE] == T_ENV_MAP:
+            wx, wy, wz, dist, r, g, b, pdf, delta = sample_environment_map(L, u1, u2)
+        else:
+            wx, wy, wz, dist, r, g, b, pdf, delta = sample_lamp(lamps, k, px, py, pz, u1, u2)
         return k, wx, wy, wz, dist, r, g, b, pdf * select, delta, 0.0
     wx, wy, wz, dist, r, g, b, pdf, margin = sample_triangle(L, k - lamps.shape[0],
                                                              px, py, pz, u1, u2)
@@ -130,6 +135,8 @@ def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t):
         pdf = pdf_point(lamps, k, px, py, pz, wix, wiy, wiz, t)
     elif kind == T_SUN or kind == T_SUN_DELTA:
         pdf = pdf_sun(lamps, k, wix, wiy, wiz)
+    elif kind == T_ENV_MAP:
+        pdf = pdf_map(L, wix, wiy, wiz)
     else:
         pdf = pdf_environment(lamps, k)
     return pdf * L[SELECT_PDF][k]
@@ -147,19 +154,38 @@ def mesh_pdf(L, prim, px, py, pz, qx, qy, qz):
 
 
 @kernel
-def environment_pdf(L):
-    """LightSet.environment_pdf for one escaped ray: pick probability x 1 / (4 pi), 0
-    when the world is not a light."""
+def environment_pdf(L, dx, dy, dz):
+    """LightSet.environment_pdf for one escaped ray along d: pick probability x the world
+    light's solid-angle pdf, 0 when the world is not a light."""
     env = L[ENV]
     k = int(env[0])
     if k < 0:
         return 0.0
-    return pdf_environment(L[LAMPS], k) * L[SELECT_PDF][k]
+    lamps = L[LAMPS]
+    if lamps[k, C_TYPE] == T_ENV_MAP:
+        return pdf_map(L, dx, dy, dz) * L[SELECT_PDF][k]
+    return pdf_environment(lamps, k) * L[SELECT_PDF][k]
+
+
+@kernel
+def world_escaped(L, world, ray_bit, dx, dy, dz):
+    """What an escaped ray of kind ray_bit (engine.visibility) along d sees of the world,
+    and the MIS pdf of that: (r, g, b, environment_pdf(L, d)); the radiance is the
+    environment map's when there is one, else the uniform world's `world` (r, g, b),
+    and black for the kinds of rays the world is hidden from."""
+    if not int(L[ENV][5]) & ray_bit:
+        return 0.0, 0.0, 0.0, 0.0
+    if has_map(L):
+        r, g, b = map_radiance(L, dx, dy, dz)
+    else:
+        r, g, b = world[0], world[1], world[2]
+    return r, g, b, environment_pdf(L, dx, dy, dz)
 
 
 @kernel
 def environment_radiance(L):
-    """The world light's radiance (zeros when the world is not a light)."""
+    """The uniform world light's radiance (zeros when the world is not a light or is an
+    environment map)."""
     env = L[ENV]
     return env[1], env[2], env[3]
 

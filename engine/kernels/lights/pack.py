@@ -17,17 +17,28 @@ every scene):
   L[TRI_RADIANCE]  float64 (n_tri, 3): emitted radiance (two-sided).
   L[TRI_ENTRY]   int64 (n_prims,): global triangle id -> triangle entry j, or -1
                  (`EmissiveTriangles.entry`; empty without mesh lights).
-  L[ENV]         float64 (5,): [lamp index of the world light or -1, radiance r, g, b,
-                 solid-angle pdf 1 / (4 pi)]; radiance 0 when the world is not a light.
+  L[ENV]         float64 (6,): [lamp index of the world light or -1, radiance r, g, b,
+                 solid-angle pdf 1 / (4 pi), the ray kinds that see the world (its
+                 `seen_by` mask, 31 without a world)]; radiance and pdf 0 when the world
+                 is not a light or is an environment map.
   L[TRI_VISIBILITY]  int64 (n_tri,): the ray kinds that see emissive triangle j (its
                  object's engine.visibility mask; all 31 when not given).
+  The environment map (`engine.environment_map.EnvironmentMap`, whether or not it is
+  bright enough to be a light; empty arrays and M_HAS = 0 without one):
+  L[ENV_MAP]     float64 (N_MAP,): the M_* fields below (flags, |det|, strength, matrix
+                 M and its inverse, row-major).
+  L[ENV_PIXELS]  float32 (4 W H,): the image's RGBA texels, as `kernels.textures` T[PIXELS].
+  L[ENV_TEXTURE] int64 (1, 6): its row of `kernels.textures` T[TEXTURES] (offset 0).
+  L[ENV_MARGINAL]  float64 (H + 1,), L[ENV_CONDITIONAL] float64 (H, W + 1): the CDFs of
+                 its `PiecewiseConstant2D`.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ...lights import (AreaLightModel, EnvironmentLightModel, PointLightModel,
-                       SunLightModel, TimeSlicedLight)
+from ...lights import AreaLightModel, PointLightModel, SunLightModel, TimeSlicedLight
+from ...world_light import EnvironmentLightModel, EnvironmentMapLightModel
+from ..textures import texture_info
 
 # ---------------------------------------------------------------- fields of the tuple L
 LAMPS = 0
@@ -44,6 +55,20 @@ TRI_RADIANCE = 10
 TRI_ENTRY = 11
 ENV = 12
 TRI_VISIBILITY = 13
+ENV_MAP = 14
+ENV_PIXELS = 15
+ENV_TEXTURE = 16
+ENV_MARGINAL = 17
+ENV_CONDITIONAL = 18
+
+# ---------------------------------------------------------------- L[ENV_MAP] fields
+M_HAS = 0           # 1: the world is an environment map
+M_IDENTITY = 1      # 1: its mapping is the identity
+M_ABS_DET = 2       # |det M|
+M_STRENGTH = 3      # 3: strength r, g, b
+M_MATRIX = 6        # 9: M (world direction -> lookup vector), row-major
+M_INVERSE = 15      # 9: M^-1
+N_MAP = 24
 
 # ---------------------------------------------------------------- lamp kinds (C_TYPE)
 T_POINT = 0         # delta point or spot (radius 0)
@@ -53,6 +78,7 @@ T_SUN_DELTA = 3     # sun with (near) zero angle
 T_SUN = 4           # sun with an angular diameter: a uniform cone
 T_AREA = 5          # SQUARE, RECTANGLE, DISK or ELLIPSE area light
 T_ENV = 6           # the uniform world
+T_ENV_MAP = 7       # the world's environment map (L[ENV_MAP] and the following fields)
 
 # ---------------------------------------------------------------- lamp table columns
 C_TYPE = 0
@@ -147,6 +173,8 @@ def _lamp_row(model) -> np.ndarray:
         row[C_TYPE] = T_ENV
         _put(row, C_RAD, model.radiance)
         row[C_ENV_PDF] = model.pdf_value
+    elif isinstance(model, EnvironmentMapLightModel):
+        row[C_TYPE] = T_ENV_MAP
     else:
         raise TypeError(f"no kernel for light model {type(model).__name__}")
     return row
@@ -180,13 +208,15 @@ def pack_lights(light_set, tri_visibility=None) -> tuple:
         z3 = np.zeros((0, 3))
         tri = (z3, z3.copy(), z3.copy(), z3.copy(), np.zeros(0), np.zeros(0), z3.copy(),
                np.zeros(0, dtype=np.int64))
-    env = np.zeros(5)
+    env = np.zeros(6)
     env[0] = -1.0
+    env[5] = getattr(light_set.world, "seen_by", 31)
     if light_set.env_index is not None:
         m = models[light_set.env_index]
         env[0] = light_set.env_index
-        env[1:4] = m.radiance[:3]
-        env[4] = m.pdf_value
+        if isinstance(m, EnvironmentLightModel):
+            env[1:4] = m.radiance[:3]
+            env[4] = m.pdf_value
     if len(select_pdf) != len(models) + len(tri[4]):
         raise ValueError("LightSet entries do not match its lamps and triangles")
     n_tri = len(tri[4])
@@ -195,4 +225,25 @@ def pack_lights(light_set, tri_visibility=None) -> tuple:
         entry = tri[7]
         prims = np.flatnonzero(entry >= 0)
         vis[entry[prims]] = np.asarray(tri_visibility)[prims]
-    return (lamps, select_pdf, cdf, suns) + tri + (env, vis)
+    return (lamps, select_pdf, cdf, suns) + tri + (env, vis) + _pack_map(light_set.world)
+
+
+def _pack_map(world) -> tuple:
+    """The L[ENV_MAP:] fields of the world model (empty without an environment map)."""
+    params = np.zeros(N_MAP)
+    if not isinstance(world, EnvironmentMapLightModel):
+        return (params, np.zeros(0, np.float32), np.zeros((0, 6), np.int64), np.zeros(1),
+                np.zeros((0, 1)))
+    env = world.map
+    params[M_HAS] = 1.0
+    params[M_IDENTITY] = float(env.identity)
+    params[M_ABS_DET] = env.abs_det
+    params[M_STRENGTH:M_STRENGTH + 3] = env.strength
+    params[M_MATRIX:M_MATRIX + 9] = env.matrix.reshape(-1)
+    params[M_INVERSE:M_INVERSE + 9] = env.inverse.reshape(-1)
+    tex = env.texture
+    pixels = np.ascontiguousarray(tex.pixels, dtype=np.float32).reshape(-1)
+    info = np.array([texture_info(tex, 0)], dtype=np.int64)
+    dist = env.distribution
+    return (params, pixels, info, _f64(dist.marginal, (-1,)),
+            _f64(dist.conditional, dist.conditional.shape))

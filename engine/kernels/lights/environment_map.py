@@ -1,0 +1,150 @@
+"""The world's environment map as compiled scalar kernels: the twin of
+`engine.environment_map.EnvironmentMap` (lookup, direction sampling, pdf) and of
+`engine.piecewise_2d.PiecewiseConstant2D`, on the L[ENV_MAP:] fields of the packed
+light set (`pack.py`). Same operations in the same order as the NumPy code, so results
+agree to rounding (NumPy's matrix products go through BLAS)."""
+from __future__ import annotations
+
+import math
+
+from ..jit import kernel
+from ..textures import texture_rgba
+from .pack import (ENV_CONDITIONAL, ENV_MAP, ENV_MARGINAL, ENV_PIXELS, ENV_TEXTURE,
+                   M_ABS_DET, M_HAS, M_IDENTITY, M_INVERSE, M_MATRIX, M_STRENGTH)
+
+PI = math.pi
+TWO_PI = 2.0 * math.pi
+TWO_PI_SQUARED = 2.0 * math.pi * math.pi
+INF = math.inf
+
+
+@kernel
+def has_map(L):
+    return L[ENV_MAP][M_HAS] != 0.0
+
+
+@kernel
+def direction_to_uv(x, y, z):
+    """engine.environment_map.direction_to_uv for one direction (any length > 0)."""
+    theta = math.atan2(math.hypot(x, y), z)
+    return 0.5 - math.atan2(y, x) / TWO_PI, 1.0 - theta / PI
+
+
+@kernel
+def uv_to_direction(u, v):
+    """engine.environment_map.uv_to_direction: (x, y, z, sin theta)."""
+    phi = PI - TWO_PI * u
+    theta = PI * (1.0 - v)
+    s = math.sin(theta)
+    return s * math.cos(phi), s * math.sin(phi), math.cos(theta), s
+
+
+@kernel
+def _apply(m, base, x, y, z):
+    """The 3x3 row-major matrix m[base:base + 9] times (x, y, z)."""
+    return (m[base] * x + m[base + 1] * y + m[base + 2] * z,
+            m[base + 3] * x + m[base + 4] * y + m[base + 5] * z,
+            m[base + 6] * x + m[base + 7] * y + m[base + 8] * z)
+
+
+@kernel
+def _to_map(L, x, y, z):
+    params = L[ENV_MAP]
+    if params[M_IDENTITY] != 0.0:
+        return x, y, z
+    return _apply(params, M_MATRIX, x, y, z)
+
+
+@kernel
+def map_radiance(L, dx, dy, dz):
+    """EnvironmentMap.radiance along one direction: (r, g, b)."""
+    params = L[ENV_MAP]
+    mx, my, mz = _to_map(L, dx, dy, dz)
+    u, v = direction_to_uv(mx, my, mz)
+    r, g, b, _ = texture_rgba((L[ENV_PIXELS], L[ENV_TEXTURE]), 0, u, v)
+    return (r * params[M_STRENGTH], g * params[M_STRENGTH + 1], b * params[M_STRENGTH + 2])
+
+
+@kernel
+def upper_bound(cdf, u):
+    """np.searchsorted(cdf, u, side='right') for one value (1D cdf)."""
+    lo = 0
+    hi = cdf.shape[0]
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if cdf[mid] <= u:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@kernel
+def invert_cdf(cdf, u):
+    """engine.piecewise_2d.invert_cdf for one row: (cell, offset in [0, 1])."""
+    n = cdf.shape[0] - 1
+    i = min(max(upper_bound(cdf, u) - 1, 0), n - 1)
+    lo = cdf[i]
+    width = cdf[i + 1] - lo
+    off = (u - lo) / width if width > 0.0 else 0.0
+    return i, min(max(off, 0.0), 1.0)
+
+
+@kernel
+def grid(L):
+    """(H, W): the map's rows and columns, as its CDFs hold them."""
+    return L[ENV_MARGINAL].shape[0] - 1, L[ENV_CONDITIONAL].shape[1] - 1
+
+
+@kernel
+def cell_pdf(L, r, c):
+    """PiecewiseConstant2D.cell_pdf: density in (u, v) of cell (r, c)."""
+    marginal = L[ENV_MARGINAL]
+    cond = L[ENV_CONDITIONAL]
+    h, w = grid(L)
+    return (h * (marginal[r + 1] - marginal[r])) * (w * (cond[r, c + 1] - cond[r, c]))
+
+
+@kernel
+def sample_map(L, u0, u1):
+    """EnvironmentMap.sample: (wx, wy, wz, solid-angle pdf; 0 = none)."""
+    h, w = grid(L)
+    r, dv = invert_cdf(L[ENV_MARGINAL], u0)
+    c, du = invert_cdf(L[ENV_CONDITIONAL][r], u1)
+    mx, my, mz, sin_t = uv_to_direction((c + du) / w, (r + dv) / h)
+    pdf = cell_pdf(L, r, c) / (TWO_PI_SQUARED * sin_t) if sin_t > 0.0 else 0.0
+    params = L[ENV_MAP]
+    if params[M_IDENTITY] != 0.0:
+        return mx, my, mz, pdf
+    x, y, z = _apply(params, M_INVERSE, mx, my, mz)
+    n = math.sqrt(x * x + y * y + z * z)
+    return x / n, y / n, z / n, pdf * (params[M_ABS_DET] * n ** 3)
+
+
+@kernel
+def pdf_map(L, dx, dy, dz):
+    """EnvironmentMap.pdf of one unit direction."""
+    h, w = grid(L)
+    params = L[ENV_MAP]
+    mx, my, mz = _to_map(L, dx, dy, dz)
+    n = math.sqrt(mx * mx + my * my + mz * mz)
+    sin_t = math.hypot(mx, my) / n
+    if not sin_t > 0.0:
+        return 0.0
+    u, v = direction_to_uv(mx, my, mz)
+    c = min(max(int(math.floor((u % 1.0) * w)), 0), w - 1)
+    r = min(max(int(math.floor(v * h)), 0), h - 1)
+    pdf = cell_pdf(L, r, c) / (TWO_PI_SQUARED * sin_t)
+    if params[M_IDENTITY] != 0.0:
+        return pdf
+    return pdf * (params[M_ABS_DET] / n ** 3)
+
+
+@kernel
+def sample_environment_map(L, u0, u1):
+    """EnvironmentMapLightModel.sample: (wix, wiy, wiz, inf, r, g, b, pdf, delta)."""
+    wx, wy, wz, pdf = sample_map(L, u0, u1)
+    r, g, b = 0.0, 0.0, 0.0
+    if pdf > 0.0:
+        r, g, b = map_radiance(L, wx, wy, wz)
+    return wx, wy, wz, INF, r, g, b, pdf, False

@@ -1,0 +1,100 @@
+"""The world as a light: what escaped rays see and how next-event estimation samples it.
+
+Two models, one per kind of `engine.scene.World`:
+- `EnvironmentLightModel`, a uniform background (colour x strength), as Cycles samples
+  it: uniform directions over the sphere, pdf 1 / (4 pi);
+- `EnvironmentMapLightModel`, an equirectangular image (`engine.environment_map`),
+  directions importance-sampled from the image's luminance.
+Both are lights of the `engine.lights.LightSet` with the same interface as the lamps
+(sample, pdf, power) plus `escaped(d)`, the radiance along escaping rays. They are never
+hit as surfaces (BSDF rays find them by escaping), weighted by MIS against the BSDF rays
+that escape (`LightSet.environment_pdf`).
+
+Ray visibility (Blender's World > Ray Visibility, `World.visibility`): `seen_by` is the
+world's mask (engine.visibility); escaped rays of a kind it lacks see black (camera rays
+off: a black background, as Cycles renders it), and `visibility`, the mask next-event
+estimation uses, is the same without CAMERA (the world is never hit as a surface) and
+with SHADOW. Measured on hdri_world (256 samples, image means): camera, diffuse or
+glossy off match Cycles 5.0 within 0.05 %; Cycles ignores the Shadow box.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from . import visibility as vis
+from .environment_map import EnvironmentMap
+from .light_sample import INF, LightSample, luminance
+from .warp import uniform_sphere
+
+
+class _World:
+    delta = False
+    visible = False
+    visible_camera = False
+    is_environment = True
+
+    def _set_visibility(self, seen_by):
+        self.seen_by = int(seen_by)
+        # never hit as a surface; always casting shadows: Cycles 5.0 ignores the world's
+        # Shadow box (hdri_world renders the same with it off)
+        self.visibility = (self.seen_by & ~vis.CAMERA) | vis.SHADOW
+
+
+class EnvironmentLightModel(_World):
+    """The world's uniform background as a light: next-event estimation from every vertex
+    (uniform directions over the sphere, pdf 1 / (4 pi))."""
+
+    def __init__(self, radiance, seen_by=vis.ALL):
+        self.radiance = np.asarray(radiance, dtype=np.float64)[:3]
+        self.pdf_value = 1.0 / (4.0 * np.pi)
+        self._set_visibility(seen_by)
+
+    def power(self, scene_radius):
+        # irradiance pi L on a scene of cross-section pi R^2 (as for the sun)
+        return luminance(self.radiance) * np.pi * np.pi * scene_radius ** 2
+
+    def escaped(self, d, time=None):
+        return np.broadcast_to(self.radiance, (len(d), 3)).copy()
+
+    def sample(self, p, u, time=None):
+        n = len(p)
+        wi = uniform_sphere(u)
+        rad = np.broadcast_to(self.radiance, (n, 3)).copy()
+        return LightSample(wi, np.full(n, INF), rad, np.full(n, self.pdf_value), False)
+
+    def pdf(self, p, wi, t, time=None):
+        return np.full(len(wi), self.pdf_value)
+
+
+class EnvironmentMapLightModel(_World):
+    """An environment map as a light (see engine.environment_map)."""
+
+    def __init__(self, env: EnvironmentMap, seen_by=vis.ALL):
+        self.map = env
+        self._set_visibility(seen_by)
+
+    def power(self, scene_radius):
+        return self.map.mean_luminance * np.pi * np.pi * scene_radius ** 2
+
+    def escaped(self, d, time=None):
+        return self.map.radiance(d)
+
+    def sample(self, p, u, time=None):
+        n = len(p)
+        wi, pdf = self.map.sample(u)
+        rad = np.where((pdf > 0)[:, None], self.map.radiance(wi), 0.0)
+        return LightSample(wi, np.full(n, INF), rad, pdf, False)
+
+    def pdf(self, p, wi, t, time=None):
+        return self.map.pdf(wi)
+
+
+def world_model(world):
+    """The light model of an `engine.scene.World` (its texture, else its colour), or of
+    a plain RGB triple (a uniform world)."""
+    texture = getattr(world, "texture", None)
+    seen_by = getattr(world, "visibility", vis.ALL)
+    if texture is not None:
+        return EnvironmentMapLightModel(EnvironmentMap(texture, world.strength, world.mapping),
+                                        seen_by)
+    return EnvironmentLightModel(getattr(world, "color", world), seen_by)

@@ -1,0 +1,168 @@
+"""The world exporter (drt_addon/export/world.py): Background colour, Environment
+Texture (image, colour space, interpolation, projection), Mapping node, Ray Visibility,
+and a clear warning (never a crash) for what it does not model."""
+import math
+
+import numpy as np
+import pytest
+
+from drt_addon.export.errors import Reporter
+from drt_addon.export.world import export_world
+
+SIZE = (16, 8)
+
+
+def _world(bpy, name="World"):
+    world = bpy.data.worlds.new(name)
+    if bpy.app.version < (5, 0, 0):
+        world.use_nodes = True
+    bg = world.node_tree.nodes["Background"]
+    bg.inputs["Color"].default_value = (0.2, 0.3, 0.4, 1.0)
+    bg.inputs["Strength"].default_value = 2.0
+    return world, bg
+
+
+def _image(bpy, name, float_buffer=True, colorspace=None):
+    w, h = SIZE
+    img = bpy.data.images.new(name, w, h, float_buffer=float_buffer)
+    px = np.random.default_rng(0).random((h, w, 4)).astype(np.float32)
+    px[..., 3] = 1.0
+    img.pixels.foreach_set(px.ravel())
+    if colorspace:
+        img.colorspace_settings.name = colorspace
+    return img
+
+
+def _environment(bpy, world, bg, image, **settings):
+    tree = world.node_tree
+    env = tree.nodes.new("ShaderNodeTexEnvironment")
+    env.image = image
+    for k, v in settings.items():
+        setattr(env, k, v)
+    tree.links.new(env.outputs["Color"], bg.inputs["Color"])
+    return env
+
+
+def _export(world):
+    reporter = Reporter()
+    return export_world(world, reporter), reporter.warnings
+
+
+def test_uniform_background_and_visibility(bpy_drt):
+    world, _ = _world(bpy_drt)
+    world.cycles_visibility.camera = False
+    world.cycles_visibility.glossy = False
+    w, warnings = _export(world)
+    assert w.texture is None and not warnings
+    np.testing.assert_allclose(w.color, (0.4, 0.6, 0.8))
+    assert w.visibility == 31 & ~1 & ~4
+
+
+def test_float_environment_texture_with_strength(bpy_drt):
+    world, bg = _world(bpy_drt)
+    img = _image(bpy_drt, "hdr")
+    _environment(bpy_drt, world, bg, img, interpolation="Closest")
+    w, warnings = _export(world)
+    assert not warnings
+    tex = w.texture
+    assert (tex.width, tex.height) == SIZE and tex.extension == "REPEAT"
+    assert tex.interpolation == "Closest" and not tex.srgb
+    px = np.empty(SIZE[0] * SIZE[1] * 4, np.float32)
+    img.pixels.foreach_get(px)
+    np.testing.assert_array_equal(tex.pixels.reshape(-1), px)
+    assert w.strength == (2.0, 2.0, 2.0) and w.mapping is None
+
+
+@pytest.mark.parametrize("colorspace,srgb", [("sRGB", True), ("Non-Color", False)])
+def test_byte_image_colour_space(bpy_drt, colorspace, srgb):
+    world, bg = _world(bpy_drt)
+    _environment(bpy_drt, world, bg, _image(bpy_drt, "ldr" + colorspace, False, colorspace))
+    w, warnings = _export(world)
+    assert w.texture.srgb is srgb and not warnings
+
+
+def _mapping(bpy, world, env, vector_type="POINT", rotation=(0.0, 0.0, 0.0),
+             scale=(1.0, 1.0, 1.0), location=(0.0, 0.0, 0.0), coords="Generated"):
+    tree = world.node_tree
+    m = tree.nodes.new("ShaderNodeMapping")
+    m.vector_type = vector_type
+    m.inputs["Rotation"].default_value = rotation
+    m.inputs["Scale"].default_value = scale
+    if "Location" in m.inputs and m.inputs["Location"].enabled:
+        m.inputs["Location"].default_value = location
+    tree.links.new(m.outputs["Vector"], env.inputs["Vector"])
+    if coords:
+        tc = tree.nodes.new("ShaderNodeTexCoord")
+        tree.links.new(tc.outputs[coords], m.inputs["Vector"])
+    return m
+
+
+@pytest.mark.parametrize("vector_type", ["POINT", "VECTOR", "TEXTURE", "NORMAL"])
+def test_mapping_node_matrix(bpy_drt, vector_type):
+    """Blender's Mapping node on a direction, as the matrix the engine applies."""
+    from mathutils import Euler
+    world, bg = _world(bpy_drt)
+    env = _environment(bpy_drt, world, bg, _image(bpy_drt, "m" + vector_type))
+    rot, scale = (0.3, -0.5, 1.2), (1.0, 2.0, 0.5)
+    _mapping(bpy_drt, world, env, vector_type, rot, scale)
+    w, warnings = _export(world)
+    assert not warnings
+    r = np.array(Euler(rot, "XYZ").to_matrix())
+    s = np.diag(scale)
+    expected = {"POINT": r @ s, "VECTOR": r @ s, "TEXTURE": np.linalg.inv(s) @ r.T,
+                "NORMAL": r @ np.linalg.inv(s)}[vector_type]
+    np.testing.assert_allclose(w.mapping, expected, atol=1e-6)
+
+
+def test_mapping_translation_and_zero_scale_are_reported(bpy_drt):
+    world, bg = _world(bpy_drt)
+    env = _environment(bpy_drt, world, bg, _image(bpy_drt, "t"))
+    m = _mapping(bpy_drt, world, env, rotation=(0, 0, math.radians(30)),
+                 location=(1.0, 0.0, 0.0), coords="Object")
+    w, warnings = _export(world)
+    assert len(warnings) == 1 and "Location" in warnings[0] and "World" in warnings[0]
+    assert w.mapping is not None and w.texture is not None
+    m.inputs["Scale"].default_value = (1.0, 0.0, 1.0)
+    w, warnings = _export(world)
+    assert any("zero scale" in t for t in warnings) and w.mapping is None
+
+
+def test_unsupported_inputs_warn_and_fall_back(bpy_drt):
+    world, bg = _world(bpy_drt)
+    tree = world.node_tree
+    # mirror ball: not modelled, the Background's own colour
+    env = _environment(bpy_drt, world, bg, _image(bpy_drt, "ball"), projection="MIRROR_BALL")
+    w, warnings = _export(world)
+    assert w.texture is None and "MIRROR_BALL" in warnings[0]
+    np.testing.assert_allclose(w.color, (0.4, 0.6, 0.8))
+    # a procedural texture on Color, and a linked Strength
+    sky = tree.nodes.new("ShaderNodeTexSky")
+    tree.links.new(sky.outputs["Color"], bg.inputs["Color"])
+    value = tree.nodes.new("ShaderNodeValue")
+    tree.links.new(value.outputs[0], bg.inputs["Strength"])
+    w, warnings = _export(world)
+    assert w.texture is None and len(warnings) == 2
+    assert any("Strength" in t for t in warnings) and any("Sky" in t for t in warnings)
+    # an unsupported vector source: the image is kept, the vector ignored
+    tree.links.new(env.outputs["Color"], bg.inputs["Color"])
+    env.projection = "EQUIRECTANGULAR"
+    noise = tree.nodes.new("ShaderNodeTexNoise")
+    tree.links.new(noise.outputs["Color"], env.inputs["Vector"])
+    w, warnings = _export(world)
+    assert w.texture is not None and w.mapping is None
+    assert any("Noise" in t for t in warnings)
+
+
+def test_missing_image_is_pink_like_cycles(bpy_drt):
+    world, bg = _world(bpy_drt)
+    _environment(bpy_drt, world, bg, None)
+    w, warnings = _export(world)
+    assert w.texture is None and not warnings
+    np.testing.assert_allclose(w.color, (2.0, 0.0, 2.0))
+    img = bpy_drt.data.images.new("gone", 4, 4)
+    img.source = "FILE"
+    img.filepath = "/nonexistent/sky.exr"          # a file that is not there
+    world.node_tree.nodes["Environment Texture"].image = img
+    w, warnings = _export(world)
+    assert w.texture is None and any("no pixels" in t for t in warnings)
+    np.testing.assert_allclose(w.color, (2.0, 0.0, 2.0))
