@@ -213,7 +213,23 @@ def _color_op(kind, **inputs):
     return build
 
 
+def _curves(nt, p):
+    n = p.node(nt, "ShaderNodeRGBCurve")
+    m = n.mapping
+    m.curves[3].points.new(0.4, 0.6)            # the combined curve
+    m.curves[0].points.new(0.5, 0.2)            # red
+    m.curves[2].points[1].location = (0.8, 1.0)  # blue: a steeper end
+    m.update()
+    n.inputs["Fac"].default_value = 0.9
+    scaled = p.node(nt, "ShaderNodeVectorMath", operation="SCALE")
+    nt.links.new(gen(nt, p), scaled.inputs[0])
+    scaled.inputs["Scale"].default_value = 1.3          # past the curves' range: extrapolated
+    nt.links.new(scaled.outputs[0], n.inputs["Color"])
+    return n.outputs[0]
+
+
 COLOR = [(f"mix_{b.lower()}", _mix(b)) for b in BLENDS] + [
+    ("rgb_curves", _curves),
     ("ramp_linear", _ramp("LINEAR")), ("ramp_constant", _ramp("CONSTANT")),
     ("ramp_ease", _ramp("EASE")),
     ("invert", _color_op("ShaderNodeInvert", Fac=0.8)),

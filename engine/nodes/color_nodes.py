@@ -10,6 +10,9 @@
   COL_GAMMA out, color, gamma
   COL_BRIGHT_CONTRAST out, color, bright, contrast
   COL_HSV out, hue, saturation, value, fac, color   Hue/Saturation/Value
+  COL_CURVES out, fac, color | table                RGB Curves: Cycles' table (field 6:
+                                                    its start, after the curves' x range
+                                                    min, max), extrapolated linearly
 
 The blend modes follow Cycles' node functions (kernel/svm/color_util.h); the factor is
 clamped by the compiler where the node clamps it.
@@ -27,7 +30,8 @@ COL_INVERT = 203
 COL_GAMMA = 204
 COL_BRIGHT_CONTRAST = 205
 COL_HSV = 206
-DATA_OPS = (COL_RAMP_COLOR, COL_RAMP_ALPHA)
+COL_CURVES = 207
+DATA_OPS = (COL_RAMP_COLOR, COL_RAMP_ALPHA, COL_CURVES)
 
 BLEND_MODES = ("MIX", "DARKEN", "MULTIPLY", "BURN", "LIGHTEN", "SCREEN", "DODGE", "ADD",
                "OVERLAY", "SOFT_LIGHT", "LINEAR_LIGHT", "DIFFERENCE", "EXCLUSION",
@@ -187,6 +191,22 @@ def ramp(data, start, f, interpolate, channel):
 
 
 @kernel
+def extrapolated(data, start, f, channel):
+    """Cycles' rgb_ramp_lookup with extrapolation: linear beyond [0, 1] from the end
+    entries' slope, interpolated inside."""
+    n = RAMP_TABLE_SIZE
+    if not math.isfinite(f):
+        f = 0.0
+    if f < 0.0:
+        t0 = data[start + channel]
+        return t0 + (t0 - data[start + 4 + channel]) * (-f) * (n - 1)
+    if f > 1.0:
+        t0 = data[start + 4 * (n - 1) + channel]
+        return t0 + (t0 - data[start + 4 * (n - 2) + channel]) * (f - 1.0) * (n - 1)
+    return ramp(data, start, f, 1, channel)
+
+
+@kernel
 def execute(ins, regs, data):
     code, out = ins[0], ins[1]
     if code == COL_MIX:
@@ -218,6 +238,14 @@ def execute(ins, regs, data):
         b = bright - contrast * 0.5
         for k in range(3):
             regs[out + k] = max(a * regs[c + k] + b, 0.0)
+    elif code == COL_CURVES:
+        t, c, start = regs[ins[2]], ins[3], ins[6]
+        lo, hi = data[start], data[start + 1]
+        span = hi - lo if hi != lo else 1.0
+        for k in range(3):
+            x = regs[c + k]
+            y = extrapolated(data, start + 2, (x - lo) / span, k)
+            regs[out + k] = (1.0 - t) * x + t * y
     elif code == COL_HSV:
         c = ins[6]
         r0, g0, b0 = regs[c], regs[c + 1], regs[c + 2]

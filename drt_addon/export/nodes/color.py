@@ -1,6 +1,6 @@
 """Colour nodes to program operations (engine.nodes.color_nodes): Mix (Color, and its
 Float and Vector kinds), MixRGB, Color Ramp, Invert, Gamma, Bright/Contrast,
-Hue/Saturation/Value."""
+Hue/Saturation/Value, RGB Curves."""
 from __future__ import annotations
 
 import importlib
@@ -109,7 +109,28 @@ def _hsv(c, node, out):
                                         c.input(node, "Color", "color")])
 
 
+def _curves(c, node, out):
+    """RGB Curves: Cycles' table of the channel curves applied after the combined one,
+    over the x range of all four curves."""
+    mapping = node.mapping
+    mapping.update()
+    xs = [p.location[0] for curve in mapping.curves for p in curve.points]
+    lo, hi = (min(xs), max(xs)) if xs else (0.0, 1.0)
+    lo, hi = min(lo, 0.0), max(hi, 1.0)
+    n = CO.RAMP_TABLE_SIZE
+    combined = mapping.curves[3]
+    table = np.zeros((n, 4))
+    for i in range(n):
+        t = lo + i / (n - 1) * (hi - lo)
+        ti = mapping.evaluate(combined, t)
+        table[i, :3] = [mapping.evaluate(mapping.curves[k], ti) for k in range(3)]
+    offset = c.b.data(np.concatenate([[lo, hi], table.ravel()]))
+    return c.emit(CO.COL_CURVES, "color", [c.input(node, "Fac", "float"),
+                                           c.input(node, "Color", "color"), 0, 0, offset])
+
+
 TRANSLATORS = {
+    "ShaderNodeRGBCurve": _curves,
     "ShaderNodeMix": _mix,
     "ShaderNodeMixRGB": _mix_rgb,
     "ShaderNodeValToRGB": _ramp,
