@@ -135,6 +135,7 @@ class TriangleMesh:
     visibility: int = 31           # the ray kinds that see it (engine.visibility)
     object_info: Optional[object] = None   # ObjectInfo, what shader nodes read of it
     tangents: Optional[np.ndarray] = None  # (T, 3, 4) float32: tangent, bitangent sign
+    colors: Optional[np.ndarray] = None    # (T, 3, 4) float32: a color attribute, RGBA
 
     def __post_init__(self):
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)

@@ -70,13 +70,10 @@ class SurfaceBuilder:
                                            for m in ordered])
                            if any(m.visibility != 31 for m in ordered) else None)
         self.tri_object, self.objects = _object_table(ordered)
-        # Tangent space per corner for Normal Maps (sign 0 where a mesh has none)
-        self.corner_tangents = None
-        if any(getattr(m, "tangents", None) is not None for m in ordered):
-            self.corner_tangents = np.concatenate([
-                np.asarray(m.tangents, np.float32).reshape(-1, 3, 4)
-                if getattr(m, "tangents", None) is not None
-                else np.zeros((len(m.triangles), 3, 4), np.float32) for m in ordered])
+        # Tangent space per corner for Normal Maps (sign 0 where a mesh has none), and
+        # a color attribute per corner (0 where a mesh has none, as in Cycles)
+        self.corner_tangents = _corner_attribute(ordered, "tangents")
+        self.corner_colors = _corner_attribute(ordered, "colors")
         self.corner_normals = None
         if any(m.corner_normals is not None for m in ordered):
             parts, offset = [], 0
@@ -114,8 +111,14 @@ class SurfaceBuilder:
             t = tangent[:, :3]
             tangent[:, :3] = t / np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-300)
             tangent[:, 3] = np.sign(tangent[:, 3])
+        color = None
+        if self.corner_colors is not None:
+            c = self.corner_colors[si.prim].astype(np.float64)
+            u, v = si.bary[:, :1], si.bary[:, 1:]
+            color = (1.0 - u - v) * c[:, 0] + u * c[:, 1] + v * c[:, 2]
         return hit_rows(si.position, si.shading_normal, si.geometric_normal, si.direction,
-                        si.uv, si.front_facing, ray, depth, None, self.objects, obj, tangent)
+                        si.uv, si.front_facing, ray, depth, None, self.objects, obj, tangent,
+                        color)
 
     def _moving_vertices(self, prim, time):
         """World vertices, normal matrices (or None) of hit triangles at the rays' times."""
@@ -189,6 +192,17 @@ class SurfaceBuilder:
             uv = w * cu[:, 0] + u * cu[:, 1] + v * cu[:, 2]
         return SurfaceHit(pos, ng_f, ns, front, self.material[prim], scale, uv, prim,
                           np.asarray(ray_dirs)[index], np.hstack([u, v]))
+
+
+def _corner_attribute(ordered, name):
+    """(T, 3, 4) float32 of every mesh's per-corner attribute `name` (zeros for meshes
+    without it), or None when no mesh has it."""
+    if not any(getattr(m, name, None) is not None for m in ordered):
+        return None
+    return np.concatenate([np.asarray(getattr(m, name), np.float32).reshape(-1, 3, 4)
+                           if getattr(m, name, None) is not None
+                           else np.zeros((len(m.triangles), 3, 4), np.float32)
+                           for m in ordered])
 
 
 def _object_table(ordered):

@@ -131,10 +131,34 @@ def _normal_map(strength):
     return build
 
 
+def _vertex_colors(kind, domain, output):
+    """A colour attribute with a colour per corner (or vertex), read by a Color Attribute
+    node (kind VertexColor) or an Attribute node."""
+    def build(nt, p):
+        mesh = p.obj.data
+        attr = mesh.color_attributes.new("Paint", "BYTE_COLOR" if domain == "CORNER"
+                                         else "FLOAT_COLOR", domain)
+        colors = [(0.9, 0.1, 0.1, 1.0), (0.1, 0.8, 0.2, 0.5), (0.1, 0.2, 0.9, 0.8),
+                  (0.9, 0.9, 0.2, 0.3)]
+        for k, item in enumerate(attr.data):
+            item.color = colors[k % 4]
+        if kind == "ShaderNodeVertexColor":
+            n = p.node(nt, kind, layer_name="Paint")
+        else:
+            n = p.node(nt, kind, attribute_name="Paint")
+        return n.outputs[output]
+    return build
+
+
 INPUT = [("tc_generated", _tex_coord("Generated")), ("tc_uv", _tex_coord("UV")),
          ("tc_object", _tex_coord("Object")),
          ("oi_color", _object_info("Color")), ("oi_location", _object_info("Location")),
-         ("oi_index", _object_info("Object Index")), ("light_path", _light_path)]
+         ("oi_index", _object_info("Object Index")), ("light_path", _light_path),
+         ("color_attribute", _vertex_colors("ShaderNodeVertexColor", "CORNER", "Color")),
+         ("color_attribute_alpha", _vertex_colors("ShaderNodeVertexColor", "CORNER",
+                                                  "Alpha")),
+         ("attribute_point", _vertex_colors("ShaderNodeAttribute", "POINT", "Color")),
+         ("attribute_fac", _vertex_colors("ShaderNodeAttribute", "POINT", "Fac"))]
 INPUT_SPHERES = [("tc_normal", _tex_coord("Normal")), ("geo_normal", _geometry("Normal")),
                  ("geo_position", _geometry("Position")),
                  ("geo_true_normal", _geometry("True Normal")), ("fresnel", _fresnel),

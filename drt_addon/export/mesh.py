@@ -17,6 +17,7 @@ from .errors import ExportError
 from . import tangents as tangent_space
 from .matrices import to_numpy
 from .tangents import mesh_tangents, uv_layer, wants_tangents
+from .vertex_colors import color_request, mesh_colors
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT", "CURVES"}
 
@@ -32,6 +33,7 @@ class LocalMesh:
     uv_request: Optional[str] = None       # the UV map asked for ('' = default), None = none
     kept: Optional[np.ndarray] = None      # indices of the mesh's triangles kept (None: all)
     tangents: Optional[np.ndarray] = None  # (T, 3, 4) float32 tangent + sign, if wanted
+    colors: Optional[np.ndarray] = None    # (T, 3, 4) float32 color attribute, if wanted
 
 
 def mesh_arrays(mesh):
@@ -130,14 +132,16 @@ class MeshCache:
         key = _cache_key(obj)
         want_uv = uv_request(obj)
         want_tangents = wants_tangents(obj)
+        want_colors = color_request(obj)
         if key is not None and key in self._local:
             cached = self._local[key]
             # a shared mesh whose other user needed no UVs (object-linked materials)
             if cached is None or ((want_uv is None or cached.uv_request == want_uv)
-                                  and (not want_tangents or cached.tangents is not None)):
+                                  and (not want_tangents or cached.tangents is not None)
+                                  and (want_colors is None or cached.colors is not None)):
                 self.reuses += 1
                 return cached
-        local = _evaluate(obj, want_uv, self.reporter, want_tangents)
+        local = _evaluate(obj, want_uv, self.reporter, want_tangents, want_colors)
         self.evaluations += 1
         if key is not None:
             self._local[key] = local
@@ -178,12 +182,12 @@ def _drop_degenerate(obj, pos, tris, mat, normals, uvs, reporter):
 
 
 def _evaluate(obj, want_uv: Optional[str] = None, reporter=None,
-              want_tangents=False) -> Optional[LocalMesh]:
+              want_tangents=False, want_colors: Optional[str] = None) -> Optional[LocalMesh]:
     try:
         mesh = obj.to_mesh()
     except RuntimeError as e:
         raise ExportError(f"object {obj.name!r}: cannot evaluate its mesh ({e})") from e
-    uvs = tangents = None
+    uvs = tangents = colors = None
     try:
         if mesh is None:
             return None
@@ -196,6 +200,8 @@ def _evaluate(obj, want_uv: Optional[str] = None, reporter=None,
                 reporter.warn(f"DRT: object {obj.name!r}: no tangents for its Normal Map (no "
                               "UV map, or faces of more than four corners); the map is not "
                               "applied", key=(obj.name, "tangents"))
+        if want_colors is not None and len(tris):
+            colors = mesh_colors(mesh, want_colors)
     finally:
         obj.to_mesh_clear()
     if len(tris) == 0:
@@ -211,7 +217,10 @@ def _evaluate(obj, want_uv: Optional[str] = None, reporter=None,
     if tangents is not None:
         tangents = tangents[kept] if kept is not None else tangents
         tangents = np.where(np.isfinite(tangents), tangents, 0.0).astype(np.float32)
-    return LocalMesh(pos, tris, mat, normals, uvs, want_uv, kept, tangents)
+    if colors is not None:
+        colors = colors[kept] if kept is not None else colors
+        colors = np.where(np.isfinite(colors), colors, 0.0).astype(np.float32)
+    return LocalMesh(pos, tris, mat, normals, uvs, want_uv, kept, tangents, colors)
 
 
 def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engine.TriangleMesh":
@@ -227,6 +236,7 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
     normals = local.normals
     uvs = local.uvs
     tangents = tangent_space.to_world(local.tangents, m3)
+    colors = local.colors
     det = float(np.linalg.det(m3))
     if normals is not None:
         normal_matrix = np.linalg.inv(m3).T if abs(det) > 1e-300 else m3
@@ -243,10 +253,12 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
             uvs = uvs[:, [0, 2, 1]]
         if tangents is not None:
             tangents = tangents[:, [0, 2, 1]]
+        if colors is not None:
+            colors = colors[:, [0, 2, 1]]
     slots = np.asarray(material_slots if len(material_slots) else [0], dtype=np.int32)
     global_mat = slots[np.clip(local.material, 0, len(slots) - 1)]
     return engine.TriangleMesh(name, world, tris, global_mat, corner_normals=normals, uvs=uvs,
-                               tangents=tangents)
+                               tangents=tangents, colors=colors)
 
 
 def export_mesh_instance(obj, matrix_world, material_slots, name,

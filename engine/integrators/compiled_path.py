@@ -66,7 +66,8 @@ class CompiledPathIntegrator:
                          ctx.accel.motion,
                          _or_empty(surf.tri_object, 0, np.int32),
                          _or_empty(surf.objects, (0, N_OBJ), np.float64),
-                         _or_empty(surf.corner_tangents, (0, 3, 4), np.float32))
+                         _or_empty(surf.corner_tangents, (0, 3, 4), np.float32),
+                         _or_empty(surf.corner_colors, (0, 3, 4), np.float32))
         self.params = kbsdf.pack_materials(mats)
         self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)
         self.textures = mats.shading()

@@ -35,7 +35,8 @@ H_OBJ_RANDOM = 34
 H_OBJ_INDEX = 35     # pass index
 H_TANGENT = 36       # tangent (3), world space, of the UV map (Normal Map)
 H_TANGENT_SIGN = 39  # bitangent sign; 0 where the mesh has no tangents
-N_HIT = 40
+H_COLOR = 40         # the color attribute, RGBA (4); 0 where the mesh has none
+N_HIT = 44
 
 # ---------------------------------------------------------------- object table columns
 O_TO_OBJECT = 0      # 3 x 4 world -> object, row-major (12)
@@ -76,13 +77,14 @@ IDENTITY_OBJECT = object_row(np.eye(4))
 
 @kernel
 def fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, u, v, front, ray, depth,
-         length, objects, obj, tx, ty, tz, ts):
+         length, objects, obj, tx, ty, tz, ts, cr, cg, cb, ca):
     """Write one hit row. (n, g): shading and geometric normals facing the ray; d: the
     ray's direction; (u, v): its UV; obj: its row in `objects` (-1: the identity
     object, texture space the unit cube around the origin); t, ts: tangent and
-    bitangent sign (ts = 0: none)."""
+    bitangent sign (ts = 0: none); c: the color attribute."""
     hit[H_TANGENT], hit[H_TANGENT + 1], hit[H_TANGENT + 2] = tx, ty, tz
     hit[H_TANGENT_SIGN] = ts
+    hit[H_COLOR], hit[H_COLOR + 1], hit[H_COLOR + 2], hit[H_COLOR + 3] = cr, cg, cb, ca
     hit[H_P], hit[H_P + 1], hit[H_P + 2] = px, py, pz
     hit[H_N], hit[H_N + 1], hit[H_N + 2] = nx, ny, nz
     hit[H_NG], hit[H_NG + 1], hit[H_NG + 2] = gx, gy, gz
@@ -123,7 +125,7 @@ def fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, u, v, front, ray, 
 
 @kernel
 def fill_rows(position, normal, geometric_normal, direction, uv, front, ray, depth, length,
-              objects, obj, tangent):
+              objects, obj, tangent, color):
     """`fill` for n hits given as arrays: an (n, N_HIT) array of hit rows."""
     n = position.shape[0]
     out = np.zeros((n, N_HIT))
@@ -132,17 +134,18 @@ def fill_rows(position, normal, geometric_normal, direction, uv, front, ray, dep
              normal[i, 1], normal[i, 2], geometric_normal[i, 0], geometric_normal[i, 1],
              geometric_normal[i, 2], direction[i, 0], direction[i, 1], direction[i, 2],
              uv[i, 0], uv[i, 1], front[i], ray[i], depth[i], length[i], objects, obj[i],
-             tangent[i, 0], tangent[i, 1], tangent[i, 2], tangent[i, 3])
+             tangent[i, 0], tangent[i, 1], tangent[i, 2], tangent[i, 3], color[i, 0],
+             color[i, 1], color[i, 2], color[i, 3])
     return out
 
 
 def hit_rows(position, normal, geometric_normal=None, direction=None, uv=None, front=None,
              ray=1, depth=0, length=None, objects=None, obj=None,
-             tangent=None) -> np.ndarray:
+             tangent=None, color=None) -> np.ndarray:
     """(n, N_HIT) hit rows from arrays (NumPy callers; anything left out takes a neutral
     value: Ng = N, the ray arriving along -N, UV (0, 0), front-facing, a camera ray at
-    depth 0 of length 1, the identity object, no tangents; tangent: (n, 4) tangent and
-    bitangent sign)."""
+    depth 0 of length 1, the identity object, no tangents, colour 0; tangent: (n, 4)
+    tangent and bitangent sign; color: (n, 4) RGBA)."""
     position = np.ascontiguousarray(position, np.float64).reshape(-1, 3)
     n = len(position)
     normal = np.ascontiguousarray(normal, np.float64).reshape(n, 3)
@@ -159,4 +162,5 @@ def hit_rows(position, normal, geometric_normal=None, direction=None, uv=None, f
                      arr(ray, ray, (n,)), arr(depth, depth, (n,)), arr(length, 1.0, (n,)),
                      np.ascontiguousarray(objects if objects is not None
                                           else np.zeros((0, N_OBJ)), np.float64),
-                     arr(obj, -1, (n,), np.int64), arr(tangent, 0.0, (n, 4)))
+                     arr(obj, -1, (n,), np.int64), arr(tangent, 0.0, (n, 4)),
+                     arr(color, 0.0, (n, 4)))

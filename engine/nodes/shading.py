@@ -1,9 +1,10 @@
 """The kernels' side of shader programs: run a hit's material program and read its
 outputs into the Principled parameter row, emission and alpha.
 
-geometry is the compiled path tracer's triangle tuple; its fields 10, 11 and 12 are each
+geometry is the compiled path tracer's triangle tuple; its fields 10 to 13 are each
 triangle's object (int32, empty when no mesh carries ObjectInfo), the object table
-(context.O_* rows) and the corner tangents ((T, 3, 4) float32, empty without)."""
+(context.O_* rows), the corner tangents and the corner colours ((T, 3, 4) float32 each,
+empty without)."""
 from __future__ import annotations
 
 import math
@@ -36,8 +37,16 @@ def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx
         if ln > 0.0:
             tx, ty, tz = tx / ln, ty / ln, tz / ln
         ts = 1.0 if ts > 0.0 else (-1.0 if ts < 0.0 else 0.0)
+    cr = cg = cb = ca = 0.0
+    colors = geometry[13]
+    if colors.shape[0] > 0:
+        b0 = 1.0 - bu - bv
+        cr = b0 * colors[prim, 0, 0] + bu * colors[prim, 1, 0] + bv * colors[prim, 2, 0]
+        cg = b0 * colors[prim, 0, 1] + bu * colors[prim, 1, 1] + bv * colors[prim, 2, 1]
+        cb = b0 * colors[prim, 0, 2] + bu * colors[prim, 1, 2] + bv * colors[prim, 2, 2]
+        ca = b0 * colors[prim, 0, 3] + bu * colors[prim, 1, 3] + bv * colors[prim, 2, 3]
     fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, uu, vv, front, ray, depth,
-         length, objects, obj, tx, ty, tz, ts)
+         length, objects, obj, tx, ty, tz, ts, cr, cg, cb, ca)
     run(T, m, hit, regs)
 
 

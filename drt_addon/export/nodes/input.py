@@ -1,5 +1,6 @@
 """Input nodes to program operations (engine.nodes.input_nodes): Texture Coordinate,
-UV Map, Geometry, Object Info, Value, RGB, Fresnel, Layer Weight, Light Path."""
+UV Map, Geometry, Object Info, Color Attribute and Attribute (colour attributes), Value,
+RGB, Fresnel, Layer Weight, Light Path."""
 from __future__ import annotations
 
 import importlib
@@ -118,7 +119,23 @@ def _light_path(c, node, out):
     raise Unsupported(f"the Light Path output {name} is not evaluated")
 
 
+def _color_attribute(c, node, out):
+    """Color Attribute / Attribute (geometry): the mesh's colour attribute (the one the
+    material names, else its render colour attribute); Fac is the colour's average."""
+    if node.bl_idname == "ShaderNodeAttribute" and node.attribute_type != "GEOMETRY":
+        raise Unsupported(f"{node.attribute_type.lower()} attributes are not evaluated")
+    color = c.convert(hit3(c, C.H_COLOR), "color")
+    name = out.identifier
+    if name == "Alpha":
+        return hit1(c, C.H_COLOR + 3)
+    if name == "Fac":
+        return c.convert(hit3(c, C.H_COLOR), "float")
+    return color if name == "Color" else c.convert(color, "vector")
+
+
 TRANSLATORS = {
+    "ShaderNodeVertexColor": _color_attribute,
+    "ShaderNodeAttribute": _color_attribute,
     "ShaderNodeTexCoord": _tex_coord,
     "ShaderNodeUVMap": _uv_map,
     "ShaderNodeNewGeometry": _geometry,
