@@ -9,7 +9,7 @@ import numpy as np
 
 
 def wants_tangents(obj) -> bool:
-    from .materials import _all_nodes, uses_nodes
+    from .nodes.links import _all_nodes, uses_nodes
     for slot in getattr(obj, "material_slots", ()):
         mat = slot.material
         if mat is None or not uses_nodes(mat):

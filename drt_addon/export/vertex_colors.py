@@ -13,7 +13,7 @@ READERS = {"ShaderNodeVertexColor": "layer_name", "ShaderNodeAttribute": "attrib
 def color_request(obj) -> Optional[str]:
     """The color attribute the object's materials read: None (none), '' (the mesh's
     render colour attribute) or a name."""
-    from .materials import _all_nodes, uses_nodes
+    from .nodes.links import _all_nodes, uses_nodes
     names = []
     for slot in getattr(obj, "material_slots", ()):
         mat = slot.material

@@ -31,7 +31,7 @@ import numpy as np
 from ..engine_link import engine
 from .errors import Reporter
 from .images import image_cache, image_texture, textures
-from .materials import _link, uses_nodes
+from .nodes.links import _link, uses_nodes
 
 BLACK = (0.0, 0.0, 0.0)
 MISSING = tuple(textures.MISSING_RGBA[:3])

@@ -1,0 +1,211 @@
+"""Closures as the exporter reads a shader tree (Cycles' meaning, kernel/svm/closure.h)
+and their reduction to one engine Material: `_Comp` is one BSDF closure as Principled
+parameters, `_Closure` a weighted set of them with transparency and emission; `_reduce`
+mixes a set into one Principled parameter set (see export/materials.py's docstring for
+what is exact and what is approximated)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..engine_link import engine
+from .material_params import _is_tex, _lin, _mean, _plain, _same, _scale
+
+WHITE = (1.0, 1.0, 1.0)
+BLACK = (0.0, 0.0, 0.0)
+
+
+@dataclass
+class _Comp:
+    """One BSDF closure as Principled parameters (Params; see the module docstring)."""
+    base: object = (0.8, 0.8, 0.8)
+    metallic: object = 0.0
+    transmission: float = 0.0
+    roughness: object = 0.5
+    ior: float = 1.5
+    spec: float = 0.5
+    metal_color: object = None      # None: the base colour (Principled)
+    glass_color: object = None      # None: sqrt(base colour) per crossing (Principled)
+    distribution: str = "MULTI_GGX"  # 'MULTI_GGX' or 'GGX' (engine glossy_model)
+
+    def glossy_weight(self):
+        """Mean weight of the lobes the distribution shapes (metal, glass, specular)."""
+        m, g, b = self.weights()
+        return m + g + (b if self.spec > 0 else 0.0)
+
+    def weights(self):
+        """Mean lobe weights (metal, glass, dielectric base) of this closure."""
+        m = float(np.clip(_mean(self.metallic), 0.0, 1.0))
+        t = float(np.clip(self.transmission, 0.0, 1.0))
+        return m, (1.0 - m) * t, (1.0 - m) * (1.0 - t)
+
+
+NULL_COMP = _Comp(base=BLACK, spec=0.0)     # absorbs: an Emission shader's "no BSDF"
+
+
+@dataclass
+class _Closure:
+    comps: list = field(default_factory=list)      # [(weight, _Comp)]
+    t_weight: float = 0.0                            # transparent closure weight
+    t_color: tuple = BLACK                           # sum of weight x transparent colour
+    emission: object = BLACK                         # expected emitted radiance (Param)
+    alpha_texture: object = None                     # a lone Principled's textured Alpha
+
+    def scaled(self, f, ctx):
+        if self.alpha_texture is not None and f != 1.0:
+            ctx.issue("a textured Alpha inside a Mix/Add Shader is replaced by its average")
+            c = self._alpha_to_constant()
+            return c.scaled(f, ctx)
+        return _Closure([(w * f, c) for w, c in self.comps], self.t_weight * f,
+                        _plain(np.asarray(self.t_color) * f), _scale(self.emission, f),
+                        self.alpha_texture)
+
+    def _alpha_to_constant(self):
+        a = float(np.clip(self.alpha_texture.mean(), 0.0, 1.0))
+        return _Closure([(w * a, c) for w, c in self.comps], self.t_weight + (1.0 - a),
+                        _plain(np.asarray(self.t_color) + (1.0 - a)), self.emission)
+
+    def is_emission_only(self):
+        return (all(c is NULL_COMP for _, c in self.comps) and self.t_weight == 0
+                and bool(self.comps))
+
+
+def _sum(a: _Closure, b: _Closure, ctx) -> _Closure:
+    for c in (a, b):
+        if c.alpha_texture is not None:
+            ctx.issue("a textured Alpha inside a Mix/Add Shader is replaced by its average")
+    a = a._alpha_to_constant() if a.alpha_texture is not None else a
+    b = b._alpha_to_constant() if b.alpha_texture is not None else b
+    return _Closure(a.comps + b.comps, a.t_weight + b.t_weight,
+                    _plain(np.asarray(a.t_color) + np.asarray(b.t_color)),
+                    _lin([(1.0, a.emission), (1.0, b.emission)], ctx, "emission"))
+
+
+def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
+    """One Material from a closure set (see the module docstring)."""
+    W = float(sum(w for w, _ in cl.comps))
+    T = float(cl.t_weight)
+    total = W + T
+    if total <= 0.0:
+        # Nothing but emission can come out (e.g. every weight mixed to zero).
+        return engine.Material(name, BLACK, specular_ior_level=0.0,
+                               emission=tuple(_mean(cl.emission)))
+    alpha = W / total
+    t_color = _plain(np.asarray(cl.t_color) * (total / T)) if T > 0 else WHITE
+    if W <= 0.0:
+        if max(_mean(cl.emission)) > 0:
+            ctx.issue("emission on a fully transparent shader is not rendered")
+        return engine.Material(name, BLACK, specular_ior_level=0.0, alpha=0.0,
+                               transparent_color=t_color)
+    comps = [(w / W, c) for w, c in cl.comps if w > 0]
+    p = _blend(comps, ctx)
+    if abs(total - 1.0) > 1e-9:
+        # closures summed past 1 (Add Shader): the opaque part keeps its full weight
+        for k in ("base", "metal_color", "glass_color"):
+            if p[k] is not None:
+                p[k] = _scale(p[k], total)
+    emission = _scale(cl.emission, 1.0 / alpha)        # emitted by the opaque part
+    alpha_tex = cl.alpha_texture
+    if alpha_tex is not None:
+        alpha = 1.0
+    m = engine.Material(name)
+    _set(m, "base_color", p["base"])
+    _set(m, "metallic", p["metallic"])
+    _set(m, "roughness", p["roughness"])
+    _set(m, "emission", emission)
+    m.ior = float(p["ior"])
+    m.transmission = float(p["transmission"])
+    m.glossy_model = p["distribution"]
+    m.specular_ior_level = float(p["spec"])
+    if p["metal_color"] is not None:
+        mc = p["metal_color"]
+        if _is_tex(mc):
+            ctx.issue("the metal colour is textured and differs from the base colour; "
+                      "DRT uses its average")
+            mc = mc.mean()
+        m.metal_color = tuple(mc)
+    if p["glass_color"] is not None:
+        m.glass_color = tuple(_mean(p["glass_color"]))
+    m.alpha = float(alpha)
+    m.transparent_color = tuple(t_color)
+    if alpha_tex is not None:
+        m.alpha_texture = alpha_tex
+        m.alpha = float(np.clip(alpha_tex.mean(), 0.0, 1.0))
+    return m
+
+
+def _set(m, attr, value):
+    if _is_tex(value):
+        value.nodes.b.output(attr, value.value)
+        mean = value.mean()
+        setattr(m, attr, tuple(mean) if isinstance(mean, tuple) else float(mean))
+    else:
+        setattr(m, attr, tuple(value) if isinstance(value, tuple) else float(value))
+
+
+def _blend(comps, ctx) -> dict:
+    """Principled parameters of a convex combination [(c_i, _Comp)] of closures."""
+    if len(comps) == 1:
+        c = comps[0][1]
+        return dict(base=c.base, metallic=c.metallic, transmission=c.transmission,
+                    roughness=c.roughness, ior=c.ior, spec=c.spec,
+                    metal_color=None if c.metal_color is None or _same(c.metal_color, c.base)
+                    else c.metal_color,
+                    glass_color=c.glass_color, distribution=c.distribution)
+    lw = [(c, comp, *comp.weights()) for c, comp in comps]
+    Wm = sum(c * m for c, _, m, _, _ in lw)
+    Wg = sum(c * g for c, _, _, g, _ in lw)
+    Wb = sum(c * b for c, _, _, _, b in lw)
+    metallic = _lin([(c, comp.metallic) for c, comp in comps], ctx, "metallic")
+    transmission = Wg / (1.0 - Wm) if Wm < 1.0 - 1e-12 else 0.0
+    metal_cols = [(c * m, comp.metal_color if comp.metal_color is not None else comp.base)
+                  for c, comp, m, _, _ in lw]
+    metal_avg = _scale(_lin(metal_cols, ctx, "metal colour"), 1.0 / Wm) if Wm > 0 else None
+    if Wb > 0:
+        base = _scale(_lin([(c * b, comp.base) for c, comp, _, _, b in lw], ctx, "base colour"),
+                      1.0 / Wb)
+    elif Wm > 0:
+        base = metal_avg
+    else:
+        base = _scale(_lin([(c * g, comp.base) for c, comp, _, g, _ in lw], ctx,
+                           "base colour"), 1.0 / max(Wg, 1e-300))
+    metal_color = None
+    if Wm > 0 and not _same(metal_avg, base):
+        metal_color = metal_avg
+    glass_color = None
+    if Wg > 0:
+        principled = all(comp.glass_color is None and _same(comp.base, base)
+                         for _, comp, _, g, _ in lw if g > 0)
+        if not principled:
+            tints = [(c * g, np.asarray(comp.glass_color) if comp.glass_color is not None
+                      else np.sqrt(np.clip(np.asarray(_mean(comp.base)), 0.0, 1.0)))
+                     for c, comp, _, g, _ in lw if g > 0]
+            glass_color = _plain(sum(w * t for w, t in tints) / Wg)
+    # the dielectric base lobe's specular layer: level weighted by the base lobes
+    spec = (sum(c * b * comp.spec for c, comp, _, _, b in lw) / Wb) if Wb > 0 else 0.5
+    # roughness and IOR: weighted by the lobes that use them
+    rough_w = [(c * (m + g + (b if comp.spec > 0 else 0.0)), comp) for c, comp, m, g, b in lw]
+    total_r = sum(w for w, _ in rough_w)
+    if total_r > 0:
+        roughness = _scale(_lin([(w, comp.roughness) for w, comp in rough_w], ctx,
+                                "roughness"), 1.0 / total_r)
+    else:
+        roughness = 0.5
+    ior_w = [(c * (g + (b if comp.spec > 0 else 0.0)), comp.ior) for c, comp, m, g, b in lw]
+    total_i = sum(w for w, _ in ior_w)
+    iors = {round(i, 6) for w, i in ior_w if w > 0}
+    if len(iors) > 1:
+        ctx.issue("closures with different IORs are mixed; DRT uses their weighted mean")
+    ior = sum(w * i for w, i in ior_w) / total_i if total_i > 0 else 1.5
+    if Wb > 0 and Wm > 0 and not _same(metal_avg, base):
+        pass   # exact: the metal lobe keeps its own colour (Material.metal_color)
+    # the microfacet distribution: the one of the closure with the most glossy weight
+    glossy = [(c * comp.glossy_weight(), comp.distribution) for c, comp in comps]
+    distribution = max(glossy, key=lambda x: x[0])[1]
+    if len({d for w, d in glossy if w > 0}) > 1:
+        ctx.issue(f"closures with different microfacet distributions are mixed; DRT uses "
+                  f"{distribution} for all")
+    return dict(base=base, metallic=metallic, transmission=float(np.clip(transmission, 0, 1)),
+                roughness=roughness, ior=ior, spec=spec, metal_color=metal_color,
+                glass_color=glass_color, distribution=distribution)

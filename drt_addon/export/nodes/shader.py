@@ -1,0 +1,291 @@
+"""Shader nodes (the BSDFs, Emission, Transparent, Mix and Add Shader) to closures:
+`_closure` reads the shader tree behind a socket; the inputs of each BSDF are compiled
+into the material's program where linked (`_input`)."""
+from __future__ import annotations
+
+import importlib
+from dataclasses import replace
+
+import numpy as np
+
+from ...engine_link import engine
+from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _sum
+from ..material_params import TOL, NodeParam, _is_tex, _lin, _mean, _same, _scale
+from .links import _link
+
+fresnel = importlib.import_module(engine.__name__ + ".bsdf.fresnel")
+
+
+def _default(sock, color):
+    v = sock.default_value
+    if color:
+        return tuple(float(x) for x in tuple(v)[:3])
+    try:
+        return float(v)
+    except TypeError:
+        return float(tuple(v)[0])
+
+
+def _input(node, name, ctx, color, default, texturable=True):
+    """The value of input `name` of `node`: its own value when unlinked; else the node
+    graph linked to it, compiled into the material's program (engine.nodes): a constant
+    when the graph does not depend on the hit (folded now), otherwise a NodeParam that
+    the program evaluates at every hit (texturable inputs), or its average (reported)."""
+    sock = node.inputs.get(name)
+    if sock is None:
+        return default
+    if _link(sock) is None:
+        return _default(sock, color)
+    value = ctx.nodes.socket(sock, "color" if color else "float")
+    folded = ctx.nodes.fold(value)
+    if folded is not None:
+        return folded
+    param = NodeParam(value, ctx.nodes)
+    if not texturable:
+        ctx.issue(f"the input '{name}' of {node.name!r} varies per hit, which DRT does not "
+                  f"render there; using its average")
+        return param.mean()
+    return param
+
+
+def _constant(node, name, ctx, default, color=False):
+    return _input(node, name, ctx, color, default, texturable=False)
+
+
+# --------------------------------------------------------------------------- nodes
+def _principled(node, ctx) -> _Closure:
+    def val(name, default, color=False):
+        return _input(node, name, ctx, color, default)
+
+    def const(name, default):
+        return _constant(node, name, ctx, default)
+
+    comp = _Comp(base=val("Base Color", (0.8, 0.8, 0.8), True),
+                 metallic=val("Metallic", 0.0), transmission=const("Transmission Weight", 0.0),
+                 roughness=val("Roughness", 0.5), ior=const("IOR", 1.5),
+                 spec=const("Specular IOR Level", 0.5),
+                 distribution=_distribution(node, ctx))
+    ignored = []
+    for sock, what in (("Coat Weight", "coat"), ("Sheen Weight", "sheen"),
+                       ("Subsurface Weight", "subsurface"), ("Anisotropic", "anisotropy"),
+                       ("Thin Film Thickness", "thin film"),
+                       ("Diffuse Roughness", "diffuse roughness")):
+        s = node.inputs.get(sock)
+        if s is not None and (s.is_linked or float(s.default_value) > 0.0):
+            ignored.append(what)
+    s = node.inputs.get("Specular Tint")
+    if s is not None and (s.is_linked or any(abs(x - 1.0) > TOL for x in s.default_value[:3])):
+        ignored.append("specular tint")
+    s = node.inputs.get("Tangent")
+    if s is not None and s.is_linked:
+        ignored.append("the tangent input")
+    _normal(node, ctx)
+    if ignored:
+        ctx.issue(f"{node.name!r} uses {', '.join(ignored)}, which DRT does not render "
+                  f"(left out)")
+    color = val("Emission Color", (1.0, 1.0, 1.0), True)
+    strength = const("Emission Strength", 0.0)
+    emission = _scale(color, strength)
+    alpha = val("Alpha", 1.0)
+    if _is_tex(alpha):
+        return _Closure([(1.0, comp)], 0.0, BLACK, emission, alpha_texture=alpha)
+    a = float(np.clip(alpha, 0.0, 1.0))
+    # Cycles: BSDF weight a, transparent 1 - a, emission times a
+    return _Closure([(a, comp)], 1.0 - a, (1.0 - a,) * 3, _scale(emission, a))
+
+
+def _normal(node, ctx):
+    """A BSDF's linked Normal input: the material's per-hit shading normal (one per
+    material: a second, different one in a mix is reported and left out)."""
+    sock = node.inputs.get("Normal")
+    if sock is None or _link(sock) is None:
+        return
+    value = ctx.nodes.socket(sock, "vector")
+    if not value.varying:
+        ctx.issue(f"the Normal of {node.name!r} is a constant direction; DRT keeps the "
+                  f"surface's normal")
+        return
+    if ctx.normal is None:
+        ctx.normal = value
+    elif ctx.normal.reg != value.reg:
+        ctx.issue(f"mixed shaders have different normals; DRT uses the first one's for "
+                  f"all ({node.name!r} left out)")
+
+
+def _diffuse(node, ctx) -> _Closure:
+    _normal(node, ctx)
+    r = _constant(node, "Roughness", ctx, 0.0)
+    if r > 0.0:
+        ctx.issue(f"{node.name!r} has roughness {r:g} (Oren-Nayar); DRT renders it Lambertian")
+    return _Closure([(1.0, _Comp(base=_input(node, "Color", ctx, True, (0.8,) * 3),
+                                 spec=0.0))])
+
+
+def _distribution(node, ctx) -> str:
+    """The engine glossy_model of a node's microfacet distribution."""
+    d = getattr(node, "distribution", "MULTI_GGX")
+    if d in ("MULTI_GGX", "GGX"):
+        return d
+    ctx.issue(f"{node.name!r} uses the {d} distribution; DRT uses GGX")
+    return "GGX"
+
+
+def _glossy(node, ctx) -> _Closure:
+    _normal(node, ctx)
+    distribution = _distribution(node, ctx)
+    s = node.inputs.get("Anisotropy")
+    if s is not None and (s.is_linked or float(s.default_value) != 0.0):
+        ctx.issue(f"{node.name!r} is anisotropic; DRT renders it isotropic")
+    color = _input(node, "Color", ctx, True, (0.8,) * 3)
+    return _Closure([(1.0, _Comp(base=color, metallic=1.0,
+                                 roughness=_input(node, "Roughness", ctx, False, 0.5),
+                                 distribution=distribution))])
+
+
+def _glass(node, ctx, refraction=False) -> _Closure:
+    if refraction:
+        ctx.issue(f"{node.name!r} (Refraction BSDF) is rendered as glass, which also "
+                  f"reflects")
+    _normal(node, ctx)
+    distribution = _distribution(node, ctx)
+    color = _input(node, "Color", ctx, True, WHITE)
+    if _is_tex(color):
+        ctx.issue(f"the colour of {node.name!r} is textured; DRT tints its refraction "
+                  f"with the texture's average")
+        color = color.mean()
+    s = node.inputs.get("Thin Film Thickness")
+    if s is not None and (s.is_linked or float(s.default_value) > 0.0):
+        ctx.issue(f"{node.name!r} uses thin film, which DRT does not render (left out)")
+    comp = _Comp(base=color, transmission=1.0,
+                 roughness=_input(node, "Roughness", ctx, False, 0.0),
+                 ior=_constant(node, "IOR", ctx, 1.5), glass_color=color,
+                 distribution=distribution)
+    return _Closure([(1.0, comp)])
+
+
+def _emission(node, ctx) -> _Closure:
+    color = _input(node, "Color", ctx, True, WHITE)
+    strength = _constant(node, "Strength", ctx, 1.0)
+    return _Closure([(1.0, NULL_COMP)], emission=_scale(color, strength))
+
+
+def _transparent(node, ctx) -> _Closure:
+    color = _constant(node, "Color", ctx, WHITE, color=True)
+    return _Closure([], 1.0, color)
+
+
+def _fresnel_average(ior):
+    """Hemispherical average of Fresnel reflectance, 2 int_0^1 F(mu) mu dmu."""
+    mu = (np.arange(1024) + 0.5) / 1024
+    return float(2.0 * np.mean(fresnel.dielectric(mu, max(float(ior), 1e-5)) * mu))
+
+
+def _mix_factor(node, ctx):
+    """(constant factor, Fresnel IOR or None) of a Mix Shader's Fac."""
+    sock = node.inputs[0]
+    found = _link(sock)
+    if found is None:
+        return float(np.clip(sock.default_value, 0.0, 1.0)), None
+    src, out = found
+    if src.bl_idname == "ShaderNodeFresnel":
+        ior = _constant(src, "IOR", ctx, 1.5)
+        return _fresnel_average(ior), ior
+    if src.bl_idname == "ShaderNodeLayerWeight":
+        blend = float(np.clip(_constant(src, "Blend", ctx, 0.5), 0.0, 1.0 - 1e-5))
+        if out.identifier == "Fresnel":
+            ior = 1.0 / max(1.0 - blend, 1e-5)
+            return _fresnel_average(ior), ior
+        # Facing: 1 - |cos|^b with Cycles' remapping of Blend; cosine-weighted average
+        b = 2.0 * blend if blend < 0.5 else 0.5 / (1.0 - blend)
+        ctx.issue(f"the Fac of {node.name!r} is Layer Weight's Facing, which depends on the "
+                  f"view angle; DRT uses its hemispherical average")
+        return 1.0 - 2.0 / (b + 2.0), None
+    value = ctx.nodes.socket(sock, "float")
+    folded = ctx.nodes.fold(value)
+    if folded is not None:
+        return float(np.clip(folded, 0.0, 1.0)), None
+    mean = float(np.clip(ctx.nodes.mean(value), 0.0, 1.0))
+    ctx.issue(f"the Fac of {node.name!r} varies per hit ({src.bl_label!r}); DRT mixes the "
+              f"shaders by its average {mean:.3f}")
+    return mean, None
+
+
+def _plastic(a: _Closure, b: _Closure, ior, fac, ctx):
+    """Mix(Fresnel(ior), A, B) with A one dielectric base closure and B one Glossy-like
+    closure: Principled's specular layer over A's base. None if not of that form."""
+    if a.alpha_texture is not None or b.alpha_texture is not None:
+        return None
+    if len(a.comps) != 1 or len(b.comps) != 1 or a.t_weight or b.t_weight:
+        return None
+    (_, ca), (_, cb) = a.comps[0], b.comps[0]
+    if ca is NULL_COMP or cb is NULL_COMP:
+        return None
+    if _mean(ca.metallic) != 0.0 or ca.transmission != 0.0:
+        return None
+    if _mean(cb.metallic) != 1.0:
+        return None
+    mc = cb.metal_color if cb.metal_color is not None else cb.base
+    if not _same(_mean(mc), WHITE):
+        ctx.issue("the glossy side of a Fresnel-mixed shader is tinted; DRT's specular "
+                  "layer is white")
+    comp = replace(ca, spec=0.5, ior=float(ior), roughness=cb.roughness,
+                   distribution=cb.distribution)
+    return _Closure([(1.0, comp)], 0.0, BLACK,
+                    _lin([(1.0 - fac, a.emission), (fac, b.emission)], ctx, "emission"))
+
+
+def _closure(socket, ctx, depth=0) -> _Closure:
+    """The closure feeding a shader socket."""
+    found = _link(socket)
+    if found is None:
+        return _Closure([(1.0, NULL_COMP)])       # no closure: black
+    node = found[0]
+    if depth > 32:
+        ctx.issue("the shader tree is too deep; rendering the rest as the viewport colour")
+        return _Closure([(1.0, ctx.viewport_comp())])
+    kind = node.bl_idname
+    if kind == "ShaderNodeBsdfPrincipled":
+        return _principled(node, ctx)
+    if kind == "ShaderNodeBsdfDiffuse":
+        return _diffuse(node, ctx)
+    if kind == "ShaderNodeBsdfGlossy" or kind == "ShaderNodeBsdfAnisotropic":
+        return _glossy(node, ctx)
+    if kind == "ShaderNodeBsdfGlass":
+        return _glass(node, ctx)
+    if kind == "ShaderNodeBsdfRefraction":
+        return _glass(node, ctx, refraction=True)
+    if kind == "ShaderNodeEmission":
+        return _emission(node, ctx)
+    if kind == "ShaderNodeBsdfTransparent":
+        return _transparent(node, ctx)
+    if kind == "ShaderNodeMixShader":
+        fac, ior = _mix_factor(node, ctx)
+        a = _closure(node.inputs[1], ctx, depth + 1)
+        b = _closure(node.inputs[2], ctx, depth + 1)
+        if ior is not None:
+            p = _plastic(a, b, ior, fac, ctx)
+            if p is not None:
+                ctx.issue(f"the Fresnel-driven {node.name!r} is rendered as a Principled "
+                          f"specular layer of IOR {ior:.3g}")
+                return p
+            ctx.issue(f"the Fac of {node.name!r} depends on the view angle (Fresnel); DRT "
+                      f"uses its hemispherical average {fac:.3f}")
+        return _sum(a.scaled(1.0 - fac, ctx), b.scaled(fac, ctx), ctx)
+    if kind == "ShaderNodeAddShader":
+        a = _closure(node.inputs[0], ctx, depth + 1)
+        b = _closure(node.inputs[1], ctx, depth + 1)
+        if a.is_emission_only() or b.is_emission_only():
+            emit, other = (a, b) if a.is_emission_only() else (b, a)
+            if other.alpha_texture is not None:
+                return _Closure(other.comps, other.t_weight, other.t_color,
+                                _lin([(1.0, emit.emission), (1.0, other.emission)], ctx,
+                                     "emission"), other.alpha_texture)
+            return _Closure(other.comps, other.t_weight, other.t_color,
+                            _lin([(1.0, emit.emission), (1.0, other.emission)], ctx,
+                                 "emission"))
+        ctx.issue(f"{node.name!r} adds two BSDFs; DRT renders their sum as one Principled "
+                  f"BSDF (lobe weights and colours summed)")
+        return _sum(a, b, ctx)
+    ctx.issue(f"it uses the {node.bl_label!r} node, which DRT does not support yet; "
+              f"rendering it as a diffuse surface of its viewport colour")
+    return _Closure([(1.0, ctx.viewport_comp())])
