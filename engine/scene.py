@@ -68,12 +68,18 @@ class Material:
     emission_texture: Optional[object] = None
     alpha_texture: Optional[object] = None
     shader: Optional[object] = None
+    mix: Optional[tuple] = None
 
     TEXTURED = ("base_color", "metallic", "roughness", "emission", "alpha")
 
     # shader: an engine.nodes.program.ShaderProgram whose outputs (OUTPUTS) replace the
     # parameters they name at every hit (their plain values above are then summaries);
     # it takes precedence over a *_texture of the same parameter.
+    # mix: (Material, Material), a Mix Shader whose Fac varies per hit (the program's
+    # "mix" output): each hit is shaded by one of the two, the second with probability
+    # Fac (an unbiased estimate of Cycles' weighted sum). The parent's own parameters
+    # are the mixture at the Fac's average: the NumPy reference renders that, and its
+    # alpha and emission are the hit's.
 
     def textures(self) -> dict:
         """{parameter name: TextureInput} of the textured parameters."""

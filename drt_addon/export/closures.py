@@ -51,6 +51,8 @@ class _Closure:
     t_color: tuple = BLACK                           # sum of weight x transparent colour
     emission: object = BLACK                         # expected emitted radiance (Param)
     alpha_texture: object = None                     # a lone Principled's textured Alpha
+    mix: object = None     # (A, B, Fac Value): a Mix Shader whose Fac varies per hit; the
+    #                        fields above are then its mixture at the Fac's average
 
     def scaled(self, f, ctx):
         if self.alpha_texture is not None and f != 1.0:
@@ -135,9 +137,19 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
     return m
 
 
+def program_outputs(m) -> dict:
+    """The program outputs collected for engine Material m ({OUTPUTS name: Value})."""
+    if not hasattr(m, "_program_outputs"):
+        m._program_outputs = {}
+    return m._program_outputs
+
+
 def _set(m, attr, value):
+    """Set a Material's parameter: a plain value, or a per-hit one (a NodeParam), which
+    becomes an output of the material's program (`program_outputs`, collected by
+    export_material) with its average as the plain value."""
     if _is_tex(value):
-        value.nodes.b.output(attr, value.value)
+        program_outputs(m)[attr] = value.value
         mean = value.mean()
         setattr(m, attr, tuple(mean) if isinstance(mean, tuple) else float(mean))
     else:

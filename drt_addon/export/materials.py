@@ -72,10 +72,11 @@ approximation is reported once per material, in one warning naming the material.
 """
 from __future__ import annotations
 
+import dataclasses
 from typing import Optional
 
 from ..engine_link import engine
-from .closures import _Comp, _reduce
+from .closures import _Comp, _reduce, program_outputs
 from .errors import Reporter
 from .images import image_cache
 from .nodes import NodeCompiler
@@ -122,6 +123,30 @@ def material_uv_maps(mat) -> Optional[set]:
     return names or {""}
 
 
+def _material(cl, ctx, name) -> "engine.Material":
+    """The Material of closure set cl; a Mix Shader with a per-hit Fac (cl.mix) becomes a
+    Material shading each hit by one of its two sides (Material.mix), picked with the
+    Fac's probability; anywhere else in the tree it mixes by the Fac's average."""
+    m = _reduce(cl, ctx, name)
+    if cl.mix is not None:
+        a, b, fac = cl.mix
+        program_outputs(m)["mix"] = fac
+        m.mix = (_material(a, ctx, name + " [1]"), _material(b, ctx, name + " [2]"))
+    return m
+
+
+def _attach_programs(m, ctx, program):
+    """Give m (and the sides of its mixes) the material's program with its own outputs
+    (all share the program's instructions and registers; the normal is everyone's)."""
+    outputs = dict(program_outputs(m))
+    if ctx.normal is not None:
+        outputs["normal"] = ctx.normal
+    if outputs:
+        m.shader = dataclasses.replace(program, outputs=outputs)
+    for side in (m.mix or ()):
+        _attach_programs(side, ctx, program)
+
+
 def export_material(mat, reporter: Reporter) -> "engine.Material":
     """`mat` (None: an empty slot) as an engine Material, with Cycles' meaning; what is
     approximated is reported once, in one warning naming the material."""
@@ -145,11 +170,8 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
         disp = out.inputs.get("Displacement")
         if disp is not None and _link(disp) is not None:
             ctx.issue("its displacement is not rendered")
-        result = _reduce(_closure(out.inputs["Surface"], ctx), ctx, name)
-        if ctx.normal is not None:
-            ctx.nodes.b.output("normal", ctx.normal)
-        if ctx.nodes.b.outputs:
-            result.shader = ctx.nodes.build()
+        result = _material(_closure(out.inputs["Surface"], ctx), ctx, name)
+        _attach_programs(result, ctx, ctx.nodes.build())
     if ctx.issues and reporter is not None:
         reporter.warn(f"DRT: material {name!r}: " + "; ".join(ctx.issues),
                       key=(name, "material"))

@@ -8,6 +8,23 @@ import numpy as np
 GLOSSY_MODELS = ("GGX", "MULTI_GGX", "BLINN_PHONG")
 
 
+def flatten_mixes(materials):
+    """(materials with the shaders of every Mix Shader appended after the scene's, their
+    indices (n, 2): the two shaders mixed per hit by material i, -1 for none)."""
+    out = list(materials)
+    children = []
+    i = 0
+    while i < len(out):
+        mix = getattr(out[i], "mix", None)
+        if mix is not None:
+            children.append((len(out), len(out) + 1))
+            out.extend(mix)
+        else:
+            children.append((-1, -1))
+        i += 1
+    return out, np.array(children, np.int64).reshape(-1, 2)
+
+
 class MaterialTable:
     """Scene materials as arrays, indexed by a hit's material id.
 
@@ -26,6 +43,8 @@ class MaterialTable:
 
     def __init__(self, materials):
         materials = list(materials)
+        self.n_scene_materials = len(materials)     # the mixed shaders' materials follow
+        materials, self.mix_children = flatten_mixes(materials)
         self.base_color = np.array([m.base_color[:3] for m in materials], dtype=np.float64)
         self.metallic = np.array([m.metallic for m in materials], dtype=np.float64)
         self.roughness = np.array([m.roughness for m in materials], dtype=np.float64)

@@ -30,8 +30,8 @@ from .textures import apply_to_row, emission_at
 from ..nodes.context import N_HIT
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import (apply_rows, bent_diffuse, program_emission, program_hit,
-                             program_normal)
+from ..nodes.shading import (apply_rows, bent_diffuse, pick_closure, program_emission,
+                             program_hit, program_normal)
 
 MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
 # Numba freezes these into its cache; the cache's fingerprint covers every engine file
@@ -213,11 +213,15 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         programmed = has_program(textures, m)
         bent = False
         rx, ry, rz = nx, ny, nz
+        # the lobe choice's number; a Mix Shader picks its shader with it first
+        u_lobe = sample_1d(kind, pkey[p], spp, index[p], base + D.BSDF_LOBE)
+        ms = m                                   # the material shaded
         if programmed:
             program_hit(textures, geometry, m, prim, hit_u[j], hit_v[j], uu, vv, px, py, pz,
                         gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bits[p], depth, t_geom,
                         hit_row, regs)
-            sx, sy, sz, rx, ry, rz = program_normal(textures, m, regs, nx, ny, nz, gx, gy,
+            ms, u_lobe = pick_closure(textures, m, regs, u_lobe)
+            sx, sy, sz, rx, ry, rz = program_normal(textures, ms, regs, nx, ny, nz, gx, gy,
                                                     gz, -dx, -dy, -dz)
             bent = sx != nx or sy != ny or sz != nz or rx != nx or ry != ny or rz != nz
             nx, ny, nz = sx, sy, sz
@@ -231,11 +235,11 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             w = hit_weight(mode, prev_pdf[p], lpdf)
             _add(L, p, br * er * w, bg * eg * w, bb * eb * w, clamp_hit)
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
-        row[:] = params[m]
+        row[:] = params[ms]
         if any_textures:
-            apply_to_row(textures, m, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
+            apply_to_row(textures, ms, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
         if programmed:
-            apply_rows(textures, m, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS)
+            apply_rows(textures, ms, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
         room = depth < max_bounces
@@ -302,7 +306,6 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         # 3. continue by BSDF sampling
         if not (ad or ag or at):
             continue
-        u_lobe = sample_1d(kind, pkey[p], spp, index[p], base + D.BSDF_LOBE)
         u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.BSDF_DIR)
         ix, iy, iz, wr, wg, wb, spdf, skind, sdelta, valid = bsdf.sample(
             state, wox, woy, woz, u_lobe, u1, u2, ad, ag, at)

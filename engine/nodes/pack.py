@@ -12,6 +12,8 @@ types, so one compilation serves every scene):
   T[OUTS]   int64 (n_mat, N_OUT): the register of each program output, -1 where the
             program does not drive that parameter
   T[NREGS]  int64 (1,): the largest register count (the size of a register file)
+  T[MIX]    int64 (n_mat, 2): the two materials a material's Mix Shader picks between
+            per hit (MaterialTable.mix_children; -1: none)
 """
 from __future__ import annotations
 
@@ -28,6 +30,7 @@ DATA = 7
 PROG = 8
 OUTS = 9
 NREGS = 10
+MIX = 11
 
 
 def pack_programs(table) -> tuple:
@@ -61,7 +64,9 @@ def pack_programs(table) -> tuple:
     return (np.concatenate(ops) if ops else np.zeros((0, WIDTH), np.int32),
             np.concatenate(init) if init else np.zeros(0),
             np.concatenate(data) if data else np.zeros(0),
-            prog, outs, np.array([int(prog[:, 3].max()) if n_mat else 0], np.int64))
+            prog, outs, np.array([int(prog[:, 3].max()) if n_mat else 0], np.int64),
+            np.ascontiguousarray(getattr(table, "mix_children",
+                                         np.full((n_mat, 2), -1, np.int64)), np.int64))
 
 
 def pack_shading(table) -> tuple:

@@ -18,10 +18,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-# MaterialTable.PARAMS, then the shading normal (a Normal Map's)
-OUTPUTS = ("base_color", "metallic", "roughness", "emission", "alpha", "normal")
+# MaterialTable.PARAMS, the shading normal (a Normal Map's) and a Mix Shader's factor
+# (the probability of its second shader, Material.mix)
+OUTPUTS = ("base_color", "metallic", "roughness", "emission", "alpha", "normal", "mix")
 OUTPUT_WIDTH = {"base_color": 3, "metallic": 1, "roughness": 1, "emission": 3, "alpha": 1,
-                "normal": 3}
+                "normal": 3, "mix": 1}
 N_OUT = len(OUTPUTS)
 WIDTH = 8            # int32 per instruction: opcode, output register, six operands
 

@@ -13,9 +13,9 @@ from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
 from .context import fill
 from .interpreter import run
-from .pack import OUTS
+from .pack import MIX, OUTS
 
-OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL = range(6)
+OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_MIX = range(7)
 
 
 @kernel
@@ -163,3 +163,26 @@ def bump_shadowing(gx, gy, gz, nx, ny, nz, lx, ly, lz):
         return 0.0
     g2 = g * g
     return -g2 * g + g2 + g
+
+
+@kernel
+def pick_closure(T, m, regs, u):
+    """Cycles' Mix Shader sums its two shaders weighted 1 - Fac and Fac; DRT picks one per
+    hit with those probabilities (an unbiased estimate of the sum: the picked shader is
+    the hit's BSDF for its light sample and its next direction). Nested mixes pick in
+    turn. Returns (the material shaded, u rescaled to [0, 1) for the lobe choice)."""
+    children = T[MIX]
+    outs = T[OUTS]
+    for _ in range(32):
+        if m < 0 or m >= children.shape[0] or children[m, 0] < 0:
+            break
+        k = outs[m, OUT_MIX]
+        f = min(max(regs[k], 0.0), 1.0) if k >= 0 else 0.5
+        if u < 1.0 - f:
+            u = u / max(1.0 - f, 1e-300)
+            m = children[m, 0]
+        else:
+            u = (u - (1.0 - f)) / max(f, 1e-300)
+            m = children[m, 1]
+        u = min(max(u, 0.0), 0.9999999999999999)
+    return m, u

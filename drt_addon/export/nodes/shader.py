@@ -181,33 +181,37 @@ def _fresnel_average(ior):
 
 
 def _mix_factor(node, ctx):
-    """(constant factor, Fresnel IOR or None) of a Mix Shader's Fac."""
+    """(constant factor, Fresnel IOR or None, the per-hit Fac Value or None) of a Mix
+    Shader's Fac (constant: its value; varying: its average)."""
     sock = node.inputs[0]
     found = _link(sock)
     if found is None:
-        return float(np.clip(sock.default_value, 0.0, 1.0)), None
+        return float(np.clip(sock.default_value, 0.0, 1.0)), None, None
     src, out = found
     if src.bl_idname == "ShaderNodeFresnel":
         ior = _constant(src, "IOR", ctx, 1.5)
-        return _fresnel_average(ior), ior
+        return _fresnel_average(ior), ior, ctx.nodes.socket(sock, "float")
     if src.bl_idname == "ShaderNodeLayerWeight":
         blend = float(np.clip(_constant(src, "Blend", ctx, 0.5), 0.0, 1.0 - 1e-5))
         if out.identifier == "Fresnel":
             ior = 1.0 / max(1.0 - blend, 1e-5)
-            return _fresnel_average(ior), ior
+            return _fresnel_average(ior), ior, ctx.nodes.socket(sock, "float")
         # Facing: 1 - |cos|^b with Cycles' remapping of Blend; cosine-weighted average
         b = 2.0 * blend if blend < 0.5 else 0.5 / (1.0 - blend)
-        ctx.issue(f"the Fac of {node.name!r} is Layer Weight's Facing, which depends on the "
-                  f"view angle; DRT uses its hemispherical average")
-        return 1.0 - 2.0 / (b + 2.0), None
+        return 1.0 - 2.0 / (b + 2.0), None, ctx.nodes.socket(sock, "float")
     value = ctx.nodes.socket(sock, "float")
     folded = ctx.nodes.fold(value)
     if folded is not None:
-        return float(np.clip(folded, 0.0, 1.0)), None
-    mean = float(np.clip(ctx.nodes.mean(value), 0.0, 1.0))
-    ctx.issue(f"the Fac of {node.name!r} varies per hit ({src.bl_label!r}); DRT mixes the "
-              f"shaders by its average {mean:.3f}")
-    return mean, None
+        return float(np.clip(folded, 0.0, 1.0)), None, None
+    return float(np.clip(ctx.nodes.mean(value), 0.0, 1.0)), None, value
+
+
+def _mixed_by_average(a, b, ctx):
+    """Report per-hit Mix Shaders that a constant Mix or an Add Shader combines (DRT then
+    mixes them by their Fac's average)."""
+    if a.mix is not None or b.mix is not None:
+        ctx.issue("a Mix Shader with a per-hit Fac inside another Mix or Add Shader mixes "
+                  "by its Fac's average")
 
 
 def _plastic(a: _Closure, b: _Closure, ior, fac, ctx):
@@ -259,7 +263,7 @@ def _closure(socket, ctx, depth=0) -> _Closure:
     if kind == "ShaderNodeBsdfTransparent":
         return _transparent(node, ctx)
     if kind == "ShaderNodeMixShader":
-        fac, ior = _mix_factor(node, ctx)
+        fac, ior, varying = _mix_factor(node, ctx)
         a = _closure(node.inputs[1], ctx, depth + 1)
         b = _closure(node.inputs[2], ctx, depth + 1)
         if ior is not None:
@@ -268,12 +272,18 @@ def _closure(socket, ctx, depth=0) -> _Closure:
                 ctx.issue(f"the Fresnel-driven {node.name!r} is rendered as a Principled "
                           f"specular layer of IOR {ior:.3g}")
                 return p
-            ctx.issue(f"the Fac of {node.name!r} depends on the view angle (Fresnel); DRT "
-                      f"uses its hemispherical average {fac:.3f}")
-        return _sum(a.scaled(1.0 - fac, ctx), b.scaled(fac, ctx), ctx)
+        mixed = _sum(a.scaled(1.0 - fac, ctx), b.scaled(fac, ctx), ctx)
+        if varying is None:
+            _mixed_by_average(a, b, ctx)
+        else:
+            # per hit, if this Mix Shader is the material's own shader (or one of a
+            # chain of them): export_material makes a Material of each side
+            mixed.mix = (a, b, varying)
+        return mixed
     if kind == "ShaderNodeAddShader":
         a = _closure(node.inputs[0], ctx, depth + 1)
         b = _closure(node.inputs[1], ctx, depth + 1)
+        _mixed_by_average(a, b, ctx)
         if a.is_emission_only() or b.is_emission_only():
             emit, other = (a, b) if a.is_emission_only() else (b, a)
             if other.alpha_texture is not None:
