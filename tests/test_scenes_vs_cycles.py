@@ -1,9 +1,12 @@
 """Comparison scenes vs Cycles: each scene of sample_blends/build_samples.py's
-COMPARISON_SCENES exercises one area of the renderer (metals, glass, a glossy dielectric,
-depth of field, instancing, world light) and is rendered by DRT and by Cycles from the
-same .blend with the same light-path settings (Cycles' defaults: path tracing, full global
-illumination). 64 x 64 pixels; Cycles 1024 samples per pixel, DRT 512; one render per
-engine and scene, cached for the module.
+COMPARISON_SCENES exercises one area of the renderer (metals, a glossy dielectric, glass,
+depth of field, instancing, world light, ray visibility, a mirror's caustic, glass
+caustics) and is rendered by DRT and by Cycles from the same .blend at Blender's defaults,
+as a user would make it: Multiscatter GGX on every Principled BSDF, Cycles' default light
+paths (path tracing, full global illumination), Filter Glossy 1, both caustics switches
+on, the default clamps (`test_scene_files_hold_blenders_defaults` checks the files).
+64 x 64 pixels; Cycles 1024 samples per pixel, DRT 512; one render per engine and scene,
+cached for the module.
 
 Thresholds (per scene):
 - MEAN_TOLERANCE = 2%: relative difference of the image means, per channel;
@@ -22,13 +25,9 @@ with one plausible modelling or export error and checks that the comparison fail
 128 samples the correct scene still passes every check (measured: blocks at most 4.5%,
 MAD at most 4.4%), so the failures come from the error, not from noise.
 
-Blender's defaults: `ray_visibility`, `mirror_caustic` and `glass_caustics` keep every
-default (Multiscatter GGX, Filter Glossy 1, caustics on, clamps). The six older scenes
-(FORCED) still set single-scatter GGX and Filter Glossy 0 in their files, until DRT's
-Principled BSDF has Multiscatter GGX (issue 8); DRT models Filter Glossy and Cycles'
-clamp bounce count since, measured by the mirror and glass scenes. Remaining known
-difference: the 6-blade aperture's polygon is 30 degrees (pi / blades) off Cycles' in
-DRT; in the dof scene (no point-like highlights) that is below every threshold.
+The six scenes built first (metals to world_light) forced single-scatter GGX and Filter
+Glossy 0 until DRT had Multiscatter GGX and Filter Glossy (issue 8); they keep Blender's
+defaults now, as the three built since do.
 """
 import math
 import os
@@ -50,8 +49,6 @@ SIZE = (64, 64)
 
 SCENES = ["metals", "glossy_dielectric", "glass", "dof", "instances", "world_light",
           "ray_visibility", "mirror_caustic", "glass_caustics"]
-# the scenes built before DRT had Cycles' defaults; the others keep Blender's defaults
-FORCED = ["metals", "glossy_dielectric", "glass", "dof", "instances", "world_light"]
 
 _renders = {}
 
@@ -205,39 +202,42 @@ def test_checks_reject_plausible_errors(bpy_drt, control):
     assert not within(wrong, cycles), control
 
 
-def test_scene_files_hold_what_the_comparison_assumes(bpy_drt):
-    """The settings every comparison relies on are in the files (cheap: no rendering)."""
+LIGHT_PATH_DEFAULTS = ("max_bounces", "diffuse_bounces", "glossy_bounces",
+                       "transmission_bounces", "transparent_max_bounces",
+                       "sample_clamp_direct", "sample_clamp_indirect", "blur_glossy",
+                       "caustics_reflective", "caustics_refractive")
+DRT_DEFAULTS = ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
+                "transparent_bounces", "clamp_direct", "clamp_indirect")
+
+
+def test_scene_files_hold_blenders_defaults(bpy_drt):
+    """Every comparison scene is as a user makes it: Blender's defaults for the light
+    paths, clamps, Filter Glossy and caustics (Cycles' and DRT's settings) and Multiscatter
+    GGX on every Principled BSDF; plus what each scene is built to show (cheap: no
+    rendering)."""
     bpy = bpy_drt
     from drt_addon.export import export_scene
     for name in SCENES:
         bpy.ops.wm.open_mainfile(filepath=_path(name), load_ui=False)
         scene = bpy.context.scene
         assert (scene.render.resolution_x, scene.render.resolution_y) == SIZE, name
-        if name not in FORCED:
-            assert scene.cycles.blur_glossy == 1.0, name      # Blender's default
-            continue
-        assert scene.cycles.blur_glossy == 0.0, name          # Filter Glossy off
-        c = scene.cycles                                       # Cycles' default light paths
+        c, d = scene.cycles, scene.drt
+        for prop in LIGHT_PATH_DEFAULTS:
+            assert getattr(c, prop) == c.bl_rna.properties[prop].default, (name, prop)
+        for prop in DRT_DEFAULTS:
+            assert getattr(d, prop) == d.bl_rna.properties[prop].default, (name, prop)
+        assert c.blur_glossy == 1.0 and c.caustics_reflective and c.caustics_refractive
         assert (c.max_bounces, c.diffuse_bounces, c.glossy_bounces, c.transmission_bounces,
                 c.sample_clamp_indirect) == (12, 4, 4, 12, 10.0), name
-        d = scene.drt
-        assert (d.max_bounces, d.diffuse_bounces, d.glossy_bounces, d.transmission_bounces,
-                d.clamp_indirect) == (12, 4, 4, 12, 10.0), name
-        for mat in bpy.data.materials:
-            node = mat.node_tree.nodes.get("Principled BSDF")
-            if node is None:
-                continue
-            specular = (node.inputs["Specular IOR Level"].default_value > 0
-                        or node.inputs["Metallic"].default_value > 0
-                        or node.inputs["Transmission Weight"].default_value > 0)
-            if specular:
-                assert node.distribution == "GGX", (name, mat.name)
+        nodes = [n for m in bpy.data.materials if m.node_tree
+                 for n in m.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled"]
+        assert nodes, name
+        for node in nodes:
+            assert node.distribution == "MULTI_GGX", (name, node.id_data.name)
         lamps = [o for o in scene.objects if o.type == "LIGHT"]
         world = scene.world.node_tree.nodes["Background"]
         world_radiance = world.inputs["Strength"].default_value * max(
             world.inputs["Color"].default_value[:3])
-        if lamps:   # lamps only with a black world: DRT's paths end at a lamp
-            assert world_radiance == 0.0, name
         if name in ("glass", "world_light"):
             assert not lamps and world_radiance > 0.5, name
         if name == "dof":
