@@ -185,7 +185,8 @@ def _furnace_plastic(path, roughness):
     import bpy
     import build_samples as bs
     scene = bs.reset()
-    mat = bs._ggx(bs.principled("Plastic", (0.8, 0.8, 0.8), roughness=roughness))
+    mat = bs.principled("Plastic", (0.8, 0.8, 0.8), roughness=roughness)
+    mat.node_tree.nodes["Principled BSDF"].distribution = "GGX"
     bs.uv_sphere("Sphere", (0.0, 0.0, 0.0), 1.0, mat)
     bs.camera(scene, (0.0, -4.0, 0.0), (math.radians(90.0), 0.0, 0.0), lens=50.0)
     bs.render_defaults(scene, size=(32, 32), samples=512)
