@@ -4,13 +4,14 @@ docs/comparisons.md with the measured differences and render times.
     .venv/bin/python docs/make_comparisons.py [SCENE ...]
 
 Each scene of sample_blends/build_samples.py's COMPARISON_SCENES (and the Cornell box) is
-opened from its .blend and rendered by both engines with the file's own settings (Cycles'
-default light paths), at 128 x 128 pixels. The numbers come from the scene-linear
+opened from its .blend and rendered by both engines with the file's own settings (Blender's
+defaults), at 128 x 128 pixels. The numbers come from the scene-linear
 renders (read back from OpenEXR); the images in docs/images/compare_<scene>.png are the
 PNGs Blender saves through the scene's view transform (AgX), DRT left, Cycles right.
-A second part measures the known differences between the engines that the sample
-scenes are built to avoid (see tests/test_scenes_vs_cycles.py). Takes about 8 minutes
-on 2 cores.
+A second part measures known differences between the engines, and settings the sample
+scenes leave at their defaults (see tests/test_scenes_vs_cycles.py), with the scene
+changes and probe scenes of docs/comparison_probes.py. Takes about 10
+minutes on 2 cores.
 """
 from __future__ import annotations
 
@@ -31,9 +32,12 @@ SAMPLES = os.path.join(ROOT, "sample_blends")
 
 from PIL import Image, ImageDraw  # noqa: E402
 
+import comparison_probes as probes  # noqa: E402
+
 # (scene, resolution percentage): every scene renders at 128 x 128 pixels.
-DOC_SCENES = [("cornell_box", 50), ("metals", 200), ("glossy_dielectric", 200),
-              ("glass", 200), ("dof", 200), ("instances", 200), ("world_light", 200)]
+DOC_SCENES = [("cornell_box", 50)] + [(name, 200) for name in (
+    "metals", "glossy_dielectric", "glass", "dof", "instances", "world_light",
+    "ray_visibility", "mirror_caustic", "glass_caustics")]
 DRT_SAMPLES = 256
 CYCLES_SAMPLES = 1024
 PANEL = 256          # images are shown at least this wide (nearest-neighbour upscaling)
@@ -129,98 +133,39 @@ def scene_comparisons(bpy, names, tmp, lines, table):
 
 # --- known differences --------------------------------------------------------------------
 
-def _scene_setup(**changes):
-    def setup(scene):
-        for key, value in changes.items():
-            obj, attr = key.split("__")
-            setattr(getattr(scene, obj), attr, value)
-    return setup
-
-
-def _grey_world(level):
-    def setup(scene):
-        bg = scene.world.node_tree.nodes["Background"]
-        bg.inputs["Color"].default_value = (level, level, level, 1.0)
-        bg.inputs["Strength"].default_value = 1.0
-    return setup
-
-
-def _glass_under_lamp(scene):
-    import bpy
-    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    light = bpy.data.lights.new("Lamp", "AREA")
-    light.size = 2.0
-    light.energy = 3.0 * math.pi * 4.0        # radiance 3
-    obj = bpy.data.objects.new("Lamp", light)
-    obj.location = (0.5, -2.0, 3.0)
-    scene.collection.objects.link(obj)
-    from mathutils import Vector
-    obj.rotation_euler = (Vector((0.0, 0.3, 0.0)) - obj.location).to_track_quat(
-        "-Z", "Y").to_euler()
-
-
-def _bokeh_probe(path):
-    """A small bright emissive square 3 m away, far out of focus (focus 0.3 m, f/0.5,
-    six blades, rotation 0): its image is the aperture polygon."""
-    import bpy
-    import build_samples as bs
-    scene = bs.reset()
-    glow = bs.principled("Glow", (0.0, 0.0, 0.0), specular=0.0, emission=(1.0, 1.0, 1.0),
-                         strength=15.0)
-    s = 0.06
-    bs.quad("Glow", [(-s, 3.0, -s), (-s, 3.0, s), (s, 3.0, s), (s, 3.0, -s)], glow)
-    cam = bs.camera(scene, (0.0, 0.0, 0.0), (math.radians(90.0), 0.0, 0.0), lens=50.0)
-    cam.data.dof.use_dof = True
-    cam.data.dof.focus_distance = 0.3
-    cam.data.dof.aperture_fstop = 0.5
-    cam.data.dof.aperture_blades = 6
-    bs.render_defaults(scene, size=(48, 48), samples=4096)
-    scene.cycles.use_adaptive_sampling = False
-    bpy.ops.wm.save_as_mainfile(filepath=path)
-
-
-def _furnace_plastic(path, roughness):
-    """A Principled plastic sphere (base 0.8, default specular, single-scatter GGX) in a
-    uniform white world: DRT's and Cycles' layering of diffuse under specular."""
-    import bpy
-    import build_samples as bs
-    scene = bs.reset()
-    mat = bs._ggx(bs.principled("Plastic", (0.8, 0.8, 0.8), roughness=roughness))
-    bs.uv_sphere("Sphere", (0.0, 0.0, 0.0), 1.0, mat)
-    bs.camera(scene, (0.0, -4.0, 0.0), (math.radians(90.0), 0.0, 0.0), lens=50.0)
-    bs.render_defaults(scene, size=(32, 32), samples=512)
-    scene.cycles.use_adaptive_sampling = False
-    scene.cycles.blur_glossy = 0.0
-    bs._set_world(scene, (1.0, 1.0, 1.0), 1.0)
-    bpy.ops.wm.save_as_mainfile(filepath=path)
-
-
 def known_differences(bpy, tmp, lines):
     rows = []
 
     def blend(name):
         return os.path.join(SAMPLES, f"{name}.blend")
 
-    # 1. Cycles' Filter Glossy (default 1) against 0, Cycles alone.
+    # 1. Cycles' Filter Glossy: the scenes keep the default (1); how much 0 changes
+    # Cycles' image, and DRT against Cycles with 0 in both (DRT reads it from the file).
+    no_blur = probes.scene_setup(cycles__blur_glossy=0.0)
     for name in ("metals", "glass"):
-        off, _ = render(bpy, blend(name), "CYCLES", 512)
-        on, _ = render(bpy, blend(name), "CYCLES", 512, setup=_scene_setup(cycles__blur_glossy=1.0))
-        rel, mad, block = compare(on, off)
-        rows.append(f"| Filter Glossy 1 (Cycles' default) instead of 0, {name} | Cycles with "
-                    f"1 against Cycles with 0 | {pct(rel)} | {100 * mad:.2f}% | "
-                    f"{100 * block:.2f}% |")
-        print(rows[-1], flush=True)
+        on, _ = render(bpy, blend(name), "CYCLES", 1024)
+        off, _ = render(bpy, blend(name), "CYCLES", 1024, setup=no_blur)
+        d_off, _ = render(bpy, blend(name), "DRT", 256, setup=no_blur)
+        for case, what, a, b in (
+                (f"Filter Glossy 0 instead of the default 1, {name}",
+                 "Cycles with 0 against Cycles with 1", off, on),
+                (f"{name} with Filter Glossy 0 in both engines", "DRT against Cycles",
+                 d_off, off)):
+            rel, mad, block = compare(a, b)
+            rows.append(f"| {case} | {what} | {pct(rel)} | {100 * mad:.2f}% | "
+                        f"{100 * block:.2f}% |")
+            print(rows[-1], flush=True)
 
     # 2. Lamps hit by a path: Cycles goes on through them (a transparent bounce), DRT
     # stops. Cycles with no transparent bounces stops there too.
-    stop = _scene_setup(cycles__transparent_max_bounces=0)
+    stop = probes.scene_setup(cycles__transparent_max_bounces=0)
 
     def grey_stop(scene):
-        _grey_world(0.05)(scene)
+        probes.grey_world(0.05)(scene)
         stop(scene)
     for label, blend_name, percentage, drt_setup, cycles_setups in (
             ("metals with a grey world (0.05) behind its lamp", "metals", 100,
-             _grey_world(0.05), (_grey_world(0.05), grey_stop)),
+             probes.grey_world(0.05), (probes.grey_world(0.05), grey_stop)),
             ("cornell_box (lamp 2 cm under the ceiling), 64 x 64", "cornell_box", 25, None,
              (None, stop))):
         d, _ = render(bpy, blend(blend_name), "DRT", 256, percentage, setup=drt_setup)
@@ -234,15 +179,29 @@ def known_differences(bpy, tmp, lines):
             print(rows[-1], flush=True)
 
     # 3. Rough glass under a lamp: next-event estimation on the transmission side.
-    d, _ = render(bpy, blend("glass"), "DRT", 256, setup=_glass_under_lamp)
-    c, _ = render(bpy, blend("glass"), "CYCLES", 1024, setup=_glass_under_lamp)
+    d, _ = render(bpy, blend("glass"), "DRT", 256, setup=probes.glass_under_lamp)
+    c, _ = render(bpy, blend("glass"), "CYCLES", 1024, setup=probes.glass_under_lamp)
     rel, mad, block = compare(d, c)
     rows.append(f"| glass lit by a 2 m area lamp (black world) instead of the sky | DRT "
                 f"against Cycles | {pct(rel)} | {100 * mad:.2f}% | {100 * block:.2f}% |")
     print(rows[-1], flush=True)
 
+    # 3b. The lamp through a rough glass sphere, with and without glossy bounces.
+    probe = os.path.join(tmp, "rough_glass_probe.blend")
+    probes.rough_glass_probe(probe)
+    for label, setup in (("glossy bounces 4 (default)", None),
+                         ("glossy bounces 0", probes.scene_setup(
+                             cycles__glossy_bounces=0, drt__glossy_bounces=0))):
+        d, _ = render(bpy, probe, "DRT", 1024, setup=setup)
+        c, _ = render(bpy, probe, "CYCLES", 1024, setup=setup)
+        rel, mad, block = compare(d, c)
+        rows.append(f"| rough glass sphere (GGX, roughness 0.67) before a lamp, {label} | "
+                    f"DRT against Cycles | {pct(rel)} | {100 * mad:.2f}% | "
+                    f"{100 * block:.2f}% |")
+        print(rows[-1], flush=True)
+
     # 4. World light at the vertex after the last allowed bounce.
-    one = _scene_setup(cycles__diffuse_bounces=1, drt__diffuse_bounces=1)
+    one = probes.scene_setup(cycles__diffuse_bounces=1, drt__diffuse_bounces=1)
     d, _ = render(bpy, blend("world_light"), "DRT", 256, setup=one)
     c, _ = render(bpy, blend("world_light"), "CYCLES", 1024, setup=one)
     rel, mad, block = compare(d, c)
@@ -252,14 +211,14 @@ def known_differences(bpy, tmp, lines):
 
     # 5. The orientation of a bladed aperture.
     probe = os.path.join(tmp, "bokeh_probe.blend")
-    _bokeh_probe(probe)
+    probes.bokeh_probe(probe)
     pngs = [os.path.join(tmp, f"bokeh_{k}.png") for k in ("drt", "cyc", "drt30")]
     d, _ = render(bpy, probe, "DRT", 4096, png=pngs[0])
     c, _ = render(bpy, probe, "CYCLES", 4096, png=pngs[1])
     def turned(scene):
         scene.camera.data.dof.aperture_rotation = math.pi / 6
     d30, _ = render(bpy, probe, "DRT", 4096, setup=turned, png=pngs[2])
-    c2, _ = render(bpy, probe, "CYCLES", 4096, setup=_scene_setup(cycles__seed=1))
+    c2, _ = render(bpy, probe, "CYCLES", 4096, setup=probes.scene_setup(cycles__seed=1))
     side_by_side(pngs, ["DRT, rotation 0", "Cycles, rotation 0", "DRT, rotation 30 deg"],
                  os.path.join(IMAGES, "compare_bokeh.png"))
     for label, img in (("DRT, rotation 0", d), ("DRT, rotation 30 degrees", d30),
@@ -273,7 +232,7 @@ def known_differences(bpy, tmp, lines):
     furnace = []
     for roughness in (0.3, 0.7, 1.0):
         path = os.path.join(tmp, f"furnace_{roughness}.blend")
-        _furnace_plastic(path, roughness)
+        probes.furnace_plastic(path, roughness)
         d, _ = render(bpy, path, "DRT", 512)
         c, _ = render(bpy, path, "CYCLES", 1024)
         sphere = np.abs(c - 1.0).max(axis=2) > 1e-3
@@ -282,14 +241,17 @@ def known_differences(bpy, tmp, lines):
         print(furnace[-1], flush=True)
 
     lines += [
-        "## Known differences (measured here, kept out of the sample scenes)", "",
+        "## Known differences and settings left at their defaults", "",
         "Each row changes one thing in a sample scene (or renders a probe scene) and "
         "compares. Columns as above: mean difference per channel, MAD, largest block.", "",
         "| case | compared | mean difference (R, G, B) | MAD | largest block |",
         "|---|---|---|---|---|", *rows, "",
-        "1. **Filter Glossy.** Cycles' default (1) raises the roughness of glossy and glass "
-        "surfaces met after a rough bounce, which darkens glossy interreflection and "
-        "caustics. DRT has no such filter, so the sample scenes set it to 0.",
+        "1. **Filter Glossy** (modelled). Cycles' default (1) raises the roughness of "
+        "glossy and glass surfaces met after an unlikely (diffuse or rough) bounce, which "
+        "darkens glossy interreflection and blurs caustics; the first row of each pair "
+        "shows how much. DRT reads the setting from the file and applies Cycles' rule, so "
+        "the sample scenes keep the default (they set it to 0 until DRT modelled it); the "
+        "second row compares the engines with it off in both.",
         "2. **Paths through lamps** (fixed). When a BSDF-sampled ray hits a lamp, Cycles adds "
         "the lamp's emission and continues the path beyond it; DRT used to end the path "
         "there, which made its Cornell box about 0.8% darker (the lit ceiling 2 cm behind "
@@ -298,9 +260,18 @@ def known_differences(bpy, tmp, lines):
         "3. **Lamps seen through rough glass** (partly fixed). Next-event estimation now "
         "samples lamps on the far side of surfaces whose material transmits, as Cycles does "
         "for closures with transmission; before, light refracted from a lamp through rough "
-        "glass was partly lost (the slab was about 20% too dark). The image mean now agrees "
-        "within 0.4%, but the slab's block still differs by about 10%: not yet explained "
-        "(caustic noise at these sample counts, or a remaining difference).",
+        "glass was partly lost (the slab was about 20% too dark). A difference remains "
+        "where glass is rough, DRT darker: the glass scene under a lamp, and a probe of the "
+        "lamp's light alone through a rough glass sphere (clamps and Filter Glossy off, "
+        "both engines at 1024 samples). It grows with the roughness and appears only once "
+        "glossy bounces, reflections inside the glass, are allowed (the two probe rows). "
+        "DRT's light-only, BSDF-only and MIS estimates of the probe agree with each "
+        "other, its BSDF values equal Cycles' formula (up to Cycles' convention for the "
+        "radiance scaling across the interface, which cancels along a path), and Cycles "
+        "gives the same with the lamp's MIS off; an independent estimate of the paths with "
+        "one reflection inside the sphere is far below the light Cycles adds with them. Not "
+        "yet explained. The glass_caustics scene carries it: after the floor's diffuse "
+        "bounce Filter Glossy widens its glass to a GGX alpha of at least 0.41.",
         "4. **World light after the last bounce** (fixed). The uniform world is now sampled "
         "as a light at every vertex, as in Cycles, so world light no longer depends on the "
         "bounce budget (before: -3.2% with one diffuse bounce).",
@@ -333,6 +304,7 @@ def main(argv=None):
     import bpy
 
     import drt_addon
+    import test_scenes_vs_cycles as t
     drt_addon.register()
     os.makedirs(IMAGES, exist_ok=True)
     t0 = time.perf_counter()
@@ -349,10 +321,11 @@ def main(argv=None):
         f"{os.cpu_count()} cores, Python {platform.python_version()}, Blender "
         f"{bpy.app.version_string} (bpy module, Cycles on the CPU).", "",
         "Each sample scene is opened from `sample_blends/` and rendered by both engines "
-        "with the file's settings: Cycles' default light paths (path tracing, 12 bounces, "
-        "4 diffuse, 4 glossy, 12 transmission, indirect clamp 10), single-scatter GGX for "
-        "specular materials and Cycles' Filter Glossy off (see the known differences "
-        "below). The numbers come from the scene-linear renders (OpenEXR); the images are "
+        "with the file's settings, Blender's defaults as a user makes them: Cycles' default "
+        "light paths (path tracing, 12 bounces, 4 diffuse, 4 glossy, 12 transmission, "
+        "indirect clamp 10), Multiscatter GGX on every Principled BSDF, Filter Glossy 1 and "
+        "both Caustics switches on. The numbers come from the scene-linear renders "
+        "(OpenEXR); the images are "
         "the PNGs Blender saves through the scene's view transform (AgX), DRT left and "
         f"Cycles right, shown at {PANEL} pixels. DRT renders {DRT_SAMPLES} samples per "
         f"pixel, Cycles {CYCLES_SAMPLES}; times are wall-clock seconds on the 2 cores, "
@@ -362,7 +335,13 @@ def main(argv=None):
         "renders' noise); the largest difference of the 8 x 8 block means (each block 1/64 "
         "of the image, relative to its mean plus 10% of the image mean). "
         "`tests/test_scenes_vs_cycles.py` checks the same scenes at 64 x 64 pixels "
-        "(DRT 512, Cycles 1024 samples) against 2%, 5% and 5%.", "",
+        f"(DRT {t.DRT_SAMPLES}, Cycles {t.CYCLES_SAMPLES} samples) against "
+        f"{100 * t.MEAN_TOLERANCE:.0f}%, {100 * t.MAD_TOLERANCE:.0f}% and "
+        f"{100 * t.BLOCK_TOLERANCE:.0f}%, and against issue 8's limits where the noise at "
+        f"those sample counts allows (means within {100 * t.ISSUE_MEAN_TOLERANCE:.0f}%: "
+        f"{', '.join(t.ISSUE_MEAN_SCENES)}; every block mean within "
+        f"{100 * t.ISSUE_BLOCK_TOLERANCE:.0f}% of the image mean: "
+        f"{', '.join(t.ISSUE_BLOCK_SCENES)}; its docstring gives the measurements).", "",
         "| scene | size | DRT s | Cycles s | mean difference (R, G, B) | MAD | "
         "largest block |",
         "|---|---|---|---|---|---|---|", *table, "",

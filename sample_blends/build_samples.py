@@ -373,28 +373,19 @@ SCENES.update(MOTION_SCENES)
 
 # --- Comparison scenes: one area of the renderer each, against Cycles ------------------
 #
-# 64 x 64 pixels, Principled BSDF only, Cycles' default light paths (full global
-# illumination), compared in tests/test_scenes_vs_cycles.py and docs/comparisons.md.
-# Two Cycles settings are changed so that both engines compute the same thing:
-# - specular materials use single-scattering GGX (`distribution = 'GGX'`), as when these
-#   comparisons were first measured; the Principled default, Multiscatter GGX, is
-#   compared with Cycles in tests/test_multiscatter_vs_cycles.py;
-# - Filter Glossy is 0 (`cycles.blur_glossy`, default 1): Cycles' default blurs glossy
-#   surfaces seen after a diffuse or rough bounce, a bias DRT does not have (measured:
-#   with the default, Cycles renders metals 1.4-2.7% and glass 4.6-5.9% darker).
-# Lamps are large and dim (radiance 3): no path contribution reaches Cycles' default
-# indirect clamp (10). Scenes with lamps have a black world and nothing behind the lamp,
-# and the glass is lit by the sky alone, which keeps two known differences out of these
-# images (tests/test_scenes_vs_cycles.py lists them).
+# 64 x 64 pixels, Principled BSDF only, compared in tests/test_scenes_vs_cycles.py and
+# docs/comparisons.md. Every setting is Blender's default, as a user would have it:
+# Multiscatter GGX on the Principled BSDFs, the default light paths (12 bounces: 4
+# diffuse, 4 glossy, 12 transmission; full global illumination) and clamps (direct off,
+# indirect 10) in both Cycles' and DRT's settings, and Cycles' Filter Glossy 1 and both
+# Caustics switches on, which DRT reads from the Cycles settings. Only the sampling is
+# set: a fixed sample count (Cycles 1024, DRT 512), no adaptive sampling, no denoising.
+# The lamps of metals, glossy_dielectric, dof and instances are large and dim
+# (radiance 3), so the clamp hardly acts there; mirror_caustic's small bright lamp
+# tests it.
 
 COMPARISON_SIZE = (64, 64)
 STRIPE_COLORS = [(0.8, 0.15, 0.1), (0.85, 0.85, 0.85), (0.1, 0.3, 0.8), (0.15, 0.6, 0.15)]
-
-
-def _ggx(mat):
-    """Single-scattering GGX for a Principled material (Cycles' default is multiscatter)."""
-    mat.node_tree.nodes["Principled BSDF"].distribution = "GGX"
-    return mat
 
 
 def uv_sphere(name, center, radius, material, segments=48, rings=24):
@@ -478,23 +469,24 @@ def _set_world(scene, color, strength=1.0):
 
 
 def _comparison_defaults(scene):
+    """64 x 64 pixels, DRT 512 and Cycles 1024 samples without adaptive sampling; every
+    other setting stays Blender's default (Filter Glossy 1, caustics on, clamps)."""
     render_defaults(scene, size=COMPARISON_SIZE, samples=512)
     scene.cycles.samples = 1024
     scene.cycles.use_adaptive_sampling = False
-    scene.cycles.blur_glossy = 0.0
 
 
 def metals():
     """Three metal spheres (gold, copper, silver at roughness 0.1, 0.3, 0.6; Principled
-    metallic 1, single-scatter GGX) on a grey floor before a striped wall that they
-    reflect, under a 2 m square area light."""
+    metallic 1) on a grey floor before a striped wall that they reflect, under a 2 m
+    square area light."""
     scene = reset()
     floor = principled("Floor", (0.5, 0.5, 0.5), specular=0.0)
     quad("Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)], floor)
     _stripes("Wall", -4.0, 4.0, 0.0, 4.0, 2.0, STRIPE_COLORS, 12)
     for x, rough, color in ((-1.15, 0.1, (1.0, 0.78, 0.34)), (0.0, 0.3, (0.95, 0.64, 0.54)),
                             (1.15, 0.6, (0.95, 0.95, 0.95))):
-        mat = _ggx(principled(f"Metal{rough}", color, roughness=rough, metallic=1.0))
+        mat = principled(f"Metal{rough}", color, roughness=rough, metallic=1.0)
         uv_sphere(f"Sphere{rough}", (x, 0.0, 0.5), 0.5, mat)
     _area_light(scene, (0.0, -2.5, 3.0), (0.0, 0.5, 0.0), 2.0, 3.0)
     camera(scene, (0.0, -4.2, 1.25), (math.radians(82.0), 0.0, 0.0), lens=50.0)
@@ -504,16 +496,16 @@ def metals():
 
 def glossy_dielectric():
     """Plastic: Principled spheres with the default specular layer (IOR 1.5, Specular
-    IOR Level 0.5, single-scatter GGX) over red, green and blue diffuse base colours at
-    roughness 0.15, 0.35 and 0.7, on a grey plastic floor (roughness 0.25) before a
-    striped wall, under a 2 m square area light."""
+    IOR Level 0.5) over red, green and blue diffuse base colours at roughness 0.15, 0.35
+    and 0.7, on a grey plastic floor (roughness 0.25) before a striped wall, under a 2 m
+    square area light."""
     scene = reset()
-    floor = _ggx(principled("Floor", (0.5, 0.5, 0.5), roughness=0.25))
+    floor = principled("Floor", (0.5, 0.5, 0.5), roughness=0.25)
     quad("Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)], floor)
     _stripes("Wall", -4.0, 4.0, 0.0, 4.0, 2.0, STRIPE_COLORS, 12)
     for x, rough, color in ((-1.15, 0.15, (0.7, 0.08, 0.05)), (0.0, 0.35, (0.1, 0.55, 0.12)),
                             (1.15, 0.7, (0.08, 0.15, 0.7))):
-        mat = _ggx(principled(f"Plastic{rough}", color, roughness=rough))
+        mat = principled(f"Plastic{rough}", color, roughness=rough)
         uv_sphere(f"Sphere{rough}", (x, 0.0, 0.5), 0.5, mat)
     _area_light(scene, (0.0, -2.5, 3.0), (0.0, 0.5, 0.0), 2.0, 3.0)
     camera(scene, (0.0, -4.2, 1.25), (math.radians(82.0), 0.0, 0.0), lens=50.0)
@@ -522,15 +514,15 @@ def glossy_dielectric():
 
 
 def glass():
-    """Glass (Principled, transmission 1, IOR 1.45, single-scatter GGX) over a checker
-    floor before a striped wall: a smooth sphere (roughness 0) with a pale blue base
-    colour (Cycles tints each crossing by its square root) and a clear rough slab
-    (roughness 0.3). Lit by a uniform sky (world colour x strength) alone: no lamps."""
+    """Glass (Principled, transmission 1, IOR 1.45) over a checker floor before a
+    striped wall: a smooth sphere (roughness 0) with a pale blue base colour (Cycles
+    tints each crossing by its square root) and a clear rough slab (roughness 0.3). Lit
+    by a uniform sky (world colour x strength) alone: no lamps."""
     scene = reset()
     _checker("Floor", -2.0, 2.0, -2.0, 2.0, 0.0, [(0.8, 0.8, 0.8), (0.15, 0.15, 0.15)], 8)
     _stripes("Wall", -4.0, 4.0, 0.0, 4.0, 2.0, STRIPE_COLORS, 12)
-    smooth = _ggx(principled("GlassSmooth", (0.7, 0.85, 1.0), roughness=0.0))
-    rough = _ggx(principled("GlassRough", (1.0, 1.0, 1.0), roughness=0.3))
+    smooth = principled("GlassSmooth", (0.7, 0.85, 1.0), roughness=0.0)
+    rough = principled("GlassRough", (1.0, 1.0, 1.0), roughness=0.3)
     for mat in (smooth, rough):
         bsdf = mat.node_tree.nodes["Principled BSDF"]
         bsdf.inputs["Transmission Weight"].default_value = 1.0
@@ -551,11 +543,11 @@ def dof():
     scene = reset()
     _checker("Floor", -2.0, 2.0, -0.5, 4.0, 0.0, [(0.85, 0.85, 0.85), (0.05, 0.05, 0.05)], 16)
     _stripes("Wall", -2.5, 2.5, 0.0, 2.5, 4.0, STRIPE_COLORS, 24)
-    near = _ggx(principled("Near", (0.75, 0.12, 0.08), roughness=0.35))
+    near = principled("Near", (0.75, 0.12, 0.08), roughness=0.35)
     uv_sphere("Near", (-0.22, 0.2, 0.12), 0.12, near)
     mid = principled("Mid", (0.85, 0.85, 0.8), roughness=0.5, specular=0.0)
     cuboid("Mid", (-0.1, 0.6, 0.0), (0.15, 0.85, 0.35), mid, math.radians(30))
-    far = _ggx(principled("Far", (0.1, 0.3, 0.8), roughness=0.35))
+    far = principled("Far", (0.1, 0.3, 0.8), roughness=0.35)
     uv_sphere("Far", (0.55, 1.6, 0.25), 0.25, far)
     _area_light(scene, (0.0, -1.0, 2.2), (0.0, 1.5, 0.0), 1.5, 3.0)
     cam = camera(scene, (0.0, -0.5, 0.45), (math.radians(82.0), 0.0, 0.0), lens=50.0)
@@ -577,7 +569,7 @@ def instances():
     floor = principled("Floor", (0.5, 0.5, 0.5), specular=0.0)
     quad("Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)], floor)
     tile = bpy.data.collections.new("Tile")
-    block = _ggx(principled("Block", (0.7, 0.25, 0.1), roughness=0.4))
+    block = principled("Block", (0.7, 0.25, 0.1), roughness=0.4)
     ball = principled("Ball", (0.2, 0.5, 0.8), specular=0.0)
     for obj in (cuboid("TileBlock", (-0.12, -0.08, 0.0), (0.12, 0.08, 0.16), block),
                 uv_sphere("TileBall", (0.06, 0.0, 0.24), 0.08, ball, 24, 12)):
@@ -628,9 +620,7 @@ def ray_visibility():
     sphere casts no shadow, the block is hidden from the camera (its shadow stays) and
     the cylinder is invisible to diffuse rays (no light bounces off it)."""
     scene = reset()
-    render_defaults(scene, size=COMPARISON_SIZE, samples=512)
-    scene.cycles.samples = 1024
-    scene.cycles.use_adaptive_sampling = False
+    _comparison_defaults(scene)
     _set_world(scene, (0.02, 0.02, 0.02))
     floor = principled("Floor", (0.6, 0.6, 0.6), specular=0.0)
     quad("Floor", [(-5, -5, 0), (5, -5, 0), (5, 5, 0), (-5, 5, 0)], floor)
@@ -668,20 +658,12 @@ def ray_visibility():
     return scene
 
 
-def _defaults(scene):
-    """Blender's defaults (Filter Glossy 1, caustics on, clamps), DRT 512 and Cycles
-    1024 samples without adaptive sampling."""
-    render_defaults(scene, size=COMPARISON_SIZE, samples=512)
-    scene.cycles.samples = 1024
-    scene.cycles.use_adaptive_sampling = False
-
-
 def mirror_caustic():
     """Blender's defaults: a small area lamp lights a tilted metal plate (roughness 0.1,
     Multiscatter GGX) that throws its reflection onto a diffuse floor and wall (a
     reflective caustic, which Filter Glossy blurs); the camera sees the plate too."""
     scene = reset()
-    _defaults(scene)
+    _comparison_defaults(scene)
     grey = principled("Grey", (0.7, 0.7, 0.7), specular=0.0)
     quad("Floor", [(-3, -3, 0), (3, -3, 0), (3, 3, 0), (-3, 3, 0)], grey)
     quad("Wall", [(-3, 1.5, 0), (3, 1.5, 0), (3, 1.5, 3), (-3, 1.5, 3)], grey)
@@ -703,7 +685,7 @@ def glass_caustics():
     1.45, on a checker floor under a 2 m area lamp, black world: the caustics under the
     spheres come from lamp light through glass."""
     scene = reset()
-    _defaults(scene)
+    _comparison_defaults(scene)
     _checker("Floor", -4, 4, -4, 4, 0.0, [(0.8, 0.8, 0.8), (0.2, 0.2, 0.2)], 8)
     for x, rough in ((-0.7, 0.0), (0.7, 0.25)):
         mat = principled(f"Glass{rough}", (1.0, 1.0, 1.0), roughness=rough)

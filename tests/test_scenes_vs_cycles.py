@@ -1,34 +1,63 @@
 """Comparison scenes vs Cycles: each scene of sample_blends/build_samples.py's
-COMPARISON_SCENES exercises one area of the renderer (metals, glass, a glossy dielectric,
-depth of field, instancing, world light) and is rendered by DRT and by Cycles from the
-same .blend with the same light-path settings (Cycles' defaults: path tracing, full global
-illumination). 64 x 64 pixels; Cycles 1024 samples per pixel, DRT 512; one render per
-engine and scene, cached for the module.
+COMPARISON_SCENES exercises one area of the renderer (metals, a glossy dielectric, glass,
+depth of field, instancing, world light, ray visibility, a mirror's caustic, glass
+caustics) and is rendered by DRT and by Cycles from the same .blend at Blender's defaults,
+as a user would make it: Multiscatter GGX on every Principled BSDF, Cycles' default light
+paths (path tracing, full global illumination), Filter Glossy 1, both caustics switches
+on, the default clamps (`test_scene_files_hold_blenders_defaults` checks the files).
+64 x 64 pixels; Cycles 1024 samples per pixel, DRT 512; one render per engine and scene,
+cached for the module.
 
-Thresholds (per scene):
+Thresholds, every scene (`within`, also the controls' check):
 - MEAN_TOLERANCE = 2%: relative difference of the image means, per channel;
 - MAD_TOLERANCE = 5%: per-pixel mean absolute difference over Cycles' image mean. It
-  contains both renders' noise: measured 0.3% (world light) to 2.5% (metals) for scenes
-  whose means agree within 0.5%;
+  contains both renders' noise: measured 0.3% (world light) to 2.2% (glass);
 - BLOCK_TOLERANCE = 5%: the mean (over channels) of every 8 x 8 pixel block differs from
   Cycles' by at most 5% of that block's Cycles mean plus 10% of the image mean (the
   floor keeps dark blocks from being judged on noise alone). The two whole-image checks
   dilute an error confined to part of the image: rendering the plastic spheres without
   their specular layer moves the image mean by under 2% and the MAD by under 3%, but
-  moves blocks by 8%. Measured on matching scenes: at most 1.6%.
+  moves blocks by 7%.
+
+Issue 8's limits ("Done when"), where the noise at these sample counts lets a test hold
+them: means within ISSUE_MEAN_TOLERANCE = 1% per channel (ISSUE_MEAN_SCENES) and every
+8 x 8 block mean within ISSUE_BLOCK_TOLERANCE = 3% of the image mean (`issue_block`,
+ISSUE_BLOCK_SCENES). Measured with 4 DRT seeds x 4 Cycles seeds (16 pairs) at the test's
+sample counts: metals' worst block 2.8% (median 1.6%; the test's seed 2.0%), glass 1.5%,
+dof 1.3%; glossy_dielectric, instances and world_light (2 pairs) at most 0.6%; the means
+of all six within 0.1%. Not held, with the reason measured:
+- ray_visibility's blocks: DRT's noise, larger than half Cycles' samples explain (its
+  per-pixel spread over seeds is 1.9 times Cycles', up to 6 times in blocks near the
+  spot-lit sphere, against 1.4): the 16 pairs give issue 8's block up to 5.4% (median
+  3.2%) and this module's block up to 7.1% (the test's seed: 1.1% and 1.3%). Averaged
+  over the 4 seeds of each engine the worst block still differs by 2.6% (near the
+  sphere that casts no shadow; not resolved). Its mean is held: within 0.3% in all 16.
+- mirror_caustic: the lamp's small bright reflection in the plate is noise in both
+  engines: Cycles against itself with another seed differs by 1.2% in the mean and by
+  39% of the image mean in that block.
+- glass_caustics: DRT is darker than Cycles, not noisier: mean -1.04% over 4 seeds each
+  (Cycles against itself: 0.08%), blocks at the spheres and their caustics up to 7.3% of
+  the image mean; the test's seed passes the 5% block check (4.7%), three other DRT seeds
+  do not (7.4% to 7.7%). With both engines' indirect clamp off the mean difference is
+  -0.59%: the clamp cuts more of DRT's caustic samples. Most of the rest is the
+  difference of rough glass under a lamp (docs/comparisons.md, known difference 3):
+  after the floor's diffuse bounce Filter Glossy widens the glass to GGX alpha >= 0.41.
+  Caustics off in both (`test_caustics_switched_off_in_the_file_match_cycles`): mean
+  0.13% (held to 1%), issue 8's block 2.5% to 3.0% over 4 pairs (not held).
 
 `test_checks_reject_plausible_errors` renders each scene once more with DRT (128 samples)
 with one plausible modelling or export error and checks that the comparison fails; at
-128 samples the correct scene still passes every check (measured: blocks at most 4.5%,
-MAD at most 4.4%), so the failures come from the error, not from noise.
+128 samples the correct scene still passes every check of `within` (measured: blocks at
+most 3.4%, MAD at most 4.6%), so the failures come from the error, not from noise, except
+glass_caustics, whose blocks fail at 128 samples (6.6%) from the difference above: its
+control fails on the mean (4.0%; the correct scene: 0.96%). Among the controls, the
+settings the six older scenes used to force: DRT with single-scatter GGX on the metals
+(issue 8's block 38%, this module's 17%) or with Filter Glossy off on the metals (10%)
+and on the glass (22%).
 
-Blender's defaults: `ray_visibility`, `mirror_caustic` and `glass_caustics` keep every
-default (Multiscatter GGX, Filter Glossy 1, caustics on, clamps). The six older scenes
-(FORCED) still set single-scatter GGX and Filter Glossy 0 in their files, until DRT's
-Principled BSDF has Multiscatter GGX (issue 8); DRT models Filter Glossy and Cycles'
-clamp bounce count since, measured by the mirror and glass scenes. Remaining known
-difference: the 6-blade aperture's polygon is 30 degrees (pi / blades) off Cycles' in
-DRT; in the dof scene (no point-like highlights) that is below every threshold.
+The six scenes built first (metals to world_light) forced single-scatter GGX and Filter
+Glossy 0 until DRT had Multiscatter GGX and Filter Glossy (issue 8); they keep Blender's
+defaults now, as the three built since do.
 """
 import math
 import os
@@ -50,8 +79,15 @@ SIZE = (64, 64)
 
 SCENES = ["metals", "glossy_dielectric", "glass", "dof", "instances", "world_light",
           "ray_visibility", "mirror_caustic", "glass_caustics"]
-# the scenes built before DRT had Cycles' defaults; the others keep Blender's defaults
-FORCED = ["metals", "glossy_dielectric", "glass", "dof", "instances", "world_light"]
+# Issue 8's limits, where the noise at these sample counts lets a test hold them (the
+# module docstring gives the measurements): image means within 1% per channel, and every
+# 8 x 8 block mean within 3% of the image mean (`issue_block`).
+ISSUE_MEAN_TOLERANCE = 0.01
+ISSUE_BLOCK_TOLERANCE = 0.03
+ISSUE_MEAN_SCENES = ["metals", "glossy_dielectric", "glass", "dof", "instances",
+                     "world_light", "ray_visibility"]
+ISSUE_BLOCK_SCENES = ["metals", "glossy_dielectric", "glass", "dof", "instances",
+                      "world_light"]
 
 _renders = {}
 
@@ -69,19 +105,27 @@ def _render(bpy, name, engine, samples=None, setup=None, tag=""):
     return _renders[key]
 
 
+def _blocks(img):
+    """The means (over channels) of the BLOCK x BLOCK pixel blocks."""
+    h, w, _ = img.shape
+    return img.mean(axis=2).reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK).mean(axis=(1, 3))
+
+
 def compare(drt, cycles):
     """(relative difference of the means per channel (3,), MAD over Cycles' mean, largest
     block difference as defined in the module docstring)."""
     m_drt, m_cyc = drt.mean(axis=(0, 1)), cycles.mean(axis=(0, 1))
     rel = np.abs(m_drt - m_cyc) / m_cyc
     mad = float(np.abs(drt - cycles).mean() / cycles.mean())
-    h, w, _ = cycles.shape
-
-    def blocks(img):
-        return img.mean(axis=2).reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK).mean(axis=(1, 3))
-    b_drt, b_cyc = blocks(drt), blocks(cycles)
+    b_drt, b_cyc = _blocks(drt), _blocks(cycles)
     block = float((np.abs(b_drt - b_cyc) / (b_cyc + BLOCK_FLOOR * cycles.mean())).max())
     return rel, mad, block
+
+
+def issue_block(drt, cycles):
+    """Issue 8's block measure: the largest |difference of the block means| over Cycles'
+    image mean."""
+    return float(np.abs(_blocks(drt) - _blocks(cycles)).max() / cycles.mean())
 
 
 def within(drt, cycles):
@@ -94,7 +138,8 @@ def _report(label, drt, cycles):
     rel, mad, block = compare(drt, cycles)
     print(f"{label}: DRT mean {np.round(drt.mean(axis=(0, 1)), 5)}, Cycles mean "
           f"{np.round(cycles.mean(axis=(0, 1)), 5)}, mean difference "
-          f"{100 * rel.max():.2f}%, MAD {100 * mad:.2f}%, largest block {100 * block:.2f}%")
+          f"{100 * rel.max():.2f}%, MAD {100 * mad:.2f}%, largest block {100 * block:.2f}%, "
+          f"issue 8's block {100 * issue_block(drt, cycles):.2f}%")
     return rel, mad, block
 
 
@@ -110,6 +155,10 @@ def test_scene_matches_cycles(bpy_drt, name):
     assert (rel <= MEAN_TOLERANCE).all(), (name, rel)
     assert mad <= MAD_TOLERANCE, (name, mad)
     assert block <= BLOCK_TOLERANCE, (name, block)
+    if name in ISSUE_MEAN_SCENES:
+        assert (rel <= ISSUE_MEAN_TOLERANCE).all(), (name, rel)
+    if name in ISSUE_BLOCK_SCENES:
+        assert issue_block(drt, cycles) <= ISSUE_BLOCK_TOLERANCE, name
 
 
 def _bsdf(material):
@@ -164,6 +213,15 @@ def _no_filter_glossy(scene):
     scene.cycles.blur_glossy = 0.0
 
 
+def _single_scatter(names):
+    """Single-scattering GGX where the file has Multiscatter GGX (the distribution not
+    exported)."""
+    def setup(scene):
+        for m in names:
+            _bsdf(m).distribution = "GGX"
+    return setup
+
+
 def _direct_clamped(scene):
     """Direct light clamped at 10 (the lamp seen in the plate from the first surface
     counted as indirect light was this error)."""
@@ -182,17 +240,21 @@ def _world_strength_ignored(scene):
 # samples (largest block difference; the other checks in brackets):
 CONTROLS = {
     "metals-alpha": ("metals", _roughness_as_alpha(["Metal0.1", "Metal0.3", "Metal0.6"])),
-    # blocks 22%, MAD 14%, mean 3.4%
-    "glass-tint": ("glass", _full_tint_per_crossing),               # blocks 13%, mean 4.9%
-    "glossy_dielectric-no-specular": ("glossy_dielectric", _no_specular_layer),  # 8%
-    "dof-aperture": ("dof", _half_aperture),                         # blocks 15%, MAD 6.5%
+    # blocks 16%, MAD 13%, mean 3.2%
+    "metals-single-scatter": ("metals", _single_scatter(["Metal0.1", "Metal0.3", "Metal0.6"])),
+    # blocks 17%, mean 3.1%
+    "metals-no-filter-glossy": ("metals", _no_filter_glossy),       # blocks 10%, mean 2.9%
+    "glass-no-filter-glossy": ("glass", _no_filter_glossy),         # blocks 22%, mean 6.3%
+    "glass-tint": ("glass", _full_tint_per_crossing),               # blocks 13%, mean 4.4%
+    "glossy_dielectric-no-specular": ("glossy_dielectric", _no_specular_layer),  # 7%
+    "dof-aperture": ("dof", _half_aperture),                         # blocks 12%, MAD 6.4%
     "instances-array": ("instances", _array_not_evaluated),          # blocks 25%
-    "instances-scale": ("instances", _instance_scale_ignored),       # blocks 8%
+    "instances-scale": ("instances", _instance_scale_ignored),       # blocks 8.3%
     "world_light-strength": ("world_light", _world_strength_ignored),  # all about 33%
-    "ray_visibility-ignored": ("ray_visibility", _ray_visibility_ignored),
-    "mirror_caustic-no-filter-glossy": ("mirror_caustic", _no_filter_glossy),
-    "mirror_caustic-direct-clamped": ("mirror_caustic", _direct_clamped),
-    "glass_caustics-no-caustics": ("glass_caustics", _no_refractive_caustics),
+    "ray_visibility-ignored": ("ray_visibility", _ray_visibility_ignored),  # mean 104%
+    "mirror_caustic-no-filter-glossy": ("mirror_caustic", _no_filter_glossy),  # blocks 5.3%
+    "mirror_caustic-direct-clamped": ("mirror_caustic", _direct_clamped),      # mean 40%
+    "glass_caustics-no-caustics": ("glass_caustics", _no_refractive_caustics),  # mean 4.0%
 }
 
 
@@ -205,39 +267,42 @@ def test_checks_reject_plausible_errors(bpy_drt, control):
     assert not within(wrong, cycles), control
 
 
-def test_scene_files_hold_what_the_comparison_assumes(bpy_drt):
-    """The settings every comparison relies on are in the files (cheap: no rendering)."""
+LIGHT_PATH_DEFAULTS = ("max_bounces", "diffuse_bounces", "glossy_bounces",
+                       "transmission_bounces", "transparent_max_bounces",
+                       "sample_clamp_direct", "sample_clamp_indirect", "blur_glossy",
+                       "caustics_reflective", "caustics_refractive")
+DRT_DEFAULTS = ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
+                "transparent_bounces", "clamp_direct", "clamp_indirect")
+
+
+def test_scene_files_hold_blenders_defaults(bpy_drt):
+    """Every comparison scene is as a user makes it: Blender's defaults for the light
+    paths, clamps, Filter Glossy and caustics (Cycles' and DRT's settings) and Multiscatter
+    GGX on every Principled BSDF; plus what each scene is built to show (cheap: no
+    rendering)."""
     bpy = bpy_drt
     from drt_addon.export import export_scene
     for name in SCENES:
         bpy.ops.wm.open_mainfile(filepath=_path(name), load_ui=False)
         scene = bpy.context.scene
         assert (scene.render.resolution_x, scene.render.resolution_y) == SIZE, name
-        if name not in FORCED:
-            assert scene.cycles.blur_glossy == 1.0, name      # Blender's default
-            continue
-        assert scene.cycles.blur_glossy == 0.0, name          # Filter Glossy off
-        c = scene.cycles                                       # Cycles' default light paths
+        c, d = scene.cycles, scene.drt
+        for prop in LIGHT_PATH_DEFAULTS:
+            assert getattr(c, prop) == c.bl_rna.properties[prop].default, (name, prop)
+        for prop in DRT_DEFAULTS:
+            assert getattr(d, prop) == d.bl_rna.properties[prop].default, (name, prop)
+        assert c.blur_glossy == 1.0 and c.caustics_reflective and c.caustics_refractive
         assert (c.max_bounces, c.diffuse_bounces, c.glossy_bounces, c.transmission_bounces,
                 c.sample_clamp_indirect) == (12, 4, 4, 12, 10.0), name
-        d = scene.drt
-        assert (d.max_bounces, d.diffuse_bounces, d.glossy_bounces, d.transmission_bounces,
-                d.clamp_indirect) == (12, 4, 4, 12, 10.0), name
-        for mat in bpy.data.materials:
-            node = mat.node_tree.nodes.get("Principled BSDF")
-            if node is None:
-                continue
-            specular = (node.inputs["Specular IOR Level"].default_value > 0
-                        or node.inputs["Metallic"].default_value > 0
-                        or node.inputs["Transmission Weight"].default_value > 0)
-            if specular:
-                assert node.distribution == "GGX", (name, mat.name)
+        nodes = [n for m in bpy.data.materials if m.node_tree
+                 for n in m.node_tree.nodes if n.bl_idname == "ShaderNodeBsdfPrincipled"]
+        assert nodes, name
+        for node in nodes:
+            assert node.distribution == "MULTI_GGX", (name, node.id_data.name)
         lamps = [o for o in scene.objects if o.type == "LIGHT"]
         world = scene.world.node_tree.nodes["Background"]
         world_radiance = world.inputs["Strength"].default_value * max(
             world.inputs["Color"].default_value[:3])
-        if lamps:   # lamps only with a black world: DRT's paths end at a lamp
-            assert world_radiance == 0.0, name
         if name in ("glass", "world_light"):
             assert not lamps and world_radiance > 0.5, name
         if name == "dof":
@@ -263,7 +328,7 @@ def test_caustics_switched_off_in_the_file_match_cycles(bpy_drt):
     cycles = _render(bpy_drt, "glass_caustics", "CYCLES", setup=_caustics_off, tag="off")
     drt = _render(bpy_drt, "glass_caustics", "DRT", setup=_caustics_off, tag="off")
     rel, mad, block = _report("glass_caustics, caustics off in both", drt, cycles)
-    assert (rel <= MEAN_TOLERANCE).all() and mad <= MAD_TOLERANCE
+    assert (rel <= ISSUE_MEAN_TOLERANCE).all() and mad <= MAD_TOLERANCE
     assert block <= BLOCK_TOLERANCE
     # and it is a different image from the one with caustics on
     assert not within(_render(bpy_drt, "glass_caustics", "CYCLES"), cycles)
