@@ -51,9 +51,13 @@ KNOWN = """## Known differences
 - **Inputs that vary per hit but feed a parameter DRT keeps per material** (IOR,
   Transmission, Specular IOR Level, Emission Strength, a Mix Shader's Fac) take the
   graph's average over the unit square of UV and generated coordinates (reported).
-- **A Mix Shader whose Fac varies per hit** (a texture mask) mixes its two shaders by
-  the Fac's average (reported); Fresnel and Layer Weight factors become Principled's
-  specular layer as before.
+- **Mix Shader with a per-hit Fac.** Cycles sums the two shaders weighted by the Fac;
+  DRT shades each hit by one of them, picked with the Fac's probability (unbiased, a
+  little noisier; `test_mix_shader_with_per_hit_factor_matches_cycles`: a checker mask
+  and a Layer Weight Facing, both within 0.1% of Cycles' mean). A per-hit Mix Shader
+  inside another Mix or Add Shader whose Fac is constant mixes by its Fac's average
+  (reported). A Fresnel or Layer Weight Fresnel factor between a diffuse and a glossy
+  shader stays Principled's specular layer of that IOR, as before.
 - Not evaluated yet (warned): Noise, Voronoi, Wave, Magic, Brick and White Noise
   textures, Bump, Texture Coordinate's Camera and Window, Light Path's depth counters
   other than Ray Depth, Map Range on vectors, Normal Map in object or world space,
