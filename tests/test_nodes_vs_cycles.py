@@ -1,5 +1,6 @@
-"""Shader nodes against Cycles, pixel by pixel (node_probe, node_cases): every case of
-every node family is one tile of an emission-only render by each engine.
+"""Shader nodes against Cycles, pixel by pixel (node_probe; the cases: node_cases and
+node_cases_procedural): every case of every node family is one tile of an emission-only
+render by each engine.
 
 Thresholds per tile (Cycles' tile mean floored at 0.02): the tile means within 1%, the
 8 x 8 block means within 3%, and the per-pixel mean absolute difference within 3% (it
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 
 import node_cases
+import node_cases_procedural
 import node_probe
 
 SAMPLES = 64
@@ -24,19 +26,23 @@ MEAN_TOL = 0.01
 BLOCK_TOL = 0.03
 PIXEL_TOL = 0.03
 
+FAMILIES = {**node_cases.FAMILIES, **node_cases_procedural.FAMILIES}
+TILES = node_cases_procedural.TILES          # pixels per tile where not node_probe.TILE
+
 _renders = {}
 
 
 def _family(bpy, name):
     if name not in _renders:
-        cases, shape = node_cases.FAMILIES[name]
-        scene, columns, rows = node_probe.build_scene(bpy, cases, shape=shape)
+        cases, shape = FAMILIES[name]
+        tile = TILES.get(name, node_probe.TILE)
+        scene, columns, rows = node_probe.build_scene(bpy, cases, shape=shape, tile=tile)
         spp = SPHERE_SAMPLES if shape == "sphere" else SAMPLES
         cycles = node_probe.render(bpy, scene, "CYCLES", spp)
         drt = node_probe.render(bpy, scene, "DRT", spp)
         node_probe.unlink_probes(bpy)
         fallback = node_probe.render(bpy, scene, "DRT", 4)
-        _renders[name] = (cases, [node_probe.tiles(img, columns, rows)
+        _renders[name] = (cases, [node_probe.tiles(img, columns, rows, tile)
                                   for img in (drt, cycles, fallback)])
     return _renders[name]
 
@@ -55,7 +61,7 @@ def _fails(errors):
     return mean > MEAN_TOL or block > BLOCK_TOL or mad > PIXEL_TOL
 
 
-@pytest.mark.parametrize("family", sorted(node_cases.FAMILIES))
+@pytest.mark.parametrize("family", sorted(FAMILIES))
 def test_nodes_match_cycles(bpy_drt, family):
     rows = _errors(bpy_drt, family)
     bad = [f"{name}: mean {e[0]:.2%}, pixels {e[1]:.2%}, block {e[2]:.2%}"
@@ -63,7 +69,7 @@ def test_nodes_match_cycles(bpy_drt, family):
     assert not bad, "\n".join(bad)
 
 
-@pytest.mark.parametrize("family", sorted(node_cases.FAMILIES))
+@pytest.mark.parametrize("family", sorted(FAMILIES))
 def test_comparison_fails_without_the_nodes(bpy_drt, family):
     rows = _errors(bpy_drt, family)
     passing = [name for name, _, control in rows if not _fails(control)]

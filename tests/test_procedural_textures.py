@@ -1,0 +1,100 @@
+"""The procedural texture nodes (White Noise) as DRT compiles and evaluates them,
+against Blender's own evaluation of the same node at the same points
+(tests/blender_fields.py: geometry nodes run the functions Cycles' kernels use, in
+float32), over every dimension, type, feature, metric, direction and profile.
+
+Each case: a shader node tree with the texture node reading Object coordinates, compiled
+by the exporter's NodeCompiler, run by the engine's interpreter at 200 random points
+(the hit positions of the identity object), compared with Blender's values. Tolerances
+are float32 rounding (1e-3 of the value's scale); the hashes must agree exactly. A
+control shows the comparison fails for a different setting.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from blender_fields import evaluate
+
+N_POINTS = 200
+RNG = np.random.default_rng(7)
+POINTS = RNG.uniform(-3.0, 3.0, (N_POINTS, 3)).astype(np.float32).astype(np.float64)
+
+
+class _Ctx:
+    """What the node compiler needs of a material export: an issue list."""
+
+    def __init__(self):
+        self.issues = []
+        self.cache = {}
+        self.name = "probe"
+
+    def issue(self, text):
+        self.issues.append(text)
+
+
+def drt_values(bpy, node_type, output, settings, inputs):
+    """DRT's value of `output` of a `node_type` node at POINTS (Vector: Object; W: its
+    x)."""
+    from drt_addon.export.nodes import NodeCompiler
+    from engine.nodes.context import hit_rows
+
+    mat = bpy.data.materials.new("probe")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    try:
+        node = nt.nodes.new(node_type)
+        for k, v in settings.items():
+            setattr(node, k, v)
+        coords = nt.nodes.new("ShaderNodeTexCoord").outputs["Object"]
+        if node.inputs.get("Vector") is not None:
+            nt.links.new(coords, node.inputs["Vector"])
+        if node.inputs.get("W") is not None:              # W: the point's x
+            sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+            nt.links.new(coords, sep.inputs[0])
+            nt.links.new(sep.outputs[0], node.inputs["W"])
+        for name, value in inputs.items():
+            if node.inputs.get(name) is not None:
+                node.inputs[name].default_value = value
+        c = NodeCompiler(_Ctx())
+        out = next(s for s in node.outputs if output in (s.name, s.identifier))
+        value = c.output(node, out)
+        hits = hit_rows(POINTS, np.tile([0.0, 0.0, 1.0], (N_POINTS, 1)))
+        return c.build().evaluate(value, hits)
+    finally:
+        bpy.data.materials.remove(mat)
+
+
+def compare(bpy, node_type, output, settings, inputs):
+    """(largest difference over the value's scale, the values' spread)."""
+    ref = evaluate(bpy, node_type, POINTS, output, settings, dict(inputs, W=POINTS[:, 0]))
+    mine = drt_values(bpy, node_type, output, settings, inputs)
+    scale = max(1.0, float(np.abs(ref).max()))
+    return float(np.abs(mine - ref).max()) / scale, float(ref.std())
+
+
+def check(bpy, node_type, output, settings, inputs, tol=1e-3):
+    err, spread = compare(bpy, node_type, output, settings, inputs)
+    assert spread > 0.01, "the case does not vary: it would show nothing"
+    assert err < tol, f"{node_type} {settings} {output}: largest error {err:.2e}"
+
+
+DIMS = ("1D", "2D", "3D", "4D")
+
+
+@pytest.mark.parametrize("dims", DIMS)
+@pytest.mark.parametrize("output", ("Value", "Color"))
+def test_white_noise_hashes_like_blender(bpy_drt, dims, output):
+    check(bpy_drt, "ShaderNodeTexWhiteNoise", output, {"noise_dimensions": dims},
+          {}, tol=1e-7)
+
+
+def test_comparison_fails_for_another_setting(bpy_drt):
+    """The control: White Noise of another dimension: the comparison fails."""
+    pairs = [("ShaderNodeTexWhiteNoise", "Value", "noise_dimensions", "3D", "2D"),
+             ("ShaderNodeTexWhiteNoise", "Color", "noise_dimensions", "4D", "3D")]
+    for node_type, output, prop, mine, theirs in pairs:
+        ref = evaluate(bpy_drt, node_type, POINTS, output, {prop: theirs}, {"W": POINTS[:, 0]})
+        got = drt_values(bpy_drt, node_type, output, {prop: mine}, {})
+        assert np.abs(got - ref).max() > 0.1, (node_type, prop)
+
