@@ -1,6 +1,6 @@
 """The procedural textures' node graphs tests/test_nodes_vs_cycles.py compares with
-Cycles (White Noise), one family per kind, on tiles of TILE pixels so that a pattern's
-features span several pixels.
+Cycles (White Noise, Noise), one family per kind, on tiles of TILE pixels so that a
+pattern's features span several pixels.
 
 Patterns read Generated coordinates (the tile's [0, 1] square) unless a case says
 otherwise. White Noise hashes the bits of its input, so its input is quantised (Snap)
@@ -9,7 +9,7 @@ pixels across cell edges mix neighbouring cells (antialiasing, the same in both)
 """
 from __future__ import annotations
 
-from node_cases import axis, gen, ident
+from node_cases import axis, gen, ident, shown
 
 TILE = 32
 
@@ -25,6 +25,14 @@ def _snapped(nt, p, step=0.25):
     nt.links.new(gen(nt, p), snap.inputs[0])
     snap.inputs[1].default_value = (step, step, 1.0)
     return snap.outputs[0]
+
+
+def _linked_w(nt, p, node, scale=1.0):
+    """The node's W from the tile's generated x (times scale)."""
+    m = p.node(nt, "ShaderNodeMath", operation="MULTIPLY")
+    nt.links.new(axis(nt, p, gen(nt, p), 0), m.inputs[0])
+    m.inputs[1].default_value = scale
+    nt.links.new(m.outputs[0], node.inputs["W"])
 
 
 # ---------------------------------------------------------------- white noise
@@ -43,6 +51,34 @@ def _white_noise(dims, output):
     return build
 
 
+# ---------------------------------------------------------------- noise
+def _noise(kind="FBM", dims="3D", output="Fac", normalize=True, show=None, **inputs):
+    def build(nt, p):
+        n = p.node(nt, "ShaderNodeTexNoise", noise_type=kind, noise_dimensions=dims,
+                   normalize=normalize)
+        _set(n, **dict(dict(Scale=3.0, Detail=2.0), **inputs))
+        if dims == "1D":
+            _linked_w(nt, p, n)
+        if show is not None:
+            return shown(nt, p, n.outputs[output], *show)
+        return n.outputs[output]
+    return build
+
+
+NOISE = [
+    ("noise_fbm", _noise()), ("noise_fbm_color", _noise(output="Color")),
+    ("noise_fbm_rough", _noise(Detail=3.5, Roughness=0.7, Lacunarity=2.5)),
+    ("noise_fbm_unnormalized", _noise(normalize=False, show=(0.4, 0.5))),
+    ("noise_distortion", _noise(Distortion=1.5, output="Color")),
+    ("noise_1d", _noise(dims="1D", Scale=4.0)), ("noise_2d", _noise(dims="2D")),
+    ("noise_4d", _noise(dims="4D", W=0.6, output="Color")),
+    ("noise_multifractal", _noise("MULTIFRACTAL", show=(0.4, 0.1))),
+    ("noise_ridged", _noise("RIDGED_MULTIFRACTAL", show=(0.5, 0.0), Offset=1.0, Gain=2.0)),
+    ("noise_hybrid", _noise("HYBRID_MULTIFRACTAL", show=(0.3, 0.2), Offset=0.5, Gain=1.5)),
+    ("noise_hetero", _noise("HETERO_TERRAIN", show=(0.3, 0.3), Offset=0.5)),
+]
+
+
 PATTERNS = [
     ("white_noise_2d", _white_noise("2D", "Value")),
     ("white_noise_3d", _white_noise("3D", "Value")),
@@ -51,5 +87,5 @@ PATTERNS = [
     ("white_noise_1d", _white_noise("1D", "Color")),
 ]
 
-FAMILIES = {"procedural_patterns": (PATTERNS, "plane")}
+FAMILIES = {"procedural_noise": (NOISE, "plane"), "procedural_patterns": (PATTERNS, "plane")}
 TILES = {name: TILE for name in FAMILIES}

@@ -1,4 +1,4 @@
-"""The procedural texture nodes (White Noise) as DRT compiles and evaluates them,
+"""The procedural texture nodes (White Noise, Noise) as DRT compiles and evaluates them,
 against Blender's own evaluation of the same node at the same points
 (tests/blender_fields.py: geometry nodes run the functions Cycles' kernels use, in
 float32), over every dimension, type, feature, metric, direction and profile.
@@ -89,12 +89,48 @@ def test_white_noise_hashes_like_blender(bpy_drt, dims, output):
           {}, tol=1e-7)
 
 
+NOISE_TYPES = ("FBM", "MULTIFRACTAL", "RIDGED_MULTIFRACTAL", "HYBRID_MULTIFRACTAL",
+               "HETERO_TERRAIN")
+
+
+@pytest.mark.parametrize("dims", DIMS)
+@pytest.mark.parametrize("kind", NOISE_TYPES)
+def test_noise(bpy_drt, kind, dims):
+    inputs = {"Scale": 1.7, "Detail": 3.5, "Roughness": 0.6, "Lacunarity": 2.2,
+              "Offset": 0.7, "Gain": 1.3, "Distortion": 0.8}
+    for output in ("Fac", "Color"):
+        check(bpy_drt, "ShaderNodeTexNoise", output,
+              {"noise_dimensions": dims, "noise_type": kind}, inputs)
+
+
+def test_noise_unnormalized(bpy_drt):
+    check(bpy_drt, "ShaderNodeTexNoise", "Fac", {"normalize": False},
+          {"Scale": 2.0, "Detail": 2.0})
+
+
 def test_comparison_fails_for_another_setting(bpy_drt):
-    """The control: White Noise of another dimension: the comparison fails."""
-    pairs = [("ShaderNodeTexWhiteNoise", "Value", "noise_dimensions", "3D", "2D"),
-             ("ShaderNodeTexWhiteNoise", "Color", "noise_dimensions", "4D", "3D")]
+    """The control: DRT's FBM against Blender's Ridged, a different White Noise
+    dimension: each comparison fails."""
+    pairs = [("ShaderNodeTexNoise", "Fac", "noise_type", "FBM", "RIDGED_MULTIFRACTAL"),
+             ("ShaderNodeTexWhiteNoise", "Value", "noise_dimensions", "3D", "2D")]
     for node_type, output, prop, mine, theirs in pairs:
         ref = evaluate(bpy_drt, node_type, POINTS, output, {prop: theirs}, {"W": POINTS[:, 0]})
         got = drt_values(bpy_drt, node_type, output, {prop: mine}, {})
         assert np.abs(got - ref).max() > 0.1, (node_type, prop)
 
+
+def test_texture_mapping_is_reported(bpy_drt):
+    """The node's legacy texture mapping (sidebar > Mapping) is not evaluated: named in
+    a warning."""
+    ctx = _Ctx()
+    mat = bpy_drt.data.materials.new("mapped")
+    mat.use_nodes = True
+    try:
+        node = mat.node_tree.nodes.new("ShaderNodeTexNoise")
+        node.texture_mapping.translation = (0.5, 0.0, 0.0)
+        from drt_addon.export.nodes import NodeCompiler
+        c = NodeCompiler(ctx)
+        c.output(node, node.outputs["Fac"])
+    finally:
+        bpy_drt.data.materials.remove(mat)
+    assert any("texture mapping" in i for i in ctx.issues), ctx.issues

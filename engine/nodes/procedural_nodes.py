@@ -1,19 +1,51 @@
-"""Procedural texture nodes: White Noise. Opcodes 120-199 (the texture range; 100-119
-are texture_nodes'). The kernels are Blender's own functions: hash.py,
+"""Procedural texture nodes: White Noise, Noise. Opcodes 120-199 (the texture range;
+100-119 are texture_nodes'). The kernels are Blender's own functions: hash.py, noise.py,
 pattern_textures.py.
+
+A node with more inputs than an instruction has operands reads them packed three to a
+register triple (the compiler's CV_COMBINE); `mode` packs the node's enum settings.
 
   TEX_WHITE_NOISE_VALUE out, vector, w, dims
   TEX_WHITE_NOISE_COLOR out, vector, w, dims
+  TEX_NOISE_FAC out, vector, (w, scale, detail), (roughness, lacunarity, distortion),
+                (offset, gain, -), mode          mode = dims + 8 type + 64 normalize
+  TEX_NOISE_COLOR ... (the same operands)
 
-dims is 1-4.
+dims is 1-4; types index noise.FRACTAL_TYPES.
 """
 from __future__ import annotations
 
 from ..kernels.jit import kernel
+from .noise import noise_texture
 from .pattern_textures import white_noise
 
 TEX_WHITE_NOISE_VALUE = 120
 TEX_WHITE_NOISE_COLOR = 121
+TEX_NOISE_FAC = 122
+TEX_NOISE_COLOR = 123
+
+
+@kernel
+def texture_point(regs, dims, v, w, scale):
+    """The node's point (its first `dims` coordinates used; a 1D point is W) times
+    scale."""
+    if dims == 1:
+        return w * scale, 0.0, 0.0, 0.0
+    return regs[v] * scale, regs[v + 1] * scale, regs[v + 2] * scale, w * scale
+
+
+@kernel
+def execute_noise(ins, regs):
+    out, v, a, b, c, mode = ins[1], ins[2], ins[3], ins[4], ins[5], ins[6]
+    dims = mode % 8
+    x, y, z, w = texture_point(regs, dims, v, regs[a], regs[a + 1])
+    fac, r, g, bl = noise_texture(dims, x, y, z, w, regs[a + 2], regs[b], regs[b + 1],
+                                  regs[c], regs[c + 1], regs[b + 2], (mode // 8) % 8,
+                                  mode // 64 == 1, ins[0] == TEX_NOISE_COLOR)
+    if ins[0] == TEX_NOISE_COLOR:
+        regs[out], regs[out + 1], regs[out + 2] = r, g, bl
+    else:
+        regs[out] = fac
 
 
 @kernel
@@ -25,3 +57,5 @@ def execute(ins, regs):
         regs[out] = r
         if code == TEX_WHITE_NOISE_COLOR:
             regs[out + 1], regs[out + 2] = g, b
+    elif code == TEX_NOISE_FAC or code == TEX_NOISE_COLOR:
+        execute_noise(ins, regs)
