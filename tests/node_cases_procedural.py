@@ -1,6 +1,6 @@
 """The procedural textures' node graphs tests/test_nodes_vs_cycles.py compares with
-Cycles (White Noise, Noise), one family per kind, on tiles of TILE pixels so that a
-pattern's features span several pixels.
+Cycles (White Noise, Noise, Voronoi), one family per kind, on tiles of TILE pixels so
+that a pattern's features span several pixels.
 
 Patterns read Generated coordinates (the tile's [0, 1] square) unless a case says
 otherwise. White Noise hashes the bits of its input, so its input is quantised (Snap)
@@ -79,6 +79,44 @@ NOISE = [
 ]
 
 
+# ---------------------------------------------------------------- voronoi
+def _voronoi(feature="F1", output="Distance", dims="3D", metric="EUCLIDEAN",
+             normalize=False, show=None, **inputs):
+    def build(nt, p):
+        v = p.node(nt, "ShaderNodeTexVoronoi", feature=feature, voronoi_dimensions=dims,
+                   distance=metric, normalize=normalize)
+        _set(v, **dict(dict(Scale=4.0), **inputs))
+        if dims == "1D":
+            _linked_w(nt, p, v)
+        out = v.outputs[output]
+        if output == "Position":
+            show_pos = p.node(nt, "ShaderNodeVectorMath", operation="FRACTION")
+            nt.links.new(out, show_pos.inputs[0])
+            return show_pos.outputs[0]
+        return shown(nt, p, out, *show) if show else out
+    return build
+
+
+VORONOI = [
+    ("voronoi_f1", _voronoi()), ("voronoi_f1_color", _voronoi(output="Color")),
+    ("voronoi_f1_position", _voronoi(output="Position")),
+    ("voronoi_f2", _voronoi("F2", show=(0.7, 0.0))),
+    ("voronoi_f2_color", _voronoi("F2", output="Color")),
+    ("voronoi_smooth_f1", _voronoi("SMOOTH_F1")),
+    ("voronoi_smooth_f1_color", _voronoi("SMOOTH_F1", output="Color", Smoothness=0.6)),
+    ("voronoi_edge", _voronoi("DISTANCE_TO_EDGE", show=(2.0, 0.0))),
+    ("voronoi_radius", _voronoi("N_SPHERE_RADIUS", output="Radius", show=(1.5, 0.0))),
+    ("voronoi_manhattan", _voronoi(metric="MANHATTAN", show=(0.7, 0.0))),
+    ("voronoi_chebychev", _voronoi(metric="CHEBYCHEV")),
+    ("voronoi_minkowski", _voronoi(metric="MINKOWSKI", Exponent=1.5)),
+    ("voronoi_2d_color", _voronoi(dims="2D", output="Color", Randomness=0.6)),
+    ("voronoi_1d", _voronoi(dims="1D", Scale=5.0)),
+    ("voronoi_4d_color", _voronoi(dims="4D", output="Color", W=0.3)),
+    ("voronoi_fractal", _voronoi(Detail=2.0, Roughness=0.6, normalize=True)),
+    ("voronoi_fractal_edge", _voronoi("DISTANCE_TO_EDGE", Detail=1.5, normalize=True)),
+]
+
+
 PATTERNS = [
     ("white_noise_2d", _white_noise("2D", "Value")),
     ("white_noise_3d", _white_noise("3D", "Value")),
@@ -87,5 +125,6 @@ PATTERNS = [
     ("white_noise_1d", _white_noise("1D", "Color")),
 ]
 
-FAMILIES = {"procedural_noise": (NOISE, "plane"), "procedural_patterns": (PATTERNS, "plane")}
+FAMILIES = {"procedural_noise": (NOISE, "plane"), "procedural_voronoi": (VORONOI, "plane"),
+            "procedural_patterns": (PATTERNS, "plane")}
 TILES = {name: TILE for name in FAMILIES}

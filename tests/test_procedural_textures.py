@@ -1,5 +1,5 @@
-"""The procedural texture nodes (White Noise, Noise) as DRT compiles and evaluates them,
-against Blender's own evaluation of the same node at the same points
+"""The procedural texture nodes (White Noise, Noise, Voronoi) as DRT compiles and
+evaluates them, against Blender's own evaluation of the same node at the same points
 (tests/blender_fields.py: geometry nodes run the functions Cycles' kernels use, in
 float32), over every dimension, type, feature, metric, direction and profile.
 
@@ -108,10 +108,38 @@ def test_noise_unnormalized(bpy_drt):
           {"Scale": 2.0, "Detail": 2.0})
 
 
+FEATURES = ("F1", "F2", "SMOOTH_F1", "DISTANCE_TO_EDGE", "N_SPHERE_RADIUS")
+METRICS = ("EUCLIDEAN", "MANHATTAN", "CHEBYCHEV", "MINKOWSKI")
+VORONOI_OUTPUTS = {"F1": ("Distance", "Color", "Position", "W"),
+                   "F2": ("Distance", "Color", "Position", "W"),
+                   "SMOOTH_F1": ("Distance", "Color", "Position", "W"),
+                   "DISTANCE_TO_EDGE": ("Distance",), "N_SPHERE_RADIUS": ("Radius",)}
+
+
+@pytest.mark.parametrize("dims", DIMS)
+@pytest.mark.parametrize("feature", FEATURES)
+def test_voronoi(bpy_drt, feature, dims):
+    metrics = METRICS if feature in ("F1", "F2", "SMOOTH_F1") and dims != "1D" else \
+        ("EUCLIDEAN",)
+    for metric in metrics:
+        for normalize, detail in ((False, 0.0), (True, 2.5)):
+            settings = {"voronoi_dimensions": dims, "feature": feature, "distance": metric,
+                        "normalize": normalize}
+            inputs = {"Scale": 1.3, "Detail": detail, "Roughness": 0.6,
+                      "Lacunarity": 2.1, "Smoothness": 0.7, "Exponent": 1.5,
+                      "Randomness": 0.9}
+            for output in VORONOI_OUTPUTS[feature]:
+                if output == "W" and dims not in ("1D", "4D") or \
+                        output == "Position" and dims == "1D":
+                    continue
+                check(bpy_drt, "ShaderNodeTexVoronoi", output, settings, inputs)
+
+
 def test_comparison_fails_for_another_setting(bpy_drt):
-    """The control: DRT's FBM against Blender's Ridged, a different White Noise
-    dimension: each comparison fails."""
+    """The control: DRT's FBM against Blender's Ridged, DRT's Voronoi F1 against
+    Blender's F2, a different White Noise dimension: each comparison fails."""
     pairs = [("ShaderNodeTexNoise", "Fac", "noise_type", "FBM", "RIDGED_MULTIFRACTAL"),
+             ("ShaderNodeTexVoronoi", "Distance", "feature", "F1", "F2"),
              ("ShaderNodeTexWhiteNoise", "Value", "noise_dimensions", "3D", "2D")]
     for node_type, output, prop, mine, theirs in pairs:
         ref = evaluate(bpy_drt, node_type, POINTS, output, {prop: theirs}, {"W": POINTS[:, 0]})

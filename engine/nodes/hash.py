@@ -1,14 +1,16 @@
 """Blender's hashes for procedural textures (Cycles' util/hash.h): Bob Jenkins' lookup3
-hash of one to four 32-bit words (hash_uint .. hash_uint4), and the float hashes built
-on it, which hash the bits of float32 values (Cycles computes in float32, so a float64
-input is first rounded to float32, then its bit pattern is hashed).
+hash of one to four 32-bit words (hash_uint .. hash_uint4), the float hashes built on
+it, which hash the bits of float32 values (Cycles computes in float32, so a float64
+input is first rounded to float32, then its bit pattern is hashed), and the PCG hashes
+of 2 to 4 signed integers (Jarzynski and Olano 2020) that Voronoi uses for its cells.
 
-Every 32-bit operation is done on int64 and masked to 32 bits, which wraps exactly as
-C's uint32 arithmetic does (two's complement).
+Every 32-bit operation is done on int64 and wrapped to 32 bits, as C's uint32 (masked)
+or int32 (two's complement, arithmetic shifts) arithmetic wraps.
 
   hash_uint*(k...)              a uint32 (as int) from one to four uint32 words
   hash_float*_to_float(x...)    a float in [0, 1] from one to four floats
-  hash_float{1,2,3,4}_to_float3 three such floats (White Noise's colours)
+  hash_float{1,2,3,4}_to_float3 three such floats (White Noise's colours, Voronoi 1D's)
+  hash_int{2,3,4}_to_float{2,3,4}  floats in [0, 1] from integer coordinates (PCG)
 """
 from __future__ import annotations
 
@@ -138,3 +140,61 @@ def hash_float4_to_float3(x, y, z, w):
     return (hash_float4_to_float(x, y, z, w), hash_float4_to_float(z, x, w, y),
             hash_float4_to_float(w, z, y, x))
 
+
+# ---------------------------------------------------------------- PCG (signed int32)
+PCG_A = 1664525
+PCG_C = 1013904223
+INV_2_31 = 1.0 / 2147483648.0     # float(0x7FFFFFFF) rounds to 2^31 in float32
+
+
+@kernel
+def i32(x):
+    """x wrapped to a signed 32-bit integer."""
+    return ((x + 0x80000000) & M32) - 0x80000000
+
+
+@kernel
+def pcg_to_float(h):
+    return float(np.float32(h & 0x7FFFFFFF)) * INV_2_31
+
+
+@kernel
+def hash_int2_to_float2(x, y):
+    x = i32(x * PCG_A + PCG_C)
+    y = i32(y * PCG_A + PCG_C)
+    x = i32(x + y * PCG_A)
+    y = i32(y + x * PCG_A)
+    x, y = x ^ (x >> 16), y ^ (y >> 16)
+    x = i32(x + y * PCG_A)
+    y = i32(y + x * PCG_A)
+    return pcg_to_float(x), pcg_to_float(y)
+
+
+@kernel
+def hash_int3_to_float3(x, y, z):
+    x = i32(x * PCG_A + PCG_C)
+    y = i32(y * PCG_A + PCG_C)
+    z = i32(z * PCG_A + PCG_C)
+    for rnd in range(2):
+        if rnd == 1:
+            x, y, z = x ^ (x >> 16), y ^ (y >> 16), z ^ (z >> 16)
+        x = i32(x + y * z)
+        y = i32(y + z * x)
+        z = i32(z + x * y)
+    return pcg_to_float(x), pcg_to_float(y), pcg_to_float(z)
+
+
+@kernel
+def hash_int4_to_float4(x, y, z, w):
+    x = i32(x * PCG_A + PCG_C)
+    y = i32(y * PCG_A + PCG_C)
+    z = i32(z * PCG_A + PCG_C)
+    w = i32(w * PCG_A + PCG_C)
+    for rnd in range(2):
+        if rnd == 1:
+            x, y, z, w = x ^ (x >> 16), y ^ (y >> 16), z ^ (z >> 16), w ^ (w >> 16)
+        x = i32(x + y * w)
+        y = i32(y + z * x)
+        z = i32(z + x * y)
+        w = i32(w + y * z)
+    return pcg_to_float(x), pcg_to_float(y), pcg_to_float(z), pcg_to_float(w)

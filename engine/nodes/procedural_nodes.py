@@ -1,6 +1,6 @@
-"""Procedural texture nodes: White Noise, Noise. Opcodes 120-199 (the texture range;
-100-119 are texture_nodes'). The kernels are Blender's own functions: hash.py, noise.py,
-pattern_textures.py.
+"""Procedural texture nodes: White Noise, Noise, Voronoi. Opcodes 120-199 (the texture
+range; 100-119 are texture_nodes'). The kernels are Blender's own functions: hash.py,
+noise.py, voronoi.py, pattern_textures.py.
 
 A node with more inputs than an instruction has operands reads them packed three to a
 register triple (the compiler's CV_COMBINE); `mode` packs the node's enum settings.
@@ -10,19 +10,28 @@ register triple (the compiler's CV_COMBINE); `mode` packs the node's enum settin
   TEX_NOISE_FAC out, vector, (w, scale, detail), (roughness, lacunarity, distortion),
                 (offset, gain, -), mode          mode = dims + 8 type + 64 normalize
   TEX_NOISE_COLOR ... (the same operands)
+  TEX_VORONOI out, vector, (w, scale, detail), (roughness, lacunarity, smoothness),
+              (exponent, randomness, -), mode    mode = dims + 8 feature + 64 metric
+                                                 + 512 normalize + 1024 output
+                                                 (VORONOI_OUTPUTS index)
 
-dims is 1-4; types index noise.FRACTAL_TYPES.
+dims is 1-4; types, features and metrics index noise.FRACTAL_TYPES and
+voronoi.FEATURES / METRICS.
 """
 from __future__ import annotations
 
 from ..kernels.jit import kernel
 from .noise import noise_texture
 from .pattern_textures import white_noise
+from .voronoi import voronoi_texture
 
 TEX_WHITE_NOISE_VALUE = 120
 TEX_WHITE_NOISE_COLOR = 121
 TEX_NOISE_FAC = 122
 TEX_NOISE_COLOR = 123
+TEX_VORONOI = 124
+
+VORONOI_OUTPUTS = ("Distance", "Color", "Position", "W", "Radius")
 
 
 @kernel
@@ -49,6 +58,30 @@ def execute_noise(ins, regs):
 
 
 @kernel
+def execute_voronoi(ins, regs):
+    out, v, a, b, c, mode = ins[1], ins[2], ins[3], ins[4], ins[5], ins[6]
+    dims = mode % 8
+    scale = regs[a + 1]
+    x, y, z, w = texture_point(regs, dims, v, regs[a], scale)
+    d, r, g, bl, px, py, pz, pw, radius = voronoi_texture(
+        dims, (mode // 8) % 8, (mode // 64) % 8, (mode // 512) % 2 == 1, x, y, z, w, scale,
+        regs[a + 2], regs[b], regs[b + 1], regs[b + 2], regs[c], regs[c + 1])
+    output = mode // 1024
+    if output == 0:
+        regs[out] = d
+    elif output == 1:
+        regs[out], regs[out + 1], regs[out + 2] = r, g, bl
+    elif output == 2:
+        if dims == 1:                        # a 1D position is its W
+            px = 0.0
+        regs[out], regs[out + 1], regs[out + 2] = px, py, pz
+    elif output == 3:
+        regs[out] = px if dims == 1 else pw if dims == 4 else 0.0
+    else:
+        regs[out] = radius
+
+
+@kernel
 def execute(ins, regs):
     code, out, v = ins[0], ins[1], ins[2]
     if code == TEX_WHITE_NOISE_VALUE or code == TEX_WHITE_NOISE_COLOR:
@@ -59,3 +92,5 @@ def execute(ins, regs):
             regs[out + 1], regs[out + 2] = g, b
     elif code == TEX_NOISE_FAC or code == TEX_NOISE_COLOR:
         execute_noise(ins, regs)
+    elif code == TEX_VORONOI:
+        execute_voronoi(ins, regs)

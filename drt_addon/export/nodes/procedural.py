@@ -1,5 +1,5 @@
 """Procedural texture nodes to program operations (engine.nodes.procedural_nodes): White
-Noise, Noise.
+Noise, Noise, Voronoi.
 
 An unlinked Vector reads Generated coordinates, as in Cycles, except White Noise's, which
 is the socket's own value. A node whose legacy texture mapping (the node's Mapping panel
@@ -15,6 +15,7 @@ from .texture import C, coordinates
 
 P = importlib.import_module(engine.__name__ + ".nodes.procedural_nodes")
 N = importlib.import_module(engine.__name__ + ".nodes.noise")
+VOR = importlib.import_module(engine.__name__ + ".nodes.voronoi")
 CV = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
 
 DIMENSIONS = {"1D": 1, "2D": 2, "3D": 3, "4D": 4}
@@ -76,7 +77,21 @@ def _noise(c, node, out):
     return c.emit(P.TEX_NOISE_FAC, "float", operands)
 
 
+def _voronoi(c, node, out):
+    output = _index(P.VORONOI_OUTPUTS, out.identifier, "the Voronoi output")
+    mode = (_dims(node, "voronoi_dimensions")
+            + 8 * _index(VOR.FEATURES, node.feature, "Voronoi feature")
+            + 64 * _index(VOR.METRICS, node.distance, "Voronoi distance")
+            + 512 * int(bool(node.normalize)) + 1024 * output)
+    kind = "color" if output == 1 else "vector" if output == 2 else "float"
+    return c.emit(P.TEX_VORONOI, kind,
+                  [_texture_coordinates(c, node), _pack(c, node, ("W", "Scale", "Detail")),
+                   _pack(c, node, ("Roughness", "Lacunarity", "Smoothness")),
+                   _pack(c, node, ("Exponent", "Randomness", None)), mode])
+
+
 TRANSLATORS = {
     "ShaderNodeTexWhiteNoise": _white_noise,
     "ShaderNodeTexNoise": _noise,
+    "ShaderNodeTexVoronoi": _voronoi,
 }
