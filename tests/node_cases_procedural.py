@@ -1,6 +1,6 @@
 """The procedural textures' node graphs tests/test_nodes_vs_cycles.py compares with
-Cycles (White Noise, Noise, Voronoi), one family per kind, on tiles of TILE pixels so
-that a pattern's features span several pixels.
+Cycles (White Noise, Noise, Voronoi, Wave, Magic, Brick), one family per kind, on tiles
+of TILE pixels so that a pattern's features span several pixels.
 
 Patterns read Generated coordinates (the tile's [0, 1] square) unless a case says
 otherwise. White Noise hashes the bits of its input, so its input is quantised (Snap)
@@ -117,12 +117,50 @@ VORONOI = [
 ]
 
 
+# ---------------------------------------------------------------- wave, magic, brick
+def _wave(kind="BANDS", direction="X", profile="SIN", **inputs):
+    def build(nt, p):
+        w = p.node(nt, "ShaderNodeTexWave", wave_type=kind, bands_direction=direction
+                   if kind == "BANDS" else "X", rings_direction=direction
+                   if kind == "RINGS" else "X", wave_profile=profile)
+        _set(w, **dict(dict(Scale=0.6), **inputs))
+        return w.outputs["Fac"]
+    return build
+
+
+def _magic(depth, **inputs):
+    def build(nt, p):
+        m = p.node(nt, "ShaderNodeTexMagic", turbulence_depth=depth)
+        _set(m, **dict(dict(Scale=1.0), **inputs))
+        return m.outputs["Color"]
+    return build
+
+
+def _brick(output="Color", **settings):
+    def build(nt, p):
+        b = p.node(nt, "ShaderNodeTexBrick", **settings)
+        _set(b, Scale=1.0, **{"Mortar Size": 0.04, "Mortar Smooth": 0.3, "Bias": 0.1,
+                              "Color1": (0.8, 0.3, 0.1, 1.0), "Color2": (0.2, 0.5, 0.7, 1.0),
+                              "Mortar": (0.05, 0.05, 0.05, 1.0)})
+        return b.outputs[output]
+    return build
+
+
 PATTERNS = [
     ("white_noise_2d", _white_noise("2D", "Value")),
     ("white_noise_3d", _white_noise("3D", "Value")),
     ("white_noise_3d_color", _white_noise("3D", "Color")),
     ("white_noise_4d_color", _white_noise("4D", "Color")),
     ("white_noise_1d", _white_noise("1D", "Color")),
+    ("wave_bands", _wave()), ("wave_bands_diagonal_saw", _wave(direction="DIAGONAL",
+                                                               profile="SAW")),
+    ("wave_rings_tri", _wave("RINGS", "SPHERICAL", "TRI", **{"Phase Offset": 1.0})),
+    ("wave_rings_z_distorted", _wave("RINGS", "Z", Distortion=4.0, Detail=3.0,
+                                     **{"Detail Scale": 2.0})),
+    ("magic_2", _magic(2)), ("magic_4", _magic(4, Distortion=1.5)),
+    ("magic_fac", lambda nt, p: _magic(3, Scale=1.5)(nt, p).node.outputs["Fac"]),
+    ("brick", _brick()), ("brick_fac", _brick("Fac")),
+    ("brick_squash", _brick(offset=0.3, offset_frequency=3, squash=0.6, squash_frequency=2)),
 ]
 
 FAMILIES = {"procedural_noise": (NOISE, "plane"), "procedural_voronoi": (VORONOI, "plane"),

@@ -82,9 +82,9 @@ def test_unsupported_node_warns_and_falls_back(bpy_drt):
     bpy = bpy_drt
 
     def build(nt, p):
-        noise = p.node(nt, "ShaderNodeTexWave")
+        gabor = p.node(nt, "ShaderNodeTexGabor")
         mix = p.node(nt, "ShaderNodeMix", data_type="RGBA")
-        nt.links.new(noise.outputs["Color"], node_cases.ident(mix.inputs, "A_Color"))
+        nt.links.new(gabor.outputs["Value"], node_cases.ident(mix.inputs, "A_Color"))
         node_cases.ident(mix.inputs, "B_Color").default_value = (0.2, 0.4, 0.6, 1.0)
         node_cases.ident(mix.inputs, "A_Color").default_value = (0.9, 0.1, 0.1, 1.0)
         node_cases.ident(mix.inputs, "Factor_Float").default_value = 0.25
@@ -94,7 +94,7 @@ def test_unsupported_node_warns_and_falls_back(bpy_drt):
     from drt_addon.export import Reporter, export_scene
     reporter = Reporter()
     desc = export_scene(bpy.context.evaluated_depsgraph_get(), reporter, size=(8, 8))
-    warnings = [w for w in reporter.warnings if "Wave Texture" in w]
+    warnings = [w for w in reporter.warnings if "Gabor Texture" in w]
     assert len(warnings) == 1 and "unsupported" in warnings[0], reporter.warnings
     # Mix of the socket's own colour (A) and B at 0.25, folded to a constant
     assert desc.materials[0].emission == pytest.approx(

@@ -1,7 +1,7 @@
-"""The procedural texture nodes (White Noise, Noise, Voronoi) as DRT compiles and
-evaluates them, against Blender's own evaluation of the same node at the same points
-(tests/blender_fields.py: geometry nodes run the functions Cycles' kernels use, in
-float32), over every dimension, type, feature, metric, direction and profile.
+"""The procedural texture nodes (White Noise, Noise, Voronoi, Wave, Magic, Brick) as DRT
+compiles and evaluates them, against Blender's own evaluation of the same node at the
+same points (tests/blender_fields.py: geometry nodes run the functions Cycles' kernels
+use, in float32), over every dimension, type, feature, metric, direction and profile.
 
 Each case: a shader node tree with the texture node reading Object coordinates, compiled
 by the exporter's NodeCompiler, run by the engine's interpreter at 200 random points
@@ -133,6 +133,35 @@ def test_voronoi(bpy_drt, feature, dims):
                         output == "Position" and dims == "1D":
                     continue
                 check(bpy_drt, "ShaderNodeTexVoronoi", output, settings, inputs)
+
+
+@pytest.mark.parametrize("kind,direction", [("BANDS", d) for d in ("X", "Y", "Z", "DIAGONAL")]
+                         + [("RINGS", d) for d in ("X", "Y", "Z", "SPHERICAL")])
+def test_wave(bpy_drt, kind, direction):
+    inputs = {"Scale": 0.8, "Distortion": 2.0, "Detail": 2.5, "Detail Scale": 1.5,
+              "Detail Roughness": 0.6, "Phase Offset": 0.7}
+    for profile in ("SIN", "SAW", "TRI"):
+        settings = {"wave_type": kind, "wave_profile": profile,
+                    ("bands_direction" if kind == "BANDS" else "rings_direction"): direction}
+        check(bpy_drt, "ShaderNodeTexWave", "Fac", settings, inputs)
+
+
+@pytest.mark.parametrize("depth", range(0, 8))
+def test_magic(bpy_drt, depth):
+    for output in ("Color", "Fac"):
+        check(bpy_drt, "ShaderNodeTexMagic", output, {"turbulence_depth": depth},
+              {"Scale": 0.7, "Distortion": 1.2})
+
+
+@pytest.mark.parametrize("settings", [
+    {}, {"offset": 0.3, "offset_frequency": 3, "squash": 0.6, "squash_frequency": 2},
+    {"offset": 0.8, "offset_frequency": 1, "squash": 1.5, "squash_frequency": 3}])
+def test_brick(bpy_drt, settings):
+    inputs = {"Scale": 2.0, "Mortar Size": 0.05, "Mortar Smooth": 0.4, "Bias": 0.2,
+              "Brick Width": 0.6, "Row Height": 0.3, "Color1": (0.8, 0.3, 0.1, 1.0),
+              "Color2": (0.2, 0.5, 0.7, 1.0), "Mortar": (0.05, 0.1, 0.05, 1.0)}
+    for output in ("Color", "Fac"):
+        check(bpy_drt, "ShaderNodeTexBrick", output, settings, inputs)
 
 
 def test_comparison_fails_for_another_setting(bpy_drt):

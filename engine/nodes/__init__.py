@@ -17,9 +17,9 @@ One module per node family on each side, so a node is found by its family:
   input_nodes.py      Texture Coordinate, Geometry, Object Info, Fresnel, Layer Weight,
                       Light Path
   texture_nodes.py    Image, Checker, Gradient
-  procedural_nodes.py White Noise, Noise, Voronoi; their kernels: hash.py (Jenkins
-                      lookup3 and PCG hashes), noise.py (Perlin noise and fractals),
-                      voronoi.py, pattern_textures.py
+  procedural_nodes.py White Noise, Noise, Voronoi, Wave, Magic, Brick; their kernels:
+                      hash.py (Jenkins lookup3 and PCG hashes), noise.py (Perlin noise
+                      and fractals), voronoi.py, pattern_textures.py
   color_nodes.py      Mix (every blend mode), Color Ramp, Invert, Gamma,
                       Bright/Contrast, Hue/Saturation/Value
   converter_nodes.py  Math (every operation), Map Range, Clamp, Separate / Combine,

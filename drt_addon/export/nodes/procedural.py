@@ -1,5 +1,5 @@
-"""Procedural texture nodes to program operations (engine.nodes.procedural_nodes): White
-Noise, Noise, Voronoi.
+"""Procedural texture nodes to program operations (engine.nodes.procedural_nodes):
+White Noise, Noise, Voronoi, Wave, Magic, Brick.
 
 An unlinked Vector reads Generated coordinates, as in Cycles, except White Noise's, which
 is the socket's own value. A node whose legacy texture mapping (the node's Mapping panel
@@ -16,6 +16,7 @@ from .texture import C, coordinates
 P = importlib.import_module(engine.__name__ + ".nodes.procedural_nodes")
 N = importlib.import_module(engine.__name__ + ".nodes.noise")
 VOR = importlib.import_module(engine.__name__ + ".nodes.voronoi")
+PAT = importlib.import_module(engine.__name__ + ".nodes.pattern_textures")
 CV = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
 
 DIMENSIONS = {"1D": 1, "2D": 2, "3D": 3, "4D": 4}
@@ -90,8 +91,47 @@ def _voronoi(c, node, out):
                    _pack(c, node, ("Exponent", "Randomness", None)), mode])
 
 
+def _wave(c, node, out):
+    mode = (_index(PAT.WAVE_TYPES, node.wave_type, "wave type")
+            + 2 * _index(PAT.BANDS_DIRECTIONS, node.bands_direction, "bands direction")
+            + 8 * _index(PAT.RINGS_DIRECTIONS, node.rings_direction, "rings direction")
+            + 32 * _index(PAT.WAVE_PROFILES, node.wave_profile, "wave profile"))
+    fac = c.emit(P.TEX_WAVE, "float",
+                 [_texture_coordinates(c, node), _float(c, node, "Scale"),
+                  _pack(c, node, ("Distortion", "Detail", "Detail Scale")),
+                  _pack(c, node, ("Detail Roughness", "Phase Offset", None)), mode])
+    return fac if out.identifier == "Fac" else c.convert(fac, "color")
+
+
+def _magic(c, node, out):
+    color = c.emit(P.TEX_MAGIC, "color",
+                   [_texture_coordinates(c, node), _float(c, node, "Scale"),
+                    _float(c, node, "Distortion"), int(node.turbulence_depth)])
+    if out.identifier == "Fac":                    # Cycles: the colour's average
+        return c.emit(CV.CV_AVERAGE, "float", [color])
+    return color
+
+
+def _brick(c, node, out):
+    props = c.const((float(node.offset), float(node.squash), 0.0), "vector")
+    frequencies = int(node.offset_frequency) + 1024 * int(node.squash_frequency)
+    bricks = c.emit(P.TEX_BRICK, "vector",
+                    [_texture_coordinates(c, node),
+                     _pack(c, node, ("Scale", "Mortar Size", "Mortar Smooth")),
+                     _pack(c, node, ("Bias", "Brick Width", "Row Height")), props,
+                     frequencies])
+    if out.identifier == "Fac":
+        return c.emit(CV.CV_SEPARATE, "float", [bricks, 1])
+    return c.emit(P.TEX_BRICK_COLOR, "color",
+                  [bricks, c.input(node, "Color1", "color"), c.input(node, "Color2", "color"),
+                   c.input(node, "Mortar", "color")])
+
+
 TRANSLATORS = {
     "ShaderNodeTexWhiteNoise": _white_noise,
     "ShaderNodeTexNoise": _noise,
     "ShaderNodeTexVoronoi": _voronoi,
+    "ShaderNodeTexWave": _wave,
+    "ShaderNodeTexMagic": _magic,
+    "ShaderNodeTexBrick": _brick,
 }
