@@ -38,8 +38,9 @@ class Probe:
         return n
 
 
-def build_scene(bpy, cases, columns=None, shape="plane"):
-    """A new scene holding one tile per case; returns (scene, columns, rows)."""
+def build_scene(bpy, cases, columns=None, shape="plane", tile=TILE):
+    """A new scene holding one tile per case, `tile` pixels square; returns (scene,
+    columns, rows)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     n = len(cases)
@@ -76,8 +77,8 @@ def build_scene(bpy, cases, columns=None, shape="plane"):
     scene.collection.objects.link(cam)
     cam.location = (0.0, 0.0, 10.0)
     scene.camera = cam
-    scene.render.resolution_x = TILE * columns
-    scene.render.resolution_y = TILE * rows
+    scene.render.resolution_x = tile * columns
+    scene.render.resolution_y = tile * rows
     if columns != rows:
         cam_data.sensor_fit = "HORIZONTAL" if columns >= rows else "VERTICAL"
     scene.render.resolution_percentage = 100
@@ -103,13 +104,13 @@ def unlink_probes(bpy):
                     mat.node_tree.links.remove(link)
 
 
-def tiles(img, columns, rows):
-    """{index: (TILE, TILE, 3)} of an image rendered by build_scene (inner pixels only
+def tiles(img, columns, rows, tile=TILE):
+    """{index: (tile, tile, 3)} of an image rendered by build_scene (inner pixels only
     would hide edge errors, so the whole tile)."""
     out = {}
     for k in range(columns * rows):
         i, j = k % columns, k // columns
-        out[k] = img[j * TILE:(j + 1) * TILE, i * TILE:(i + 1) * TILE]
+        out[k] = img[j * tile:(j + 1) * tile, i * tile:(i + 1) * tile]
     return out
 
 

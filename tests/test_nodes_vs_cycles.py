@@ -1,5 +1,6 @@
-"""Shader nodes against Cycles, pixel by pixel (node_probe, node_cases): every case of
-every node family is one tile of an emission-only render by each engine.
+"""Shader nodes against Cycles, pixel by pixel (node_probe; the cases: node_cases and
+node_cases_procedural): every case of every node family is one tile of an emission-only
+render by each engine.
 
 Thresholds per tile (Cycles' tile mean floored at 0.02): the tile means within 1%, the
 8 x 8 block means within 3%, and the per-pixel mean absolute difference within 3% (it
@@ -14,6 +15,7 @@ import numpy as np
 import pytest
 
 import node_cases
+import node_cases_procedural
 import node_probe
 
 SAMPLES = 64
@@ -24,19 +26,23 @@ MEAN_TOL = 0.01
 BLOCK_TOL = 0.03
 PIXEL_TOL = 0.03
 
+FAMILIES = {**node_cases.FAMILIES, **node_cases_procedural.FAMILIES}
+TILES = node_cases_procedural.TILES          # pixels per tile where not node_probe.TILE
+
 _renders = {}
 
 
 def _family(bpy, name):
     if name not in _renders:
-        cases, shape = node_cases.FAMILIES[name]
-        scene, columns, rows = node_probe.build_scene(bpy, cases, shape=shape)
+        cases, shape = FAMILIES[name]
+        tile = TILES.get(name, node_probe.TILE)
+        scene, columns, rows = node_probe.build_scene(bpy, cases, shape=shape, tile=tile)
         spp = SPHERE_SAMPLES if shape == "sphere" else SAMPLES
         cycles = node_probe.render(bpy, scene, "CYCLES", spp)
         drt = node_probe.render(bpy, scene, "DRT", spp)
         node_probe.unlink_probes(bpy)
         fallback = node_probe.render(bpy, scene, "DRT", 4)
-        _renders[name] = (cases, [node_probe.tiles(img, columns, rows)
+        _renders[name] = (cases, [node_probe.tiles(img, columns, rows, tile)
                                   for img in (drt, cycles, fallback)])
     return _renders[name]
 
@@ -55,7 +61,7 @@ def _fails(errors):
     return mean > MEAN_TOL or block > BLOCK_TOL or mad > PIXEL_TOL
 
 
-@pytest.mark.parametrize("family", sorted(node_cases.FAMILIES))
+@pytest.mark.parametrize("family", sorted(FAMILIES))
 def test_nodes_match_cycles(bpy_drt, family):
     rows = _errors(bpy_drt, family)
     bad = [f"{name}: mean {e[0]:.2%}, pixels {e[1]:.2%}, block {e[2]:.2%}"
@@ -63,7 +69,7 @@ def test_nodes_match_cycles(bpy_drt, family):
     assert not bad, "\n".join(bad)
 
 
-@pytest.mark.parametrize("family", sorted(node_cases.FAMILIES))
+@pytest.mark.parametrize("family", sorted(FAMILIES))
 def test_comparison_fails_without_the_nodes(bpy_drt, family):
     rows = _errors(bpy_drt, family)
     passing = [name for name, _, control in rows if not _fails(control)]
@@ -76,9 +82,9 @@ def test_unsupported_node_warns_and_falls_back(bpy_drt):
     bpy = bpy_drt
 
     def build(nt, p):
-        noise = p.node(nt, "ShaderNodeTexWave")
+        gabor = p.node(nt, "ShaderNodeTexGabor")
         mix = p.node(nt, "ShaderNodeMix", data_type="RGBA")
-        nt.links.new(noise.outputs["Color"], node_cases.ident(mix.inputs, "A_Color"))
+        nt.links.new(gabor.outputs["Value"], node_cases.ident(mix.inputs, "A_Color"))
         node_cases.ident(mix.inputs, "B_Color").default_value = (0.2, 0.4, 0.6, 1.0)
         node_cases.ident(mix.inputs, "A_Color").default_value = (0.9, 0.1, 0.1, 1.0)
         node_cases.ident(mix.inputs, "Factor_Float").default_value = 0.25
@@ -88,7 +94,7 @@ def test_unsupported_node_warns_and_falls_back(bpy_drt):
     from drt_addon.export import Reporter, export_scene
     reporter = Reporter()
     desc = export_scene(bpy.context.evaluated_depsgraph_get(), reporter, size=(8, 8))
-    warnings = [w for w in reporter.warnings if "Wave Texture" in w]
+    warnings = [w for w in reporter.warnings if "Gabor Texture" in w]
     assert len(warnings) == 1 and "unsupported" in warnings[0], reporter.warnings
     # Mix of the socket's own colour (A) and B at 0.25, folded to a constant
     assert desc.materials[0].emission == pytest.approx(

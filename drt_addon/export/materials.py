@@ -56,7 +56,9 @@ Add Shader
 Linked inputs (any node graph, engine/nodes and export/nodes)
     The graph linked to an input is compiled into the material's shader program, which
     the engine runs at every hit (`engine.nodes`): Image, Checker and Gradient textures,
-    the colour, converter, vector and input nodes, node groups and reroutes. A graph
+    the procedural textures with Blender's own noise (White Noise, Noise, Voronoi, Wave,
+    Magic, Brick), the colour, converter, vector and input nodes, node groups and
+    reroutes. A graph
     that does not depend on the hit is folded into a constant at export. Base Color,
     Metallic, Roughness, Emission Color and Strength and Alpha (and the Color of
     Diffuse, Glossy and Emission) vary per hit; other inputs (IOR, Transmission, the

@@ -17,6 +17,9 @@ One module per node family on each side, so a node is found by its family:
   input_nodes.py      Texture Coordinate, Geometry, Object Info, Fresnel, Layer Weight,
                       Light Path
   texture_nodes.py    Image, Checker, Gradient
+  procedural_nodes.py White Noise, Noise, Voronoi, Wave, Magic, Brick; their kernels:
+                      hash.py (Jenkins lookup3 and PCG hashes), noise.py (Perlin noise
+                      and fractals), voronoi.py, pattern_textures.py
   color_nodes.py      Mix (every blend mode), Color Ramp, Invert, Gamma,
                       Bright/Contrast, Hue/Saturation/Value
   converter_nodes.py  Math (every operation), Map Range, Clamp, Separate / Combine,
@@ -26,6 +29,6 @@ One module per node family on each side, so a node is found by its family:
 Registers are float64; a colour or vector takes three consecutive registers (colours
 carry no alpha: an Image's Alpha is its own output). An instruction is eight int32:
 opcode, output register, then operands (input registers or immediate codes, as each
-family documents). Opcode ranges: input 0-99, texture 100-199, colour 200-299,
-converter 300-399, vector 400-499.
+family documents). Opcode ranges: input 0-99, texture 100-119, procedural textures
+120-199, colour 200-299, converter 300-399, vector 400-499.
 """

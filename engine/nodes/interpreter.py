@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.jit import kernel
-from . import color_nodes, converter_nodes, input_nodes, texture_nodes, vector_nodes
+from . import color_nodes, converter_nodes, input_nodes, procedural_nodes, texture_nodes, \
+    vector_nodes
 from .pack import DATA, INIT, NREGS, OPS, PROG, pack_shading
 
 
@@ -31,8 +32,10 @@ def run(T, m, hit, regs):
         code = ins[0]
         if code < 100:
             input_nodes.execute(ins, regs, hit)
-        elif code < 200:
+        elif code < 120:
             texture_nodes.execute(ins, regs, T)
+        elif code < 200:
+            procedural_nodes.execute(ins, regs)
         elif code < 300:
             color_nodes.execute(ins, regs, data)
         elif code < 400:

@@ -1,4 +1,4 @@
-"""Texture nodes. Opcodes 100-199. Vectors are registers of the texture coordinates (the
+"""Texture nodes. Opcodes 100-119 (120-199: procedural_nodes). Vectors are registers of the texture coordinates (the
 compiler feeds the node's default, UV for Image and Generated for the procedural ones,
 when its Vector is unlinked).
 

@@ -18,14 +18,14 @@ from __future__ import annotations
 import importlib
 
 from ...engine_link import engine
-from . import color, converter, input, texture, vector
+from . import color, converter, input, procedural, texture, vector
 from .errors import Unsupported
 
 program = importlib.import_module(engine.__name__ + ".nodes.program")
 cv = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
 
 TRANSLATORS = {}
-for _family in (input, texture, color, converter, vector):
+for _family in (input, texture, procedural, color, converter, vector):
     TRANSLATORS.update(_family.TRANSLATORS)
 
 SOCKET_KINDS = {"VALUE": "float", "INT": "float", "BOOLEAN": "float", "RGBA": "color",
