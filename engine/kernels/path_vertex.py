@@ -216,6 +216,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         # the lobe choice's number; a Mix Shader picks its shader with it first
         u_lobe = sample_1d(kind, pkey[p], spp, index[p], base + D.BSDF_LOBE)
         ms = m                                   # the material shaded
+        n0x, n0y, n0z = nx, ny, nz               # the surface's own shading normal
         if programmed:
             program_hit(textures, geometry, m, prim, hit_u[j], hit_v[j], uu, vv, px, py, pz,
                         gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bits[p], depth, t_geom,
@@ -265,8 +266,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                                             see_t)
                 fr, fg, fb = fr * cosine, fg * cosine, fb * cosine
                 if see_d:
-                    dr, dg, db = bent_diffuse(state, wox, woy, woz, gx, gy, gz, rx, ry, rz,
-                                              wx, wy, wz)
+                    dr, dg, db = bent_diffuse(state, wox, woy, woz, n0x, n0y, n0z, rx, ry,
+                                              rz, wx, wy, wz)
                     fr, fg, fb = fr + dr, fg + dg, fb + db
                 cosine = 1.0
             else:
@@ -317,7 +318,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             # cosine to the raw normal's (with bump shadowing)
             fd_r, fd_g, fd_b = bsdf.eval_seen(state, wox, woy, woz, 0.0, 0.0, 1.0, True,
                                               False, False)
-            dr, dg, db = bent_diffuse(state, wox, woy, woz, gx, gy, gz, rx, ry, rz, wx, wy, wz)
+            dr, dg, db = bent_diffuse(state, wox, woy, woz, n0x, n0y, n0z, rx, ry, rz, wx, wy,
+                                      wz)
             c = abs(iz)
             wr = max(wr + (dr - fd_r * c) / spdf, 0.0)
             wg = max(wg + (dg - fd_g * c) / spdf, 0.0)

@@ -135,25 +135,29 @@ def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz):
 
 
 @kernel
-def bent_diffuse(state, wox, woy, woz, gx, gy, gz, rx, ry, rz, lx, ly, lz):
+def bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz):
     """The diffuse lobe's f x cos towards world direction l under the raw bent normal r
-    (Cycles: Lambert on the node's normal, times bump_shadowing), with the lobe's
-    (direction-independent) value read from the BSDF set up on the specular frame."""
+    (Cycles: Lambert on the node's normal, times bump_shadowing against the surface's
+    own shading normal s), with the lobe's (direction-independent) value read from the
+    BSDF set up on the specular frame."""
     cos_d = rx * lx + ry * ly + rz * lz
     if not cos_d > 0.0:
         return 0.0, 0.0, 0.0
     fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, 0.0, 0.0, 1.0, True, False, False)
-    k = cos_d * bump_shadowing(gx, gy, gz, rx, ry, rz, lx, ly, lz)
+    k = cos_d * bump_shadowing(sx, sy, sz, rx, ry, rz, lx, ly, lz)
     return fr * k, fg * k, fb * k
 
 
 @kernel
 def bump_shadowing(gx, gy, gz, nx, ny, nz, lx, ly, lz):
-    """Cycles' bump_shadowing_term (after appleseed) for a diffuse lobe whose normal n
-    is not the surface's: fades light towards the geometric terminator instead of the
-    bent normal's, g = (Ng.L) / ((N.L)(Ng.N)); 1 for g >= 1, 0 for g < 0, smoothed
-    between."""
+    """Cycles' bump_shadowing_term ("Taming the Shadow Terminator", Chiang et al.) for a
+    diffuse lobe whose normal n is not the surface's shading normal g: fades light
+    towards the surface's terminator instead of the bent normal's, with
+    t = (g.L) / ((n.L)(g.n)) (g flipped when n.L < 0); 1 for t >= 1, 0 for t < 0,
+    smoothed between."""
     ndl = nx * lx + ny * ly + nz * lz
+    if ndl < 0.0:
+        gx, gy, gz = -gx, -gy, -gz
     gdn = gx * nx + gy * ny + gz * nz
     den = ndl * gdn
     g = (gx * lx + gy * ly + gz * lz) / den if den != 0.0 else 0.0
