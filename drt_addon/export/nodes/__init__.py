@@ -1,5 +1,7 @@
 """Shader node graphs to engine.nodes programs: `compiler.NodeCompiler` walks the graph
-from the sockets a shader reads; one module per node family (input, texture, color,
-converter, vector; procedural for the noise textures) translates each node to program
+from the sockets a shader reads; one module per node family (input, texture,
+procedural, color, converter, vector, shader) translates each node to program
 operations, named by the same families as the engine's interpreter (engine/nodes/)."""
-from .compiler import NodeCompiler  # noqa: F401
+from .compiler import NodeCompiler
+
+__all__ = ["NodeCompiler"]
