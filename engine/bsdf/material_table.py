@@ -153,6 +153,10 @@ class MaterialTable:
         index = np.asarray(index, dtype=np.int64)
         if name in self.programmed and len(index):
             return self._programmed_lookup(name, index, uv, hits)
+        return self._plain_lookup(name, index, uv)
+
+    def _plain_lookup(self, name, index, uv) -> np.ndarray:
+        """`lookup` from the plain values and textures (no programs)."""
         if name == "emission":
             out = np.where(self.emission_textured[index][:, None], 0.0, self.emission[index])
         else:
@@ -181,7 +185,7 @@ class MaterialTable:
         colour = name in ("base_color", "emission")
         out = np.zeros((len(index), 3)) if colour else np.zeros(len(index))
         if rest.size:
-            out[rest] = self.lookup_plain(name, index[rest], None if uv is None else uv[rest])
+            out[rest] = self._plain_lookup(name, index[rest], None if uv is None else uv[rest])
         if hits is None:
             n = len(index)
             uv2 = np.zeros((n, 2)) if uv is None else uv
@@ -199,9 +203,9 @@ class MaterialTable:
         """The shading normals (n, 3) of hits whose materials' programs set one (a Normal
         Map), else ns; as in the kernels (engine.nodes.shading.program_normal), made a
         valid specular reflector for the hit's view direction as Cycles does."""
+        from ..nodes.context import H_I
         from ..nodes.interpreter import evaluate_materials
-        from ..nodes.pack import OUTS
-        from ..nodes.program import OUTPUTS
+        from ..nodes.shading import normal_rows
         index = np.asarray(index, np.int64)
         has = np.array([p is not None and "normal" in p.outputs for p in self.programs],
                        bool)
@@ -210,27 +214,11 @@ class MaterialTable:
             return ns
         T = self.shading()
         regs = evaluate_materials(T, index[rows], hits[rows])
-        reg = T[OUTS][index[rows], OUTPUTS.index("normal")]
-        n = np.stack([regs[np.arange(len(rows)), reg + k] for k in range(3)], 1)
-        from ..nodes.context import H_I
-        from ..nodes.shading import valid_reflection_normal
         out = ns.copy()
-        for j, r in enumerate(rows):
-            x, y, z = n[j]
-            length = float(np.sqrt(x * x + y * y + z * z))
-            if length > 0 and np.isfinite(length):
-                out[r] = valid_reflection_normal(*ng[r], *hits[r, H_I:H_I + 3], x / length,
-                                                 y / length, z / length)
+        out[rows] = normal_rows(T, index[rows], regs, np.ascontiguousarray(ns[rows]),
+                                np.ascontiguousarray(ng[rows]),
+                                np.ascontiguousarray(hits[rows, H_I:H_I + 3]))
         return out
-
-    def lookup_plain(self, name, index, uv=None) -> np.ndarray:
-        """`lookup` without programs (their plain values and textures)."""
-        programmed = self.programmed.pop(name, None)
-        try:
-            return self.lookup(name, index, uv)
-        finally:
-            if programmed is not None:
-                self.programmed[name] = programmed
 
     def emission_at(self, index, uv=None, hits=None) -> np.ndarray:
         """Emitted radiance (n, 3) of the hits' materials, textures evaluated."""

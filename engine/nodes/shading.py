@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
 from .context import fill
@@ -132,6 +134,19 @@ def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz):
     x, y, z = x / ln, y / ln, z / ln
     vx, vy, vz = valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z)
     return vx, vy, vz, x, y, z
+
+
+@kernel
+def normal_rows(T, material, regs, ns, ng, incoming):
+    """`program_normal` (its specular normal) for hits given as arrays, for the NumPy
+    reference: (n, 3)."""
+    out = np.empty_like(ns)
+    for i in range(material.shape[0]):
+        x, y, z, _, _, _ = program_normal(T, material[i], regs[i], ns[i, 0], ns[i, 1],
+                                          ns[i, 2], ng[i, 0], ng[i, 1], ng[i, 2],
+                                          incoming[i, 0], incoming[i, 1], incoming[i, 2])
+        out[i, 0], out[i, 1], out[i, 2] = x, y, z
+    return out
 
 
 @kernel
