@@ -35,6 +35,9 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
     glossy_bounces: IntProperty(name="Glossy", default=4, min=0, max=1024)
     transmission_bounces: IntProperty(name="Transmission", default=12, min=0, max=1024)
     transparent_bounces: IntProperty(name="Transparent", default=8, min=0, max=1024)
+    volume_bounces: IntProperty(name="Volume", description="Scatterings in volumes a path "
+                                "goes on after (0: direct light in volumes only)",
+                                default=0, min=0, max=1024)
     clamp_direct: FloatProperty(name="Direct Light", description="Clamp direct light "
                                 "samples to this value (0 disables)", default=0.0, min=0.0)
     clamp_indirect: FloatProperty(name="Indirect Light", description="Clamp indirect light "
@@ -61,7 +64,8 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
             integrator=self.integrator, max_bounces=self.max_bounces,
             diffuse_bounces=self.diffuse_bounces, glossy_bounces=self.glossy_bounces,
             transmission_bounces=self.transmission_bounces,
-            transparent_bounces=self.transparent_bounces, clamp_direct=self.clamp_direct,
+            transparent_bounces=self.transparent_bounces,
+            volume_bounces=self.volume_bounces, clamp_direct=self.clamp_direct,
             clamp_indirect=self.clamp_indirect, filter_type=self.filter_type,
             filter_width=self.filter_width, threads=self.threads)
 

@@ -38,7 +38,7 @@ class DRT_PT_light_paths(DRTPanel, bpy.types.Panel):
         col = self.layout.column(align=True)
         col.use_property_split = True
         for name in ("max_bounces", "diffuse_bounces", "glossy_bounces",
-                     "transmission_bounces", "transparent_bounces"):
+                     "transmission_bounces", "transparent_bounces", "volume_bounces"):
             col.prop(s, name)
         col = self.layout.column(align=True)
         col.use_property_split = True

@@ -5,11 +5,11 @@ Never imports bpy. The input is an `engine.scene.Scene`, the output an `engine.f
 from .film import Film
 from .render import RenderContext, RenderStats, render
 from .scene import (AreaLight, Camera, Material, ObjectInfo, PointLight, Scene, SunLight,
-                    TriangleMesh, World)
+                    TriangleMesh, Volume, World)
 from .settings import RenderSettings
 from . import visibility  # noqa: E402  (the Ray Visibility bits, for exporters)
 
 __all__ = ["AreaLight", "Camera", "Film", "Material", "ObjectInfo", "PointLight",
            "RenderContext",
-           "RenderSettings", "RenderStats", "Scene", "SunLight", "TriangleMesh", "World",
+           "RenderSettings", "RenderStats", "Scene", "SunLight", "TriangleMesh", "Volume", "World",
            "render"]

@@ -69,6 +69,8 @@ class Material:
     alpha_texture: Optional[object] = None
     shader: Optional[object] = None
     mix: Optional[tuple] = None
+    volume: Optional[object] = None      # Volume: the homogeneous medium inside its meshes
+    surface: bool = True                 # False: no surface shader, a volume's boundary
 
     TEXTURED = ("base_color", "metallic", "roughness", "emission", "alpha")
 
@@ -96,6 +98,24 @@ class Material:
 
     def uses_uv(self) -> bool:
         return bool(self.textures()) or self.shader is not None
+
+
+@dataclass
+class Volume:
+    """A homogeneous medium, with Cycles' meaning of its coefficients (per metre, RGB):
+    absorption sigma_a and scattering sigma_s (extinction sigma_t = sigma_a + sigma_s),
+    Henyey-Greenstein `anisotropy` g of the scattering (-1 back, 0 isotropic, 1 forward)
+    and `emission`, radiance emitted per metre of path. A material's volume fills the
+    inside of its (closed) meshes; the world's fills all space outside them. See
+    engine.kernels.volume."""
+    absorption: tuple = (0.0, 0.0, 0.0)
+    scattering: tuple = (0.0, 0.0, 0.0)
+    anisotropy: float = 0.0
+    emission: tuple = (0.0, 0.0, 0.0)
+
+    def is_empty(self) -> bool:
+        return not (any(v > 0 for v in self.absorption) or any(v > 0 for v in self.scattering)
+                    or any(v > 0 for v in self.emission))
 
 
 @dataclass
@@ -266,6 +286,7 @@ class World:
     strength: tuple = (1.0, 1.0, 1.0)
     mapping: Optional[np.ndarray] = None
     visibility: int = 31
+    volume: Optional[object] = None      # Volume filling the space outside every mesh
 
 
 @dataclass
@@ -302,6 +323,11 @@ class Scene:
         lm = self.camera.lens_motion
         zooms = lm is not None and bool(np.ptp(np.asarray(lm[1], dtype=np.float64)) > 0)
         return bool(moving) or camera_moves or zooms or lamps_move
+
+    def has_volumes(self) -> bool:
+        """Whether any material or the world holds a medium (engine.kernels.volume)."""
+        return any(m.volume is not None or not m.surface for m in self.materials) \
+            or self.world.volume is not None
 
     def has_holdouts(self) -> bool:
         return any(m.holdout for m in self.meshes)

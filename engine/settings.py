@@ -19,6 +19,7 @@ class RenderSettings:
     glossy_bounces: int = 4
     transmission_bounces: int = 12
     transparent_bounces: int = 8
+    volume_bounces: int = 0           # scatterings in volumes a path goes on after
     clamp_direct: float = 0.0         # 0 = off, as in Cycles
     clamp_indirect: float = 10.0
     # Cycles' Filter Glossy (`blur_glossy`, 0 = off) and caustics switches
@@ -47,7 +48,7 @@ class RenderSettings:
         if self.integrator not in INTEGRATORS:
             problems.append(f"integrator must be one of {INTEGRATORS}, got {self.integrator!r}")
         for name in ("max_bounces", "diffuse_bounces", "glossy_bounces",
-                     "transmission_bounces", "transparent_bounces"):
+                     "transmission_bounces", "transparent_bounces", "volume_bounces"):
             v = getattr(self, name)
             if not isinstance(v, int) or v < 0 or v > 1024:
                 problems.append(f"{name} must be an integer in 0..1024, got {v!r}")

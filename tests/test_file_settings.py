@@ -222,7 +222,7 @@ def test_fresh_scene_defaults_are_quiet(bpy_drt):
     (lambda s: setattr(s.cycles, "use_animated_seed", True), "same Seed on every frame"),
     (lambda s: setattr(s.cycles, "use_light_tree", False), "Light Tree is off"),
     (lambda s: setattr(s.cycles, "time_limit", 30.0), "Time Limit is 30"),
-    (lambda s: setattr(s.cycles, "volume_bounces", 2), "no volumes"),
+    (lambda s: setattr(s.cycles, "volume_bounces", 2), "Volume bounces"),
     (lambda s: setattr(s.cycles, "use_fast_gi", True), "full global illumination"),
     (lambda s: setattr(s.render, "use_freestyle", True), "Freestyle"),
     (lambda s: setattr(s.view_layers[0], "samples", 16), "View Layer > Override > Samples"),

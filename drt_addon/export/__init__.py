@@ -12,6 +12,7 @@ from .materials import export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
 from .motion import MotionExport, read_settings
 from .object_info import object_info
+from .volumes import world_volume
 from .world import export_world
 
 __all__ = ["ExportError", "RenderRegion", "Reporter", "export_scene", "render_region",
@@ -120,6 +121,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
     if not materials:
         materials.append(engine.Material())
     world = export_world(scene.world, reporter)
+    if scene.world is not None:
+        world.volume = world_volume(scene.world, reporter)
     shutter = tracker.finish(meshes, camera, lights) if tracker is not None else None
     if stats is not None:
         stats.update(mesh_evaluations=cache.evaluations, mesh_reuses=cache.reuses,

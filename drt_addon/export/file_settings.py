@@ -64,7 +64,9 @@ def _no_effect(names, how, prefix="scene.cycles"):
     return [_s(f"{prefix}.{name}", name, NO_EFFECT, how) for name in names]
 
 
-_NO_VOLUMES = "DRT renders no volumes (volume shaders are skipped with a warning)"
+_NO_VOLUMES = "DRT renders homogeneous volumes only (a varying density by its average)"
+_HOMOGENEOUS = ("DRT renders homogeneous volumes exactly, without ray marching steps "
+                "(a varying density is replaced by its average, with a warning)")
 _SIMPLIFY = ("scene.render.use_simplify", (True,))
 WRITTEN_PASSES = "Combined, Depth, Normal, Denoising Data and DRT Noise"
 _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
@@ -251,11 +253,10 @@ SETTINGS: list[FileSetting] = [
         "surface_guiding_probability", "use_volume_guiding", "guiding_training_samples",
         "volume_guiding_probability", "use_guiding_direct_light", "use_guiding_mis_weights",
         "guiding_roughness_threshold"]),
-    _ignored("scene.cycles.volume_bounces", "Light Paths > Max Bounces > Volume",
-             _NO_VOLUMES, 0),
-    _ignored("scene.cycles.volume_step_rate", "Volumes > Step Rate Render", _NO_VOLUMES, 1.0),
-    _ignored("scene.cycles.volume_max_steps", "Volumes > Max Steps", _NO_VOLUMES, 1024),
-    _ignored("scene.cycles.volume_biased", "Volumes > Biased", _NO_VOLUMES, False),
+    _own("volume_bounces", "Light Paths > Max Bounces > Volume", "volume_bounces",
+         "Volume bounces (DRT's Light Paths panel)", 0),
+    *_no_effect(["volume_step_rate", "volume_max_steps"], _HOMOGENEOUS),
+    _ignored("scene.cycles.volume_biased", "Volumes > Biased", _HOMOGENEOUS, False),
     _ignored("scene.render.simplify_volumes", "Simplify > Volume Resolution", _NO_VOLUMES,
              1.0, when=_SIMPLIFY),
     _ignored("scene.cycles.use_fast_gi", "Light Paths > Fast GI Approximation",

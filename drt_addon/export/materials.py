@@ -84,6 +84,7 @@ from .images import image_cache
 from .nodes import NodeCompiler
 from .nodes.links import _all_nodes, _link, _output_node, uses_nodes
 from .nodes.shader import _closure
+from .volumes import export_volume
 
 
 
@@ -166,14 +167,14 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
         ctx.issue("it has no Material Output node; using its viewport colour")
         result = fallback
     else:
-        vol = out.inputs.get("Volume")
-        if vol is not None and _link(vol) is not None:
-            ctx.issue("its volume shader is not rendered")
         disp = out.inputs.get("Displacement")
         if disp is not None and _link(disp) is not None:
             ctx.issue("its displacement is not rendered")
         result = _material(_closure(out.inputs["Surface"], ctx), ctx, name)
         _attach_programs(result, ctx, ctx.nodes.build())
+        # a volume inside its meshes; with no surface shader, the surface is its boundary
+        result.volume = export_volume(out.inputs.get("Volume"), ctx)
+        result.surface = result.volume is None or _link(out.inputs["Surface"]) is not None
     if ctx.issues and reporter is not None:
         reporter.warn(f"DRT: material {name!r}: " + "; ".join(ctx.issues),
                       key=(name, "material"))

@@ -15,8 +15,15 @@ def make_integrator(name, ctx):
              "whitted": WhittedIntegrator}
     if name == "path":
         from .compiled_path import CompiledPathIntegrator, unsupported
-        if unsupported(ctx) is None:
+        why = unsupported(ctx)
+        if why is None:
             return CompiledPathIntegrator(ctx)
+        if ctx.scene.has_volumes():
+            raise ValueError(f"the scene has volumes, which the path integrator renders "
+                             f"only where it runs compiled; here it cannot: {why}")
+    elif ctx.scene.has_volumes():
+        raise ValueError(f"the scene has volumes, which only the 'path' integrator renders "
+                         f"(not {name!r})")
     try:
         return table[name](ctx)
     except KeyError:

@@ -22,14 +22,19 @@ import numpy as np
 from .. import visibility
 from ..kernels import lights as klights
 from ..kernels.bsdf import principled as kbsdf
-from ..kernels.path_vertex import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
-                                   add_unoccluded, shade)
+from ..bsdf.material_table import flatten_mixes
+from ..kernels.path_vertex import shade
+from ..kernels.path_weights import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
+                                    add_unoccluded)
+from ..kernels.volume import STACK, pack_volumes
+from .volume_stack import camera_stack
 from ..nodes.context import N_OBJ
 from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
 from ..sampling.dispatch import pixel_keys
 from .path import MIS_MODES
 
 _MODE_IDS = {"mis": MIS, "light": LIGHT_ONLY, "bsdf": BSDF_ONLY}
+VOLUME_BOUNDS_MAX = 256     # volume boundaries one path may cross (Cycles: 1024)
 
 
 def unsupported(ctx) -> str | None:
@@ -57,7 +62,8 @@ class CompiledPathIntegrator:
                              s.diffuse_bounces, s.glossy_bounces, s.transmission_bounces,
                              s.clamp_direct, s.clamp_indirect, MIS, ctx.scene_radius,
                              float(ctx.scene.film_transparent), s.filter_glossy,
-                             float(s.caustics_reflective), float(s.caustics_refractive)],
+                             float(s.caustics_reflective), float(s.caustics_refractive),
+                             s.volume_bounces],
                             dtype=np.float64)
         self.geometry = (surf.v0, surf.v1, surf.v2, surf.normal, surf.tri_scale, surf.material,
                          _or_empty(surf.corner_normals, (0, 3, 3), np.float32),
@@ -86,6 +92,13 @@ class CompiledPathIntegrator:
         self.tables = kbsdf.kernel_tables()
         self.lights = klights.pack_lights(ctx.lights, surf.visibility)
         self.world = np.ascontiguousarray(ctx.world_radiance, dtype=np.float64)
+        # homogeneous volumes (engine.kernels.volume): the table, and the media the
+        # camera is inside, where every path starts
+        self.vol = pack_volumes(flatten_mixes(ctx.scene.materials)[0],
+                                ctx.scene.world.volume)
+        self.has_volumes = self.vol.shape[0] > 0
+        self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
+                            else np.full(STACK, -1, np.int32))
 
     @property
     def mis_mode(self) -> str:
@@ -128,9 +141,10 @@ class CompiledPathIntegrator:
             layer += 1
         return t_all, prim_all, u_all, v_all, factor, stopped
 
-    def _transmittance(self, org, dirs, far, time):
-        """Transmittance (n, 3) of shadow rays through transparent layers; time: their
-        shutter times (None when nothing moves)."""
+    def _transmittance(self, org, dirs, far, time, stacks):
+        """Transmittance (n, 3) of shadow rays through transparent layers and volumes
+        (stacks: each ray's volume stack, updated as it crosses boundaries; (0, STACK)
+        without volumes); time: their shutter times (None when nothing moves)."""
         n = len(org)
         trans = np.ones((n, 3))
         rows = np.arange(n, dtype=np.int64)
@@ -143,7 +157,7 @@ class CompiledPathIntegrator:
                                          None if time is None else time[rows])
             k = shadow_pass(layer, self.transparent_limit, rows, dirs, ray_time, remaining,
                             h.t, h.prim, h.u, h.v, trans, self.geometry, self.materials,
-                            out_rows, out_org, out_far)
+                            self.vol, stacks, out_rows, out_org, out_far)
             rows = out_rows[:k].copy()
             o, remaining = out_org[:k].copy(), out_far[:k].copy()
             layer += 1
@@ -166,6 +180,13 @@ class CompiledPathIntegrator:
         prev_pdf = np.full(n, np.inf)              # camera rays count as specular: weight 1
         prev_pos = np.ascontiguousarray(origins, dtype=np.float64).copy()
         live = np.arange(n, dtype=np.int64)
+        bounce = np.zeros(n, dtype=np.int64)       # bounces per path (not boundaries)
+        vbounce = np.zeros(n, dtype=np.int64)      # volume scatterings per path
+        k = n if self.has_volumes else 0
+        stacks = np.ascontiguousarray(np.tile(self.start_stack, (k, 1)), np.int32)
+        sh_stack = np.full((k, STACK), -1, np.int32)
+        sh_bounce = np.empty(n, np.int64)
+        media = (bounce, vbounce, self.vol, stacks, sh_stack, sh_bounce)
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(dirs, dtype=np.float64)
         tm = np.ascontiguousarray(np.broadcast_to(tmax, (n,)), dtype=np.float64)
@@ -178,7 +199,9 @@ class CompiledPathIntegrator:
         # each path's shutter time, kept for all its rays (zeros when nothing moves)
         moving = time is not None
         path_time = np.ascontiguousarray(time, np.float64) if moving else np.zeros(n)
-        for depth in range(self.max_bounces + 1):
+        # one step per bounce, and per crossing of a volume's boundary
+        steps = self.max_bounces + 1 + (VOLUME_BOUNDS_MAX if self.has_volumes else 0)
+        for depth in range(steps):
             if live.size == 0:
                 break
             ray_time = path_time[live] if moving else None
@@ -193,19 +216,20 @@ class CompiledPathIntegrator:
                            prev_pdf, prev_pos, ray_bits, min_pdf, path_time, live, o, d, tm,
                            t, prim, u, v, stopped,
                            self.geometry, self.params, self.emission, self.textures,
-                           self.tables, self.lights, self.world,
+                           self.tables, self.lights, self.world, media,
                            sh_path, sh_org, sh_dir, sh_far, sh_contrib,
                            nx_path, nx_org, nx_dir)
             if ns:
-                limit = s.clamp_direct if depth == 0 else s.clamp_indirect
                 sh_time = path_time[sh_path[:ns]] if moving else None
-                if self.any_transparent or self.skips_shadows:
-                    trans = self._transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns], sh_time)
-                    add_transmitted(L, sh_path[:ns], sh_contrib[:ns], trans, limit)
+                clamps = (sh_bounce[:ns], s.clamp_direct, s.clamp_indirect)
+                if self.any_transparent or self.skips_shadows or self.has_volumes:
+                    trans = self._transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns], sh_time,
+                                                sh_stack[:ns] if k else sh_stack)
+                    add_transmitted(L, sh_path[:ns], sh_contrib[:ns], trans, *clamps)
                 else:
                     blocked = ctx.accel.occluded(sh_org[:ns], sh_dir[:ns], sh_far[:ns],
                                                  sh_time)
-                    add_unoccluded(L, sh_path[:ns], sh_contrib[:ns], blocked, limit)
+                    add_unoccluded(L, sh_path[:ns], sh_contrib[:ns], blocked, *clamps)
             live = nx_path[:nn].copy()
             o, d = nx_org[:nn].copy(), nx_dir[:nn].copy()
             tm = np.full(nn, np.inf)

@@ -16,14 +16,20 @@ import math
 
 import numpy as np
 
-from .. import visibility
 from ..bsdf.lobes import TRANSMISSION
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
 from .bsdf import principled as bsdf
 from .frame import dot, to_local, to_world
+from . import shadow_rays
+from .frame import length
 from .jit import kernel
+from .medium_vertex import scatter
+from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
+                           TRANSMISSION_BIT, _add, _INF, hit_weight, nee_weight, roulette,
+                           uncovered)
+from .volume import V_BOUNDARY, V_HAS, in_medium, passed, segment, stack_cross, volume_dim
 from .bsdf.params import P_BASE, P_FILTER_ALPHA, P_METALLIC, P_ROUGHNESS
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import apply_to_row, emission_at
@@ -32,69 +38,6 @@ from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
 from ..nodes.shading import (apply_rows, bent_diffuse, pick_closure, program_emission,
                              program_hit, program_normal)
-
-MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
-# Numba freezes these into its cache; the cache's fingerprint covers every engine file
-DIFFUSE_BIT, GLOSSY_BIT, TRANSMISSION_BIT, SHADOW_BIT = (
-    visibility.DIFFUSE, visibility.GLOSSY, visibility.TRANSMISSION, visibility.SHADOW)
-ROULETTE_START = 3
-_INF = np.inf
-
-
-@kernel
-def power_heuristic(a, b):
-    if math.isinf(a):
-        return 1.0
-    if math.isinf(b):
-        return 0.0
-    a2, b2 = a * a, b * b
-    return a2 / (a2 + b2) if a2 + b2 > 0.0 else 0.0
-
-
-@kernel
-def hit_weight(mode, prev_pdf, light_pdf):
-    """Weight of emission found by a BSDF-sampled ray (pdf prev_pdf; inf after a camera
-    ray or a specular bounce) that light sampling reaches with light_pdf."""
-    if mode == MIS:
-        return power_heuristic(prev_pdf, light_pdf)
-    if mode == LIGHT_ONLY:
-        return 1.0 if (math.isinf(prev_pdf) or not light_pdf > 0.0) else 0.0
-    return 1.0
-
-
-@kernel
-def nee_weight(mode, light_pdf, bsdf_pdf, delta):
-    """Weight of a light sample that the BSDF would have sampled with bsdf_pdf."""
-    if mode == MIS:
-        return 1.0 if delta else power_heuristic(light_pdf, bsdf_pdf)
-    if mode == LIGHT_ONLY:
-        return 1.0
-    return 1.0 if (delta or not bsdf_pdf > 0.0) else 0.0
-
-
-@kernel
-def clamp_scale(r, g, b, limit):
-    """Cycles' clamp: the factor that scales (r, g, b) so no channel exceeds limit."""
-    m = max(r, g, b)
-    if limit > 0.0 and m > limit:
-        return limit / max(m, 1e-300)
-    return 1.0
-
-
-@kernel
-def _add(L, p, r, g, b, limit):
-    s = clamp_scale(r, g, b, limit)
-    L[p, 0] += r * s
-    L[p, 1] += g * s
-    L[p, 2] += b * s
-
-
-@kernel
-def uncovered(br, bg, bb):
-    """Alpha of a camera sample whose ray got through with throughput b (see
-    engine.integrators.coverage)."""
-    return 1.0 - min(max((br + bg + bb) / 3.0, 0.0), 1.0)
-
 
 @kernel
 def prepare_closures(cfg, row, min_pdf, ray_bit):
@@ -125,7 +68,7 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
 @kernel
 def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, ray_bits,
           min_pdf, path_time, live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
-          geometry, params, emission, textures, tables, lights, world,
+          geometry, params, emission, textures, tables, lights, world, media,
           sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
 
@@ -147,7 +90,18 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     far (Filter Glossy, `prepare_closures`). Writes the shadow rays to sh_* (their
     contributions before the clamp, which `add_transmitted` applies) and the continuing paths' next
     rays to nx_*; returns (shadow count, next count). beta, counts, L, alpha, prev_pdf,
-    prev_pos are per-path state, updated in place."""
+    prev_pos are per-path state, updated in place.
+
+    media: (bounce, volume bounces, VOL, stacks, shadow stacks, shadow bounces): each
+    path's bounces so
+    far (depth counts the wavefront's steps, which include crossings of volume
+    boundaries) and volume scatterings, the volume table and the paths' volume stacks
+    (engine.kernels.volume; empty when the scene has no media) and the shadow rays'
+    copies of them. A ray in a medium first travels through it (`volume.segment`): it
+    may scatter there (`medium_vertex.scatter` shades that point), emission along it is
+    added, and what it reaches beyond is weighted by its transmittance. A hit on a
+    volume's boundary surface is crossed without a bounce."""
+    bounce, vbounce, vol, stacks, sh_stack, sh_bounce = media
     tri_material, holdout, corner_uvs = geometry[5], geometry[7], geometry[8]
     any_textures = textures[1].shape[0] > 0
     film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
@@ -155,10 +109,6 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     max_bounces = int(cfg[2])
     clamp_direct, clamp_indirect, mode = cfg[6], cfg[7], int(cfg[8])
     scene_radius = cfg[9]
-    # Emission found by this bounce's rays is lit by bounce depth - 1 (Cycles' count): a
-    # lamp hit from the first surface is direct light, as its next-event estimate is;
-    # what the camera sees directly is never clamped.
-    clamp_hit = 0.0 if depth == 0 else (clamp_direct if depth == 1 else clamp_indirect)
     n_lights = lt.n_entries(lights)
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
@@ -173,19 +123,46 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         br, bg, bb = beta[p, 0], beta[p, 1], beta[p, 2]
         hit = hit_prim[j] >= 0
         t_geom = hit_t[j] if hit else rt[j]
+        b = bounce[p]
+        # Emission found by this bounce's rays is lit by bounce b - 1 (Cycles' count): a
+        # lamp hit from the first surface is direct light, as its next-event estimate is;
+        # what the camera sees directly is never clamped.
+        clamp_hit = 0.0 if b == 0 else (clamp_direct if b == 1 else clamp_indirect)
+        # 0. the medium along the ray: emission, transmittance, maybe a scattering
+        b0r, b0g, b0b = br, bg, bb
+        vmode, scattered, t_end = 0, False, t_geom
+        str_ = stg = stb = wcr = wcg = wcb = 0.0
+        if in_medium(stacks, p):
+            vmode, scattered, t_end, br, bg, bb, str_, stg, stb, wcr, wcg, wcb, er, eg, eb = \
+                segment(vol, stacks, p, br, bg, bb, t_geom,
+                        sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 0)),
+                        sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 1)))
+            _add(L, p, er, eg, eb, clamp_hit)
         # 1a. area and sphere lamps in front of the geometry; the ray goes on behind them
         if n_lights > 0:
-            t_l, k_l, lr, lg, lb = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_geom,
+            t_l, k_l, lr, lg, lb = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_end,
                                                 ray_bits[p])
             if k_l >= 0:
+                fr, fg, fb = passed(vmode, str_, stg, stb, wcr, wcg, wcb, t_l)
+                if vmode != 0:     # the lamp's distance from the path's last vertex
+                    t_l = length(ox + dx * t_l - prev_pos[p, 0], oy + dy * t_l - prev_pos[p, 1],
+                                 oz + dz * t_l - prev_pos[p, 2])
                 lpdf = lt.lamp_pdf(lights, k_l, prev_pos[p, 0], prev_pos[p, 1],
                                    prev_pos[p, 2], dx, dy, dz, t_l)
                 w = hit_weight(mode, prev_pdf[p], lpdf)
-                _add(L, p, br * lr * w, bg * lg * w, bb * lb * w, clamp_hit)
+                _add(L, p, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w, clamp_hit)
+        if scattered:
+            ns_out, nn_out = scatter(depth, cfg, pkey, index, p, ox + dx * t_end,
+                                     oy + dy * t_end, oz + dz * t_end, dx, dy, dz, br, bg, bb,
+                                     bounce, vbounce, beta, prev_pdf, prev_pos, ray_bits, L,
+                                     lights, vol, stacks, sh_path, sh_org, sh_dir, sh_far,
+                                     sh_contrib, sh_bounce, sh_stack, ns_out, nx_path, nx_org, nx_dir,
+                                     nn_out)
+            continue
         # 1b. escaped rays: the world and sun discs (or, for camera rays on a transparent
         # film, no colour and the coverage left)
         if not hit:
-            if depth == 0 and film_transparent:
+            if b == 0 and film_transparent:
                 alpha[p] = uncovered(br, bg, bb)
                 continue
             er, eg, eb, epdf = lt.world_escaped(lights, world, ray_bits[p], dx, dy, dz)
@@ -202,13 +179,23 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         if stopped[j]:
             continue                      # past the transparent bounce limit
         prim = hit_prim[j]
-        if depth == 0 and holdout.shape[0] > 0 and holdout[prim]:
+        if b == 0 and holdout.shape[0] > 0 and holdout[prim]:
             if alpha.shape[0] > 0:        # Cycles' holdout: a hole, for camera rays only
                 alpha[p] = uncovered(br, bg, bb)
             continue
         px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
             geometry, prim, hit_u[j], hit_v[j], dx, dy, dz, path_time[p])
         m = tri_material[prim]
+        if vol.shape[0] > 0 and vol[m, V_BOUNDARY] != 0.0:
+            # a volume's boundary: no surface; the ray goes on inside or outside it
+            stack_cross(stacks, p, m, front)
+            beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
+            nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
+            nx_path[nn_out] = p
+            nx_org[nn_out, 0], nx_org[nn_out, 1], nx_org[nn_out, 2] = nox, noy, noz
+            nx_dir[nn_out, 0], nx_dir[nn_out, 1], nx_dir[nn_out, 2] = dx, dy, dz
+            nn_out += 1
+            continue
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         programmed = has_program(textures, m)
         bent = False
@@ -219,7 +206,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         n0x, n0y, n0z = nx, ny, nz               # the surface's own shading normal
         if programmed:
             program_hit(textures, geometry, m, prim, hit_u[j], hit_v[j], uu, vv, px, py, pz,
-                        gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bits[p], depth, t_geom,
+                        gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bits[p], b, t_geom,
                         hit_row, regs)
             ms, u_lobe = pick_closure(textures, m, regs, u_lobe)
             sx, sy, sz, rx, ry, rz = program_normal(textures, ms, regs, nx, ny, nz, gx, gy,
@@ -243,7 +230,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             apply_rows(textures, ms, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
-        room = depth < max_bounces
+        room = b < max_bounces
         ad = room and counts[p, 0] < cfg[3]
         ag = room and counts[p, 1] < cfg[4] and keep_g
         at = room and counts[p, 2] < cfg[5] and keep_t
@@ -277,33 +264,19 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0
                     and (front_side or bsdf.transmits(state))):
                 sox, soy, soz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
-                sdx, sdy, sdz = wx, wy, wz
-                if math.isfinite(dist):
-                    # to the sampled point, stopping short of it by the origin's margin
-                    tx = px + wx * dist - sox
-                    ty = py + wy * dist - soy
-                    tz = pz + wz * dist - soz
-                    seg = math.sqrt(tx * tx + ty * ty + tz * tz)
-                    if seg > 0.0:
-                        sdx, sdy, sdz = tx / seg, ty / seg, tz / seg
-                    far = min(seg * (1.0 - 2e-5), seg - margin)
-                else:
-                    far = scene_radius * 4.0
+                sdx, sdy, sdz, far = shadow_rays.towards(sox, soy, soz, px, py, pz, wx, wy,
+                                                         wz, dist, margin, scene_radius)
                 bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
                                      see_d, see_g, see_t)
                 w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine
                 if not seen & SHADOW_BIT:        # a light casting no shadow: no shadow ray
                     _add(L, p, br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w,
-                         clamp_direct if depth == 0 else clamp_indirect)
+                         clamp_direct if b == 0 else clamp_indirect)
                 else:
-                    sh_path[ns_out] = p
-                    sh_org[ns_out, 0], sh_org[ns_out, 1], sh_org[ns_out, 2] = sox, soy, soz
-                    sh_dir[ns_out, 0], sh_dir[ns_out, 1], sh_dir[ns_out, 2] = sdx, sdy, sdz
-                    sh_far[ns_out] = max(far, 0.0)
-                    sh_contrib[ns_out, 0] = br * fr * lr * w
-                    sh_contrib[ns_out, 1] = bg * fg * lg * w
-                    sh_contrib[ns_out, 2] = bb * fb * lb * w
-                    ns_out += 1
+                    ns_out = shadow_rays.push(ns_out, p, b, sox, soy, soz, sdx, sdy, sdz, far,
+                                              br * fr * lr * w, bg * fg * lg * w,
+                                              bb * fb * lb * w, sh_path, sh_org, sh_dir,
+                                              sh_far, sh_contrib, sh_bounce, stacks, sh_stack)
         # 3. continue by BSDF sampling
         if not (ad or ag or at):
             continue
@@ -328,17 +301,18 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         if (side >= 0.0) if skind == TRANSMISSION else (side <= 0.0):
             continue       # reflection leaves on the geometric normal's side, refraction through
         br, bg, bb = br * wr, bg * wg, bb * wb
-        if depth + 1 >= ROULETTE_START:
+        if b + 1 >= ROULETTE_START:
             u_rr = sample_1d(kind, pkey[p], spp, index[p], base + D.ROULETTE)
-            q = min(max(max(br, bg, bb), 0.0), 0.95)
-            if not u_rr < q:
+            alive, br, bg, bb = roulette(u_rr, br, bg, bb)
+            if not alive:
                 continue
-            q = max(q, 1e-300)
-            br, bg, bb = br / q, bg / q, bb / q
         if not max(br, bg, bb) > 0.0:
             continue
         beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
         counts[p, skind] += 1
+        bounce[p] = b + 1
+        if skind == TRANSMISSION and vol.shape[0] > 0 and vol[m, V_HAS] != 0.0:
+            stack_cross(stacks, p, m, front)     # into or out of the material's volume
         ray_bits[p] = DIFFUSE_BIT << skind     # diffuse, glossy, transmission: 2, 4, 8
         if not sdelta:
             min_pdf[p] = min(min_pdf[p], spdf)
@@ -350,20 +324,3 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         prev_pdf[p] = _INF if sdelta else spdf
         nn_out += 1
     return ns_out, nn_out
-
-
-@kernel
-def add_unoccluded(L, sh_path, sh_contrib, blocked, limit):
-    """Add the contributions of the shadow rays that reached their light, clamped."""
-    for i in range(sh_path.shape[0]):
-        if not blocked[i]:
-            _add(L, sh_path[i], sh_contrib[i, 0], sh_contrib[i, 1], sh_contrib[i, 2], limit)
-
-
-@kernel
-def add_transmitted(L, sh_path, sh_contrib, trans, limit):
-    """Add the contributions of shadow rays times their transmittance, clamped."""
-    for i in range(sh_path.shape[0]):
-        if trans[i, 0] > 0.0 or trans[i, 1] > 0.0 or trans[i, 2] > 0.0:
-            _add(L, sh_path[i], sh_contrib[i, 0] * trans[i, 0], sh_contrib[i, 1] * trans[i, 1],
-                 sh_contrib[i, 2] * trans[i, 2], limit)

@@ -21,6 +21,7 @@ from ..sampling.dispatch import sample_1d
 from .jit import kernel
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import alpha_at
+from .volume import V_BOUNDARY, attenuate, stack_cross
 from ..nodes.context import N_HIT
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
@@ -125,17 +126,32 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
 
 @kernel
 def shadow_pass(layer, limit, rows, sd, ray_time, remaining, cur_t, cur_prim, cur_u, cur_v,
-                trans, geometry, materials, out_rows, out_org, out_far):
+                trans, geometry, materials, vol, stacks, out_rows, out_org, out_far):
     """One layer of transparent shadows for the shadow rays `rows`: an opaque surface (or
     one past `limit` transparent layers) blocks; a transparent one multiplies the
     transmittance by (1 - alpha) x its transparent colour and the ray goes on; through a
-    surface whose object casts no shadow it goes on unchanged."""
+    surface whose object casts no shadow it goes on unchanged. With volumes (vol, the
+    rays' stacks; engine.kernels.volume) the medium between layers attenuates the ray,
+    and a volume's boundary is crossed (the stack updated) without counting a layer."""
     tri_material, maybe_transparent, _, tcolor, _, tri_vis = materials
     n_out = 0
     for i in range(rows.shape[0]):
         r = rows[i]
         prim = cur_prim[i]
-        if prim < 0 or not cur_t[i] < remaining[i]:
+        reached = prim < 0 or not cur_t[i] < remaining[i]
+        if stacks.shape[0] > 0:
+            attenuate(vol, stacks, r, trans, remaining[i] if reached else cur_t[i])
+        if reached:
+            continue
+        if vol.shape[0] > 0 and vol[tri_material[prim], V_BOUNDARY] != 0.0:
+            dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
+            px, py, pz, gx, gy, gz, _, _, _, front, scale = rebuild_at_time(
+                geometry, prim, cur_u[i], cur_v[i], dx, dy, dz, ray_time[r])
+            if stacks.shape[0] > 0:
+                stack_cross(stacks, r, tri_material[prim], front)
+            _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale,
+                  dx, dy, dz, remaining[i] - cur_t[i])
+            n_out += 1
             continue
         if tri_vis.shape[0] > 0 and not tri_vis[prim] & SHADOW_BIT:
             _pass_through(geometry, prim, cur_u[i], cur_v[i], sd, r, ray_time[r],

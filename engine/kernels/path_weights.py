@@ -1,0 +1,104 @@
+"""What the shading stages add up: multiple importance sampling weights (the power
+heuristic, as Cycles and pbrt use), Cycles' clamp, and the film coverage of a camera
+sample, shared by the surface stage (path_vertex) and the volume stage (medium_vertex)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .. import visibility
+from .jit import kernel
+
+MIS, LIGHT_ONLY, BSDF_ONLY = 0, 1, 2
+# Numba freezes these into its cache; the cache's fingerprint covers every engine file
+DIFFUSE_BIT, GLOSSY_BIT, TRANSMISSION_BIT, SHADOW_BIT = (
+    visibility.DIFFUSE, visibility.GLOSSY, visibility.TRANSMISSION, visibility.SHADOW)
+ROULETTE_START = 3
+_INF = np.inf
+
+
+@kernel
+def power_heuristic(a, b):
+    if math.isinf(a):
+        return 1.0
+    if math.isinf(b):
+        return 0.0
+    a2, b2 = a * a, b * b
+    return a2 / (a2 + b2) if a2 + b2 > 0.0 else 0.0
+
+
+@kernel
+def hit_weight(mode, prev_pdf, light_pdf):
+    """Weight of emission found by a BSDF-sampled ray (pdf prev_pdf; inf after a camera
+    ray or a specular bounce) that light sampling reaches with light_pdf."""
+    if mode == MIS:
+        return power_heuristic(prev_pdf, light_pdf)
+    if mode == LIGHT_ONLY:
+        return 1.0 if (math.isinf(prev_pdf) or not light_pdf > 0.0) else 0.0
+    return 1.0
+
+
+@kernel
+def nee_weight(mode, light_pdf, bsdf_pdf, delta):
+    """Weight of a light sample that the BSDF would have sampled with bsdf_pdf."""
+    if mode == MIS:
+        return 1.0 if delta else power_heuristic(light_pdf, bsdf_pdf)
+    if mode == LIGHT_ONLY:
+        return 1.0
+    return 1.0 if (delta or not bsdf_pdf > 0.0) else 0.0
+
+
+@kernel
+def clamp_scale(r, g, b, limit):
+    """Cycles' clamp: the factor that scales (r, g, b) so no channel exceeds limit."""
+    m = max(r, g, b)
+    if limit > 0.0 and m > limit:
+        return limit / max(m, 1e-300)
+    return 1.0
+
+
+@kernel
+def _add(L, p, r, g, b, limit):
+    s = clamp_scale(r, g, b, limit)
+    L[p, 0] += r * s
+    L[p, 1] += g * s
+    L[p, 2] += b * s
+
+
+@kernel
+def uncovered(br, bg, bb):
+    """Alpha of a camera sample whose ray got through with throughput b (see
+    engine.integrators.coverage)."""
+    return 1.0 - min(max((br + bg + bb) / 3.0, 0.0), 1.0)
+
+
+@kernel
+def add_unoccluded(L, sh_path, sh_contrib, blocked, sh_bounce, clamp_direct, clamp_indirect):
+    """Add the contributions of the shadow rays that reached their light, clamped (the
+    direct clamp for shadow rays of a path's first vertex, sh_bounce 0)."""
+    for i in range(sh_path.shape[0]):
+        if not blocked[i]:
+            _add(L, sh_path[i], sh_contrib[i, 0], sh_contrib[i, 1], sh_contrib[i, 2],
+                 clamp_direct if sh_bounce[i] == 0 else clamp_indirect)
+
+
+@kernel
+def add_transmitted(L, sh_path, sh_contrib, trans, sh_bounce, clamp_direct, clamp_indirect):
+    """Add the contributions of shadow rays times their transmittance, clamped."""
+    for i in range(sh_path.shape[0]):
+        if trans[i, 0] > 0.0 or trans[i, 1] > 0.0 or trans[i, 2] > 0.0:
+            _add(L, sh_path[i], sh_contrib[i, 0] * trans[i, 0], sh_contrib[i, 1] * trans[i, 1],
+                 sh_contrib[i, 2] * trans[i, 2],
+                 clamp_direct if sh_bounce[i] == 0 else clamp_indirect)
+
+
+@kernel
+def roulette(u, br, bg, bb):
+    """Russian roulette on throughput b: survives with probability min(max(b), 0.95),
+    its throughput divided by it. Returns (survives, b)."""
+    q = min(max(max(br, bg, bb), 0.0), 0.95)
+    if not u < q:
+        return False, br, bg, bb
+    q = max(q, 1e-300)
+    return True, br / q, bg / q, bb / q

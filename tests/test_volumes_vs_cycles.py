@@ -1,0 +1,120 @@
+"""Homogeneous volumes against Cycles at Blender's defaults (tests/volume_scenes.py: a
+grey floor and a red block under an area lamp, black world, 48 x 32 pixels), one scene
+per kind of volume: fog in a box (Principled Volume, a volume-only material), tinted
+forward-scattering fog (Color, Absorption Color, Anisotropy), multiple scattering
+(Volume Scatter, 4 volume bounces), an emitting volume, a world volume, the camera
+inside the fog, and coloured glass (a Glass BSDF with Volume Absorption inside).
+
+Checks (tests/test_multiscatter_vs_cycles.py's `compare`): image means within 1 % per
+channel and every 8 x 8 block within 3 % of the image mean. Controls show each check
+can fail: the fog left out, no volume bounces against Cycles' four, the Absorption
+Color left out.
+
+Coloured glass: the clear glass cube alone differs from Cycles by about -0.9 % (mean)
+and 6 % (blocks around its caustic and shadow): issue 8's glass gap, measured in
+docs/comparisons.md. The absorption inside is checked by its own effect, the ratio of
+the coloured glass image to the clear glass image, per channel and per block, against
+Cycles' ratio."""
+import numpy as np
+import pytest
+
+from conftest import render_current, use_engine
+from test_multiscatter_vs_cycles import compare
+import volume_scenes
+
+SIZE = (48, 32)
+CYCLES_SAMPLES = 1024
+DRT_SAMPLES = 512
+# The lamp seen through forward-scattering fog, and multiple scattering, are the noisiest (Cycles against
+# itself at another seed: 2 % at 1024 samples): both engines take more samples there.
+MORE_SAMPLES = {"tinted": 2048, "multiple": 2048}
+MEAN_TOLERANCE = 0.01
+BLOCK_TOLERANCE = 0.03
+
+_renders = {}
+
+
+def _render(bpy, case, engine, samples, setup=None, tag=""):
+    key = (case, engine, samples, tag)
+    if key not in _renders:
+        scene = volume_scenes.build(bpy, case, SIZE)
+        use_engine(scene, engine, samples)
+        if setup is not None:
+            setup(bpy, scene)
+        _renders[key] = render_current(bpy, scene)
+    return _renders[key]
+
+
+def _pair(bpy, case):
+    return (_render(bpy, case, "DRT", MORE_SAMPLES.get(case, DRT_SAMPLES)),
+            _render(bpy, case, "CYCLES", MORE_SAMPLES.get(case, CYCLES_SAMPLES)))
+
+
+def _check(case, drt, cycles):
+    means, block = compare(drt, cycles)
+    print(f"{case}: mean {np.round(means * 100, 2)} %, worst block {block:.2%}")
+    return bool(np.all(np.abs(means) < MEAN_TOLERANCE)) and block < BLOCK_TOLERANCE
+
+
+@pytest.mark.parametrize("case", ["scatter", "tinted", "multiple", "emission", "world",
+                                  "camera_inside"])
+def test_volume_matches_cycles(bpy_drt, case):
+    assert _check(case, *_pair(bpy_drt, case))
+
+
+def test_coloured_glass_absorption_matches_cycles(bpy_drt):
+    d_col, c_col = _pair(bpy_drt, "absorption_glass")
+    d_clr, c_clr = _pair(bpy_drt, "clear_glass")
+    ratio_d = d_col.mean(axis=(0, 1)) / d_clr.mean(axis=(0, 1))
+    ratio_c = c_col.mean(axis=(0, 1)) / c_clr.mean(axis=(0, 1))
+    print("coloured / clear glass, DRT", ratio_d, "Cycles", ratio_c)
+    np.testing.assert_allclose(ratio_d, ratio_c, rtol=MEAN_TOLERANCE)
+    # what the absorption removes, per block, against Cycles' (blocks of the image)
+    lost_d, lost_c = d_clr - d_col, c_clr - c_col
+    _, block = compare(lost_d + c_clr, lost_c + c_clr)
+    print(f"absorbed light, worst block {block:.2%}")
+    assert block < BLOCK_TOLERANCE
+    # a control: without the absorption, the ratio is 1 and far from Cycles'
+    assert np.abs(ratio_c - 1.0).max() > 0.05
+
+
+def _no_fog(bpy, scene):
+    mat = bpy.data.materials["Fog"]
+    out = mat.node_tree.nodes["Material Output"]
+    for link in list(out.inputs["Volume"].links):
+        mat.node_tree.links.remove(link)
+
+
+def _no_volume_bounces(bpy, scene):
+    scene.drt.volume_bounces = 0
+
+
+def _no_absorption_color(bpy, scene):
+    node = bpy.data.materials["Fog"].node_tree.nodes["Principled Volume"]
+    node.inputs["Absorption Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+
+
+@pytest.mark.parametrize("case,setup", [("scatter", _no_fog),
+                                        ("multiple", _no_volume_bounces),
+                                        ("tinted", _no_absorption_color)])
+def test_controls_fail(bpy_drt, case, setup):
+    drt = _render(bpy_drt, case, "DRT", 128, setup, tag=setup.__name__)
+    assert not _check(case + " control " + setup.__name__, drt,
+                      _pair(bpy_drt, case)[1])
+
+
+def test_volume_only_material_warns_nothing_and_surface_is_a_boundary(bpy_drt):
+    """The exporter: a volume-only material is a boundary with its volume; Surface and
+    Volume both linked keep the surface."""
+    from drt_addon.export.errors import Reporter
+    from drt_addon.export.materials import export_material
+    volume_scenes.build(bpy_drt, "scatter", SIZE)
+    rep = Reporter()
+    fog = export_material(bpy_drt.data.materials["Fog"], rep)
+    assert not fog.surface and fog.volume is not None
+    np.testing.assert_allclose(fog.volume.scattering, (0.125,) * 3)      # 0.5 x 0.25
+    np.testing.assert_allclose(fog.volume.absorption, (0.125,) * 3)     # (1 - 0.5) x 0.25
+    volume_scenes.build(bpy_drt, "absorption_glass", SIZE)
+    glass = export_material(bpy_drt.data.materials["TintedGlass"], rep)
+    assert glass.surface and glass.transmission == 1.0
+    np.testing.assert_allclose(glass.volume.absorption, (1.2, 0.6, 0.15), rtol=1e-6)

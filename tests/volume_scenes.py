@@ -1,0 +1,133 @@
+"""Small volume scenes built with bpy at Blender's defaults, for DRT against Cycles
+(tests/test_volumes_vs_cycles.py) and the docs: a grey floor and a diffuse cube seen
+through a box of fog under an area lamp, in a black world, with one variation per case."""
+from __future__ import annotations
+
+import math
+
+WIDTH, HEIGHT = 64, 48
+
+
+def _new_material(bpy, name):
+    mat = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):
+        mat.use_nodes = True
+    return mat
+
+
+def _mesh_object(bpy, scene, name, verts, faces, mat):
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(verts, [], faces)
+    obj = bpy.data.objects.new(name, mesh)
+    scene.collection.objects.link(obj)
+    if mat is not None:
+        mesh.materials.append(mat)
+    return obj
+
+
+def cube(bpy, scene, name, lo, hi, mat):
+    (x0, y0, z0), (x1, y1, z1) = lo, hi
+    v = [(x0, y0, z0), (x1, y0, z0), (x1, y1, z0), (x0, y1, z0),
+         (x0, y0, z1), (x1, y0, z1), (x1, y1, z1), (x0, y1, z1)]
+    f = [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6), (3, 0, 4, 7)]
+    return _mesh_object(bpy, scene, name, v, f, mat)
+
+
+def volume_material(bpy, name, node_type, inputs, surface=None):
+    """A material whose Volume socket is fed by a `node_type` node with `inputs`; its
+    Surface unlinked (a volume-only material) unless `surface` names a BSDF node type."""
+    mat = _new_material(bpy, name)
+    nt = mat.node_tree
+    out = nt.nodes["Material Output"]
+    bsdf = nt.nodes.get("Principled BSDF")
+    if surface is None:
+        if bsdf is not None:
+            nt.nodes.remove(bsdf)
+    else:
+        if bsdf is not None:
+            nt.nodes.remove(bsdf)
+        s = nt.nodes.new(surface)
+        nt.links.new(s.outputs[0], out.inputs["Surface"])
+        if surface == "ShaderNodeBsdfGlass":
+            s.inputs["Roughness"].default_value = 0.0
+    v = nt.nodes.new(node_type)
+    for k, val in inputs.items():
+        v.inputs[k].default_value = val
+    nt.links.new(v.outputs[0], out.inputs["Volume"])
+    return mat
+
+
+def build(bpy, case, size=(WIDTH, HEIGHT)):
+    """A fresh file with the fog scene and the variation `case` names."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.resolution_x, scene.render.resolution_y = size
+    scene.render.resolution_percentage = 100
+    scene.world = bpy.data.worlds.new("Black")
+    if bpy.app.version < (5, 0, 0):
+        scene.world.use_nodes = True
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.location = (0.0, -7.0, 2.2)
+    cam.rotation_euler = (math.radians(78.0), 0.0, 0.0)
+    cam.data.lens = 35.0
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    lamp = bpy.data.objects.new("Lamp", bpy.data.lights.new("Lamp", "AREA"))
+    lamp.data.size = 1.5
+    lamp.data.energy = 400.0
+    lamp.location = (0.6, 0.0, 3.6)
+    scene.collection.objects.link(lamp)
+    grey = _new_material(bpy, "Grey")
+    grey.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = \
+        (0.5, 0.5, 0.5, 1.0)
+    _mesh_object(bpy, scene, "Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)],
+                 [(0, 1, 2, 3)], grey)
+    red = _new_material(bpy, "Red")
+    red.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = \
+        (0.7, 0.15, 0.1, 1.0)
+    cube(bpy, scene, "Block", (-0.9, 0.2, 0.0), (-0.1, 1.0, 0.8), red)
+    fog_box = ((-2.0, -1.5, 0.01), (2.0, 2.0, 3.0))
+    if case == "scatter":
+        fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled",
+                              {"Density": 0.25})
+        cube(bpy, scene, "Fog", *fog_box, fog)
+    elif case == "tinted":
+        fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled",
+                              {"Density": 0.4, "Color": (0.9, 0.6, 0.3, 1.0),
+                               "Absorption Color": (0.2, 0.5, 0.9, 1.0), "Anisotropy": 0.5})
+        cube(bpy, scene, "Fog", *fog_box, fog)
+    elif case == "multiple":
+        scene.cycles.volume_bounces = 4
+        scene.drt.volume_bounces = 4
+        fog = volume_material(bpy, "Fog", "ShaderNodeVolumeScatter",
+                              {"Density": 0.6, "Color": (0.9, 0.9, 0.9, 1.0)})
+        cube(bpy, scene, "Fog", *fog_box, fog)
+    elif case == "absorption_glass":
+        glass = volume_material(bpy, "TintedGlass", "ShaderNodeVolumeAbsorption",
+                                {"Density": 1.5, "Color": (0.2, 0.6, 0.9, 1.0)},
+                                surface="ShaderNodeBsdfGlass")
+        cube(bpy, scene, "Glass", (0.2, -1.0, 0.01), (1.4, 0.2, 1.2), glass)
+    elif case == "clear_glass":       # the same glass, no volume (for comparison)
+        glass = volume_material(bpy, "ClearGlass", "ShaderNodeVolumeAbsorption",
+                                {"Density": 0.0}, surface="ShaderNodeBsdfGlass")
+        cube(bpy, scene, "Glass", (0.2, -1.0, 0.01), (1.4, 0.2, 1.2), glass)
+    elif case == "emission":
+        glow = volume_material(bpy, "Glow", "ShaderNodeEmission",
+                               {"Strength": 1.5, "Color": (1.0, 0.5, 0.2, 1.0)})
+        cube(bpy, scene, "Glow", (0.2, -1.0, 0.3), (1.4, 0.2, 1.5), glow)
+    elif case == "world":
+        nt = scene.world.node_tree
+        v = nt.nodes.new("ShaderNodeVolumePrincipled")
+        v.inputs["Density"].default_value = 0.05
+        nt.links.new(v.outputs[0], nt.nodes["World Output"].inputs["Volume"])
+    elif case == "camera_inside":
+        fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled", {"Density": 0.15})
+        cube(bpy, scene, "Fog", (-5.0, -8.0, -0.5), (5.0, 5.0, 5.0), fog)
+    else:
+        raise ValueError(case)
+    return scene
+
+
+CASES = ("scatter", "tinted", "multiple", "absorption_glass", "clear_glass", "emission",
+         "world", "camera_inside")
