@@ -44,6 +44,16 @@ class Material:
     exponent n = 2 / alpha^2 - 2 that matches GGX's alpha, Walter et al. 2007; glass
     stays single-scattering GGX).
 
+    Layers and lobes beyond the base (compiled path tracer only; Cycles' meanings):
+      coat_*      Principled's Coat: a GGX dielectric reflection (IOR coat_ior, alpha
+                  coat_roughness^2) over everything else, which it dims by its albedo and
+                  tints by coat_tint^(path length in the coat);
+      sheen_*     Principled's Sheen (Cycles' microfiber sheen, Zeltner et al. 2022) over
+                  the coat, dimming what is below by its albedo; sheen_layered False: a
+                  Sheen BSDF node's, added beside the rest (weight 1, tint its colour);
+      translucent_color   a Translucent BSDF (diffuse transmission), its weight included;
+      refraction_only     the glass lobe refracts without reflecting (Refraction BSDF).
+
     alpha: coverage, Cycles' Principled Alpha or 1 - the weight of a Transparent BSDF in
     a Mix Shader. Where alpha < 1 the integrators let rays through with probability
     1 - alpha, tinted by `transparent_color` (the Transparent BSDF's colour), counted
@@ -62,6 +72,16 @@ class Material:
     glass_color: Optional[tuple] = None
     transparent_color: tuple = (1.0, 1.0, 1.0)
     glossy_model: str = "GGX"
+    coat_weight: float = 0.0
+    coat_roughness: float = 0.03
+    coat_ior: float = 1.5
+    coat_tint: tuple = (1.0, 1.0, 1.0)
+    sheen_weight: float = 0.0
+    sheen_roughness: float = 0.5
+    sheen_tint: tuple = (1.0, 1.0, 1.0)
+    sheen_layered: bool = True
+    translucent_color: tuple = (0.0, 0.0, 0.0)
+    refraction_only: bool = False
     base_color_texture: Optional[object] = None
     metallic_texture: Optional[object] = None
     roughness_texture: Optional[object] = None

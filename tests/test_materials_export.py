@@ -83,10 +83,20 @@ def test_principled_values(bpy_drt):
     m, _ = _export(mat)
     assert m.alpha == pytest.approx(0.25) and close(m.emission, (4.0, 2.0, 1.0))
     assert close(m.transparent_color, (1, 1, 1))
-    # coat is not modelled: reported, naming the material
+    # coat and sheen are exported; subsurface is not modelled: reported, naming the node
     p.inputs["Coat Weight"].default_value = 0.5
+    p.inputs["Coat Tint"].default_value = (0.9, 0.8, 0.7, 1.0)
+    p.inputs["Sheen Weight"].default_value = 0.25
+    p.inputs["Sheen Roughness"].default_value = 0.3
     m, warnings = _export(mat)
-    assert len(warnings) == 1 and "'P'" in warnings[0] and "coat" in warnings[0]
+    assert warnings == []
+    assert m.coat_weight == pytest.approx(0.5) and m.coat_roughness == pytest.approx(0.03)
+    assert m.coat_ior == pytest.approx(1.5) and close(m.coat_tint, (0.9, 0.8, 0.7))
+    assert m.sheen_weight == pytest.approx(0.25) and m.sheen_layered
+    assert m.sheen_roughness == pytest.approx(0.3)
+    p.inputs["Subsurface Weight"].default_value = 0.5
+    m, warnings = _export(mat)
+    assert len(warnings) == 1 and "'P'" in warnings[0] and "subsurface" in warnings[0]
 
 
 def test_diffuse_glossy_glass_emission_transparent(bpy_drt):
@@ -114,6 +124,31 @@ def test_diffuse_glossy_glass_emission_transparent(bpy_drt):
 
     m, w = _export(_single(bpy, "ShaderNodeBsdfTransparent", Color=(1.0, 0.5, 0.25, 1))[0])
     assert m.alpha == 0.0 and close(m.transparent_color, (1.0, 0.5, 0.25))
+
+
+def test_sheen_translucent_refraction(bpy_drt):
+    bpy = bpy_drt
+    _reset(bpy)
+    m, w = _export(_single(bpy, "ShaderNodeBsdfSheen", Color=(0.5, 0.4, 0.3, 1),
+                           Roughness=0.2)[0])
+    assert m.sheen_weight == 1.0 and not m.sheen_layered and w == []
+    assert close(m.sheen_tint, (0.5, 0.4, 0.3)) and m.sheen_roughness == pytest.approx(0.2)
+    assert close(m.base_color, (0, 0, 0)) and m.specular_ior_level == 0.0
+    m, w = _export(_single(bpy, "ShaderNodeBsdfTranslucent", Color=(0.2, 0.6, 0.1, 1))[0])
+    assert close(m.translucent_color, (0.2, 0.6, 0.1)) and w == []
+    assert close(m.base_color, (0, 0, 0)) and m.specular_ior_level == 0.0
+    # Refraction BSDF: the glass lobe without reflection (its default Beckmann
+    # distribution is not reported while the surface is smooth)
+    m, w = _export(_single(bpy, "ShaderNodeBsdfRefraction", Color=(0.9, 0.9, 1.0, 1),
+                           IOR=1.33)[0])
+    assert m.transmission == 1.0 and m.refraction_only and w == []
+    assert m.ior == pytest.approx(1.33) and close(m.glass_color, (0.9, 0.9, 1.0))
+    # a leaf: Mix(Diffuse, Translucent) is a half-weight diffuse beside half translucency
+    mat, _, _ = _mix(bpy, "Leaf", ("ShaderNodeBsdfDiffuse", {"Color": (0.2, 0.6, 0.1, 1)}),
+                     ("ShaderNodeBsdfTranslucent", {"Color": (0.4, 0.8, 0.2, 1)}))
+    m, w = _export(mat)
+    assert close(m.base_color, (0.1, 0.3, 0.05)) and close(m.translucent_color, (0.2, 0.4, 0.1))
+    assert w == []
 
 
 def _mix(bpy, name, a, b, fac=0.5, add=False):

@@ -5,7 +5,7 @@ mixes a set into one Principled parameter set (see export/materials.py's docstri
 what is exact and what is approximated)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -28,6 +28,8 @@ class _Comp:
     metal_color: object = None      # None: the base colour (Principled)
     glass_color: object = None      # None: sqrt(base colour) per crossing (Principled)
     distribution: str = "MULTI_GGX"  # 'MULTI_GGX' or 'GGX' (engine glossy_model)
+    layers: object = None           # a _Layers: coat, sheen, translucency (None: none)
+    refraction_only: bool = False   # the glass lobe does not reflect (Refraction BSDF)
 
     def glossy_weight(self):
         """Mean weight of the lobes the distribution shapes (metal, glass, specular)."""
@@ -42,6 +44,67 @@ class _Comp:
 
 
 NULL_COMP = _Comp(base=BLACK, spec=0.0)     # absorbs: an Emission shader's "no BSDF"
+
+LAYER_FIELDS = ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",
+                "sheen_roughness", "sheen_tint", "sheen_layered", "translucent_color")
+
+
+@dataclass
+class _Layers:
+    """A closure's lobes beyond the Principled base, as engine.scene.Material fields:
+    Principled's coat and sheen (layered over the base), a Sheen BSDF node's sheen
+    (sheen_layered False: beside the other closures) and a Translucent BSDF's colour."""
+    coat_weight: float = 0.0
+    coat_roughness: float = 0.03
+    coat_ior: float = 1.5
+    coat_tint: tuple = WHITE
+    sheen_weight: float = 0.0
+    sheen_roughness: float = 0.5
+    sheen_tint: tuple = WHITE
+    sheen_layered: bool = True
+    translucent_color: tuple = BLACK
+
+
+def _blend_layers(comps, ctx):
+    """The _Layers of a convex combination [(c_i, _Comp)]: weights and colours summed
+    (Cycles sums the mixed closures), roughness, IOR and tint averaged by weight (exact
+    when they agree; reported otherwise)."""
+    with_layers = [(c, comp.layers) for c, comp in comps if comp.layers is not None]
+    if not with_layers:
+        return None
+    if len(with_layers) == 1 and len(comps) == 1:
+        return with_layers[0][1]
+    out = _Layers()
+    cw = [(c * L.coat_weight, L) for c, L in with_layers if L.coat_weight > 0]
+    sw = [(c * L.sheen_weight, L) for c, L in with_layers if L.sheen_weight > 0]
+    out.coat_weight = float(sum(w for w, _ in cw))
+    out.sheen_weight = float(sum(w for w, _ in sw))
+
+    def avg(terms, name):
+        total = sum(w for w, _ in terms)
+        vals = [np.asarray(getattr(L, name), float) for _, L in terms]
+        if len({tuple(np.atleast_1d(v).round(6)) for v in vals}) > 1:
+            ctx.issue(f"mixed shaders have different {name.replace('_', ' ')}s; DRT uses "
+                      f"their weighted mean")
+        return _plain(sum(w * v for (w, _), v in zip(terms, vals)) / total)
+    if cw:
+        for name in ("coat_roughness", "coat_ior", "coat_tint"):
+            setattr(out, name, avg(cw, name))
+    if sw:
+        for name in ("sheen_roughness", "sheen_tint"):
+            setattr(out, name, avg(sw, name))
+        kinds = {L.sheen_layered for _, L in sw}
+        if len(kinds) > 1:
+            ctx.issue("a Principled sheen and a Sheen BSDF are mixed; DRT layers both")
+        out.sheen_layered = True in kinds
+    if out.coat_weight > 0 or (out.sheen_weight > 0 and out.sheen_layered):
+        if any(L.coat_weight == 0 and L.sheen_weight == 0 for _, L in with_layers) or \
+                len(with_layers) < len(comps):
+            ctx.issue("a coated or sheened Principled BSDF is mixed with other shaders; DRT "
+                      "layers the mixture's coat and sheen over all of them")
+    out.translucent_color = _plain(sum(c * np.asarray(L.translucent_color, float)
+                                       for c, L in with_layers))
+    return out
 
 
 @dataclass
@@ -107,6 +170,10 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
         for k in ("base", "metal_color", "glass_color"):
             if p[k] is not None:
                 p[k] = _scale(p[k], total)
+        if p["layers"] is not None:
+            L = p["layers"] = replace(p["layers"])
+            L.coat_weight, L.sheen_weight = L.coat_weight * total, L.sheen_weight * total
+            L.translucent_color = _scale(L.translucent_color, total)
     emission = _scale(cl.emission, 1.0 / alpha)        # emitted by the opaque part
     alpha_tex = cl.alpha_texture
     if alpha_tex is not None:
@@ -129,6 +196,11 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
         m.metal_color = tuple(mc)
     if p["glass_color"] is not None:
         m.glass_color = tuple(_mean(p["glass_color"]))
+    m.refraction_only = bool(p["refraction_only"])
+    if p["layers"] is not None:
+        for k in LAYER_FIELDS:
+            v = getattr(p["layers"], k)
+            setattr(m, k, tuple(float(x) for x in v) if isinstance(v, tuple) else v)
     m.alpha = float(alpha)
     m.transparent_color = tuple(t_color)
     if alpha_tex is not None:
@@ -164,7 +236,8 @@ def _blend(comps, ctx) -> dict:
                     roughness=c.roughness, ior=c.ior, spec=c.spec,
                     metal_color=None if c.metal_color is None or _same(c.metal_color, c.base)
                     else c.metal_color,
-                    glass_color=c.glass_color, distribution=c.distribution)
+                    glass_color=c.glass_color, distribution=c.distribution,
+                    layers=c.layers, refraction_only=c.refraction_only)
     lw = [(c, comp, *comp.weights()) for c, comp in comps]
     Wm = sum(c * m for c, _, m, _, _ in lw)
     Wg = sum(c * g for c, _, _, g, _ in lw)
@@ -218,6 +291,10 @@ def _blend(comps, ctx) -> dict:
     if len({d for w, d in glossy if w > 0}) > 1:
         ctx.issue(f"closures with different microfacet distributions are mixed; DRT uses "
                   f"{distribution} for all")
+    refr = {comp.refraction_only for _, comp, _, g, _ in lw if g > 0}
+    if len(refr) > 1:
+        ctx.issue("a Refraction BSDF is mixed with a glass; DRT renders both as glass")
     return dict(base=base, metallic=metallic, transmission=float(np.clip(transmission, 0, 1)),
                 roughness=roughness, ior=ior, spec=spec, metal_color=metal_color,
-                glass_color=glass_color, distribution=distribution)
+                glass_color=glass_color, distribution=distribution,
+                layers=_blend_layers(comps, ctx), refraction_only=refr == {True})

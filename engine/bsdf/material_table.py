@@ -69,6 +69,7 @@ class MaterialTable:
                                      zip(metal, self.base_color)], np.float64).reshape(-1, 3)
         self.glass_color = np.array([(c if c is not None else (1.0, 1.0, 1.0))[:3]
                                      for c in glass], np.float64).reshape(-1, 3)
+        self._layer_params(materials)
         self.transparent_color = np.array(
             [tuple(getattr(m, "transparent_color", (1.0, 1.0, 1.0)))[:3] for m in materials],
             np.float64).reshape(-1, 3)
@@ -123,8 +124,40 @@ class MaterialTable:
         # Which lobes any material can produce (a scene of plain diffuse materials never
         # touches the microfacet code; PrincipledBSDF also skips lobes per batch).
         self.any_glossy = bool(((self.specular_ior_level > 0) | (self.metallic > 0)
-                                | (self.transmission > 0)).any()
+                                | (self.transmission > 0) | (self.coat_weight > 0)).any()
                                or "metallic" in self.textured)
+
+    def _layer_params(self, materials):
+        """The lobes beyond Principled's base (engine/kernels/bsdf/layers.py): coat,
+        sheen, translucency and refraction without reflection, and `layered`, whether a
+        material uses any of them (the others never run their code)."""
+        def scalar(name, default):
+            return np.array([float(getattr(m, name, default)) for m in materials], np.float64)
+
+        def colour(name, default):
+            return np.array([tuple(getattr(m, name, default))[:3] for m in materials],
+                            np.float64).reshape(-1, 3)
+        self.coat_weight = np.maximum(scalar("coat_weight", 0.0), 0.0)
+        self.coat_roughness = scalar("coat_roughness", 0.03)
+        self.coat_ior = scalar("coat_ior", 1.5)
+        self.coat_tint = colour("coat_tint", (1.0, 1.0, 1.0))
+        self.sheen_weight = np.maximum(scalar("sheen_weight", 0.0), 0.0)
+        self.sheen_roughness = scalar("sheen_roughness", 0.5)
+        self.sheen_tint = colour("sheen_tint", (1.0, 1.0, 1.0))
+        self.translucent_color = np.maximum(colour("translucent_color", (0.0, 0.0, 0.0)), 0.0)
+        self.refraction_only = np.array([bool(getattr(m, "refraction_only", False))
+                                         for m in materials], bool)
+        self.sheen_layered = np.array([bool(getattr(m, "sheen_layered", True))
+                                       for m in materials], bool)
+        self.layered = ((self.coat_weight > 1e-5) | (self.sheen_weight > 1e-5)
+                        | (self.translucent_color.max(1) > 0.0) | self.refraction_only)
+        for name in ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",
+                     "sheen_roughness", "sheen_tint", "translucent_color"):
+            arr = getattr(self, name)
+            if not np.all(np.isfinite(arr)):
+                bad = [m.name for m, row in zip(materials, arr.reshape(len(materials), -1))
+                       if not np.all(np.isfinite(row))]
+                raise ValueError(f"material {bad[0]!r} has a non-finite {name}")
 
     @property
     def any_textures(self) -> bool:

@@ -9,7 +9,7 @@ from dataclasses import replace
 import numpy as np
 
 from ...engine_link import engine
-from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _sum
+from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _Layers, _sum
 from ..material_params import TOL, NodeParam, _is_tex, _lin, _mean, _same, _scale
 from .links import _link
 
@@ -64,10 +64,9 @@ def _principled(node, ctx) -> _Closure:
                  metallic=val("Metallic", 0.0), transmission=const("Transmission Weight", 0.0),
                  roughness=val("Roughness", 0.5), ior=const("IOR", 1.5),
                  spec=const("Specular IOR Level", 0.5),
-                 distribution=_distribution(node, ctx))
+                 distribution=_distribution(node, ctx), layers=_principled_layers(node, ctx))
     ignored = []
-    for sock, what in (("Coat Weight", "coat"), ("Sheen Weight", "sheen"),
-                       ("Subsurface Weight", "subsurface"), ("Anisotropic", "anisotropy"),
+    for sock, what in (("Subsurface Weight", "subsurface"), ("Anisotropic", "anisotropy"),
                        ("Thin Film Thickness", "thin film"),
                        ("Diffuse Roughness", "diffuse roughness")):
         s = node.inputs.get(sock)
@@ -92,6 +91,46 @@ def _principled(node, ctx) -> _Closure:
     a = float(np.clip(alpha, 0.0, 1.0))
     # Cycles: BSDF weight a, transparent 1 - a, emission times a
     return _Closure([(a, comp)], 1.0 - a, (1.0 - a,) * 3, _scale(emission, a))
+
+
+def _principled_layers(node, ctx):
+    """Principled's coat and sheen (constants; a per-hit input is replaced by its
+    average, reported), or None when both weights are 0."""
+    def const(name, default, color=False):
+        return _constant(node, name, ctx, default, color)
+    coat = max(float(const("Coat Weight", 0.0)), 0.0)
+    sheen = max(float(const("Sheen Weight", 0.0)), 0.0)
+    if coat <= 0.0 and sheen <= 0.0:
+        return None
+    s = node.inputs.get("Coat Normal")
+    if coat > 0.0 and s is not None and s.is_linked:
+        ctx.issue(f"the Coat Normal of {node.name!r} is not rendered; DRT's coat uses the "
+                  f"surface's normal")
+    return _Layers(coat_weight=coat, coat_roughness=float(const("Coat Roughness", 0.03)),
+                   coat_ior=float(const("Coat IOR", 1.5)),
+                   coat_tint=tuple(const("Coat Tint", WHITE, True)), sheen_weight=sheen,
+                   sheen_roughness=float(const("Sheen Roughness", 0.5)),
+                   sheen_tint=tuple(const("Sheen Tint", WHITE, True)))
+
+
+def _sheen(node, ctx) -> _Closure:
+    """Sheen BSDF: Cycles' microfiber sheen beside the other closures."""
+    _normal(node, ctx)
+    if getattr(node, "distribution", "MICROFIBER") != "MICROFIBER":
+        ctx.issue(f"{node.name!r} uses the {node.distribution} sheen; DRT renders the "
+                  f"Microfiber one")
+    color = _constant(node, "Color", ctx, (0.8,) * 3, color=True)
+    layers = _Layers(sheen_weight=1.0, sheen_tint=tuple(color), sheen_layered=False,
+                     sheen_roughness=float(_constant(node, "Roughness", ctx, 0.5)))
+    return _Closure([(1.0, _Comp(base=BLACK, spec=0.0, layers=layers))])
+
+
+def _translucent(node, ctx) -> _Closure:
+    """Translucent BSDF: Lambertian transmission of its colour."""
+    _normal(node, ctx)
+    color = _constant(node, "Color", ctx, (0.8,) * 3, color=True)
+    return _Closure([(1.0, _Comp(base=BLACK, spec=0.0,
+                                 layers=_Layers(translucent_color=tuple(color))))])
 
 
 def _normal(node, ctx):
@@ -143,11 +182,12 @@ def _glossy(node, ctx) -> _Closure:
 
 
 def _glass(node, ctx, refraction=False) -> _Closure:
-    if refraction:
-        ctx.issue(f"{node.name!r} (Refraction BSDF) is rendered as glass, which also "
-                  f"reflects")
+    """Glass BSDF, or with `refraction` the Refraction BSDF (its refraction alone)."""
     _normal(node, ctx)
-    distribution = _distribution(node, ctx)
+    smooth = _link(node.inputs["Roughness"]) is None and \
+        float(node.inputs["Roughness"].default_value) == 0.0
+    # a smooth interface has no microfacet distribution to report
+    distribution = "GGX" if refraction and smooth else _distribution(node, ctx)
     color = _input(node, "Color", ctx, True, WHITE)
     if _is_tex(color):
         ctx.issue(f"the colour of {node.name!r} is textured; DRT tints its refraction "
@@ -159,7 +199,7 @@ def _glass(node, ctx, refraction=False) -> _Closure:
     comp = _Comp(base=color, transmission=1.0,
                  roughness=_input(node, "Roughness", ctx, False, 0.0),
                  ior=_constant(node, "IOR", ctx, 1.5), glass_color=color,
-                 distribution=distribution)
+                 distribution=distribution, refraction_only=refraction)
     return _Closure([(1.0, comp)])
 
 
@@ -258,6 +298,10 @@ def _closure(socket, ctx, depth=0) -> _Closure:
         return _glass(node, ctx)
     if kind == "ShaderNodeBsdfRefraction":
         return _glass(node, ctx, refraction=True)
+    if kind == "ShaderNodeBsdfSheen":
+        return _sheen(node, ctx)
+    if kind == "ShaderNodeBsdfTranslucent":
+        return _translucent(node, ctx)
     if kind == "ShaderNodeEmission":
         return _emission(node, ctx)
     if kind == "ShaderNodeBsdfTransparent":

@@ -67,6 +67,18 @@ def smooth_sample(ox, oy, oz, eta, u, allow_reflect, allow_refract):
     return ix, iy, iz * sign, w, refr, ok
 
 
+@kernel
+def smooth_refract(ox, oy, oz, eta):
+    """The delta refraction alone (Refraction BSDF): (wi_x, wi_y, wi_z, weight, valid),
+    weight 1 / eta^2 (radiance scaling, no Fresnel factor), invalid under total internal
+    reflection."""
+    sign, eta_rel = canonical(oz, eta)
+    cz = oz * sign
+    F, cos_t, eta_t = fresnel.dielectric_full(cz, eta_rel)
+    ok = cz > 0.0 and F < 1.0
+    return -ox / eta_t, -oy / eta_t, -cos_t * sign, 1.0 / (eta_t * eta_t) if ok else 0.0, ok
+
+
 # --- rough interface -------------------------------------------------------------------
 
 @kernel
@@ -92,13 +104,21 @@ def refraction_half(ox, oy, oz, ix, iy, iz, eta_rel):
 @kernel
 def rough_eval(ox, oy, oz, ix, iy, iz, eta, alpha):
     """(f_reflect, f_refract) in 1/sr; one of them is zero for each pair."""
+    return rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, False)
+
+
+@kernel
+def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only):
+    """`rough_eval`, or with `refract_only` Cycles' Refraction BSDF: no reflection and
+    the refraction without its Fresnel factor 1 - F (zero under total internal
+    reflection)."""
     a = mf.clamp_alpha(alpha)
     sign, eta_rel = canonical(oz, eta)
     oz = oz * sign
     iz = iz * sign
     if iz > 0.0:
         base_r, hx, hy, hz = mf.reflection_eval(ox, oy, oz, ix, iy, iz, a)
-        if base_r == 0.0:
+        if base_r == 0.0 or refract_only:
             return 0.0, 0.0
         F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
         return F_r * base_r, 0.0
@@ -106,6 +126,8 @@ def rough_eval(ox, oy, oz, ix, iy, iz, eta, alpha):
     if not (ok and oz > 0.0 and iz < 0.0):
         return 0.0, 0.0
     F_t = fresnel.dielectric(cos_oh, eta_rel)
+    if refract_only:
+        F_t = 1.0 if F_t >= 1.0 else 0.0
     a2 = a * a
     zo, zi = oz, -iz
     g_den = zi * mf.r_len(ox, oy, oz, a2) + zo * mf.r_len(ix, iy, iz, a2)

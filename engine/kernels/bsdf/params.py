@@ -23,7 +23,19 @@ P_HAS_GLASS_COLOR = 15   # 0 / 1
 P_GLOSSY_MODEL = 16      # GLOSSY_GGX, GLOSSY_BLINN_PHONG or GLOSSY_MULTI_GGX
 P_FILTER_ALPHA = 17      # per hit, 0 in the material rows: Filter Glossy's smallest GGX
 #                          alpha for the microfacet lobes (see principled.setup)
-NPARAM = 18
+# The lobes beyond Principled's base (layers.py): read only where P_LAYERS is 1
+P_LAYERS = 18            # 0 / 1: any of the columns below is in use
+P_COAT_WEIGHT = 19
+P_COAT_ROUGHNESS = 20
+P_COAT_IOR = 21
+P_COAT_TINT = 22         # 3 columns
+P_SHEEN_WEIGHT = 25
+P_SHEEN_ROUGHNESS = 26
+P_SHEEN_TINT = 27        # 3 columns
+P_TRANSLUCENT = 30       # 3 columns: the Translucent BSDF's colour (weight included)
+P_REFRACT_ONLY = 33      # 0 / 1: the glass lobe refracts only (Refraction BSDF)
+P_SHEEN_LAYERED = 34     # 0 / 1: the sheen dims the lobes below it (Principled's)
+NPARAM = 35
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -48,4 +60,15 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_GLOSSY_MODEL] = np.where(table.blinn_phong, GLOSSY_BLINN_PHONG,
                                        np.where(table.multiscatter, GLOSSY_MULTI_GGX,
                                                 GLOSSY_GGX))
+    rows[:, P_COAT_WEIGHT] = table.coat_weight
+    rows[:, P_COAT_ROUGHNESS] = table.coat_roughness
+    rows[:, P_COAT_IOR] = table.coat_ior
+    rows[:, P_COAT_TINT:P_COAT_TINT + 3] = table.coat_tint
+    rows[:, P_SHEEN_WEIGHT] = table.sheen_weight
+    rows[:, P_SHEEN_ROUGHNESS] = table.sheen_roughness
+    rows[:, P_SHEEN_TINT:P_SHEEN_TINT + 3] = table.sheen_tint
+    rows[:, P_TRANSLUCENT:P_TRANSLUCENT + 3] = table.translucent_color
+    rows[:, P_REFRACT_ONLY] = table.refraction_only
+    rows[:, P_SHEEN_LAYERED] = table.sheen_layered
+    rows[:, P_LAYERS] = table.layered
     return rows

@@ -2,8 +2,11 @@
 of `engine.bsdf.principled.PrincipledBSDF` (see that module for the model: diffuse under
 a dielectric specular layer with albedo scaling, Schlick metal, smooth or rough glass,
 Cycles' multiple-scattering compensation of the GGX lobes; the lobe selection by albedo
-estimates with the MIN_SELECTION floor; the `allowed` masks). Same formulas, same order of operations, so the values agree with the NumPy
-class to rounding (to the bit where the maths library agrees).
+estimates with the MIN_SELECTION floor; the `allowed` masks). Same formulas, same order
+of operations, so the values agree with the NumPy class to rounding (to the bit where the
+maths library agrees). Coat, sheen, translucency and the Refraction BSDF's refraction-only
+glass (layers.py; rows with P_LAYERS / P_REFRACT_ONLY) exist in the compiled BSDF only.
+The state's slots: state.py.
 
 Use, per hit:
     setup(row, front_facing, wox, woy, woz, tables, state)   # fills state[:NSTATE]
@@ -22,15 +25,20 @@ from __future__ import annotations
 import math
 
 from ..jit import kernel
-from . import blinn_phong, dielectric, fresnel
+from . import blinn_phong, dielectric, fresnel, layers
 from . import microfacet as mf
 from . import multiscatter as ms
 from .albedo import specular_albedo
+from .compensation import compensate
+from .state import (NSTATE, S_ALPHA, S_BLINN, S_DIFFUSE, S_EST, S_ETA_GLASS,  # noqa: F401
+                    S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH, S_LAYERED, S_METAL_F0, S_MS_E,
+                    S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY, S_TINT, S_W_GLASS,
+                    S_W_METAL, S_W_SPEC)
 from .params import (GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
                      NPARAM, P_BASE,
                      P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
-                     P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR, P_METAL_COLOR, P_METALLIC,
-                     P_ROUGHNESS,
+                     P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR, P_LAYERS, P_METAL_COLOR,
+                     P_METALLIC, P_REFRACT_ONLY, P_ROUGHNESS,
                      P_SPEC_LEVEL, P_TRANSMISSION, pack_materials)
 from .tables import kernel_tables  # noqa: F401  (re-exported)
 from ..warp import INV_PI, cosine_hemisphere
@@ -43,25 +51,6 @@ MIN_SELECTION = 0.02                       # engine/bsdf/principled.py
 # Largest float below 1: the rescaled lobe coordinate stays in [0, 1)
 ONE_MINUS_EPS = 1.0 - 2.0 ** -53
 
-# --- the per-hit state vector ------------------------------------------------------------
-S_DIFFUSE = 0        # 3: diffuse colour under the specular layer at wo, lobe weight included
-S_EST = 3            # 5: selection estimates: diffuse, specular, metal, glass R, glass T
-S_W_SPEC = 8         # lobe weights (the diffuse one is inside S_DIFFUSE)
-S_W_METAL = 9
-S_W_GLASS = 10
-S_ALPHA = 11         # GGX alpha, clamped
-S_EXPONENT = 12      # Blinn-Phong exponent matching alpha
-S_BLINN = 13         # 1: the reflection lobes use Blinn-Phong instead of GGX
-S_ETA_SPEC = 14      # IOR of the specular layer (adjusted by specular_ior_level)
-S_METAL_F0 = 15      # 3: Schlick F0 of the metal lobe
-S_ETA_GLASS = 18     # relative IOR of the glass lobe (1/ior on back faces)
-S_GLASS_SMOOTH = 19  # 1: the glass lobe is the smooth (delta) interface
-S_TINT = 20          # 3: refraction tint per crossing
-S_MS_SPEC = 23       # multiple-scattering factor of the specular lobe (1: none)
-S_MS_METAL = 24      # 3: ... of the metal lobe, per channel
-S_MS_GLASS = 27      # 3: ... of the rough glass lobe, per channel
-S_MS_E = 30          # GGX's E(wo) behind the factors (1: none)
-NSTATE = 31
 
 
 @kernel
@@ -73,6 +62,11 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     rough = min(max(row[P_ROUGHNESS], 0.0), 1.0)
     ior = max(row[P_IOR], 1e-5)
     level = max(row[P_SPEC_LEVEL], 0.0)
+    layered = row[P_LAYERS] != 0.0
+    state[S_LAYERED] = 1.0 if layered else 0.0
+    state[S_REFRACT_ONLY] = row[P_REFRACT_ONLY]
+    if layered:
+        layers.setup(row, wox, woy, woz, tables, state)
     alpha = mf.clamp_alpha(rough * rough)
     # Filter Glossy widens the lobes after setup, as Cycles' closure blur does: the energy
     # compensation and the layering below keep the material's own alpha
@@ -142,10 +136,12 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     est_gt = 0.0
     if w_glass > 0.0:
         F = fresnel.dielectric(woz, eta_glass)
+        if state[S_REFRACT_ONLY] != 0.0:          # no reflection, refraction unless TIR
+            F = 1.0 if F >= 1.0 else 0.0
         eta_rel = 1.0 / eta_glass if woz < 0.0 else eta_glass
         tint_max = max(state[S_TINT], max(state[S_TINT + 1], state[S_TINT + 2]))
         c_max = max(state[S_MS_GLASS], max(state[S_MS_GLASS + 1], state[S_MS_GLASS + 2]))
-        est_gr = w_glass * F * c_max
+        est_gr = w_glass * F * c_max if state[S_REFRACT_ONLY] == 0.0 else 0.0
         est_gt = w_glass * (1.0 - F) * tint_max / (eta_rel * eta_rel) * c_max
     # floors so that every present lobe can be sampled
     state[S_EST] = max(est_diff, MIN_SELECTION * w_diff) if w_diff > 0.0 else 0.0
@@ -154,57 +150,36 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     half_floor = 0.5 * (MIN_SELECTION * w_glass)
     state[S_EST + 3] = max(est_gr, half_floor) if w_glass > 0.0 else 0.0
     state[S_EST + 4] = max(est_gt, half_floor) if w_glass > 0.0 else 0.0
-
-
-@kernel
-def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, w_glass,
-               tables, state):
-    """The multiple-scattering factors at wo (PrincipledBSDF._compensation): 1 unless
-    `multiscatter`; the lobe weights, metal F0 and tint must be in the state already."""
-    state[S_MS_SPEC] = 1.0
-    state[S_MS_E] = 1.0
-    for c in range(3):
-        state[S_MS_METAL + c] = 1.0
-        state[S_MS_GLASS + c] = 1.0
-    if not multiscatter:
-        return
-    if w_spec > 0.0 or m > 0.0:
-        E = ms.ggx_albedo(cos_o, alpha, tables)
-        E_avg = ms.ggx_albedo_avg(alpha, tables)
-        state[S_MS_E] = E
-        if w_spec > 0.0:
-            state[S_MS_SPEC] = ms.compensation(E, E_avg,
-                                               ms.dielectric_fresnel_avg(eta_spec, tables))
-        if m > 0.0:
-            for c in range(3):
-                state[S_MS_METAL + c] = ms.compensation(
-                    E, E_avg, ms.schlick_fresnel_avg(state[S_METAL_F0 + c]))
-    if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0:
-        eta_rel = 1.0 / eta_glass if woz < 0.0 else eta_glass
-        c_o = min(abs(woz), 1.0)
-        E = ms.glass_albedo(c_o, alpha, eta_rel, tables)
-        E_avg = ms.glass_albedo_avg(alpha, eta_rel, tables)
+    if layered:                  # the layers above dim (and tint) every base lobe
+        smax = layers.base_scale_max(state)
         for c in range(3):
-            state[S_MS_GLASS + c] = ms.compensation(E, E_avg, state[S_TINT + c])
+            state[S_DIFFUSE + c] = state[S_DIFFUSE + c] * state[layers.S_BASE_SCALE + c]
+        for k in range(5):
+            state[S_EST + k] = state[S_EST + k] * smax
 
 
 @kernel
 def transmits(state):
-    """True where light from behind the surface can contribute (a glass lobe)."""
-    return state[S_W_GLASS] > 0.0
+    """True where light from behind the surface can contribute (glass, translucency)."""
+    return state[S_W_GLASS] > 0.0 or (state[S_LAYERED] != 0.0
+                                      and state[layers.S_EST_TRANS] > 0.0)
 
 
 @kernel
 def selection(state, allow_d, allow_g, allow_t):
-    """Lobe probabilities (diffuse, specular, metal, glass) over the allowed kinds."""
+    """Lobe probabilities (diffuse, specular, metal, glass; coat, sheen, translucent of
+    layers.py) over the allowed kinds."""
     w0 = state[S_EST] if allow_d else 0.0
     w1 = state[S_EST + 1] if allow_g else 0.0
     w2 = state[S_EST + 2] if allow_g else 0.0
     w3 = (state[S_EST + 3] if allow_g else 0.0) + (state[S_EST + 4] if allow_t else 0.0)
-    total = w0 + w1 + w2 + w3
+    wc = ws = wt = 0.0
+    if state[S_LAYERED] != 0.0:
+        wc, ws, wt = layers.selection(state, allow_d, allow_g, allow_t)
+    total = w0 + w1 + w2 + w3 + wc + ws + wt
     if not total > 0.0:
-        return 0.0, 0.0, 0.0, 0.0
-    return w0 / total, w1 / total, w2 / total, w3 / total
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    return w0 / total, w1 / total, w2 / total, w3 / total, wc / total, ws / total, wt / total
 
 
 @kernel
@@ -242,6 +217,21 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
         fr = state[S_DIFFUSE] * INV_PI
         fg = state[S_DIFFUSE + 1] * INV_PI
         fb = state[S_DIFFUSE + 2] * INV_PI
+    gr, gg, gb = base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t)
+    if state[S_LAYERED] == 0.0:
+        return fr + gr, fg + gg, fb + gb
+    s = layers.S_BASE_SCALE
+    lr, lg, lb = layers.eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g)
+    return (fr + gr * state[s] + lr, fg + gg * state[s + 1] + lg,
+            fb + gb * state[s + 2] + lb)
+
+
+@kernel
+def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
+    """f (1/sr) of the specular, metal and glass lobes a light of these kinds sees."""
+    fr = 0.0
+    fg = 0.0
+    fb = 0.0
     w_spec = state[S_W_SPEC]
     w_metal = state[S_W_METAL]
     if see_g and (w_spec > 0.0 or w_metal > 0.0):
@@ -260,8 +250,9 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
             fb += fresnel.schlick(state[S_METAL_F0 + 2], cos_oh) * bw * state[S_MS_METAL + 2]
     w_glass = state[S_W_GLASS]
     if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0 and (see_g if wiz > 0.0 else see_t):
-        f_r, f_t = dielectric.rough_eval(wox, woy, woz, wix, wiy, wiz,
-                                         state[S_ETA_GLASS], state[S_ALPHA])
+        f_r, f_t = dielectric.rough_eval_lobes(wox, woy, woz, wix, wiy, wiz,
+                                               state[S_ETA_GLASS], state[S_ALPHA],
+                                               state[S_REFRACT_ONLY] != 0.0)
         fr += (f_r + f_t * state[S_TINT]) * w_glass * state[S_MS_GLASS]
         fg += (f_r + f_t * state[S_TINT + 1]) * w_glass * state[S_MS_GLASS + 1]
         fb += (f_r + f_t * state[S_TINT + 2]) * w_glass * state[S_MS_GLASS + 2]
@@ -275,8 +266,9 @@ def eval_f(state, wox, woy, woz, wix, wiy, wiz):
 
 
 @kernel
-def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3, allow_g, allow_t):
-    """sum_i q_i pdf_i over the lobes, for selection probabilities q."""
+def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
+    """sum_i q_i pdf_i over the lobes, for the selection probabilities q (`selection`)."""
+    q0, q1, q2, q3, qc, qs, qt = q
     p = 0.0
     if woz > 0.0 and wiz > 0.0:
         p += q0 * (wiz * INV_PI)
@@ -285,16 +277,18 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3, allow_g, al
         p += q_refl * reflection_pdf(state, wox, woy, woz, wix, wiy, wiz)
     if q3 > 0.0 and state[S_GLASS_SMOOTH] == 0.0:
         p += q3 * dielectric.rough_pdf(wox, woy, woz, wix, wiy, wiz, state[S_ETA_GLASS],
-                                       state[S_ALPHA], allow_g, allow_t)
+                                       state[S_ALPHA], allow_g and state[S_REFRACT_ONLY] == 0.0,
+                                       allow_t)
+    if qc > 0.0 or qs > 0.0 or qt > 0.0:
+        p += layers.mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt)
     return p
 
 
 @kernel
 def pdf(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t):
     """Mixture pdf (1/sr) of `sample` with the same allow flags."""
-    q0, q1, q2, q3 = selection(state, allow_d, allow_g, allow_t)
-    return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3,
-                       allow_g, allow_t)
+    q = selection(state, allow_d, allow_g, allow_t)
+    return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t)
 
 
 @kernel
@@ -302,14 +296,14 @@ def pdf_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t,
              see_d, see_g, see_t):
     """The part of `pdf` (same allow flags) due to the lobes of the kinds a light is seen
     by: the density with which BSDF sampling reaches that light through wi."""
-    q0, q1, q2, q3 = selection(state, allow_d, allow_g, allow_t)
+    q0, q1, q2, q3, qc, qs, qt = selection(state, allow_d, allow_g, allow_t)
     if not see_d:
-        q0 = 0.0
+        q0 = qs = qt = 0.0
     if not see_g:
-        q1 = q2 = 0.0
+        q1 = q2 = qc = 0.0
     if not (see_g if wiz > 0.0 else see_t):
         q3 = 0.0
-    return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3,
+    return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, (q0, q1, q2, q3, qc, qs, qt),
                        allow_g, allow_t)
 
 
@@ -320,20 +314,15 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     (wix, wiy, wiz, weight_r, weight_g, weight_b, pdf, kind, delta, valid): weight is
     f |cos| / pdf (zero where invalid), pdf the mixture pdf over the allowed lobes (inf
     for the delta choices of a smooth glass, with delta True)."""
-    q0, q1, q2, q3 = selection(state, allow_d, allow_g, allow_t)
-    c0 = q0
-    c1 = c0 + q1
-    c2 = c1 + q2
-    total = c2 + q3
+    q = selection(state, allow_d, allow_g, allow_t)
     lobe = 0
     lo = 0.0
-    q_sel = q0
-    if u_lobe >= c0:
-        lobe, lo, q_sel = 1, c0, q1
-    if u_lobe >= c1:
-        lobe, lo, q_sel = 2, c1, q2
-    if u_lobe >= c2:
-        lobe, lo, q_sel = 3, c2, q3
+    total = 0.0
+    for k in range(7):
+        if k > 0 and u_lobe >= total and q[k] > 0.0:
+            lobe, lo = k, total
+        total += q[k]
+    q_sel = q[lobe]
     u_re = min(max((u_lobe - lo) / (q_sel if q_sel > 0.0 else 1.0), 0.0), ONE_MINUS_EPS)
 
     wix, wiy, wiz = 0.0, 0.0, 1.0
@@ -347,27 +336,39 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     elif lobe == 1 or lobe == 2:
         wix, wiy, wiz, ok = reflection_sample(state, wox, woy, woz, u1, u2)
         kind = GLOSSY
+    elif lobe > 3:                      # coat, sheen, translucent
+        wix, wiy, wiz, ok = layers.sample(state, wox, woy, woz, lobe - 4, u1, u2)
+        kind = (GLOSSY, DIFFUSE, TRANSMISSION)[lobe - 4]
     elif state[S_GLASS_SMOOTH] != 0.0:
-        wix, wiy, wiz, ws, refr, ok = dielectric.smooth_sample(
-            wox, woy, woz, state[S_ETA_GLASS], u_re, allow_g, allow_t)
+        if state[S_REFRACT_ONLY] != 0.0:
+            wix, wiy, wiz, ws, ok = dielectric.smooth_refract(wox, woy, woz,
+                                                              state[S_ETA_GLASS])
+            refr = True
+            ok = ok and allow_t
+        else:
+            wix, wiy, wiz, ws, refr, ok = dielectric.smooth_sample(
+                wox, woy, woz, state[S_ETA_GLASS], u_re, allow_g, allow_t)
         kind = TRANSMISSION if refr else GLOSSY
         if not ok:
             return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
         w = ws * state[S_W_GLASS] / q_sel
+        wr, wg, wb = w, w, w
         if refr:
-            return (wix, wiy, wiz, state[S_TINT] * w, state[S_TINT + 1] * w,
-                    state[S_TINT + 2] * w, math.inf, kind, True, True)
-        return wix, wiy, wiz, w, w, w, math.inf, kind, True, True
+            wr, wg, wb = state[S_TINT] * w, state[S_TINT + 1] * w, state[S_TINT + 2] * w
+        if state[S_LAYERED] != 0.0:
+            s = layers.S_BASE_SCALE
+            wr, wg, wb = wr * state[s], wg * state[s + 1], wb * state[s + 2]
+        return wix, wiy, wiz, wr, wg, wb, math.inf, kind, True, True
     else:
         wix, wiy, wiz, refr, ok = dielectric.rough_sample(
             wox, woy, woz, state[S_ETA_GLASS], state[S_ALPHA], u_re, u1, u2,
-            allow_g, allow_t)
+            allow_g and state[S_REFRACT_ONLY] == 0.0, allow_t)
         kind = TRANSMISSION if refr else GLOSSY
     if not ok:
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
     # non-delta choices: one-sample mixture estimator f |cos| / sum_j q_j pdf_j
     fr, fg, fb = eval_f(state, wox, woy, woz, wix, wiy, wiz)
-    p = mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q0, q1, q2, q3, allow_g, allow_t)
+    p = mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t)
     if not (p > 0.0 and p < math.inf):
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
     s = abs(wiz) / p

@@ -1,0 +1,169 @@
+"""The lobes beyond Principled's base, as Cycles stacks them (kernel/svm/closure.h):
+
+    sheen        (sheen.py)        on top, dimming what is below by its albedo (a Sheen
+                                   BSDF node's sheen, P_SHEEN_LAYERED 0, dims nothing);
+    coat         (coat.py)         under the sheen, dimming and tinting what is below;
+    base         (principled.py)   diffuse, specular, metal, glass: scaled per channel by
+                                   `S_BASE_SCALE`, the product of the layers' factors;
+    translucent  (translucent.py)  a Translucent BSDF mixed in beside them (no layering).
+
+A material row uses them only where P_LAYERS is 1; then principled.setup calls `setup`
+here, which fills the slots below and returns nothing else, and principled's eval, pdf
+and sample add this module's lobes. A row with P_LAYERS = 0 never reads a slot here
+(tests/test_layered_bsdf.py checks that with NaN slots).
+
+Lobe kinds: coat GLOSSY; sheen DIFFUSE (Cycles labels it diffuse reflection); translucent
+TRANSMISSION for the bounce that follows it (it leaves through the surface) and seen by
+lights as diffuse, as Cycles classifies it; it is sampled only while both the diffuse
+and the transmission bounce budgets last (Cycles counts it against both).
+"""
+from __future__ import annotations
+
+from ..jit import kernel
+from . import coat, sheen, translucent
+from . import microfacet as mf
+from .params import (P_COAT_IOR, P_COAT_ROUGHNESS, P_COAT_TINT, P_COAT_WEIGHT,
+                     P_FILTER_ALPHA, P_SHEEN_LAYERED, P_SHEEN_ROUGHNESS, P_SHEEN_TINT,
+                     P_SHEEN_WEIGHT, P_TRANSLUCENT)
+
+WEIGHT_CUTOFF = 1e-5            # Cycles' CLOSURE_WEIGHT_CUTOFF
+MIN_SELECTION = 0.02            # principled.MIN_SELECTION
+
+S_FIRST = 33                    # principled.py's slots end here
+S_BASE_SCALE = 33               # 3: the factor of every base lobe, per channel
+S_COAT_W = 36                   # the coat lobe's weight (coat weight x sheen's factor)
+S_COAT_ALPHA = 37               # the coat lobe's GGX alpha (Filter Glossy included)
+S_COAT_IOR = 38
+S_SHEEN_W = 39                  # 3: sheen weight x tint x R(wo)
+S_SHEEN_A = 42                  # the LTC's a, b and frame (wo's azimuth cx, cy)
+S_SHEEN_B = 43
+S_SHEEN_CX = 44
+S_SHEEN_CY = 45
+S_TRANS = 46                    # 3: the translucent colour
+S_EST_COAT = 49                 # selection estimates of the three lobes
+S_EST_SHEEN = 50
+S_EST_TRANS = 51
+NSTATE = 52
+
+
+@kernel
+def setup(row, wox, woy, woz, tables, state):
+    """Fill the slots above for outgoing wo (local, wo_z > 0)."""
+    cos_o = min(max(woz, 0.0), 1.0)
+    scale = 1.0                                  # the layers' scalar factor so far
+    # sheen
+    sw = max(row[P_SHEEN_WEIGHT], 0.0)
+    sheen_max = 0.0
+    state[S_SHEEN_CX], state[S_SHEEN_CY] = sheen.azimuth(wox, woy)
+    state[S_SHEEN_A], state[S_SHEEN_B] = 1.0, 0.0
+    for c in range(3):
+        state[S_SHEEN_W + c] = 0.0
+    if sw > WEIGHT_CUTOFF:
+        rough = min(max(row[P_SHEEN_ROUGHNESS], 0.0), 1.0)
+        a, b, R = sheen.lookup(cos_o, rough, tables)
+        state[S_SHEEN_A], state[S_SHEEN_B] = a, b
+        for c in range(3):
+            w = sw * max(row[P_SHEEN_TINT + c], 0.0) * max(R, 0.0)
+            state[S_SHEEN_W + c] = w
+            sheen_max = max(sheen_max, w)
+        if row[P_SHEEN_LAYERED] != 0.0:
+            scale = min(max(1.0 - sheen_max, 0.0), 1.0)
+    state[S_EST_SHEEN] = max(sheen_max, MIN_SELECTION * sw) if sheen_max > 0.0 else 0.0
+    # coat
+    cw = max(row[P_COAT_WEIGHT], 0.0)
+    ior = max(row[P_COAT_IOR], 1.0)
+    state[S_COAT_W] = 0.0
+    state[S_COAT_IOR] = ior
+    state[S_COAT_ALPHA] = 1.0
+    state[S_EST_COAT] = 0.0
+    for c in range(3):
+        state[S_BASE_SCALE + c] = 1.0
+    if cw > WEIGHT_CUTOFF:
+        rough = min(max(row[P_COAT_ROUGHNESS], 0.0), 1.0)
+        alpha = mf.clamp_alpha(rough * rough)
+        state[S_COAT_ALPHA] = mf.clamp_alpha(max(alpha, row[P_FILTER_ALPHA]))
+        if ior > 1.0:
+            state[S_COAT_W] = cw * scale
+            E = coat.layer_albedo(cos_o, alpha, ior, tables)
+            state[S_EST_COAT] = cw * scale * max(E, MIN_SELECTION)
+            scale = scale * min(max(1.0 - cw * E, 0.0), 1.0)
+        tinted = (row[P_COAT_TINT] != 1.0 or row[P_COAT_TINT + 1] != 1.0
+                  or row[P_COAT_TINT + 2] != 1.0)
+        if tinted:
+            depth = coat.path_length(cos_o, ior)
+            for c in range(3):
+                state[S_BASE_SCALE + c] = coat.tint_factor(row[P_COAT_TINT + c], cw, depth)
+    for c in range(3):
+        state[S_BASE_SCALE + c] = state[S_BASE_SCALE + c] * scale
+    # translucent
+    t_max = 0.0
+    for c in range(3):
+        state[S_TRANS + c] = max(row[P_TRANSLUCENT + c], 0.0)
+        t_max = max(t_max, state[S_TRANS + c])
+    state[S_EST_TRANS] = t_max
+
+
+@kernel
+def base_scale_max(state):
+    return max(state[S_BASE_SCALE], max(state[S_BASE_SCALE + 1], state[S_BASE_SCALE + 2]))
+
+
+@kernel
+def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g):
+    """f (1/sr) of the sheen, coat and translucent lobes that a light of the given kinds
+    sees (principled.eval_seen adds the scaled base)."""
+    fr = fg = fb = 0.0
+    if see_d and state[S_EST_SHEEN] > 0.0 and woz > 0.0:
+        s = sheen.shape(wix, wiy, wiz, state[S_SHEEN_CX], state[S_SHEEN_CY],
+                        state[S_SHEEN_A], state[S_SHEEN_B])
+        fr += state[S_SHEEN_W] * s
+        fg += state[S_SHEEN_W + 1] * s
+        fb += state[S_SHEEN_W + 2] * s
+    if see_g and state[S_COAT_W] > 0.0:
+        v = state[S_COAT_W] * coat.eval_unit(wox, woy, woz, wix, wiy, wiz,
+                                             state[S_COAT_ALPHA], state[S_COAT_IOR])
+        fr += v
+        fg += v
+        fb += v
+    if see_d and state[S_EST_TRANS] > 0.0:
+        t = translucent.eval_unit(woz, wiz)
+        fr += state[S_TRANS] * t
+        fg += state[S_TRANS + 1] * t
+        fb += state[S_TRANS + 2] * t
+    return fr, fg, fb
+
+
+@kernel
+def selection(state, allow_d, allow_g, allow_t):
+    """Unnormalised selection weights (coat, sheen, translucent) over the allowed kinds."""
+    wc = state[S_EST_COAT] if allow_g else 0.0
+    ws = state[S_EST_SHEEN] if allow_d else 0.0
+    wt = state[S_EST_TRANS] if (allow_d and allow_t) else 0.0
+    return wc, ws, wt
+
+
+@kernel
+def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt):
+    """sum q_i pdf_i over the coat, sheen and translucent lobes."""
+    p = 0.0
+    if qc > 0.0:
+        p += qc * mf.reflection_pdf(wox, woy, woz, wix, wiy, wiz, state[S_COAT_ALPHA])
+    if qs > 0.0:
+        p += qs * sheen.pdf(wix, wiy, wiz, state[S_SHEEN_CX], state[S_SHEEN_CY],
+                            state[S_SHEEN_A], state[S_SHEEN_B])
+    if qt > 0.0:
+        p += qt * translucent.pdf(woz, wiz)
+    return p
+
+
+@kernel
+def sample(state, wox, woy, woz, lobe, u1, u2):
+    """A direction from lobe 0 (coat), 1 (sheen) or 2 (translucent): (wi, valid)."""
+    if lobe == 0:
+        return mf.reflection_sample(wox, woy, woz, state[S_COAT_ALPHA], u1, u2)
+    if lobe == 1:
+        x, y, z = sheen.sample(u1, u2, state[S_SHEEN_CX], state[S_SHEEN_CY],
+                               state[S_SHEEN_A], state[S_SHEEN_B])
+        return x, y, z, z > 0.0 and woz > 0.0
+    x, y, z = translucent.sample(u1, u2)
+    return x, y, z, z < 0.0 and woz > 0.0

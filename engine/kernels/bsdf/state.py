@@ -1,0 +1,24 @@
+"""The per-hit state vector of the compiled Principled BSDF (principled.setup fills it):
+the slots of the base lobes here, those of the layers' lobes in layers.py, after them."""
+from . import layers
+
+S_DIFFUSE = 0        # 3: diffuse colour under the specular layer at wo, lobe weight included
+S_EST = 3            # 5: selection estimates: diffuse, specular, metal, glass R, glass T
+S_W_SPEC = 8         # lobe weights (the diffuse one is inside S_DIFFUSE)
+S_W_METAL = 9
+S_W_GLASS = 10
+S_ALPHA = 11         # GGX alpha, clamped
+S_EXPONENT = 12      # Blinn-Phong exponent matching alpha
+S_BLINN = 13         # 1: the reflection lobes use Blinn-Phong instead of GGX
+S_ETA_SPEC = 14      # IOR of the specular layer (adjusted by specular_ior_level)
+S_METAL_F0 = 15      # 3: Schlick F0 of the metal lobe
+S_ETA_GLASS = 18     # relative IOR of the glass lobe (1/ior on back faces)
+S_GLASS_SMOOTH = 19  # 1: the glass lobe is the smooth (delta) interface
+S_TINT = 20          # 3: refraction tint per crossing
+S_MS_SPEC = 23       # multiple-scattering factor of the specular lobe (1: none)
+S_MS_METAL = 24      # 3: ... of the metal lobe, per channel
+S_MS_GLASS = 27      # 3: ... of the rough glass lobe, per channel
+S_MS_E = 30          # GGX's E(wo) behind the factors (1: none)
+S_REFRACT_ONLY = 31  # 1: the glass lobe refracts only (Refraction BSDF)
+S_LAYERED = 32       # 1: the lobes of layers.py are in use (their slots follow)
+NSTATE = layers.NSTATE
