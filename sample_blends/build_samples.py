@@ -792,6 +792,17 @@ def hdri_world():
 SCENES["hdri_world"] = hdri_world
 
 
+def _artist_scenes():
+    """sample_blends/artist_scenes.py's scenes (which use this module's helpers)."""
+    sys.path.insert(0, HERE)
+    import artist_scenes
+    return artist_scenes.SCENES
+
+
+if __name__ == "__main__":
+    SCENES.update(_artist_scenes())
+
+
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("names", nargs="*", help=f"scenes to build (default all: {', '.join(SCENES)})")

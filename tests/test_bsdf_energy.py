@@ -413,7 +413,7 @@ def test_sample_weight_equals_f_cos_over_pdf():
     for allowed in (None, rng.random((n, 3)) < 0.7):
         s = b.sample(wo, rng.random(n), rng.random((n, 2)), allowed)
         nd = s.valid & ~s.delta
-        f = b.eval_f(wo, s.wi)
+        f = b.eval_f(wo, s.wi, allowed)     # the allowed lobes (tests/test_lobe_limits.py)
         p = b.pdf(wo, s.wi, allowed)
         assert nd.mean() > 0.5 and s.delta.any()
         assert np.allclose(s.pdf[nd], p[nd], rtol=1e-9)

@@ -327,12 +327,18 @@ class PrincipledBSDF:
                 _sub(self.blinn, g) if self.any_blinn else None)
 
     # -- evaluation ----------------------------------------------------------------------
-    def _eval(self, idx, wo, wi, diffuse, comp):
+    def _eval(self, idx, wo, wi, diffuse, comp, allowed=None):
+        """f of rows idx; `allowed` (len(wo), 3) keeps only the lobe kinds a sampled
+        path may continue by (DIFFUSE, GLOSSY, TRANSMISSION), None all of them."""
         f = np.zeros((len(wo), 3))
+        if allowed is None:
+            allowed = np.ones((len(wo), 3), bool)
+        keep = allowed.astype(np.float64)
         if self.active[L_DIFFUSE]:
             g, loc = self._lobe_rows(L_DIFFUSE, idx)
             if g is None or len(g):
-                val = lambert.eval_f(_sub(diffuse, g), _sub(wo, loc), _sub(wi, loc))
+                val = lambert.eval_f(_sub(diffuse, g), _sub(wo, loc), _sub(wi, loc)) \
+                    * _sub(keep[:, 0:1], loc)
                 if loc is None:
                     f += val
                 else:
@@ -350,7 +356,8 @@ class PrincipledBSDF:
                 F = fresnel.dielectric(cos_oh, _sub(self.eta_spec, g))[:, None]
             else:
                 F = fresnel.schlick(_sub(self.base_clamped, g), cos_oh)
-            val = F * (base * _sub(self.weight[:, lobe], g))[:, None]
+            val = F * (base * _sub(self.weight[:, lobe], g))[:, None] \
+                * _sub(keep[:, 1:2], loc)
             if comp is not None:
                 val = val * (_sub(comp[:, 0:1], g) if lobe == L_SPECULAR
                              else _sub(comp[:, 1:4], g))
@@ -368,19 +375,22 @@ class PrincipledBSDF:
                     lr = rr if loc is None else loc[rr]
                     f_r, f_t = dielectric.rough_eval(wo[lr], wi[lr], self.eta_glass[gr],
                                                      self.alpha[gr])
-                    val = (f_r[:, None] + f_t[:, None] * self.tint_t[gr]) \
+                    val = (f_r[:, None] * keep[lr, 1:2]
+                           + f_t[:, None] * self.tint_t[gr] * keep[lr, 2:3]) \
                         * self.weight[gr, L_GLASS][:, None]
                     if comp is not None:
                         val = val * comp[gr, 4:7]
                     f[lr] += val
         return f
 
-    def eval_f(self, wo, wi):
-        """The whole BSDF f(wo, wi) (n, 3) in 1/sr (delta parts excluded)."""
+    def eval_f(self, wo, wi, allowed=None):
+        """The whole BSDF f(wo, wi) (n, 3) in 1/sr (delta parts excluded), or only the
+        lobe kinds `allowed` (n, 3) keeps (what `sample`'s weight estimates)."""
         if self.diffuse_only:
-            return lambert.eval_f(self.diffuse_color, wo, wi)
+            f = lambert.eval_f(self.diffuse_color, wo, wi)
+            return f if allowed is None else f * allowed[:, 0:1]
         diffuse, _, comp = self._wo_state(wo)
-        return self._eval(None, wo, wi, diffuse, comp)
+        return self._eval(None, wo, wi, diffuse, comp, allowed)
 
     def _pdf(self, idx, wo, wi, q, a_g, a_t):
         """Mixture pdf on the subset idx; q, a_g, a_t already restricted to it."""
@@ -484,7 +494,9 @@ class PrincipledBSDF:
         # non-delta choices: one-sample mixture estimator f |cos| / sum_j q_j pdf_j
         r = np.nonzero(ok & ~delta)[0]
         if len(r):
-            f = self._eval(r, wo[r], wi[r], diffuse, comp)
+            # the allowed lobes only: a lobe past its bounce limit adds nothing
+            f = self._eval(r, wo[r], wi[r], diffuse, comp,
+                           None if allowed is None else allowed[r])
             p = self._pdf(r, wo[r], wi[r], q[r], a_g[r], a_t[r])
             good = (p > 0) & np.isfinite(p)
             weight[r] = np.where(good[:, None],

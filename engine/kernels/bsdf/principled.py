@@ -366,8 +366,10 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
         kind = TRANSMISSION if refr else GLOSSY
     if not ok:
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
-    # non-delta choices: one-sample mixture estimator f |cos| / sum_j q_j pdf_j
-    fr, fg, fb = eval_f(state, wox, woy, woz, wix, wiy, wiz)
+    # non-delta choices: one-sample mixture estimator f |cos| / sum_j q_j pdf_j, of the
+    # allowed lobes only (a lobe past its bounce limit adds nothing, as in Cycles, where
+    # a path that picks it ends)
+    fr, fg, fb = eval_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t)
     p = mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t)
     if not (p > 0.0 and p < math.inf):
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
