@@ -26,6 +26,11 @@ with y = (elevation - sun elevation) / size + 1/2 (`sun_disc_radiance`). DRT ren
 as a `engine.scene.SunLight` of the same size whose uniform radiance is that disc's mean
 over its solid angle (`sun_light`): the same power from the same cone, sampled as a
 lamp; only a camera that resolves the disc sees the limb darkening flattened.
+Why a lamp rather than the disc baked into the map: on sky_world (64 spp, 4 seeds) the
+lamp's per-pixel noise is 1.37 % of the image mean against 1.60 % with the disc
+supersampled into a 4096 x 2048 map (the disc about 6 texels across, importance-sampled
+with the sky), at about half the render time (2.1 s against 4.0 s per render) and
+without that map's 200 MB of texels and CDFs.
 """
 from __future__ import annotations
 

@@ -64,7 +64,11 @@ def sky_world(node, strength, vis, mapping, ctx):
     if kind == "SINGLE_SCATTERING":
         params = engine.sky_texture.SkyParameters(
             **{**params.__dict__, "sky_type": "MULTIPLE_SCATTERING"})
-    texture, sun = engine.sky_texture.sky_world(params)
+    try:
+        texture, sun = engine.sky_texture.sky_world(params)
+    except (ValueError, NotImplementedError) as exc:       # a sky type of a newer Blender
+        ctx.issue(f"{node.name!r}: {exc}; using the Background's own colour")
+        return None
     rgb = (float(strength),) * 3
     mean = tuple(float(c) * strength for c in texture.mean_rgba()[:3])
     world = engine.World(mean, texture=texture, strength=rgb, mapping=mapping,
