@@ -8,6 +8,7 @@ from .scene import (AreaLight, Camera, Material, ObjectInfo, PointLight, Scene, 
                     TriangleMesh, Volume, World)
 from .settings import RenderSettings
 from . import visibility  # noqa: E402  (the Ray Visibility bits, for exporters)
+from . import sky_texture  # noqa: E402  (Blender's Sky Texture node, for exporters)
 
 __all__ = ["AreaLight", "Camera", "Film", "Material", "ObjectInfo", "PointLight",
            "RenderContext",

@@ -75,7 +75,10 @@ class RenderContext:
         self.world = world_model(scene.world)
         self.world_radiance = np.asarray(getattr(self.world, "radiance", np.zeros(3)),
                                          dtype=np.float64)[:3]
-        self.lights = LightSet(scene.lights, self.scene_radius,
+        # a Sky Texture's sun disc is one more lamp (engine.scene.World.sun)
+        sun = getattr(scene.world, "sun", None)
+        lamps = list(scene.lights) + ([sun] if sun is not None else [])
+        self.lights = LightSet(lamps, self.scene_radius,
                                mesh_lights=EmissiveTriangles.from_scene(
                                    scene, self.accel, self.materials.emission),
                                world=self.world)

@@ -300,13 +300,16 @@ class World:
     `mapping` @ direction (a 3x3 matrix, Blender's Mapping node; None = identity); see
     `engine.environment_map` for the projection. `color` is then not used.
     visibility: the ray kinds that see it (engine.visibility; Blender's World > Ray
-    Visibility); see `engine.world_light`."""
+    Visibility); see `engine.world_light`.
+    sun: a `SunLight` that belongs to the world (a Sky Texture's sun disc,
+    `engine.sky_texture`), rendered as one more lamp; None = none."""
     color: tuple = (0.0, 0.0, 0.0)
     texture: Optional[object] = None
     strength: tuple = (1.0, 1.0, 1.0)
     mapping: Optional[np.ndarray] = None
     visibility: int = 31
     volume: Optional[object] = None      # Volume filling the space outside every mesh
+    sun: Optional[SunLight] = None
 
 
 @dataclass

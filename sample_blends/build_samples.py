@@ -761,13 +761,11 @@ def _packed_sky(name):
     return img
 
 
-def hdri_world():
-    """Blender's defaults: a diffuse sphere and a glossy metal sphere (roughness 0.25)
-    on a diffuse floor, lit only by an environment map (a procedural sky with a small,
-    very bright sun, `sky_pixels`, packed as OpenEXR) through a Mapping node that turns
-    it 60 degrees about Z."""
+def _two_spheres_on_floor():
+    """A diffuse and a glossy metal sphere (roughness 0.25) on a diffuse floor, seen
+    from -Y, at the comparison defaults; the world is left to the caller."""
     scene = reset()
-    _defaults(scene)
+    _comparison_defaults(scene)
     grey = principled("Floor", (0.6, 0.6, 0.6), specular=0.0)
     quad("Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)], grey)
     clay = principled("Clay", (0.8, 0.45, 0.25), specular=0.0)
@@ -775,6 +773,15 @@ def hdri_world():
     metal = principled("Metal", (0.9, 0.9, 0.9), roughness=0.25, metallic=1.0)
     uv_sphere("Glossy", (0.6, 0.0, 0.5), 0.5, metal)
     camera(scene, (0.0, -4.0, 1.6), (math.radians(75.0), 0.0, 0.0), lens=35.0)
+    return scene
+
+
+def hdri_world():
+    """Blender's defaults: a diffuse sphere and a glossy metal sphere (roughness 0.25)
+    on a diffuse floor, lit only by an environment map (a procedural sky with a small,
+    very bright sun, `sky_pixels`, packed as OpenEXR) through a Mapping node that turns
+    it 60 degrees about Z."""
+    scene = _two_spheres_on_floor()
     tree = scene.world.node_tree
     bg = tree.nodes["Background"]
     env = tree.nodes.new("ShaderNodeTexEnvironment")
@@ -790,6 +797,21 @@ def hdri_world():
 
 
 SCENES["hdri_world"] = hdri_world
+
+
+def sky_world():
+    """A diffuse and a glossy metal sphere (roughness 0.25) on a diffuse floor, lit
+    only by a Sky Texture at Blender's defaults (Multiple Scattering, sun 15 degrees up
+    along +Y, in front of the camera and just above its view), 64 x 64."""
+    scene = _two_spheres_on_floor()
+    tree = scene.world.node_tree
+    sky = tree.nodes.new("ShaderNodeTexSky")
+    tree.links.new(sky.outputs["Color"], tree.nodes["Background"].inputs["Color"])
+    tree.nodes["Background"].inputs["Strength"].default_value = 1.0
+    return scene
+
+
+SCENES["sky_world"] = sky_world
 
 
 def _artist_scenes():

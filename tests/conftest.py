@@ -64,6 +64,16 @@ def render_blend(bpy, path, engine, samples, percentage=50, setup=None) -> np.nd
     return render_current(bpy, scene)
 
 
+def cached_render(cache, bpy, path, engine, samples, setup=None, tag="") -> np.ndarray:
+    """render_blend at 100 % of `path`, kept in `cache` (a test module's dict) under
+    (engine, samples, tag): one render per setting for the whole module."""
+    key = (engine, samples, tag)
+    if key not in cache:
+        cache[key] = render_blend(bpy, path, engine, samples=samples, percentage=100,
+                                  setup=setup)
+    return cache[key]
+
+
 def read_render_result(bpy, scene) -> np.ndarray:
     """Blender's Render Result as Blender writes it: scene-linear OpenEXR, read back as
     float64 (h, w, 3), row 0 at the top."""

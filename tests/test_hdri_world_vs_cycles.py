@@ -31,7 +31,7 @@ import os
 import numpy as np
 import pytest
 
-from conftest import SAMPLES_DIR, render_blend
+from conftest import SAMPLES_DIR, cached_render
 
 MEAN_TOLERANCE = 0.01
 BLOCK_MAD_TOLERANCE = 0.03
@@ -47,11 +47,7 @@ _renders = {}
 
 
 def _render(bpy, engine, samples, setup=None, tag=""):
-    key = (engine, samples, tag)
-    if key not in _renders:
-        _renders[key] = render_blend(bpy, PATH, engine, samples=samples, percentage=100,
-                                     setup=setup)
-    return _renders[key]
+    return cached_render(_renders, bpy, PATH, engine, samples, setup, tag)
 
 
 def compare(drt, cycles):

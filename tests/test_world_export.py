@@ -136,13 +136,13 @@ def test_unsupported_inputs_warn_and_fall_back(bpy_drt):
     assert w.texture is None and "MIRROR_BALL" in warnings[0]
     np.testing.assert_allclose(w.color, (0.4, 0.6, 0.8))
     # a procedural texture on Color, and a linked Strength
-    sky = tree.nodes.new("ShaderNodeTexSky")
-    tree.links.new(sky.outputs["Color"], bg.inputs["Color"])
+    wave = tree.nodes.new("ShaderNodeTexWave")
+    tree.links.new(wave.outputs["Color"], bg.inputs["Color"])
     value = tree.nodes.new("ShaderNodeValue")
     tree.links.new(value.outputs[0], bg.inputs["Strength"])
     w, warnings = _export(world)
     assert w.texture is None and len(warnings) == 2
-    assert any("Strength" in t for t in warnings) and any("Sky" in t for t in warnings)
+    assert any("Strength" in t for t in warnings) and any("Wave" in t for t in warnings)
     # an unsupported vector source: the image is kept, the vector ignored
     tree.links.new(env.outputs["Color"], bg.inputs["Color"])
     env.projection = "EQUIRECTANGULAR"
@@ -166,3 +166,68 @@ def test_missing_image_is_pink_like_cycles(bpy_drt):
     w, warnings = _export(world)
     assert w.texture is None and any("no pixels" in t for t in warnings)
     np.testing.assert_allclose(w.color, (2.0, 0.0, 2.0))
+
+
+def _sky(bpy, **settings):
+    world, bg = _world(bpy, "Sky")
+    sky = world.node_tree.nodes.new("ShaderNodeTexSky")
+    for k, v in settings.items():
+        setattr(sky, k, v)
+    world.node_tree.links.new(sky.outputs["Color"], bg.inputs["Color"])
+    return world, bg, sky
+
+
+def test_sky_texture_becomes_a_map_and_a_sun(bpy_drt):
+    """The default sky: an equirectangular map times the Strength (2) and a sun lamp
+    along +Y, 15 degrees up, of the node's size, seen as the world is."""
+    world, bg, sky = _sky(bpy_drt)
+    world.cycles_visibility.glossy = False
+    w, warnings = _export(world)
+    assert not warnings and w.texture is not None and w.mapping is None
+    assert w.strength == (2.0, 2.0, 2.0)
+    sun = w.sun
+    e = math.radians(15.0)
+    np.testing.assert_allclose(sun.direction, (0.0, -math.cos(e), -math.sin(e)), atol=1e-6)
+    assert sun.angle == pytest.approx(sky.sun_size)
+    assert sun.visibility == 31 & ~4          # glossy off, shadows always cast
+    bg.inputs["Strength"].default_value = 1.0
+    one, _ = _export(world)
+    np.testing.assert_allclose(np.asarray(sun.strength), 2.0 * np.asarray(one.sun.strength))
+    # no disc, no lamp
+    sky.sun_disc = False
+    assert _export(world)[0].sun is None
+
+
+def test_sky_texture_vector(bpy_drt):
+    """A Mapping node on the Vector turns a Preetham sky; Blender 5.0 makes the socket
+    unavailable on the physical skies (Cycles never reads it), so there it is ignored
+    and the sun stays put."""
+    world, bg, sky = _sky(bpy_drt, sky_type="PREETHAM")
+    tree = world.node_tree
+    mapping = tree.nodes.new("ShaderNodeMapping")
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(90.0))
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+    tree.links.new(mapping.outputs["Vector"], sky.inputs[0])
+    w, warnings = _export(world)
+    assert not warnings and w.mapping is not None and w.sun is None
+    np.testing.assert_allclose(w.mapping @ (1.0, 0.0, 0.0), (0.0, 1.0, 0.0), atol=1e-6)
+    sky.sky_type = "MULTIPLE_SCATTERING"
+    assert not sky.inputs[0].enabled
+    w, warnings = _export(world)
+    assert not warnings and w.mapping is None
+    e = math.radians(15.0)
+    np.testing.assert_allclose(w.sun.direction, (0.0, -math.cos(e), -math.sin(e)), atol=1e-6)
+
+
+def test_unmodelled_sky_types_are_reported(bpy_drt):
+    world, bg, sky = _sky(bpy_drt, sky_type="HOSEK_WILKIE")
+    w, warnings = _export(world)
+    assert w.texture is None and w.sun is None and "Hosek" in warnings[0]
+    np.testing.assert_allclose(w.color, (0.4, 0.6, 0.8))
+    sky.sky_type = "SINGLE_SCATTERING"
+    w, warnings = _export(world)
+    assert w.texture is not None and "Single Scattering" in warnings[0]
+    sky.sky_type = "PREETHAM"
+    w, warnings = _export(world)
+    assert w.texture is not None and w.sun is None and not warnings

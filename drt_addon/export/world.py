@@ -18,6 +18,8 @@ shader (anything else: a black background, reported):
   diag(1/S) R^T, Normal R diag(1/S); R the XYZ Euler rotation). A translation is ignored
   (the lookup direction is normalised and Cycles adds it before: reported), as is a
   singular scale (reported). Any other vector source is reported and ignored.
+- Color from a Sky Texture node: its sky as an environment map and its sun disc as a
+  distant light (`world_sky`), through the node's Vector as above.
 - Anything else linked to Color, or a linked Strength: reported; the socket's own value
   is used.
 World > Ray Visibility (`world.cycles_visibility`: camera, diffuse, glossy, transmission,
@@ -32,6 +34,7 @@ from ..engine_link import engine
 from .errors import Reporter
 from .images import image_cache, image_texture, textures
 from .nodes.links import _link, uses_nodes
+from .world_sky import sky_world
 
 BLACK = (0.0, 0.0, 0.0)
 MISSING = tuple(textures.MISSING_RGBA[:3])
@@ -91,6 +94,8 @@ def export_world(world, reporter: Reporter) -> "engine.World":
     world_out = None
     if src.bl_idname == "ShaderNodeTexEnvironment" and socket.identifier == "Color":
         world_out = _environment(src, s, vis, ctx)
+    elif src.bl_idname == "ShaderNodeTexSky":
+        world_out = sky_world(src, s, vis, _mapping(src, ctx), ctx)
     else:
         ctx.issue(f"the Background's Color comes from {src.bl_label!r}, which DRT does not "
                   f"evaluate; using the Background's own colour")
@@ -122,8 +127,10 @@ def _environment(node, strength, vis, ctx):
 
 
 def _mapping(env_node, ctx):
-    """The 3x3 matrix of the Environment Texture's Vector input (None = identity)."""
-    found = _link(env_node.inputs["Vector"])
+    """The 3x3 matrix of an Environment or Sky Texture's Vector input (None =
+    identity)."""
+    sock = env_node.inputs.get("Vector")
+    found = _link(sock) if sock is not None and sock.enabled else None
     if found is None:
         return None
     src, out = found
