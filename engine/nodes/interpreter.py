@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.jit import kernel
-from . import color_nodes, converter_nodes, input_nodes, procedural_nodes, texture_nodes, \
-    vector_nodes
+from . import bump, color_nodes, converter_nodes, input_nodes, procedural_nodes, \
+    texture_nodes, vector_nodes
 from .pack import DATA, INIT, NREGS, OPS, PROG, pack_shading
 
 
@@ -40,8 +40,10 @@ def run(T, m, hit, regs):
             color_nodes.execute(ins, regs, data)
         elif code < 400:
             converter_nodes.execute(ins, regs)
-        else:
+        elif code < 420:
             vector_nodes.execute(ins, regs, hit)
+        else:
+            bump.execute(ins, regs, hit)
 
 
 @kernel

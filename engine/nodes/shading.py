@@ -1,9 +1,10 @@
 """The kernels' side of shader programs: run a hit's material program and read its
 outputs into the Principled parameter row, emission and alpha.
 
-geometry is the compiled path tracer's triangle tuple; its fields 10 to 13 are each
+geometry is the compiled path tracer's triangle tuple; its fields 10 to 14 are each
 triangle's object (int32, empty when no mesh carries ObjectInfo), the object table
 (context.O_* rows), the corner tangents and the corner colours ((T, 3, 4) float32 each,
+empty without), and the packed render camera (engine.kernels.camera_rays.pack_camera;
 empty without)."""
 from __future__ import annotations
 
@@ -14,6 +15,7 @@ import numpy as np
 from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
 from .context import fill
+from .differentials import fill_differentials
 from .interpreter import run
 from .pack import MIX, OUTS
 
@@ -24,7 +26,8 @@ OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_
 def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
                 dx, dy, dz, front, ray, depth, length, hit, regs):
     """Fill the hit row of a hit on triangle prim (material m) at barycentrics (bu, bv)
-    and run m's program."""
+    and run m's program. The caller has written the row's path fields
+    (context.path_fields; zeros: a path of no bounces and a ray without footprint)."""
     tri_object, objects, corner_tangents = geometry[10], geometry[11], geometry[12]
     obj = tri_object[prim] if tri_object.shape[0] > 0 else -1
     tx = ty = tz = ts = 0.0
@@ -47,8 +50,10 @@ def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx
         cg = b0 * colors[prim, 0, 1] + bu * colors[prim, 1, 1] + bv * colors[prim, 2, 1]
         cb = b0 * colors[prim, 0, 2] + bu * colors[prim, 1, 2] + bv * colors[prim, 2, 2]
         ca = b0 * colors[prim, 0, 3] + bu * colors[prim, 1, 3] + bv * colors[prim, 2, 3]
+    camera = geometry[14]
     fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, uu, vv, front, ray, depth,
-         length, objects, obj, tx, ty, tz, ts, cr, cg, cb, ca)
+         length, objects, obj, camera, tx, ty, tz, ts, cr, cg, cb, ca)
+    fill_differentials(hit, geometry, prim, obj, camera)
     run(T, m, hit, regs)
 
 
