@@ -56,7 +56,8 @@ def _bump_scene(bpy):
     bsdf.inputs["Roughness"].default_value = 0.3
     noise = nt.nodes.new("ShaderNodeTexNoise")
     noise.inputs["Scale"].default_value = 2.0
-    nt.links.new(nt.nodes.new("ShaderNodeTexCoord").outputs["Object"], noise.inputs["Vector"])
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    nt.links.new(coords.outputs["Object"], noise.inputs["Vector"])
     bump = nt.nodes.new("ShaderNodeBump")
     bump.inputs["Distance"].default_value = 0.3
     nt.links.new(noise.outputs["Fac"], bump.inputs["Height"])

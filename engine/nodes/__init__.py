@@ -10,7 +10,9 @@ parameters (base colour, metallic, roughness), emission and alpha.
 One module per node family on each side, so a node is found by its family:
 
   context.py          the hit a program reads (position, normals, incoming direction,
-                      UV, the object's coordinates and info, the ray kind)
+                      UV, the object's coordinates and info, the camera's, the ray
+                      kind, the path's bounces, the ray's footprint and the changes
+                      of the surface fields over a pixel step)
   program.py          ShaderProgram and its builder; the outputs a program can drive
   interpreter.py      the compiled interpreter and its array driver
   pack.py             every material's program as the arrays the kernels take

@@ -7,6 +7,9 @@ Object coordinates are the hit in the object's space (its matrix_world at the fr
 Generated coordinates map the object's texture space (Blender's auto texture space:
 the mesh's bounding box) to [0, 1]^3; the Texture Coordinate node's Normal is N in
 object space. Moving objects read them at the frame, not at the ray's shutter time.
+Camera and Window are the render camera's (camera_coords). The path's bounce counts and
+the ray's footprint are the caller's to write (`path_fields`), the changes of the
+surface fields over a pixel step engine.nodes.differentials'.
 """
 from __future__ import annotations
 
@@ -166,8 +169,8 @@ def fill_rows(position, normal, geometric_normal, direction, uv, front, ray, dep
              normal[i, 1], normal[i, 2], geometric_normal[i, 0], geometric_normal[i, 1],
              geometric_normal[i, 2], direction[i, 0], direction[i, 1], direction[i, 2],
              uv[i, 0], uv[i, 1], front[i], ray[i], depth[i], length[i], objects, obj[i],
-             no_camera, tangent[i, 0], tangent[i, 1], tangent[i, 2], tangent[i, 3], color[i, 0],
-             color[i, 1], color[i, 2], color[i, 3])
+             no_camera, tangent[i, 0], tangent[i, 1], tangent[i, 2], tangent[i, 3],
+             color[i, 0], color[i, 1], color[i, 2], color[i, 3])
     return out
 
 

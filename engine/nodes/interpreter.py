@@ -18,6 +18,12 @@ def has_program(T, m):
 
 
 @kernel
+def reads_differentials(T, m):
+    """Whether material m's program reads the hit's differentials (context.H_DX, H_DY)."""
+    return has_program(T, m) and T[PROG][m, 4] != 0
+
+
+@kernel
 def run(T, m, hit, regs):
     """Run material m's program on the hit row `hit`; its registers end in regs (at
     least T[NREGS][0] long). No-op for a material without a program."""

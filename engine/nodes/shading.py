@@ -16,7 +16,7 @@ from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
 from .context import fill
 from .differentials import fill_differentials
-from .interpreter import run
+from .interpreter import reads_differentials, run
 from .pack import MIX, OUTS
 
 OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_MIX = range(7)
@@ -27,7 +27,8 @@ def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx
                 dx, dy, dz, front, ray, depth, length, hit, regs):
     """Fill the hit row of a hit on triangle prim (material m) at barycentrics (bu, bv)
     and run m's program. The caller has written the row's path fields
-    (context.path_fields; zeros: a path of no bounces and a ray without footprint)."""
+    (context.path_fields; zeros: a path of no bounces and a ray without footprint); the
+    differentials are filled only for a program that reads them (a Bump's)."""
     tri_object, objects, corner_tangents = geometry[10], geometry[11], geometry[12]
     obj = tri_object[prim] if tri_object.shape[0] > 0 else -1
     tx = ty = tz = ts = 0.0
@@ -53,7 +54,8 @@ def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx
     camera = geometry[14]
     fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, uu, vv, front, ray, depth,
          length, objects, obj, camera, tx, ty, tz, ts, cr, cg, cb, ca)
-    fill_differentials(hit, geometry, prim, obj, camera)
+    if reads_differentials(T, m):
+        fill_differentials(hit, geometry, prim, obj, camera)
     run(T, m, hit, regs)
 
 
@@ -125,7 +127,7 @@ def valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z):
 
 @kernel
 def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz):
-    """The program's shading normal (a Normal Map's), normalised, twice: as Cycles'
+    """The program's shading normal (a Normal Map's or a Bump's), normalised, twice: as Cycles'
     Principled BSDF uses it for its specular lobes, made a valid specular reflector for
     the view direction I (valid_reflection_normal), then as its diffuse lobe uses it,
     unchanged. Both are n when the program does not set one."""

@@ -68,7 +68,8 @@ def _bump(c, node, out):
     h = c.socket(height, "float")
     if not h.varying:
         return normal
-    hx, hy = (c.at_offset(axis, width, lambda: c.socket(height, "float")) for axis in (0, 1))
+    hx, hy = (c.at_offset(axis, width, lambda: c.socket(height, "float"))
+              for axis in (0, 1))
     return c.emit(BU.BUMP_NORMAL, "vector", [normal, strength, distance, width,
                                             _math(c, "SUBTRACT", hx, h),
                                             _math(c, "SUBTRACT", hy, h)], varying=True)
