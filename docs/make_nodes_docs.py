@@ -48,6 +48,16 @@ KNOWN = """## Known differences
   DRT does the same and applies Cycles' bump shadowing term. A plane tilted by its map
   under an overhead sun agrees to 0.5%; with the sun off the vertical DRT is 2 to 4%
   brighter, and a normal-mapped diffuse sphere 5 to 12%. The cause is not found yet.
+- **Bump.** Evaluated as Cycles 5.0 does: the Height's nodes run again at the hit moved
+  by Filter Width pixel steps along two tangents, the steps from each ray's footprint
+  (Cycles' compact ray differentials: a cone from the camera's pixel that keeps growing
+  with the path's length after bounces). The normals match Cycles per pixel (the
+  `bump` tiles; on a perspective view of a bumped floor to 0.2%), so the lit gap of
+  Normal Map above applies to Bump as well: a bumped lit floor is 0.7% darker than
+  Cycles (`tests/test_bump_vs_cycles.py`), a bumped sphere up to 8% per 8 x 8 block.
+  Texture Coordinate's Normal is not moved at the offset hits (Cycles moves it with
+  the interpolated normal), and the NumPy reference integrator has no footprints
+  (its bumps are flat).
 - **Inputs that vary per hit but feed a parameter DRT keeps per material** (IOR,
   Transmission, Specular IOR Level, Emission Strength, a Mix Shader's Fac) take the
   graph's average over the unit square of UV and generated coordinates (reported).
@@ -66,9 +76,12 @@ KNOWN = """## Known differences
   octaves. Against Blender's own evaluation at random points
   (`tests/test_procedural_textures.py`): White Noise exact, Voronoi 1.3e-6, Wave
   4.3e-6, Magic 9.4e-6, Brick 2.5e-5, Noise 1.5e-4 of the value's scale.
-- Not evaluated yet (warned): Gabor, Sky and IES textures, Bump, Texture Coordinate's
-  Camera and Window, Light Path's depth counters other than Ray Depth, Map Range on
-  vectors, Normal Map in object or world space, attributes other than colour
+- **Light Path depths** count the path's diffuse, glossy, transmission and transparent
+  bounces as Cycles does; a program run for a surface's alpha (transparent layers,
+  shadow rays) sees no bounces.
+- Not evaluated yet (warned): Gabor, Sky and IES textures, Geometry's Tangent,
+  Parametric, Pointiness and Random Per Island, Light Path's Is Singular Ray and Is
+  Volume Scatter Ray, Map Range on vectors, Normal Map in object or world space, attributes other than colour
   attributes, a texture node's legacy Mapping panel.
 """
 

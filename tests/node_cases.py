@@ -113,18 +113,23 @@ def _light_path(nt, p):
     return ident(mix.outputs, "Result_Color")
 
 
+def checker_normal_map(nt, p, strength=1.0):
+    """A tangent-space Normal Map of a UV checker of two normals; its output socket."""
+    c = p.node(nt, "ShaderNodeTexChecker")
+    c.inputs["Scale"].default_value = 4.0
+    c.inputs["Color1"].default_value = (0.5, 0.5, 1.0, 1.0)
+    c.inputs["Color2"].default_value = (0.8, 0.3, 0.85, 1.0)
+    nt.links.new(p.coords(nt).outputs["UV"], c.inputs["Vector"])
+    nm = p.node(nt, "ShaderNodeNormalMap")
+    nm.inputs["Strength"].default_value = strength
+    nt.links.new(c.outputs["Color"], nm.inputs["Color"])
+    return nm.outputs[0]
+
+
 def _normal_map(strength):
     def build(nt, p):
-        c = p.node(nt, "ShaderNodeTexChecker")
-        c.inputs["Scale"].default_value = 4.0
-        c.inputs["Color1"].default_value = (0.5, 0.5, 1.0, 1.0)
-        c.inputs["Color2"].default_value = (0.8, 0.3, 0.85, 1.0)
-        nt.links.new(p.coords(nt).outputs["UV"], c.inputs["Vector"])
-        nm = p.node(nt, "ShaderNodeNormalMap")
-        nm.inputs["Strength"].default_value = strength
-        nt.links.new(c.outputs["Color"], nm.inputs["Color"])
         vm = p.node(nt, "ShaderNodeVectorMath", operation="MULTIPLY_ADD")
-        nt.links.new(nm.outputs[0], vm.inputs[0])
+        nt.links.new(checker_normal_map(nt, p, strength), vm.inputs[0])
         vm.inputs[1].default_value = (0.5, 0.5, 0.5)
         vm.inputs[2].default_value = (0.5, 0.5, 0.5)
         return vm.outputs[0]

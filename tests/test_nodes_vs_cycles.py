@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import node_cases
+import node_cases_bump
 import node_cases_procedural
 import node_probe
 
@@ -26,7 +27,8 @@ MEAN_TOL = 0.01
 BLOCK_TOL = 0.03
 PIXEL_TOL = 0.03
 
-FAMILIES = {**node_cases.FAMILIES, **node_cases_procedural.FAMILIES}
+FAMILIES = {**node_cases.FAMILIES, **node_cases_procedural.FAMILIES,
+            **node_cases_bump.FAMILIES}
 TILES = node_cases_procedural.TILES          # pixels per tile where not node_probe.TILE
 
 _renders = {}
@@ -74,6 +76,24 @@ def test_comparison_fails_without_the_nodes(bpy_drt, family):
     rows = _errors(bpy_drt, family)
     passing = [name for name, _, control in rows if not _fails(control)]
     assert not passing, f"these cases match Cycles even with their nodes left out: {passing}"
+
+
+@pytest.mark.parametrize("family", sorted(node_cases_bump.FAMILIES))
+def test_bump_cases_fail_with_flat_bumps(bpy_drt, family):
+    """The bump cases differ from the surface's own normal: with every Bump's Height
+    unlinked (the Normal input passed through) DRT fails each bump case's comparison."""
+    bpy = bpy_drt
+    cases, (_, cycles, _) = _family(bpy, family)
+    scene, columns, rows = node_probe.build_scene(bpy, cases, shape=FAMILIES[family][1])
+    for mat in bpy.data.materials:
+        for node in mat.node_tree.nodes:
+            if node.bl_idname == "ShaderNodeBump":
+                for link in list(node.inputs["Height"].links):
+                    mat.node_tree.links.remove(link)
+    flat = node_probe.tiles(node_probe.render(bpy, scene, "DRT", 16), columns, rows)
+    passing = [name for k, (name, _) in enumerate(cases) if name.startswith("bump")
+               and not _fails(node_probe.tile_errors(flat[k], cycles[k]))]
+    assert not passing, f"these bump cases match Cycles with flat bumps: {passing}"
 
 
 def test_unsupported_node_warns_and_falls_back(bpy_drt):

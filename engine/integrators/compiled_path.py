@@ -28,7 +28,9 @@ from ..kernels.path_weights import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
                                     add_unoccluded)
 from ..kernels.volume import STACK, pack_volumes
 from .volume_stack import camera_stack
+from ..kernels.camera_rays import pack_camera
 from ..nodes.context import N_OBJ
+from ..nodes.differentials import camera_cones
 from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
 from ..sampling.dispatch import pixel_keys
 from .path import MIS_MODES
@@ -56,6 +58,10 @@ class CompiledPathIntegrator:
         s = ctx.settings
         surf, mats = ctx.surfaces, ctx.materials
         self.max_bounces = s.max_bounces
+        # the render camera, for Camera and Window coordinates and the rays' footprints
+        camera = getattr(ctx, "camera", None)
+        self.camera = pack_camera(camera, ctx.filter)[0] if camera is not None \
+            else np.zeros(0)
         self.transparent_limit = s.transparent_bounces
         self._mode = "mis"
         self.cfg = np.array([ctx.sampler.kind, ctx.sampler.samples_per_pixel, s.max_bounces,
@@ -73,7 +79,8 @@ class CompiledPathIntegrator:
                          _or_empty(surf.tri_object, 0, np.int32),
                          _or_empty(surf.objects, (0, N_OBJ), np.float64),
                          _or_empty(surf.corner_tangents, (0, 3, 4), np.float32),
-                         _or_empty(surf.corner_colors, (0, 3, 4), np.float32))
+                         _or_empty(surf.corner_colors, (0, 3, 4), np.float32),
+                         self.camera)
         self.params = kbsdf.pack_materials(mats)
         self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)
         self.textures = mats.shading()
@@ -175,6 +182,7 @@ class CompiledPathIntegrator:
         beta = np.ones((n, 3))
         counts = np.zeros((n, 3), dtype=np.int64)
         used = np.zeros(n, dtype=np.int64)         # transparent bounces per path
+        cone = camera_cones(self.camera, np.ascontiguousarray(dirs, dtype=np.float64))
         ray_bits = np.full(n, visibility.CAMERA, dtype=np.int64)   # each path's ray kind
         min_pdf = np.full(n, np.inf)               # smallest BSDF pdf so far per path
         prev_pdf = np.full(n, np.inf)              # camera rays count as specular: weight 1
@@ -218,7 +226,7 @@ class CompiledPathIntegrator:
                            self.geometry, self.params, self.emission, self.textures,
                            self.tables, self.lights, self.world, media,
                            sh_path, sh_org, sh_dir, sh_far, sh_contrib,
-                           nx_path, nx_org, nx_dir)
+                           nx_path, nx_org, nx_dir, (used, cone))
             if ns:
                 sh_time = path_time[sh_path[:ns]] if moving else None
                 clamps = (sh_bounce[:ns], s.clamp_direct, s.clamp_indirect)

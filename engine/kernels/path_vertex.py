@@ -33,7 +33,8 @@ from .volume import V_BOUNDARY, V_HAS, in_medium, passed, segment, stack_cross, 
 from .bsdf.params import P_BASE, P_FILTER_ALPHA, P_METALLIC, P_ROUGHNESS
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import apply_to_row, emission_at
-from ..nodes.context import N_HIT
+from ..nodes.context import N_HIT, path_fields
+from ..nodes.differentials import cone_at, cone_moves
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
 from ..nodes.shading import (apply_rows, bent_diffuse, pick_closure, program_emission,
@@ -69,7 +70,7 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
 def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, ray_bits,
           min_pdf, path_time, live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
           geometry, params, emission, textures, tables, lights, world, media,
-          sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir):
+          sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir, path_info):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
 
     cfg: float64 [sampler kind, spp, max_bounces, diffuse, glossy, transmission limits,
@@ -90,17 +91,19 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     far (Filter Glossy, `prepare_closures`). Writes the shadow rays to sh_* (their
     contributions before the clamp, which `add_transmitted` applies) and the continuing paths' next
     rays to nx_*; returns (shadow count, next count). beta, counts, L, alpha, prev_pdf,
-    prev_pos are per-path state, updated in place.
+    prev_pos are per-path state, updated in place. path_info: (transparent bounces per
+    path, ray cone per path (n, 2): footprint at the ray's origin and spread, see
+    engine.nodes.differentials), what shader programs read of the path; the cone moves
+    on to the next ray's origin.
 
     media: (bounce, volume bounces, VOL, stacks, shadow stacks, shadow bounces): each
-    path's bounces so
-    far (depth counts the wavefront's steps, which include crossings of volume
-    boundaries) and volume scatterings, the volume table and the paths' volume stacks
-    (engine.kernels.volume; empty when the scene has no media) and the shadow rays'
-    copies of them. A ray in a medium first travels through it (`volume.segment`): it
-    may scatter there (`medium_vertex.scatter` shades that point), emission along it is
-    added, and what it reaches beyond is weighted by its transmittance. A hit on a
-    volume's boundary surface is crossed without a bounce."""
+    path's bounces so far (depth counts the wavefront's steps, which include crossings
+    of volume boundaries) and volume scatterings, the volume table and the paths'
+    volume stacks (engine.kernels.volume; empty when the scene has no media) and the
+    shadow rays' copies of them. A ray in a medium first travels through it
+    (`volume.segment`): it may scatter there (`medium_vertex.scatter` shades that
+    point), emission along it is added, and what it reaches beyond is weighted by its
+    transmittance. A hit on a volume's boundary surface is crossed without a bounce."""
     bounce, vbounce, vol, stacks, sh_stack, sh_bounce = media
     tri_material, holdout, corner_uvs = geometry[5], geometry[7], geometry[8]
     any_textures = textures[1].shape[0] > 0
@@ -152,6 +155,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 w = hit_weight(mode, prev_pdf[p], lpdf)
                 _add(L, p, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w, clamp_hit)
         if scattered:
+            cone_moves(path_info[1], p, t_end)
             ns_out, nn_out = scatter(depth, cfg, pkey, index, p, ox + dx * t_end,
                                      oy + dy * t_end, oz + dz * t_end, dx, dy, dz, br, bg, bb,
                                      bounce, vbounce, beta, prev_pdf, prev_pos, ray_bits, L,
@@ -189,6 +193,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         if vol.shape[0] > 0 and vol[m, V_BOUNDARY] != 0.0:
             # a volume's boundary: no surface; the ray goes on inside or outside it
             stack_cross(stacks, p, m, front)
+            cone_moves(path_info[1], p, t_geom)
             beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
             nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
             nx_path[nn_out] = p
@@ -205,6 +210,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         ms = m                                   # the material shaded
         n0x, n0y, n0z = nx, ny, nz               # the surface's own shading normal
         if programmed:
+            path_fields(hit_row, counts, path_info[0], p, cone_at(path_info[1], p, t_geom))
             program_hit(textures, geometry, m, prim, hit_u[j], hit_v[j], uu, vv, px, py, pz,
                         gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bits[p], b, t_geom,
                         hit_row, regs)
@@ -318,6 +324,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             min_pdf[p] = min(min_pdf[p], spdf)
         nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
         nx_path[nn_out] = p
+        cone_moves(path_info[1], p, t_geom)
         nx_org[nn_out, 0], nx_org[nn_out, 1], nx_org[nn_out, 2] = nox, noy, noz
         nx_dir[nn_out, 0], nx_dir[nn_out, 1], nx_dir[nn_out, 2] = wx, wy, wz
         prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2] = px, py, pz

@@ -10,7 +10,9 @@ parameters (base colour, metallic, roughness), emission and alpha.
 One module per node family on each side, so a node is found by its family:
 
   context.py          the hit a program reads (position, normals, incoming direction,
-                      UV, the object's coordinates and info, the ray kind)
+                      UV, the object's coordinates and info, the camera's, the ray
+                      kind, the path's bounces, the ray's footprint and the changes
+                      of the surface fields over a pixel step)
   program.py          ShaderProgram and its builder; the outputs a program can drive
   interpreter.py      the compiled interpreter and its array driver
   pack.py             every material's program as the arrays the kernels take
@@ -24,11 +26,14 @@ One module per node family on each side, so a node is found by its family:
                       Bright/Contrast, Hue/Saturation/Value
   converter_nodes.py  Math (every operation), Map Range, Clamp, Separate / Combine,
                       RGB to BW
-  vector_nodes.py     Vector Math, Mapping
+  vector_nodes.py     Vector Math, Mapping, Normal Map
+  bump.py             Bump; the hit's ray differentials it offsets the Height by:
+                      differentials.py
+  camera_coords.py    Texture Coordinate's Camera and Window
 
 Registers are float64; a colour or vector takes three consecutive registers (colours
 carry no alpha: an Image's Alpha is its own output). An instruction is eight int32:
 opcode, output register, then operands (input registers or immediate codes, as each
 family documents). Opcode ranges: input 0-99, texture 100-119, procedural textures
-120-199, colour 200-299, converter 300-399, vector 400-499.
+120-199, colour 200-299, converter 300-399, vector 400-419, bump 420-439.
 """

@@ -7,6 +7,9 @@ Object coordinates are the hit in the object's space (its matrix_world at the fr
 Generated coordinates map the object's texture space (Blender's auto texture space:
 the mesh's bounding box) to [0, 1]^3; the Texture Coordinate node's Normal is N in
 object space. Moving objects read them at the frame, not at the ray's shutter time.
+Camera and Window are the render camera's (camera_coords). The path's bounce counts and
+the ray's footprint are the caller's to write (`path_fields`), the changes of the
+surface fields over a pixel step engine.nodes.differentials'.
 """
 from __future__ import annotations
 
@@ -15,28 +18,43 @@ import math
 import numpy as np
 
 from ..kernels.jit import kernel
+from .camera_coords import camera_space, window
 
 # ---------------------------------------------------------------- hit row
+# The first N_DIFF columns vary along the surface: the row also holds their change over a
+# pixel step in x (H_DX + column) and in y (H_DY + column), which the Bump node's offset
+# evaluations add (engine.nodes.differentials, engine.nodes.bump).
 H_P = 0              # position (3)
-H_N = 3              # shading normal, facing the ray (3)
-H_NG = 6             # geometric normal, facing the ray (3)
-H_I = 9              # towards the ray's origin (3)
-H_UV = 12            # UV map (3; w = 0)
-H_GENERATED = 15     # generated coordinates (3)
-H_OBJECT = 18        # object-space position (3)
-H_OBJ_NORMAL = 21    # object-space normal (3)
-H_BACKFACING = 24
-H_RAY = 25           # engine.visibility bit of the ray (CAMERA, DIFFUSE, ...; SHADOW)
-H_DEPTH = 26         # bounces before this hit
-H_RAY_LENGTH = 27
-H_OBJ_LOCATION = 28  # the object's location (3)
-H_OBJ_COLOR = 31     # the object's colour (3)
-H_OBJ_RANDOM = 34
-H_OBJ_INDEX = 35     # pass index
-H_TANGENT = 36       # tangent (3), world space, of the UV map (Normal Map)
-H_TANGENT_SIGN = 39  # bitangent sign; 0 where the mesh has no tangents
-H_COLOR = 40         # the color attribute, RGBA (4); 0 where the mesh has none
-N_HIT = 44
+H_UV = 3             # UV map (3; w = 0)
+H_GENERATED = 6      # generated coordinates (3)
+H_OBJECT = 9         # object-space position (3)
+H_COLOR = 12         # the color attribute, RGBA (4); 0 where the mesh has none
+H_CAMERA = 16        # camera-space position (3), Cycles' camera space
+H_WINDOW = 19        # the position in the camera's frame, [0, 1]^2 (3; z = 0)
+N_DIFF = 22
+H_N = 22             # shading normal, facing the ray (3)
+H_NG = 25            # geometric normal, facing the ray (3)
+H_I = 28             # towards the ray's origin (3)
+H_OBJ_NORMAL = 31    # object-space normal (3)
+H_BACKFACING = 34
+H_RAY = 35           # engine.visibility bit of the ray (CAMERA, DIFFUSE, ...; SHADOW)
+H_DEPTH = 36         # bounces before this hit
+H_RAY_LENGTH = 37
+H_OBJ_LOCATION = 38  # the object's location (3)
+H_OBJ_COLOR = 41     # the object's colour (3)
+H_OBJ_RANDOM = 44
+H_OBJ_INDEX = 45     # pass index
+H_TANGENT = 46       # tangent (3), world space, of the UV map (Normal Map)
+H_TANGENT_SIGN = 49  # bitangent sign; 0 where the mesh has no tangents
+H_DIFFUSE_DEPTH = 50         # diffuse, glossy, transmission bounces before this hit
+H_GLOSSY_DEPTH = 51
+H_TRANSMISSION_DEPTH = 52
+H_TRANSPARENT_DEPTH = 53     # transparent surfaces passed so far
+H_FOOTPRINT = 54     # the ray's footprint at the hit (Cycles' compact sd->dP); 0: none
+N_BASE = 55
+H_DX = N_BASE        # d(column)/dx of the first N_DIFF columns
+H_DY = N_BASE + N_DIFF
+N_HIT = N_BASE + 2 * N_DIFF
 
 # ---------------------------------------------------------------- object table columns
 O_TO_OBJECT = 0      # 3 x 4 world -> object, row-major (12)
@@ -77,11 +95,16 @@ IDENTITY_OBJECT = object_row(np.eye(4))
 
 @kernel
 def fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, u, v, front, ray, depth,
-         length, objects, obj, tx, ty, tz, ts, cr, cg, cb, ca):
-    """Write one hit row. (n, g): shading and geometric normals facing the ray; d: the
-    ray's direction; (u, v): its UV; obj: its row in `objects` (-1: the identity
-    object, texture space the unit cube around the origin); t, ts: tangent and
-    bitangent sign (ts = 0: none); c: the color attribute."""
+         length, objects, obj, camera, tx, ty, tz, ts, cr, cg, cb, ca):
+    """Write one hit row's fields of the hit itself (the path's fields and the
+    differentials are the callers', see `path_fields` and engine.nodes.differentials).
+    (n, g): shading and geometric normals facing the ray; d: the ray's direction;
+    (u, v): its UV; obj: its row in `objects` (-1: the identity object, texture space
+    the unit cube around the origin); camera: the packed render camera (empty: none);
+    t, ts: tangent and bitangent sign (ts = 0: none); c: the color attribute."""
+    hit[H_CAMERA], hit[H_CAMERA + 1], hit[H_CAMERA + 2] = camera_space(camera, px, py, pz)
+    hit[H_WINDOW], hit[H_WINDOW + 1] = window(camera, px, py, pz)
+    hit[H_WINDOW + 2] = 0.0
     hit[H_TANGENT], hit[H_TANGENT + 1], hit[H_TANGENT + 2] = tx, ty, tz
     hit[H_TANGENT_SIGN] = ts
     hit[H_COLOR], hit[H_COLOR + 1], hit[H_COLOR + 2], hit[H_COLOR + 3] = cr, cg, cb, ca
@@ -124,18 +147,30 @@ def fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, u, v, front, ray, 
 
 
 @kernel
+def path_fields(hit, counts, used, p, footprint):
+    """The path's fields of a hit row: path p's diffuse, glossy and transmission bounces
+    (counts[p]), its transparent ones (used[p]) and the ray's footprint at the hit."""
+    hit[H_DIFFUSE_DEPTH] = counts[p, 0]
+    hit[H_GLOSSY_DEPTH] = counts[p, 1]
+    hit[H_TRANSMISSION_DEPTH] = counts[p, 2]
+    hit[H_TRANSPARENT_DEPTH] = used[p]
+    hit[H_FOOTPRINT] = footprint
+
+
+@kernel
 def fill_rows(position, normal, geometric_normal, direction, uv, front, ray, depth, length,
               objects, obj, tangent, color):
     """`fill` for n hits given as arrays: an (n, N_HIT) array of hit rows."""
     n = position.shape[0]
     out = np.zeros((n, N_HIT))
+    no_camera = np.zeros(0)
     for i in range(n):
         fill(out[i], position[i, 0], position[i, 1], position[i, 2], normal[i, 0],
              normal[i, 1], normal[i, 2], geometric_normal[i, 0], geometric_normal[i, 1],
              geometric_normal[i, 2], direction[i, 0], direction[i, 1], direction[i, 2],
              uv[i, 0], uv[i, 1], front[i], ray[i], depth[i], length[i], objects, obj[i],
-             tangent[i, 0], tangent[i, 1], tangent[i, 2], tangent[i, 3], color[i, 0],
-             color[i, 1], color[i, 2], color[i, 3])
+             no_camera, tangent[i, 0], tangent[i, 1], tangent[i, 2], tangent[i, 3],
+             color[i, 0], color[i, 1], color[i, 2], color[i, 3])
     return out
 
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.jit import kernel
-from . import color_nodes, converter_nodes, input_nodes, procedural_nodes, texture_nodes, \
-    vector_nodes
+from . import bump, color_nodes, converter_nodes, input_nodes, procedural_nodes, \
+    texture_nodes, vector_nodes
 from .pack import DATA, INIT, NREGS, OPS, PROG, pack_shading
 
 
@@ -15,6 +15,12 @@ from .pack import DATA, INIT, NREGS, OPS, PROG, pack_shading
 def has_program(T, m):
     prog = T[PROG]
     return 0 <= m < prog.shape[0] and prog[m, 1] > 0
+
+
+@kernel
+def reads_differentials(T, m):
+    """Whether material m's program reads the hit's differentials (context.H_DX, H_DY)."""
+    return has_program(T, m) and T[PROG][m, 4] != 0
 
 
 @kernel
@@ -40,8 +46,10 @@ def run(T, m, hit, regs):
             color_nodes.execute(ins, regs, data)
         elif code < 400:
             converter_nodes.execute(ins, regs)
-        else:
+        elif code < 420:
             vector_nodes.execute(ins, regs, hit)
+        else:
+            bump.execute(ins, regs, hit)
 
 
 @kernel

@@ -7,8 +7,9 @@ types, so one compilation serves every scene):
             operations global offsets into T[DATA]
   T[INIT]   float64: every program's initial registers, concatenated
   T[DATA]   float64: every program's tables, concatenated
-  T[PROG]   int64 (n_mat, 4): first instruction, instruction count, first initial
-            register, register count (0 instructions: no program)
+  T[PROG]   int64 (n_mat, 5): first instruction, instruction count, first initial
+            register, register count (0 instructions: no program), 1 when the
+            program reads the hit's differentials (a Bump), else 0
   T[OUTS]   int64 (n_mat, N_OUT): the register of each program output, -1 where the
             program does not drive that parameter
   T[NREGS]  int64 (1,): the largest register count (the size of a register file)
@@ -20,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kernels.textures import pack_textures
+from .bump import BUMP_ENTER, BUMP_NORMAL
 from .color_nodes import DATA_OPS
 from .program import N_OUT, OUTPUTS, WIDTH
 from .texture_nodes import IMAGE_OPS
@@ -38,7 +40,7 @@ def pack_programs(table) -> tuple:
     `texture_index` (id(Texture) -> global texture id)."""
     programs = list(getattr(table, "programs", None) or [])
     n_mat = len(table.metallic)
-    prog = np.zeros((n_mat, 4), np.int64)
+    prog = np.zeros((n_mat, 5), np.int64)
     outs = np.full((n_mat, N_OUT), -1, np.int64)
     ops, init, data = [], [], []
     n_ops = n_init = n_data = 0
@@ -51,7 +53,8 @@ def pack_programs(table) -> tuple:
                 o[k, 7] = table.texture_index[id(p.images[o[k, 7]])]
             if o[k, 0] in DATA_OPS:
                 o[k, 6] += n_data
-        prog[m] = (n_ops, len(o), n_init, p.n_regs)
+        bumps = bool(np.isin(o[:, 0], (BUMP_ENTER, BUMP_NORMAL)).any())
+        prog[m] = (n_ops, len(o), n_init, p.n_regs, bumps)
         for j, name in enumerate(OUTPUTS):
             if name in p.outputs:
                 outs[m, j] = p.outputs[name].reg

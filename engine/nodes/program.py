@@ -96,6 +96,11 @@ class ProgramBuilder:
         self._init.extend([0.0] * width)
         return reg
 
+    def block(self, width: int) -> int:
+        """The first of `width` registers an instruction uses as scratch (a saved part of
+        the hit row: engine.nodes.bump)."""
+        return self._alloc(width)
+
     def constant(self, x, kind=None) -> Value:
         """A constant register: a float, or a triple (kind 'color' unless given)."""
         if np.ndim(x) == 0:

@@ -1,9 +1,10 @@
 """The kernels' side of shader programs: run a hit's material program and read its
 outputs into the Principled parameter row, emission and alpha.
 
-geometry is the compiled path tracer's triangle tuple; its fields 10 to 13 are each
+geometry is the compiled path tracer's triangle tuple; its fields 10 to 14 are each
 triangle's object (int32, empty when no mesh carries ObjectInfo), the object table
 (context.O_* rows), the corner tangents and the corner colours ((T, 3, 4) float32 each,
+empty without), and the packed render camera (engine.kernels.camera_rays.pack_camera;
 empty without)."""
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ import numpy as np
 from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
 from .context import fill
-from .interpreter import run
+from .differentials import fill_differentials
+from .interpreter import reads_differentials, run
 from .pack import MIX, OUTS
 
 OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_MIX = range(7)
@@ -24,7 +26,9 @@ OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_
 def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
                 dx, dy, dz, front, ray, depth, length, hit, regs):
     """Fill the hit row of a hit on triangle prim (material m) at barycentrics (bu, bv)
-    and run m's program."""
+    and run m's program. The caller has written the row's path fields
+    (context.path_fields; zeros: a path of no bounces and a ray without footprint); the
+    differentials are filled only for a program that reads them (a Bump's)."""
     tri_object, objects, corner_tangents = geometry[10], geometry[11], geometry[12]
     obj = tri_object[prim] if tri_object.shape[0] > 0 else -1
     tx = ty = tz = ts = 0.0
@@ -47,8 +51,11 @@ def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx
         cg = b0 * colors[prim, 0, 1] + bu * colors[prim, 1, 1] + bv * colors[prim, 2, 1]
         cb = b0 * colors[prim, 0, 2] + bu * colors[prim, 1, 2] + bv * colors[prim, 2, 2]
         ca = b0 * colors[prim, 0, 3] + bu * colors[prim, 1, 3] + bv * colors[prim, 2, 3]
+    camera = geometry[14]
     fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, uu, vv, front, ray, depth,
-         length, objects, obj, tx, ty, tz, ts, cr, cg, cb, ca)
+         length, objects, obj, camera, tx, ty, tz, ts, cr, cg, cb, ca)
+    if reads_differentials(T, m):
+        fill_differentials(hit, geometry, prim, obj, camera)
     run(T, m, hit, regs)
 
 
@@ -120,7 +127,7 @@ def valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z):
 
 @kernel
 def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz):
-    """The program's shading normal (a Normal Map's), normalised, twice: as Cycles'
+    """The program's shading normal (a Normal Map's or a Bump's), normalised, twice: as Cycles'
     Principled BSDF uses it for its specular lobes, made a valid specular reflector for
     the view direction I (valid_reflection_normal), then as its diffuse lobe uses it,
     unchanged. Both are n when the program does not set one."""

@@ -10,6 +10,11 @@ node groups (nested) are flattened: inside a group, a Group Input output is the 
 the group node's input receives. Muted nodes pass their first matching input through,
 as Blender does.
 
+The Bump node evaluates its Height at offset hits (`at_offset`): the nodes feeding it are
+compiled again there, as new values (each offset region has its own memo), between the
+instructions that move the hit and put it back, as Cycles' SVM compiler copies the
+Height's nodes for its offset evaluations.
+
 A node no family translates is reported once per material, naming it, and the socket it
 feeds falls back to its own value: never an error, never a black render.
 """
@@ -23,6 +28,8 @@ from .errors import Unsupported
 
 program = importlib.import_module(engine.__name__ + ".nodes.program")
 cv = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
+bump = importlib.import_module(engine.__name__ + ".nodes.bump")
+context = importlib.import_module(engine.__name__ + ".nodes.context")
 
 TRANSLATORS = {}
 for _family in (input, texture, procedural, color, converter, vector):
@@ -38,6 +45,8 @@ class NodeCompiler:
         self.b = program.ProgramBuilder()
         self._memo = {}
         self._groups = []                  # stack of group nodes being flattened
+        self._region = 0                   # the offset region being compiled (0: none)
+        self._regions = 0
 
     # -- values --------------------------------------------------------------------
     def const(self, x, kind=None):
@@ -130,8 +139,8 @@ class NodeCompiler:
     def output(self, node, out):
         """The compiled value of output socket `out` of `node` (None: not evaluated,
         reported)."""
-        key = (tuple(g.as_pointer() for g in self._groups), node.as_pointer(),
-               out.identifier)
+        key = (self._region, tuple(g.as_pointer() for g in self._groups),
+               node.as_pointer(), out.identifier)
         if key in self._memo:
             return self._memo[key]
         self._memo[key] = None              # a cycle reads the fallback
@@ -182,6 +191,20 @@ class NodeCompiler:
             return self.socket(sock, SOCKET_KINDS.get(out.type, "float"))
         finally:
             self._groups.pop()
+
+    def at_offset(self, axis, width, compute):
+        """What `compute()` compiles, evaluated with the hit moved by `width` (a float
+        Value) times its pixel step along axis 0 (x) or 1 (y)."""
+        save = self.b.block(context.N_DIFF)
+        self.emit(bump.BUMP_ENTER, "float", [save, axis, width], varying=True)
+        self._regions += 1
+        outer, self._region = self._region, self._regions
+        try:
+            value = compute()
+        finally:
+            self._region = outer
+        self.emit(bump.BUMP_LEAVE, "float", [save], varying=True)
+        return value
 
     # -- results -------------------------------------------------------------------
     def fold(self, value):

@@ -42,6 +42,10 @@ def _tex_coord(c, node, out):
         return hit3(c, C.H_UV)
     if name == "Object":
         return hit3(c, C.H_OBJECT)
+    if name == "Camera":
+        return hit3(c, C.H_CAMERA)
+    if name == "Window":
+        return hit3(c, C.H_WINDOW)
     if name == "Reflection":
         incoming = hit3(c, C.H_I)
         minus = c.emit(V.VEC_MATH, "vector", [incoming, incoming, incoming, c.const(-1.0),
@@ -108,14 +112,21 @@ RAY_MASKS = {"Is Camera Ray": vis.CAMERA, "Is Shadow Ray": vis.SHADOW,
              "Is Transmission Ray": vis.TRANSMISSION}
 
 
+DEPTHS = {"Ray Depth": C.H_DEPTH, "Diffuse Depth": C.H_DIFFUSE_DEPTH,
+          "Glossy Depth": C.H_GLOSSY_DEPTH, "Transmission Depth": C.H_TRANSMISSION_DEPTH,
+          "Transparent Depth": C.H_TRANSPARENT_DEPTH}
+
+
 def _light_path(c, node, out):
     name = out.identifier
     if name in RAY_MASKS:
         return c.emit(I.IN_RAY_IS, "float", [RAY_MASKS[name]], varying=True)
     if name == "Ray Length":
         return hit1(c, C.H_RAY_LENGTH)
-    if name == "Ray Depth":
-        return hit1(c, C.H_DEPTH)
+    if name in DEPTHS:
+        return hit1(c, DEPTHS[name])
+    if name == "Portal Depth":
+        return c.const(0.0)                  # DRT has no ray portals
     raise Unsupported(f"the Light Path output {name} is not evaluated")
 
 

@@ -1,13 +1,18 @@
-"""Vector nodes to program operations (engine.nodes.vector_nodes): Vector Math, Mapping
-and Normal Map (tangent space, from the tangents of the mesh's UV map)."""
+"""Vector nodes to program operations (engine.nodes.vector_nodes, engine.nodes.bump):
+Vector Math, Mapping, Normal Map (tangent space, from the tangents of the mesh's UV map)
+and Bump."""
 from __future__ import annotations
 
 import importlib
 
 from ...engine_link import engine
 from .errors import Unsupported
+from .input import normal_input
 
 VE = importlib.import_module(engine.__name__ + ".nodes.vector_nodes")
+BU = importlib.import_module(engine.__name__ + ".nodes.bump")
+CV = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
+FILTER_WIDTH = 0.1           # Cycles' bump offset before the Filter Width input (4.x)
 
 
 def _vector_math(c, node, out):
@@ -43,7 +48,35 @@ def _normal_map(c, node, out):
                   varying=True)
 
 
+def _math(c, op, a, b):
+    return c.emit(CV.CV_MATH, "float", [a, b, b, CV.MATH_OPS.index(op), 0])
+
+
+def _bump(c, node, out):
+    """Cycles' Bump: the Height at the hit and at the hit moved by Filter Width pixel
+    steps in x and y; an unlinked Height leaves the Normal input as it is."""
+    normal = normal_input(c, node)
+    height = node.inputs["Height"]
+    if not height.is_linked:
+        return normal
+    strength = c.input(node, "Strength", "float")
+    distance = c.input(node, "Distance", "float")
+    if node.invert:
+        distance = _math(c, "MULTIPLY", distance, c.const(-1.0))
+    width = c.input(node, "Filter Width", "float") if node.inputs.get("Filter Width") \
+        else c.const(FILTER_WIDTH)
+    h = c.socket(height, "float")
+    if not h.varying:
+        return normal
+    hx, hy = (c.at_offset(axis, width, lambda: c.socket(height, "float"))
+              for axis in (0, 1))
+    return c.emit(BU.BUMP_NORMAL, "vector", [normal, strength, distance, width,
+                                            _math(c, "SUBTRACT", hx, h),
+                                            _math(c, "SUBTRACT", hy, h)], varying=True)
+
+
 TRANSLATORS = {
+    "ShaderNodeBump": _bump,
     "ShaderNodeNormalMap": _normal_map,
     "ShaderNodeVectorMath": _vector_math,
     "ShaderNodeMapping": _mapping,
