@@ -16,14 +16,12 @@ import sys
 import tempfile
 import time
 
-import numpy as np
-
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [ROOT, os.path.join(ROOT, "tests"), os.path.join(ROOT, "docs")]
 DOCS = os.path.join(ROOT, "docs")
 IMAGES = os.path.join(DOCS, "images")
 
-from make_comparisons import save_png, side_by_side  # noqa: E402
+from make_comparisons import render, save_png, side_by_side  # noqa: E402
 from test_multiscatter_vs_cycles import compare  # noqa: E402
 
 CYCLES_SAMPLES = 1024
@@ -59,7 +57,6 @@ def main():
     import bpy
     import drt_addon
     import volume_scenes
-    from conftest import render_blend
     drt_addon.register()
     lines = ["# Volumes", "",
              "DRT renders homogeneous volumes as Cycles does: Principled Volume, Volume "
@@ -91,12 +88,9 @@ def main():
             for engine, samples in (("DRT", DRT_SAMPLES), ("CYCLES", CYCLES_SAMPLES)):
                 png = os.path.join(tmp, f"{case}_{engine}.png")
                 if build is None:
-                    t0 = time.perf_counter()
-                    img = render_blend(bpy, os.path.join(ROOT, "sample_blends",
-                                                         "fog_room.blend"), engine, samples,
-                                       percentage=100)
-                    sec = time.perf_counter() - t0
-                    save_png(bpy, bpy.context.scene, png)
+                    img, sec = render(bpy, os.path.join(ROOT, "sample_blends",
+                                                        "fog_room.blend"), engine, samples,
+                                      png=png)
                 else:
                     img, sec = _render(bpy, build, engine, samples, png)
                 out[engine] = (img, sec, png)

@@ -30,6 +30,7 @@ import numpy as np
 from ..engine_link import engine
 from .nodes.links import _link
 from .nodes.shader import _constant
+from .world import _WorldCtx, world_output
 
 _ZERO = np.zeros(3)
 
@@ -136,33 +137,24 @@ def export_volume(socket, ctx) -> "engine.Volume | None":
     return None if v.is_empty() else v
 
 
-class _WorldCtx:
-    """What the node readers need of a material's context, for the world's tree."""
+class _VolumeCtx(_WorldCtx):
+    """The world's context with what the node readers need of a material's."""
 
-    def __init__(self, world):
+    def __init__(self, world, reporter):
         from .nodes import NodeCompiler
-        self.name = world.name
-        self.issues = []
+        super().__init__(world, reporter)
         self.normal = None
         self.nodes = NodeCompiler(self)
-
-    def issue(self, text):
-        if text not in self.issues:
-            self.issues.append(text)
 
 
 def world_volume(world, reporter) -> "engine.Volume | None":
     """The volume of the world's active World Output (None without one), filling the
     space outside every mesh; what is approximated is reported."""
     tree = getattr(world, "node_tree", None)
-    if tree is None:
-        return None
-    out = next((n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputWorld"
-                and getattr(n, "is_active_output", True)), None)
+    out = world_output(tree) if tree is not None else None
     if out is None:
         return None
-    ctx = _WorldCtx(world)
+    ctx = _VolumeCtx(world, reporter)
     v = export_volume(out.inputs.get("Volume"), ctx)
-    for text in ctx.issues:
-        reporter.warn(f"DRT: world {world.name!r}: {text}", key=("world", text))
+    ctx.report(reporter)
     return v

@@ -53,6 +53,16 @@ class _WorldCtx:
         if text not in self.issues:
             self.issues.append(text)
 
+    def report(self, reporter):
+        for text in self.issues:
+            reporter.warn(f"DRT: world {self.name!r}: {text}", key=("world", text))
+
+
+def world_output(tree):
+    """The tree's active World Output node (None without one)."""
+    return next((n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputWorld"
+                 and getattr(n, "is_active_output", True)), None)
+
 
 def _visibility(world) -> int:
     v = getattr(world, "cycles_visibility", None)
@@ -69,8 +79,7 @@ def export_world(world, reporter: Reporter) -> "engine.World":
     if not uses_nodes(world):
         return engine.World(tuple(world.color[:3]), visibility=vis)
     tree = world.node_tree
-    out = next((n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputWorld"
-                and getattr(n, "is_active_output", True)), None)
+    out = world_output(tree)
     found = _link(out.inputs["Surface"]) if out is not None else None
     if found is None:
         return engine.World(BLACK, visibility=vis)
@@ -99,8 +108,7 @@ def export_world(world, reporter: Reporter) -> "engine.World":
     else:
         ctx.issue(f"the Background's Color comes from {src.bl_label!r}, which DRT does not "
                   f"evaluate; using the Background's own colour")
-    for text in ctx.issues:
-        reporter.warn(f"DRT: world {world.name!r}: {text}", key=("world", text))
+    ctx.report(reporter)
     return world_out if world_out is not None else engine.World(plain, visibility=vis)
 
 

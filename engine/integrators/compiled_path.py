@@ -23,17 +23,17 @@ from .. import visibility
 from ..kernels import lights as klights
 from ..kernels.bsdf import principled as kbsdf
 from ..bsdf.material_table import flatten_mixes
+from ..kernels.camera_rays import pack_camera
 from ..kernels.path_vertex import shade
 from ..kernels.path_weights import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
                                     add_unoccluded)
+from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
 from ..kernels.volume import STACK, pack_volumes
-from .volume_stack import camera_stack
-from ..kernels.camera_rays import pack_camera
 from ..nodes.context import N_OBJ
 from ..nodes.differentials import camera_cones
-from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
 from ..sampling.dispatch import pixel_keys
 from .path import MIS_MODES
+from .volume_stack import camera_stack
 
 _MODE_IDS = {"mis": MIS, "light": LIGHT_ONLY, "bsdf": BSDF_ONLY}
 VOLUME_BOUNDS_MAX = 256     # volume boundaries one path may cross (Cycles: 1024)

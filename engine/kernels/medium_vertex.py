@@ -11,7 +11,7 @@ from __future__ import annotations
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
-from . import shadow_rays
+from . import ray_queues
 from .jit import kernel
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, nee_weight,
                            roulette)
@@ -48,9 +48,9 @@ def scatter(depth, cfg, pkey, index, p, px, py, pz, dx, dy, dz, br, bg, bb, boun
             if not seen & SHADOW_BIT:
                 _add(L, p, cr, cg, cb, clamp)
             else:
-                sdx, sdy, sdz, far = shadow_rays.towards(px, py, pz, px, py, pz, wx, wy, wz,
+                sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz,
                                                          dist, margin, cfg[9])
-                ns = shadow_rays.push(ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr,
+                ns = ray_queues.push(ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr,
                                       cg, cb, sh_path, sh_org, sh_dir, sh_far, sh_contrib,
                                       sh_bounce, stacks, sh_stack)
     if not goes_on:
@@ -68,9 +68,6 @@ def scatter(depth, cfg, pkey, index, p, px, py, pz, dx, dy, dz, br, bg, bb, boun
     bounce[p] += 1
     vbounce[p] += 1
     ray_bits[p] = DIFFUSE_BIT
-    nx_path[nn] = p
-    nx_org[nn, 0], nx_org[nn, 1], nx_org[nn, 2] = px, py, pz
-    nx_dir[nn, 0], nx_dir[nn, 1], nx_dir[nn, 2] = wx, wy, wz
     prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2] = px, py, pz
     prev_pdf[p] = pdf
-    return ns, nn + 1
+    return ns, ray_queues.push_next(nn, p, px, py, pz, wx, wy, wz, nx_path, nx_org, nx_dir)

@@ -21,9 +21,8 @@ from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
 from .bsdf import principled as bsdf
-from .frame import dot, to_local, to_world
-from . import shadow_rays
-from .frame import length
+from . import ray_queues
+from .frame import dot, length, to_local, to_world
 from .jit import kernel
 from .medium_vertex import scatter
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
@@ -147,7 +146,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                                                 ray_bits[p])
             if k_l >= 0:
                 fr, fg, fb = passed(vmode, str_, stg, stb, wcr, wcg, wcb, t_l)
-                if vmode != 0:     # the lamp's distance from the path's last vertex
+                if vol.shape[0] > 0:
+                    # the ray may start past volume boundaries: the lamp's distance is
+                    # from the path's last vertex
                     t_l = length(ox + dx * t_l - prev_pos[p, 0], oy + dy * t_l - prev_pos[p, 1],
                                  oz + dz * t_l - prev_pos[p, 2])
                 lpdf = lt.lamp_pdf(lights, k_l, prev_pos[p, 0], prev_pos[p, 1],
@@ -196,10 +197,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             cone_moves(path_info[1], p, t_geom)
             beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
             nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
-            nx_path[nn_out] = p
-            nx_org[nn_out, 0], nx_org[nn_out, 1], nx_org[nn_out, 2] = nox, noy, noz
-            nx_dir[nn_out, 0], nx_dir[nn_out, 1], nx_dir[nn_out, 2] = dx, dy, dz
-            nn_out += 1
+            nn_out = ray_queues.push_next(nn_out, p, nox, noy, noz, dx, dy, dz, nx_path,
+                                          nx_org, nx_dir)
             continue
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         programmed = has_program(textures, m)
@@ -270,7 +269,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0
                     and (front_side or bsdf.transmits(state))):
                 sox, soy, soz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
-                sdx, sdy, sdz, far = shadow_rays.towards(sox, soy, soz, px, py, pz, wx, wy,
+                sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy,
                                                          wz, dist, margin, scene_radius)
                 bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
                                      see_d, see_g, see_t)
@@ -279,7 +278,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                     _add(L, p, br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w,
                          clamp_direct if b == 0 else clamp_indirect)
                 else:
-                    ns_out = shadow_rays.push(ns_out, p, b, sox, soy, soz, sdx, sdy, sdz, far,
+                    ns_out = ray_queues.push(ns_out, p, b, sox, soy, soz, sdx, sdy, sdz, far,
                                               br * fr * lr * w, bg * fg * lg * w,
                                               bb * fb * lb * w, sh_path, sh_org, sh_dir,
                                               sh_far, sh_contrib, sh_bounce, stacks, sh_stack)
@@ -323,11 +322,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         if not sdelta:
             min_pdf[p] = min(min_pdf[p], spdf)
         nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
-        nx_path[nn_out] = p
         cone_moves(path_info[1], p, t_geom)
-        nx_org[nn_out, 0], nx_org[nn_out, 1], nx_org[nn_out, 2] = nox, noy, noz
-        nx_dir[nn_out, 0], nx_dir[nn_out, 1], nx_dir[nn_out, 2] = wx, wy, wz
+        nn_out = ray_queues.push_next(nn_out, p, nox, noy, noz, wx, wy, wz, nx_path, nx_org,
+                                      nx_dir)
         prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2] = px, py, pz
         prev_pdf[p] = _INF if sdelta else spdf
-        nn_out += 1
     return ns_out, nn_out

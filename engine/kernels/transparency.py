@@ -69,12 +69,14 @@ def _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, d
 
 @kernel
 def _pass_through(geometry, prim, u, v, d, r, time, far, out_rows, out_org, out_far, n_out):
-    """Ray r (direction d[r]) goes on, unchanged, beyond the triangle it hit."""
+    """Ray r (direction d[r]) goes on, unchanged, beyond the triangle it hit; returns
+    whether it hit the triangle's front."""
     dx, dy, dz = d[r, 0], d[r, 1], d[r, 2]
-    px, py, pz, gx, gy, gz, _, _, _, _, scale = rebuild_at_time(geometry, prim, u, v,
-                                                                dx, dy, dz, time)
+    px, py, pz, gx, gy, gz, _, _, _, front, scale = rebuild_at_time(geometry, prim, u, v,
+                                                                    dx, dy, dz, time)
     _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, dx, dy, dz,
           far)
+    return front
 
 
 @kernel
@@ -144,14 +146,11 @@ def shadow_pass(layer, limit, rows, sd, ray_time, remaining, cur_t, cur_prim, cu
         if reached:
             continue
         if vol.shape[0] > 0 and vol[tri_material[prim], V_BOUNDARY] != 0.0:
-            dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
-            px, py, pz, gx, gy, gz, _, _, _, front, scale = rebuild_at_time(
-                geometry, prim, cur_u[i], cur_v[i], dx, dy, dz, ray_time[r])
+            front = _pass_through(geometry, prim, cur_u[i], cur_v[i], sd, r, ray_time[r],
+                                  remaining[i] - cur_t[i], out_rows, out_org, out_far, n_out)
+            n_out += 1
             if stacks.shape[0] > 0:
                 stack_cross(stacks, r, tri_material[prim], front)
-            _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale,
-                  dx, dy, dz, remaining[i] - cur_t[i])
-            n_out += 1
             continue
         if tri_vis.shape[0] > 0 and not tri_vis[prim] & SHADOW_BIT:
             _pass_through(geometry, prim, cur_u[i], cur_v[i], sd, r, ray_time[r],

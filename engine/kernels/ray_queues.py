@@ -1,6 +1,7 @@
-"""The shadow rays of next-event estimation, as the shading stages write them: from a
-surface point (its origin offset off the surface) or a point in a volume, towards a
-sampled light point or direction; the caller traces them after the stage."""
+"""The rays the shading stages queue for the next Embree queries: the shadow rays of
+next-event estimation, from a surface point (its origin offset off the surface) or a
+point in a volume towards a sampled light point or direction, and each continuing
+path's next ray; the caller traces them after the stage."""
 from __future__ import annotations
 
 import math
@@ -41,4 +42,13 @@ def push(n, p, b, ox, oy, oz, dx, dy, dz, far, cr, cg, cb, sh_path, sh_org, sh_d
     sh_contrib[n, 0], sh_contrib[n, 1], sh_contrib[n, 2] = cr, cg, cb
     if sh_stack.shape[0] > 0:
         sh_stack[n, :] = stacks[p, :]
+    return n + 1
+
+
+@kernel
+def push_next(n, p, ox, oy, oz, dx, dy, dz, nx_path, nx_org, nx_dir):
+    """Write next ray n: path p goes on from o along d. Returns n + 1."""
+    nx_path[n] = p
+    nx_org[n, 0], nx_org[n, 1], nx_org[n, 2] = ox, oy, oz
+    nx_dir[n, 0], nx_dir[n, 1], nx_dir[n, 2] = dx, dy, dz
     return n + 1
