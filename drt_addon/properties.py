@@ -1,6 +1,6 @@
 """DRT's render settings, stored in the .blend as `scene.drt`."""
 import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
 SAMPLER_ITEMS = [
     ("jittered", "Jittered", "Stratified jittered samples with Cook's ray-id chaining across "
@@ -25,6 +25,22 @@ FILTER_ITEMS = [
 class DRTRenderSettings(bpy.types.PropertyGroup):
     samples: IntProperty(name="Samples", description="Samples per pixel",
                          default=64, min=1, max=1 << 24, soft_max=4096)
+    use_adaptive_sampling: BoolProperty(
+        name="Noise Threshold", default=False,
+        description="Adaptive sampling, as Cycles': pixels stop taking samples once their "
+                    "error estimate is under the threshold (Samples is then the maximum)")
+    adaptive_threshold: FloatProperty(
+        name="Threshold", default=0.01, min=0.0, max=1.0, soft_min=0.001, soft_max=0.1,
+        precision=4, description="Noise level at which a pixel stops; lower is less noise "
+        "and more samples (0: automatic, max(0.001, 1 / Samples))")
+    adaptive_min_samples: IntProperty(
+        name="Min Samples", default=0, min=0, max=1 << 24, soft_max=4096,
+        description="Samples every pixel takes before it may stop (0: automatic, from the "
+                    "threshold: 64 at 0.01)")
+    time_limit: FloatProperty(
+        name="Time Limit", default=0.0, min=0.0, subtype="TIME_ABSOLUTE", unit="TIME_ABSOLUTE",
+        description="Stop after this many seconds of tracing, or at Samples, whichever comes "
+                    "first (0: no limit; export and acceleration structure do not count)")
     seed: IntProperty(name="Seed", description="Seed of every random number of the render; "
                       "different seeds give independent images", default=0, min=0)
     sampler: EnumProperty(name="Sampler", items=SAMPLER_ITEMS, default="jittered")
@@ -60,7 +76,10 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
             filter_glossy=float(getattr(cycles, "blur_glossy", 1.0)),
             caustics_reflective=bool(getattr(cycles, "caustics_reflective", True)),
             caustics_refractive=bool(getattr(cycles, "caustics_refractive", True)),
-            samples=self.samples, seed=self.seed, sampler=self.sampler,
+            samples=self.samples, seed=self.seed,
+            adaptive_sampling=self.use_adaptive_sampling,
+            adaptive_threshold=self.adaptive_threshold,
+            adaptive_min_samples=self.adaptive_min_samples, time_limit=self.time_limit, sampler=self.sampler,
             integrator=self.integrator, max_bounces=self.max_bounces,
             diffuse_bounces=self.diffuse_bounces, glossy_bounces=self.glossy_bounces,
             transmission_bounces=self.transmission_bounces,

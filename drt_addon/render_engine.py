@@ -69,6 +69,12 @@ def enabled_passes(view_layer) -> list:
     return [name for name, (*_, enabled) in PASSES.items() if enabled(view_layer)]
 
 
+def _clock(seconds: float) -> str:
+    """Blender's time format in its render log: MM:SS.hh."""
+    m, sec = divmod(max(seconds, 0.0), 60.0)
+    return f"{int(m):02d}:{sec:05.2f}"
+
+
 def _bottom_up(image: np.ndarray) -> np.ndarray:
     """(h, w[, c]) top-down image to Blender's flat bottom-up float32 buffer."""
     return np.ascontiguousarray(image[::-1], dtype=np.float32).reshape(-1)
@@ -180,8 +186,14 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 last_render["progress"].append((stats.samples_done, fraction))
                 rate = stats.paths_per_second()
                 left = stats.seconds * (1 - fraction) / max(fraction, 1e-9)
-                self.update_stats("", f"DRT | Sample {stats.samples_done}/{settings.samples} | "
-                                      f"{rate / 1e3:.0f}k paths/s | {left:.0f} s left")
+                n_pixels = description.width * description.height
+                line = (f"DRT | {stats.status(settings.samples, n_pixels)} | "
+                        f"{rate / 1e3:.0f}k paths/s | {left:.0f} s left")
+                self.update_stats("", line)
+                if bpy.app.background:
+                    # the line render-farm managers parse (Deadline: `Sample ([0-9]+)/([0-9]+)`)
+                    print(f"Fra:{scene.frame_current} | Time:{_clock(time.perf_counter() - t0)}"
+                          f" | {line}", flush=True)
 
             film, stats = engine.render(description, settings, context=ctx, progress=progress,
                                         cancelled=self._cancel_requested)

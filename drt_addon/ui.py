@@ -23,7 +23,15 @@ class DRT_PT_sampling(DRTPanel, bpy.types.Panel):
         s = context.scene.drt
         col = self.layout.column()
         col.use_property_split = True
-        col.prop(s, "samples")
+        col.prop(s, "use_adaptive_sampling")
+        sub = col.column()
+        sub.active = s.use_adaptive_sampling
+        sub.prop(s, "adaptive_threshold")
+        col.prop(s, "samples", text="Max Samples" if s.use_adaptive_sampling else "Samples")
+        sub = col.column()
+        sub.active = s.use_adaptive_sampling
+        sub.prop(s, "adaptive_min_samples")
+        col.prop(s, "time_limit")
         col.prop(s, "sampler")
         col.prop(s, "seed")
         col.prop(s, "integrator")

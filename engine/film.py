@@ -7,6 +7,12 @@ values per pixel, and the variance is a difference of two such sums). With filte
 importance sampling every sample counts in exactly one pixel with weight one, so two
 films rendered from disjoint sample ranges merge by addition into exactly the film of
 the whole range, variance estimate included.
+
+It also keeps the sum of the odd-indexed samples alone (and their count): a second film
+of every other sample, as Cycles keeps for adaptive sampling. The difference between the
+whole mean and that half's mean estimates the error of the pixel honestly even for
+stratified and quasi-Monte Carlo samples, whose sum of squares overstates it
+(engine.adaptive_sampling).
 """
 from __future__ import annotations
 
@@ -16,17 +22,23 @@ from .kernels.jit import kernel
 
 
 @kernel
-def _accumulate(pixel, radiance, alpha, count, total, total_sq, alpha_sum):
-    """Add each sample to its pixel's statistics (alpha empty: coverage 1)."""
+def _accumulate(pixel, index, radiance, alpha, count, total, total_sq, alpha_sum,
+                count_odd, total_odd):
+    """Add each sample to its pixel's statistics (alpha empty: coverage 1); samples of
+    odd index also to the half film."""
     has_alpha = alpha.shape[0] > 0
     for i in range(pixel.shape[0]):
         p = pixel[i]
+        odd = index[i] & 1
         count[p] += 1
+        count_odd[p] += odd
         alpha_sum[p] += alpha[i] if has_alpha else 1.0
         for c in range(3):
             v = radiance[i, c]
             total[p, c] += v
             total_sq[p, c] += v * v
+            if odd:
+                total_odd[p, c] += v
 
 
 class Film:
@@ -37,14 +49,23 @@ class Film:
         self.sum = np.zeros((n, 3), dtype=np.float64)
         self.sum_sq = np.zeros((n, 3), dtype=np.float64)
         self.alpha_sum = np.zeros(n, dtype=np.float64)
+        self.count_odd = np.zeros(n, dtype=np.int64)
+        self.sum_odd = np.zeros((n, 3), dtype=np.float64)
 
-    def add(self, pixel: np.ndarray, radiance: np.ndarray, alpha: np.ndarray | None = None) -> None:
+    def add(self, pixel: np.ndarray, radiance: np.ndarray, alpha: np.ndarray | None = None,
+            *, index: np.ndarray) -> None:
+        """Add samples: `pixel` and sample `index` (n,), radiance (n, 3), alpha (n,)
+        or None (opaque)."""
         pixel = np.ascontiguousarray(pixel, dtype=np.int64)
+        index = np.ascontiguousarray(index, dtype=np.int64)
         if len(pixel) and (pixel.min() < 0 or pixel.max() >= self.count.size):
             raise IndexError("sample pixel outside the film")
-        _accumulate(pixel, np.ascontiguousarray(radiance, dtype=np.float64),
+        if index.shape != pixel.shape:
+            raise ValueError("one sample index per sample")
+        _accumulate(pixel, index, np.ascontiguousarray(radiance, dtype=np.float64),
                     np.zeros(0) if alpha is None else np.ascontiguousarray(alpha, np.float64),
-                    self.count, self.sum, self.sum_sq, self.alpha_sum)
+                    self.count, self.sum, self.sum_sq, self.alpha_sum,
+                    self.count_odd, self.sum_odd)
 
     def merge(self, other: "Film") -> "Film":
         if (other.width, other.height) != (self.width, self.height):
@@ -53,6 +74,8 @@ class Film:
         self.sum += other.sum
         self.sum_sq += other.sum_sq
         self.alpha_sum += other.alpha_sum
+        self.count_odd += other.count_odd
+        self.sum_odd += other.sum_odd
         return self
 
     def mean(self) -> np.ndarray:
@@ -64,6 +87,18 @@ class Film:
         """(height, width) coverage in [0, 1]; the colour from mean() is premultiplied by
         it (background samples add no radiance), as Blender expects."""
         return (self.alpha_sum / np.maximum(self.count, 1)).reshape(self.height, self.width)
+
+    def half_difference(self) -> np.ndarray:
+        """(n, 3) mean of all samples minus mean of the odd-indexed ones, per pixel (flat
+        order); 0 where a pixel has no odd or no even sample. Its square estimates the
+        variance of the pixel mean (with n/2 samples in each half, E[(I - A)^2] =
+        sigma^2 / n), whatever the sampler's stratification."""
+        c = self.count[:, None].astype(np.float64)
+        co = self.count_odd[:, None].astype(np.float64)
+        ok = (co > 0) & (co < c)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            d = self.sum / c - self.sum_odd / co
+        return np.where(ok, d, 0.0)
 
     def variance_of_mean(self) -> np.ndarray:
         """Per-pixel estimate of the variance of the pixel mean (unbiased sample

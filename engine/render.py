@@ -18,11 +18,12 @@ import os
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from .accel import Accelerator
+from .adaptive_sampling import AdaptiveSampling
 from .bsdf.principled import MaterialTable
 from .camera import CameraModel, CameraRays
 from .film import Film
@@ -50,9 +51,22 @@ class RenderStats:
     cancelled: bool = False
     units_done: int = 0
     units_running_at_cancel: int = 0   # finished after the cancel (at most the thread count)
+    time_limited: bool = False         # stopped by settings.time_limit
+    active_pixels: int = -1            # pixels still sampled after the last pass (adaptive)
+    pixel_samples: int = 0             # samples taken over all pixels
 
     def paths_per_second(self) -> float:
         return self.paths / self.seconds if self.seconds > 0 else 0.0
+
+    def status(self, samples: int, n_pixels: int) -> str:
+        """The stats line: samples, adaptive sampling's share of converged pixels, the
+        time limit."""
+        text = f"Sample {self.samples_done}/{samples}"
+        if self.active_pixels >= 0:
+            text += f" | {100.0 * (1 - self.active_pixels / max(n_pixels, 1)):.0f}% converged"
+        if self.time_limited:
+            text += " | time limit reached"
+        return text
 
 
 class RenderContext:
@@ -160,7 +174,9 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
     """Render samples [sample_start, sample_end) (default: all of settings.samples).
 
     progress(film, stats, fraction) is called after every pass; cancelled() is polled
-    between work units. Returns (film, stats)."""
+    between work units. With adaptive sampling (engine.adaptive_sampling) later passes
+    take samples only in the pixels that have not converged; with a time limit the render
+    stops at the first unit boundary after it. Returns (film, stats)."""
     ctx = context or RenderContext(scene, settings)
     sample_end = settings.samples if sample_end is None else sample_end
     if not (0 <= sample_start < sample_end):
@@ -173,6 +189,10 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
     t0 = time.perf_counter()
     total = sample_end - sample_start
     stop = threading.Event()
+    adaptive = AdaptiveSampling.from_settings(settings)
+    active = np.arange(n_pixels)
+    passes = adaptive.passes(total, plan_passes, lambda: len(active), 8192 * threads) \
+        if adaptive else plan_passes(total)
 
     running = [0]
 
@@ -191,16 +211,28 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
             rad[bad] = 0.0
         if settings.film_exposure != 1.0:
             rad *= settings.film_exposure      # Film > Exposure, on the way into the film
+        index = np.tile(np.arange(a, b, dtype=np.int64), len(pixels))
         with lock:
-            film.add(pix, rad, alpha)
+            film.add(pix, rad, alpha, index=index)
             stats.paths += len(pix)
             stats.nonfinite_samples += int(bad.sum())
             stats.units_done += 1
         return len(pix)
 
+    def should_stop() -> bool:
+        if cancelled is not None and cancelled():
+            stats.cancelled = True
+        elif settings.time_limit > 0 and stats.samples_done > 0 and \
+                time.perf_counter() - t0 >= settings.time_limit:
+            # after the first pass, so that every pixel has a sample
+            stats.time_limited = True
+        else:
+            return False
+        return True
+
     try:
         with ThreadPoolExecutor(threads) as pool:
-            for a, b in plan_passes(total):
+            for a, b in passes:
                 a, b = a + sample_start, b + sample_start
                 # Pixels per unit: two units per thread, but no unit over chunk_paths
                 # paths (memory) nor under 8192 (smaller arrays cost more in per-call
@@ -208,26 +240,33 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
                 k = b - a
                 most = max(1, settings.chunk_paths // k)
                 least = -(-8192 // k)
-                per_unit = min(most, max(least, -(-n_pixels // (2 * threads))))
-                futures = []
-                for start in range(0, n_pixels, per_unit):
-                    pixels = np.arange(start, min(start + per_unit, n_pixels))
-                    futures.append(pool.submit(run, pixels, a, b))
+                per_unit = min(most, max(least, -(-len(active) // (2 * threads))))
+                futures = [pool.submit(run, active[start:start + per_unit], a, b)
+                           for start in range(0, len(active), per_unit)]
                 for f in futures:
-                    if cancelled is not None and not stop.is_set() and cancelled():
+                    if not stop.is_set() and should_stop():
                         with lock:
                             stop.set()
                             stats.units_running_at_cancel = running[0]
                     f.result()
-                if stop.is_set():
-                    stats.cancelled = True
-                    break
-                stats.samples_done = b - sample_start
                 stats.seconds = time.perf_counter() - t0
+                if stats.cancelled:
+                    break
+                if not stop.is_set():
+                    stats.samples_done = b - sample_start
+                if adaptive is not None and stats.samples_done >= adaptive.min_samples:
+                    active = np.flatnonzero(adaptive.active(film))
+                    stats.active_pixels = len(active)
                 if progress is not None:
-                    progress(film, stats, stats.samples_done / total)
+                    fraction = stats.samples_done / total
+                    if settings.time_limit > 0:
+                        fraction = max(fraction, min(stats.seconds / settings.time_limit, 1.0))
+                    progress(film, stats, 1.0 if stop.is_set() or not len(active) else fraction)
+                if stop.is_set() or not len(active):
+                    break
     finally:
         if context is None:
             ctx.close()
     stats.seconds = time.perf_counter() - t0
+    stats.pixel_samples = int(film.count.sum())
     return film, stats

@@ -35,6 +35,15 @@ class RenderSettings:
     # estimate scale by it and the first-hit passes (depth, normal, albedo) do not, as
     # Cycles applies it to its light passes only. Clamps act before it, as in Cycles.
     film_exposure: float = 1.0
+    # Adaptive sampling (engine.adaptive_sampling), as Cycles': pixels stop once their
+    # error estimate is under the threshold (0 = Cycles' automatic max(0.001, 1/samples));
+    # min samples 0 = Cycles' automatic ceil(16 / threshold^0.3), at least 4.
+    adaptive_sampling: bool = False
+    adaptive_threshold: float = 0.01
+    adaptive_min_samples: int = 0
+    # Seconds of tracing after which the render stops (0 = no limit), as Cycles' Time
+    # Limit: export and the acceleration structure do not count.
+    time_limit: float = 0.0
     # Execution: paths per work unit bounds memory (about 1 KB of state per path).
     chunk_paths: int = 1 << 15
     threads: int = 0                   # 0 = all cores
@@ -64,6 +73,16 @@ class RenderSettings:
                             f"{self.film_exposure!r}")
         if not (0 < self.filter_width <= 100):
             problems.append(f"filter_width must be in (0, 100] pixels, got {self.filter_width!r}")
+        if not (0.0 <= self.adaptive_threshold <= 1.0):
+            problems.append(f"adaptive_threshold must be in [0, 1] (0 = automatic), got "
+                            f"{self.adaptive_threshold!r}")
+        if not isinstance(self.adaptive_min_samples, int) or not \
+                0 <= self.adaptive_min_samples <= 1 << 24:
+            problems.append(f"adaptive_min_samples must be an integer in 0..16777216 "
+                            f"(0 = automatic), got {self.adaptive_min_samples!r}")
+        if not (0.0 <= self.time_limit < float("inf")):
+            problems.append(f"time_limit must be a finite number of seconds >= 0 (0 = off), "
+                            f"got {self.time_limit!r}")
         if self.chunk_paths < 256:
             problems.append("chunk_paths must be at least 256")
         if problems:

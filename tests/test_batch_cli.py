@@ -1,5 +1,6 @@
 """The batch renderer's exit codes, each one, with a single clear line on stderr."""
 import os
+import re
 import subprocess
 import sys
 
@@ -29,6 +30,8 @@ def test_success_writes_the_image(tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert out.exists()
     assert f"wrote {out}" in proc.stdout
+    # the progress lines render-farm managers parse (Deadline: `Sample ([0-9]+)/([0-9]+)`)
+    assert re.findall(r"Sample ([0-9]+)/([0-9]+)", proc.stdout) == [("1", "2"), ("2", "2")]
     from PIL import Image
     img = np.asarray(Image.open(out)).astype(float)
     assert img.shape[:2] == (256, 256)

@@ -192,12 +192,13 @@ def _quiet_defaults(scene):
     scene.cycles.use_adaptive_sampling = False
 
 
-def test_factory_defaults_warn_only_about_denoise_and_adaptive_sampling(factory_scene):
-    """Blender turns both on by default and DRT does neither; nothing else warns."""
+def test_factory_defaults_warn_only_about_denoise(factory_scene):
+    """Blender turns Denoise on by default and DRT does not denoise; Cycles' adaptive
+    sampling at its defaults is not warned (DRT has its own Noise Threshold, off by
+    default); nothing else warns."""
     warnings = _warnings(factory_scene)
-    assert len(warnings) == 2, warnings
+    assert len(warnings) == 1, warnings
     assert "Denoise" in warnings[0] and "does not denoise" in warnings[0]
-    assert "Noise Threshold" in warnings[1] and "adaptive" in warnings[1]
 
 
 def test_no_warning_at_defaults(factory_scene):
@@ -218,7 +219,9 @@ def test_fresh_scene_defaults_are_quiet(bpy_drt):
 
 @pytest.mark.parametrize("change, expected", [
     (lambda s: setattr(s.cycles, "use_denoising", True), "does not denoise"),
-    (lambda s: setattr(s.cycles, "use_adaptive_sampling", True), "does not sample adaptively"),
+    (lambda s: (setattr(s.cycles, "use_adaptive_sampling", True),
+                setattr(s.cycles, "adaptive_threshold", 0.05)),
+     "Noise Threshold is 0.05, not used: DRT renders with its own Noise Threshold"),
     (lambda s: setattr(s.cycles, "use_animated_seed", True), "same Seed on every frame"),
     (lambda s: setattr(s.cycles, "use_light_tree", False), "Light Tree is off"),
     (lambda s: setattr(s.cycles, "time_limit", 30.0), "Time Limit is 30"),
@@ -310,8 +313,8 @@ def test_the_table_covers_every_cycles_setting_and_pass(bpy_drt):
 
 
 def test_quiet_values_are_blenders_defaults(bpy_drt):
-    """Every row's path exists in this Blender and, but for Denoise and adaptive
-    sampling, its quiet value is the default of a new scene."""
+    """Every row's path exists in this Blender and, but for Denoise, its quiet value is
+    the default of a new scene."""
     from drt_addon.export.file_settings import IGNORED, OWN, SETTINGS
     from drt_addon.export.settings_check import _MISSING, is_quiet, read
     scene = bpy_drt.data.scenes.new("defaults")
@@ -323,7 +326,7 @@ def test_quiet_values_are_blenders_defaults(bpy_drt):
             assert value is not _MISSING, s.path
             if s.kind in (IGNORED, OWN) and s.warns and not is_quiet(s, value):
                 loud.append(s.path)
-        assert loud == ["scene.cycles.use_denoising", "scene.cycles.use_adaptive_sampling"]
+        assert loud == ["scene.cycles.use_denoising"]
     finally:
         bpy_drt.data.scenes.remove(scene)
 

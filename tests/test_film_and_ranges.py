@@ -16,6 +16,10 @@ def test_split_sample_ranges_merge_into_the_whole_render():
     assert np.array_equal(merged.count, whole.count)
     np.testing.assert_allclose(merged.sum, whole.sum, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(merged.sum_sq, whole.sum_sq, rtol=1e-12, atol=1e-12)
+    # the half film of odd samples (adaptive sampling's error estimate) merges too
+    assert np.array_equal(merged.count_odd, whole.count_odd)
+    assert np.array_equal(whole.count_odd, np.full(24 * 24, 4))
+    np.testing.assert_allclose(merged.sum_odd, whole.sum_odd, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(merged.variance_of_mean(), whole.variance_of_mean(),
                                rtol=1e-9, atol=1e-12)
 
@@ -46,7 +50,7 @@ def test_film_statistics():
     film = Film(2, 1)
     rng = np.random.default_rng(0)
     v = rng.random((1000, 3))
-    film.add(np.zeros(1000, int), v)
+    film.add(np.zeros(1000, int), v, index=np.arange(1000))
     np.testing.assert_allclose(film.mean()[0, 0], v.mean(0))
     np.testing.assert_allclose(film.variance_of_mean()[0, 0], v.var(0, ddof=1) / 1000)
     assert np.isinf(film.variance_of_mean()[0, 1]).all()

@@ -3,6 +3,7 @@ within one work unit and leaves a valid partial image, and the error path."""
 import os
 
 import numpy as np
+import pytest
 
 from conftest import SAMPLES_DIR
 
@@ -89,3 +90,25 @@ def test_material_previews_are_rendered_by_drt_quickly(bpy_drt):
     s = preview_settings(engine.RenderSettings(samples=4096, max_bounces=12, seed=7))
     assert s.samples == PREVIEW_SAMPLES and s.max_bounces == 4 and s.seed == 7
     assert preview_settings(engine.RenderSettings(samples=4)).samples == 4
+
+
+def test_noise_threshold_and_time_limit_reach_the_engine(bpy_drt):
+    """DRT's Sampling panel settings: with a Noise Threshold the render stops pixels
+    early (fewer samples than Max Samples over the frame, progress ends at 1), and the
+    stats line says how many pixels converged."""
+    from drt_addon.render_engine import last_render
+    scene = _open(bpy_drt, samples=512, percentage=12)
+    scene.drt.use_adaptive_sampling = True
+    scene.drt.adaptive_threshold = 0.1
+    settings = scene.drt.to_engine_settings()
+    assert settings.adaptive_sampling and settings.adaptive_threshold == pytest.approx(0.1)
+    bpy_drt.ops.render.render()
+    assert last_render["ok"]
+    stats = last_render["stats"]
+    n = last_render["pixels"].shape[0] * last_render["pixels"].shape[1]
+    assert 32 * n <= stats.pixel_samples < 512 * n * 0.5
+    assert stats.active_pixels >= 0 and "converged" in stats.status(512, n)
+    assert last_render["progress"][-1][1] == 1.0
+    scene.drt.use_adaptive_sampling = False
+    scene.drt.time_limit = 0.5
+    assert scene.drt.to_engine_settings().time_limit == pytest.approx(0.5)

@@ -45,9 +45,9 @@ def _s(path, label, kind, how, **kw):
     return FileSetting(path, label, kind, how, **kw)
 
 
-def _own(name, label, drt, drt_label, default):
+def _own(name, label, drt, drt_label, default, **kw):
     return _s(f"scene.cycles.{name}", label, OWN, f"DRT renders with its own {drt_label}",
-              quiet=default, drt=f"scene.drt.{drt}")
+              quiet=default, drt=f"scene.drt.{drt}", **kw)
 
 
 def _ignored(path, label, how, quiet, **kw):
@@ -68,6 +68,7 @@ _NO_VOLUMES = "DRT renders homogeneous volumes only (a varying density by its av
 _HOMOGENEOUS = ("DRT renders homogeneous volumes exactly, without ray marching steps "
                 "(a varying density is replaced by its average, with a warning)")
 _SIMPLIFY = ("scene.render.use_simplify", (True,))
+_ADAPTIVE = ("scene.cycles.use_adaptive_sampling", (True,))
 WRITTEN_PASSES = "Combined, Depth, Normal, Denoising Data and DRT Noise"
 _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
 
@@ -202,15 +203,17 @@ SETTINGS: list[FileSetting] = [
     _ignored("scene.cycles.use_denoising", "Sampling > Render > Denoise",
              "DRT does not denoise; it renders without (the compositor's Denoise node "
              "can use DRT's Denoising Data passes)", False),
-    _ignored("scene.cycles.use_adaptive_sampling", "Sampling > Render > Noise Threshold "
-             "(adaptive sampling)", "DRT does not sample adaptively: every pixel gets DRT's Samples",
-             False),
+    _own("use_adaptive_sampling", "Sampling > Render > Noise Threshold (adaptive "
+         "sampling)", "use_adaptive_sampling", "Noise Threshold switch (DRT's Sampling "
+         "panel)", True),
+    _own("adaptive_threshold", "Sampling > Render > Noise Threshold", "adaptive_threshold",
+         "Noise Threshold (DRT's Sampling panel)", 0.01, when=_ADAPTIVE),
+    _own("adaptive_min_samples", "Sampling > Render > Min Samples", "adaptive_min_samples",
+         "Min Samples (DRT's Sampling panel)", 0, when=_ADAPTIVE),
+    _own("time_limit", "Sampling > Render > Time Limit", "time_limit",
+         "Time Limit (DRT's Sampling panel)", 0.0),
     *_part_of("Sampling > Render > Denoise", ["denoiser", "denoising_prefilter",
               "denoising_quality", "denoising_input_passes", "denoising_use_gpu"]),
-    *_part_of("Sampling > Render > Noise Threshold", ["adaptive_threshold",
-              "adaptive_min_samples"]),
-    _ignored("scene.cycles.time_limit", "Sampling > Render > Time Limit",
-             "DRT renders all its samples, however long they take", 0.0),
     _ignored("scene.cycles.use_sample_subset", "Sampling > Advanced > Sample Subset",
              "DRT renders all its samples (the engine can render a sample range, "
              "engine.render(sample_start, sample_end), but the add-on does not)", False),
