@@ -72,3 +72,22 @@ def test_a_video_output_falls_back_to_png(bpy_drt, tmp_path, capsys):
     assert "video" in err and "PNG" in err and err.startswith("drt: note:")
     assert (tmp_path / "out" / "anim_0003.png").read_bytes().startswith(PNG_MAGIC)
     assert open(blend, "rb").read() == before               # the file is not changed
+
+
+def test_a_multilayer_exr_output_keeps_the_enabled_passes(bpy_drt, anim_blend, tmp_path,
+                                                          capsys):
+    """The file's own format, multilayer OpenEXR: one file per frame with the view
+    layer's enabled passes beside Combined."""
+    bpy = bpy_drt
+    bpy.ops.wm.open_mainfile(filepath=anim_blend, load_ui=False)
+    settings = bpy.context.scene.render.image_settings
+    settings.media_type = "MULTI_LAYER_IMAGE"
+    settings.file_format = "OPEN_EXR_MULTILAYER"
+    bpy.context.scene.view_layers[0].use_pass_z = True
+    blend = str(tmp_path / "multilayer.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=blend, copy=True)
+    code = drt(blend, "--frame", "2", "--samples", "1", "-o", tmp_path / "ml_#",
+               "--no-progress")
+    assert code == 0, capsys.readouterr().err
+    header = (tmp_path / "ml_2.exr").read_bytes()[:4096]
+    assert b"Combined.R" in header and b"Depth.Z" in header
