@@ -87,10 +87,15 @@ def test_sample_batches_merge_into_the_whole_render(bpy_drt, anim_blend, cluster
     assert np.allclose(split, single_machine[2], rtol=1e-6, atol=1e-7)
 
 
-async def _exit_worker_process():
-    """Run on a worker: the process dies at once, as a crashed or killed machine would
-    (Dask's client.run needs a coroutine function to return without waiting)."""
-    os._exit(1)
+def _die_in_the_next_render():
+    """Run on one worker: its next task's engine.render ends the process at once, as a
+    crashed or killed machine would, while that task is running."""
+    from drt_addon.engine_link import engine
+
+    def exit_now(*args, **kwargs):
+        os._exit(1)
+
+    engine.render = exit_now
 
 
 def test_a_killed_worker_loses_no_frame(bpy_drt, anim_blend, cluster, single_machine,
@@ -104,20 +109,11 @@ def test_a_killed_worker_loses_no_frame(bpy_drt, anim_blend, cluster, single_mac
     bpy.ops.wm.open_mainfile(filepath=anim_blend, load_ui=False)
     scene = bpy.context.scene
     jobs, _ = plan_outputs(bpy, scene, str(tmp_path / "k_#.exr"), list(FRAMES))
-    killed = []
-
-    def kill_a_busy_worker(part):
-        if killed:
-            return
-        busy = {w: len(keys) for w, keys in client.processing().items() if keys}
-        assert busy, "no task left running to interrupt"
-        victim = max(busy, key=busy.get)
-        killed.append((victim, busy[victim]))
-        client.run(_exit_worker_process, workers=[victim], wait=False)
-
+    victim = sorted(client.scheduler_info()["workers"])[0]
+    client.run(_die_in_the_next_render, workers=[victim])
     results = render_frames(client, bpy, scene, anim_blend, jobs, Overrides(),
-                            sample_batches=4, retries=1, on_part=kill_a_busy_worker)
-    assert killed and killed[0][1] >= 1
+                            sample_batches=4, retries=1)
+    assert victim not in client.scheduler_info()["workers"]     # it did die
     assert sorted(r.frame for r in results) == list(FRAMES)
     assert sorted(os.listdir(tmp_path)) == [f"k_{f}.exr" for f in FRAMES]
     for f in FRAMES:
