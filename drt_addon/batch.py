@@ -277,12 +277,17 @@ def run_render(args) -> int:
     progress = Progress(len(todo), enabled=not args.no_progress and bool(todo))
     ok = False
     try:
-        if args.workers is not None or args.cluster is not None:
-            from .dask_jobs import ClusterError, render_on_dask
+        if not todo:
+            rendered = []
+        elif args.workers is not None or args.cluster is not None:
+            from .dask_jobs import ClusterError, FrameRenderError, render_on_dask
             try:
                 rendered = render_on_dask(bpy, scene, args, overrides, todo, progress)
             except ClusterError as e:
                 raise CliError(EXIT_CLUSTER, f"drt: error: {e}") from None
+            except FrameRenderError as e:
+                raise CliError(EXIT_RENDER, f"drt: error: a frame failed on the cluster "
+                                            f"after {args.retries} retries: {e}") from None
         else:
             rendered = _render_here(bpy, scene, todo, overrides, progress)
         ok = True

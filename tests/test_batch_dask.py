@@ -119,3 +119,16 @@ def test_a_killed_worker_loses_no_frame(bpy_drt, anim_blend, cluster, single_mac
     for f in FRAMES:
         image = read_image_linear(bpy_drt, str(tmp_path / f"k_{f}.exr"))
         assert np.allclose(image, single_machine[f], rtol=1e-6, atol=1e-7), f"frame {f}"
+
+
+def test_an_unreachable_scheduler_is_a_clear_error():
+    from drt_addon.dask_jobs import ClusterError, connect
+    with pytest.raises(ClusterError, match="cannot reach the scheduler tcp://127.0.0.1:1"):
+        connect(address="tcp://127.0.0.1:1", timeout=1)
+
+
+def test_sample_ranges_cover_every_sample_once():
+    from drt_addon.dask_jobs import sample_ranges
+    assert sample_ranges(10, 3) == [(0, 3), (3, 6), (6, 10)]
+    assert sample_ranges(2, 8) == [(0, 1), (1, 2)]          # never an empty range
+    assert sample_ranges(7, 1) == [(0, 7)]
