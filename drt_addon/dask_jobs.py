@@ -88,7 +88,7 @@ def _keep_malloc_default() -> None:
 
 # ----------------------------------------------------------------- on the worker
 _BPY_LOCK = threading.Lock()        # bpy is one global state per process
-_worker_state = {"file": None, "export": None}
+_worker_state = {"registered": False, "file": None, "export": None}
 _exported: list = []
 
 
@@ -147,9 +147,10 @@ def _export_frame(blend: str, stamp, frame: int, overrides: Overrides) -> FrameE
 
     from . import register
     with _BPY_LOCK:
-        if _worker_state["file"] is None:
+        if not _worker_state["registered"]:
             register()
             bpy.utils.register_class(_export_engine_class(bpy))
+            _worker_state["registered"] = True
         key = (blend, stamp, overrides)
         if _worker_state["file"] != key:
             bpy.ops.wm.open_mainfile(filepath=blend, load_ui=False)
