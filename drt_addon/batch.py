@@ -1,10 +1,16 @@
 """The headless batch renderer on the bpy module.
 
-    python -m drt_addon render SCENE.blend -o OUT.png [--samples N] [--seed S] [--frame F]
+    python -m drt_addon render SCENE.blend [-o OUT] [--frame F | --frames 1-240 | -a]
+                                           [--skip-existing] [overrides] [Dask options]
     python -m drt_addon package [-o DIR] [--platform P]   (build the extension zips;
                                                            see docs/install.md)
 
-Exit codes: 0 success, 2 bad arguments, 3 file missing or not a .blend, 4 render or package failed.
+One machine renders the frames one after the other through Blender's render pipeline
+(the DRT RenderEngine); `--workers N` or `--cluster ADDRESS` hands them to Dask
+(drt_addon.dask_jobs). docs/batch.md is the user's guide.
+
+Exit codes: 0 success, 2 bad arguments, 3 file missing or not a .blend, 4 render or package
+failed, 5 the Dask cluster could not be started or reached.
 Errors go to stderr as one line; no traceback reaches the user.
 """
 from __future__ import annotations
@@ -14,9 +20,12 @@ import os
 import sys
 import time
 
-EXIT_OK, EXIT_USAGE, EXIT_FILE, EXIT_RENDER = 0, 2, 3, 4
-FORMATS = {".png": "PNG", ".exr": "OPEN_EXR", ".jpg": "JPEG", ".jpeg": "JPEG",
-           ".tif": "TIFF", ".tiff": "TIFF"}
+from . import frames as frame_lists
+from .batch_report import FrameResult, Progress, summary_table
+from .frame_output import FORMATS, choose_format, save_render_result, set_still_format
+from .overrides import Overrides, apply_overrides
+
+EXIT_OK, EXIT_USAGE, EXIT_FILE, EXIT_RENDER, EXIT_CLUSTER = 0, 2, 3, 4, 5
 # A .blend starts with "BLENDER", or is zstd- or gzip-compressed.
 _BLEND_MAGICS = (b"BLENDER", b"\x28\xb5\x2f\xfd", b"\x1f\x8b")
 
@@ -35,19 +44,47 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="drt", description="DRT headless renderer (Blender's bpy module).")
     sub = p.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    r = sub.add_parser("render", help="render one frame of a .blend with DRT")
+    r = sub.add_parser("render", help="render frames of a .blend with DRT")
     r.add_argument("blend", help="the .blend file")
-    r.add_argument("-o", "--output", required=True,
-                   help="output image; the format follows the extension "
-                        f"({', '.join(sorted(FORMATS))}); PNG/JPEG/TIFF use the scene's "
-                        "colour management, EXR is scene-linear")
-    r.add_argument("--samples", type=int, help="samples per pixel (default: the scene's)")
-    r.add_argument("--seed", type=int, help="random seed (default: the scene's)")
-    r.add_argument("--frame", type=int, help="frame to render (default: the current frame)")
-    r.add_argument("--percentage", type=int,
+    r.add_argument("-o", "--output",
+                   help="output file, with Blender's # frame placeholders (shot_####.png), "
+                        "or a folder (ending in /); the format follows the extension "
+                        f"({', '.join(sorted(FORMATS))}), else the file's own. PNG/JPEG/"
+                        "TIFF use the scene's colour management, EXR is scene-linear. "
+                        "Default: the output path and format set in the .blend")
+    which = r.add_mutually_exclusive_group()
+    which.add_argument("--frame", type=int, help="frame to render (default: the current frame)")
+    which.add_argument("--frames", metavar="LIST",
+                       help="frames to render: 1-240, 1,5,10-20, 1-240:2 or 1..240")
+    which.add_argument("-a", "--animation", action="store_true",
+                       help="render the scene's frame range (Start..End, Step)")
+    r.add_argument("--skip-existing", action="store_true",
+                   help="leave frames whose file already exists (resume a job)")
+    r.add_argument("--no-progress", action="store_true", help="no progress bars on stderr")
+    o = r.add_argument_group("overrides (in memory; the .blend on disk is not changed)")
+    o.add_argument("--samples", type=int, help="samples per pixel (default: the scene's)")
+    o.add_argument("--seed", type=int, help="random seed (default: the scene's)")
+    o.add_argument("--percentage", type=int,
                    help="resolution percentage, 1..10000 (default: the scene's)")
-    r.add_argument("--engine", default="DRT", choices=("DRT", "CYCLES"),
+    o.add_argument("--noise-threshold", type=float, metavar="T",
+                   help="turn adaptive sampling on with this noise threshold")
+    o.add_argument("--min-samples", type=int, metavar="N",
+                   help="adaptive sampling's minimum samples per pixel")
+    o.add_argument("--time-limit", type=float, metavar="SECONDS",
+                   help="stop sampling a frame after this long (0: no limit)")
+    o.add_argument("--engine", default="DRT", choices=("DRT", "CYCLES"),
                    help="render engine (CYCLES for reference images)")
+    d = r.add_argument_group("Dask (docs/batch.md)")
+    where = d.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, metavar="N",
+                       help="start a local Dask cluster of N worker processes")
+    where.add_argument("--cluster", metavar="ADDRESS",
+                       help="send the frames to this Dask scheduler (tcp://HOST:PORT)")
+    d.add_argument("--sample-batches", type=int, default=1, metavar="K",
+                   help="split each frame into K sample ranges rendered on different "
+                        "workers and merged exactly")
+    d.add_argument("--retries", type=int, default=2, metavar="R",
+                   help="times a failed task is tried again (default: 2)")
     pk = sub.add_parser("package", help="build and validate the Blender extension zips, one "
                                         "per platform (downloads the pinned wheels into "
                                         "wheels/); prints one zip path per line")
@@ -97,86 +134,176 @@ def run_package(args) -> int:
     return EXIT_OK
 
 
-def set_still_format(settings, file_format: str) -> None:
-    """Point the scene's output settings (in memory only; the file on disk is not
-    written) at a still image format. Since Blender 5.0 a file whose output is a video
-    has `media_type` VIDEO, which offers only FFMPEG as file format (and MULTI_LAYER_IMAGE
-    only multilayer EXR): switch it to IMAGE first."""
-    if getattr(settings, "media_type", "IMAGE") != "IMAGE":
-        settings.media_type = "IMAGE"
-    settings.file_format = file_format
-    if file_format == "OPEN_EXR":
-        settings.color_depth = "32"
+def _check_arguments(args, overrides: Overrides) -> None:
+    """Everything that can be refused before the file is opened (exit 2)."""
+    problems = overrides.problems()
+    if problems:
+        raise CliError(EXIT_USAGE, f"drt: error: {problems[0]}")
+    if args.output and not args.output.endswith(("/", os.sep)) \
+            and not os.path.isdir(args.output):
+        ext = frame_lists.split_extension(args.output)[1].lower()
+        if ext and ext not in FORMATS:
+            raise CliError(EXIT_USAGE, f"drt: error: unsupported output extension {ext!r}; "
+                                       f"use one of {', '.join(sorted(FORMATS))}, or none "
+                                       "for the file's own format")
+    if args.frames is not None:
+        try:
+            frame_lists.parse_frames(args.frames)
+        except frame_lists.FrameSpecError as e:
+            raise CliError(EXIT_USAGE, f"drt: error: --frames: {e}") from None
+    if args.workers is not None and args.workers < 1:
+        raise CliError(EXIT_USAGE, "drt: error: --workers must be at least 1")
+    if args.sample_batches < 1:
+        raise CliError(EXIT_USAGE, "drt: error: --sample-batches must be at least 1")
+    if args.retries < 0:
+        raise CliError(EXIT_USAGE, "drt: error: --retries must be >= 0")
+    on_dask = args.workers is not None or args.cluster is not None
+    if args.sample_batches > 1 and not on_dask:
+        raise CliError(EXIT_USAGE, "drt: error: --sample-batches needs --workers or --cluster")
+    if on_dask and overrides.engine != "DRT":
+        raise CliError(EXIT_USAGE, "drt: error: --workers and --cluster render with DRT only")
+
+
+def _open_blend(bpy, path: str) -> None:
+    try:
+        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
+    except RuntimeError as e:
+        first = str(e).strip().splitlines()[0] if str(e).strip() else "unreadable file"
+        raise CliError(EXIT_FILE, f"drt: error: cannot open {path}: {first}") from None
+
+
+def _frame_list(args, scene) -> list[int]:
+    if args.frames is not None:
+        return frame_lists.parse_frames(args.frames)
+    if args.animation:
+        return frame_lists.scene_frames(scene.frame_start, scene.frame_end, scene.frame_step)
+    return [scene.frame_current if args.frame is None else args.frame]
+
+
+def plan_outputs(bpy, scene, output: str | None, frames: list[int]):
+    """[(frame, final path)] and the output settings set on the scene (in memory): `-o`
+    with its extension (or the file's own format), else the .blend's output path and
+    format. Returns (jobs, note); note says why the file's own format was not used."""
+    r = scene.render
+    if output is None:
+        fmt, _, note = choose_format(r.image_settings, None)
+        set_still_format(r.image_settings, fmt)
+        return [(f, r.frame_path(frame=f)) for f in frames], note
+    if output.startswith("//"):
+        output = bpy.path.abspath(output)           # relative to the .blend, as Blender
+    folder = output.endswith(("/", os.sep)) or os.path.isdir(output)
+    ext = "" if folder else frame_lists.split_extension(output)[1]
+    fmt, ext, note = choose_format(r.image_settings, ext or None)
+    set_still_format(r.image_settings, fmt)
+    pattern = frame_lists.output_pattern(output, ext, len(frames) > 1)
+    pattern = os.path.join(os.path.abspath(os.path.dirname(pattern)), os.path.basename(pattern))
+    return [(f, frame_lists.fill_placeholder(pattern, f)) for f in frames], note
+
+
+def _make_folders(jobs) -> None:
+    for folder in sorted({os.path.dirname(path) for _, path in jobs}):
+        try:
+            os.makedirs(folder, exist_ok=True)      # like Blender's own output paths
+        except OSError as e:
+            raise CliError(EXIT_USAGE, f"drt: error: cannot create the output folder "
+                                       f"{folder}: {e.strerror}") from None
+
+
+def render_frame_here(bpy, scene, frame: int, path: str, overrides, progress) -> FrameResult:
+    """One frame through Blender's render pipeline, written to `path` atomically."""
+    from . import render_engine
+    scene.frame_set(frame)
+    drt = overrides.engine == "DRT"
+    asked = scene.drt.samples if drt else scene.cycles.samples
+    progress.start_frame(f"frame {frame}", asked)
+    t0 = time.perf_counter()
+    bpy.ops.render.render(write_still=False)
+    seconds = time.perf_counter() - t0
+    if drt and not render_engine.last_render.get("ok"):
+        raise CliError(EXIT_RENDER, f"drt: error: render of frame {frame} failed: "
+                                    f"{render_engine.last_render.get('error') or 'unknown'}")
+    try:
+        save_render_result(bpy, scene, path)
+    except (RuntimeError, OSError) as e:
+        raise CliError(EXIT_RENDER, f"drt: error: cannot write {path}: {e}") from None
+    stats = render_engine.last_render.get("stats") if drt else None
+    result = FrameResult(frame, path, seconds=seconds,
+                         samples=stats.samples_done if stats else asked,
+                         paths=stats.paths if stats else 0)
+    w = scene.render.resolution_x * scene.render.resolution_percentage // 100
+    h = scene.render.resolution_y * scene.render.resolution_percentage // 100
+    progress.say(f"drt: wrote {path} ({w}x{h}, {result.samples} samples, "
+                 f"{overrides.engine}, {seconds:.1f} s)")
+    return result
+
+
+def _render_here(bpy, scene, jobs, overrides, progress) -> list[FrameResult]:
+    from . import render_engine
+    listener = progress.samples_done
+    render_engine.progress_listeners.append(listener)
+    try:
+        results = []
+        for frame, path in jobs:
+            results.append(render_frame_here(bpy, scene, frame, path, overrides, progress))
+            progress.frame_done()
+        return results
+    finally:
+        render_engine.progress_listeners.remove(listener)
+
+
+def run_render(args) -> int:
+    overrides = Overrides.from_args(args)
+    _check_arguments(args, overrides)
+    check_blend(args.blend)
+
+    import bpy
+
+    from . import register
+    register()
+    _open_blend(bpy, args.blend)
+    scene = bpy.context.scene
+    for message in apply_overrides(scene, overrides):
+        print(f"drt: warning: {message}", file=sys.stderr)
+    frames = _frame_list(args, scene)
+    jobs, note = plan_outputs(bpy, scene, args.output, frames)
+    if note:
+        print(f"drt: note: {note}", file=sys.stderr)
+    _make_folders(jobs)
+    if scene.camera is None:
+        raise CliError(EXIT_RENDER, "drt: error: render failed: the scene has no active camera")
+    skipped = [FrameResult(f, p, status="skipped") for f, p in jobs
+               if args.skip_existing and os.path.exists(p)]
+    todo = [(f, p) for f, p in jobs if not (args.skip_existing and os.path.exists(p))]
+    progress = Progress(len(todo), enabled=not args.no_progress and bool(todo))
+    ok = False
+    try:
+        if not todo:
+            rendered = []
+        elif args.workers is not None or args.cluster is not None:
+            from .dask_jobs import ClusterError, FrameRenderError, render_on_dask
+            try:
+                rendered = render_on_dask(bpy, scene, args, overrides, todo, progress)
+            except ClusterError as e:
+                raise CliError(EXIT_CLUSTER, f"drt: error: {e}") from None
+            except FrameRenderError as e:
+                raise CliError(EXIT_RENDER, f"drt: error: a frame failed on the cluster "
+                                            f"after {args.retries} retries: {e}") from None
+        else:
+            rendered = _render_here(bpy, scene, todo, overrides, progress)
+        ok = True
+    finally:
+        progress.close(ok)
+    order = {f: i for i, (f, _) in enumerate(jobs)}
+    results = sorted(skipped + rendered, key=lambda r: order[r.frame])
+    print(summary_table(results))
+    return EXIT_OK
 
 
 def run(argv) -> int:
     args = build_parser().parse_args(argv)
     if args.command == "package":
         return run_package(args)
-    ext = os.path.splitext(args.output)[1].lower()
-    if ext not in FORMATS:
-        raise CliError(EXIT_USAGE, f"drt: error: unsupported output extension {ext or '(none)'!r};"
-                                   f" use one of {', '.join(sorted(FORMATS))}")
-    if args.samples is not None and not (1 <= args.samples <= 1 << 24):
-        raise CliError(EXIT_USAGE, "drt: error: --samples must be between 1 and 16777216")
-    if args.seed is not None and args.seed < 0:
-        raise CliError(EXIT_USAGE, "drt: error: --seed must be >= 0")
-    check_blend(args.blend)
-    out_dir = os.path.dirname(os.path.abspath(args.output))
-    try:
-        os.makedirs(out_dir, exist_ok=True)      # like Blender's own output paths
-    except OSError as e:
-        raise CliError(EXIT_USAGE, f"drt: error: cannot create the output folder {out_dir}: "
-                                   f"{e.strerror}") from None
-
-    import bpy
-
-    from . import register
-    from . import render_engine
-    register()
-    try:
-        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.blend), load_ui=False)
-    except RuntimeError as e:
-        first = str(e).strip().splitlines()[0] if str(e).strip() else "unreadable file"
-        raise CliError(EXIT_FILE, f"drt: error: cannot open {args.blend}: {first}") from None
-    scene = bpy.context.scene
-    if args.frame is not None:
-        scene.frame_set(args.frame)
-    scene.render.engine = args.engine
-    if args.samples is not None:
-        scene.drt.samples = args.samples
-        if args.engine == "CYCLES":
-            scene.cycles.samples = args.samples
-    if args.seed is not None:
-        scene.drt.seed = args.seed
-        if args.engine == "CYCLES":
-            scene.cycles.seed = args.seed
-    if args.percentage is not None:
-        if not 1 <= args.percentage <= 10000:
-            raise CliError(EXIT_USAGE, "drt: error: --percentage must be in 1..10000")
-        scene.render.resolution_percentage = args.percentage
-    if scene.camera is None:
-        raise CliError(EXIT_RENDER, "drt: error: render failed: the scene has no active camera")
-    t0 = time.perf_counter()
-    bpy.ops.render.render(write_still=False)
-    seconds = time.perf_counter() - t0
-    if args.engine == "DRT" and not render_engine.last_render.get("ok"):
-        raise CliError(EXIT_RENDER, f"drt: error: render failed: "
-                                    f"{render_engine.last_render.get('error') or 'unknown error'}")
-    set_still_format(scene.render.image_settings, FORMATS[ext])
-    image = bpy.data.images.get("Render Result")
-    if image is None:
-        raise CliError(EXIT_RENDER, "drt: error: render failed: Blender produced no image")
-    try:
-        image.save_render(filepath=os.path.abspath(args.output), scene=scene)
-    except RuntimeError as e:
-        raise CliError(EXIT_RENDER, f"drt: error: cannot write {args.output}: {e}") from None
-    w = int(scene.render.resolution_x * scene.render.resolution_percentage / 100)
-    h = int(scene.render.resolution_y * scene.render.resolution_percentage / 100)
-    samples = scene.drt.samples if args.engine == "DRT" else scene.cycles.samples
-    print(f"drt: wrote {args.output} ({w}x{h}, {samples} samples, {args.engine}, "
-          f"{seconds:.1f} s)")
-    return EXIT_OK
+    return run_render(args)
 
 
 def main(argv=None) -> int:

@@ -37,6 +37,9 @@ aov = import_module(engine.__name__ + ".aov")   # engine.aov, in either package 
 # "passes" the extra passes written (top-down float arrays by pass name).
 last_render = {"ok": None, "error": None, "warnings": [], "stats": None, "pixels": None,
                "scene": None, "export_stats": None, "passes": {}, "region": None}
+# Callables told (samples done, samples asked) after every progressive pass (the batch
+# renderer's progress bar).
+progress_listeners: list = []
 
 
 class DRTViewLayerSettings(bpy.types.PropertyGroup):
@@ -184,6 +187,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 self.update_result(result)
                 self.update_progress(fraction)
                 last_render["progress"].append((stats.samples_done, fraction))
+                for listener in progress_listeners:
+                    listener(stats.samples_done, settings.samples)
                 rate = stats.paths_per_second()
                 left = stats.seconds * (1 - fraction) / max(fraction, 1e-9)
                 n_pixels = description.width * description.height

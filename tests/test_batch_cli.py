@@ -41,7 +41,11 @@ def test_success_writes_the_image(tmp_path):
 @pytest.mark.parametrize("args", [
     (),                                             # no command
     ("render",),                                    # no file
-    ("render", CORNELL),                            # no output
+    ("render", CORNELL, "--frames", "5-1"),         # a range ending before it starts
+    ("render", CORNELL, "--frame", "1", "--frames", "2"),   # two frame choices
+    ("render", CORNELL, "--sample-batches", "2"),   # batches need Dask workers
+    ("render", CORNELL, "--workers", "2", "--engine", "CYCLES"),  # Dask renders DRT only
+    ("render", CORNELL, "--noise-threshold", "0"),
     ("render", CORNELL, "-o", "x.png", "--samples", "zero"),
     ("render", CORNELL, "-o", "x.png", "--samples", "0"),
     ("render", CORNELL, "-o", "x.png", "--seed", "-1"),
