@@ -190,8 +190,7 @@ def render_part(blend: str, stamp, frame: int, overrides: Overrides, sample_star
     except (ImportError, ValueError):
         where = "local"
     return {"frame": frame, "start": sample_start, "end": sample_end,
-            "width": film.width, "height": film.height, "count": film.count,
-            "sum": film.sum, "sum_sq": film.sum_sq, "alpha_sum": film.alpha_sum,
+            "width": film.width, "height": film.height, "film": film.statistics(),
             "region": exported.region, "crop": exported.crop, "paths": stats.paths,
             "seconds": time.perf_counter() - t0, "worker": where,
             "warnings": exported.warnings}
@@ -205,9 +204,7 @@ def merge_parts(parts: list[dict]):
     parts = sorted(parts, key=lambda p: p["start"])
     film = None
     for p in parts:
-        f = engine.Film(p["width"], p["height"])
-        f.count[:], f.sum[:], f.sum_sq[:], f.alpha_sum[:] = (p["count"], p["sum"],
-                                                             p["sum_sq"], p["alpha_sum"])
+        f = engine.Film.from_statistics(p["width"], p["height"], p["film"])
         film = f if film is None else film.merge(f)
     return film
 

@@ -67,6 +67,20 @@ class Film:
                     self.count, self.sum, self.sum_sq, self.alpha_sum,
                     self.count_odd, self.sum_odd)
 
+    STATISTICS = ("count", "sum", "sum_sq", "alpha_sum", "count_odd", "sum_odd")
+
+    def statistics(self) -> dict:
+        """Every per-pixel array by name: all a film is, to ship to another process and
+        rebuild there with `from_statistics`."""
+        return {name: getattr(self, name) for name in self.STATISTICS}
+
+    @classmethod
+    def from_statistics(cls, width: int, height: int, arrays: dict) -> "Film":
+        film = cls(width, height)
+        for name in cls.STATISTICS:
+            getattr(film, name)[:] = arrays[name]
+        return film
+
     def merge(self, other: "Film") -> "Film":
         if (other.width, other.height) != (self.width, self.height):
             raise ValueError("cannot merge films of different sizes")

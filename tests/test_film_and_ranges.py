@@ -69,3 +69,15 @@ def test_cancel_returns_a_valid_partial_film():
     assert stats.cancelled
     assert 0 < film.count.sum() < 32 * 32 * 64
     assert np.isfinite(film.mean()).all()
+
+
+def test_film_statistics_rebuild_the_film_in_another_process():
+    """What a Dask worker ships: every per-pixel array, the half film included."""
+    film = Film(3, 2)
+    rng = np.random.default_rng(1)
+    film.add(rng.integers(0, 6, 50), rng.random((50, 3)), rng.random(50),
+             index=np.arange(50))
+    copy = Film.from_statistics(3, 2, {k: v.copy() for k, v in film.statistics().items()})
+    for name in Film.STATISTICS:
+        assert np.array_equal(getattr(copy, name), getattr(film, name)), name
+    assert copy.count_odd.sum() == 25
