@@ -10,7 +10,9 @@ anything):
   2. cores: the speed-up of N threads over one;
   3. time to equal error against Cycles, whole processes side by side;
   4. a 1M-triangle mesh: depsgraph to first sample, and peak memory, against Cycles;
-  5. 1000 rigidly moving objects: one sample with motion blur over one without.
+  5. 1000 rigidly moving objects: one sample with motion blur over one without;
+and, for the trade of speed against accuracy, 6. what adaptive sampling saves per sample
+scene (docs/adaptive_benchmark.py).
 Every figure in docs/benchmarks.md is printed by this script.
 """
 from __future__ import annotations
@@ -224,18 +226,27 @@ def _fmt_equal_error(name, r):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller renders, for a smoke run")
-    ap.add_argument("--skip", default="", help="comma-separated sections to skip (1..5)")
+    ap.add_argument("--skip", default="", help="comma-separated sections to skip (1..6)")
+    ap.add_argument("--only", default="", help="comma-separated sections to run (1..6); the "
+                    "others keep their last measured figures (docs/benchmarks.json)")
     args = ap.parse_args()
     skip = set(args.skip.split(",")) - {""}
+    if args.only:
+        skip |= set(map(str, range(1, 7))) - set(args.only.split(","))
+    saved = _load_sections()
     q = args.quick
     cores = os.cpu_count() or 1
     load = os.getloadavg()[0]
-    lines = ["# Benchmarks", "",
-             "Written by `docs/make_benchmarks.py`; rerun it to reproduce. Machine: "
-             f"{platform.machine()}, {cores} cores, Python {platform.python_version()}; "
-             f"load average {load:.2f} when it started (above 0.5, other work shared the "
-             "cores and the figures are pessimistic).", ""]
-    targets = []
+    machine = (f"{platform.machine()}, {cores} cores, Python {platform.python_version()}; "
+               f"load average {load:.2f} when it started")
+    lines, targets = [], []
+
+    def done(section):
+        """Keep what the section just measured (its lines and targets) and start the next."""
+        saved[section] = dict(lines=lines[:], targets=targets[:], machine=machine)
+        _save_sections(saved)
+        lines.clear()
+        targets.clear()
 
     if "1" not in skip:
         r = per_core_efficiency(*((128, 128, 4) if q else (256, 256, 16)))
@@ -252,6 +263,7 @@ def main():
                   f"{r['bare_rate']:,.0f} |",
                   f"| ratio | | | **{eff:.2f}** |", ""]
         print(lines[-3:], flush=True)
+        done("1")
     if "2" not in skip:
         rates = thread_scaling(*((128, 128, 4) if q else (320, 240, 16)), cores)
         top = rates[cores] / rates[1]
@@ -262,6 +274,7 @@ def main():
         lines += [f"| {n} | {v:,.0f} | {v / rates[1]:.2f}x |" for n, v in rates.items()]
         lines += [""]
         print(lines[-4:], flush=True)
+        done("2")
     if "3" not in skip:
         scenes = [("Cornell box", "cornell_box.blend"), ("metals", "metals.blend"),
                   ("glass", "glass.blend"), ("glossy dielectric", "glossy_dielectric.blend"),
@@ -287,6 +300,7 @@ def main():
                   "a power law fitted to its sample ladder.", "",
                   "| scene | Cycles | DRT to the same error | DRT / Cycles | DRT ladder |",
                   "|---|---|---|---|---|", *rows, ""]
+        done("3")
     if "4" not in skip:
         r = big_mesh()
         c, d = r["CYCLES"], r["DRT"]
@@ -305,6 +319,7 @@ def main():
                   f"| DRT: depsgraph to first sample (s) | | {d['first_sample'] or 0:.2f} |",
                   f"| peak resident memory (MB) | {c['maxrss_mb']:.0f} | {d['maxrss_mb']:.0f} |",
                   ""]
+        done("4")
     if "5" not in skip:
         r = many_moving(200 if q else 1000)
         ratio = r["blur"] / r["static"]
@@ -315,11 +330,54 @@ def main():
                   "sample (160x120).", "",
                   "| motion blur | s per sample |", "|---|---|",
                   f"| off | {r['static']:.2f} |", f"| on | {r['blur']:.2f} |", ""]
-    head = ["## Targets", "", "| target | wanted | measured | met |", "|---|---|---|---|"]
-    head += [f"| {a} | {b} | {c} | {'yes' if ok else '**no**'} |" for a, b, c, ok in targets]
-    lines[4:4] = head + [""]
+        done("5")
+    if "6" not in skip:
+        from adaptive_benchmark import measure, table
+        rows = []
+        for blend in ADAPTIVE_SCENES:
+            rows.append(measure(os.path.join(SAMPLES, blend), long_side=32 if q else 96,
+                                ref_spp=256 if q else 2048,
+                                ladder=(4, 16, 64) if q else (16, 64, 256)))
+            print(blend, rows[-1]["metrics"], flush=True)
+        lines += table(rows)
+        done("6")
+    _write_page(saved)
+
+
+ADAPTIVE_SCENES = ("cornell_box.blend", "metals.blend", "glass.blend",
+                   "glossy_dielectric.blend", "dof.blend", "motion_cube.blend",
+                   "hdri_world.blend", "fog_room.blend")
+SECTIONS_JSON = os.path.join(DOCS, "benchmarks.json")
+
+
+def _load_sections() -> dict:
+    if os.path.exists(SECTIONS_JSON):
+        with open(SECTIONS_JSON) as f:
+            return json.load(f)
+    return {}
+
+
+def _save_sections(saved: dict) -> None:
+    with open(SECTIONS_JSON, "w") as f:
+        json.dump(saved, f, indent=1)
+
+
+def _write_page(saved: dict) -> None:
+    order = sorted(saved, key=int)
+    head = ["# Benchmarks", "",
+            "Written by `docs/make_benchmarks.py` (figures kept in docs/benchmarks.json, so "
+            "one section can be rerun with `--only N`); rerun it to reproduce. Each "
+            "section's machine and load: "
+            + "; ".join(f"{k}: {saved[k]['machine']}" for k in order)
+            + " (a load above 0.5 means other work shared the cores and the figures are "
+            "pessimistic).", "",
+            "## Targets", "", "| target | wanted | measured | met |", "|---|---|---|---|"]
+    for k in order:
+        head += [f"| {a} | {b} | {c} | {'yes' if ok else '**no**'} |"
+                 for a, b, c, ok in saved[k]["targets"]]
+    body = [line for k in order for line in saved[k]["lines"]]
     with open(os.path.join(DOCS, "benchmarks.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+        f.write("\n".join(head + [""] + body) + "\n")
     print("\n".join(head))
 
 

@@ -7,8 +7,9 @@ nothing of the development tree; installed with Blender's own operator into a th
 extension repository it is enabled as `bl_ext.user_default.drt` and renders the Cornell box
 with the DRT engine, its kernels compiled by the bundled numba and cached in the
 extension's user folder (<user>/extensions/.user/user_default/drt/numba_cache), which a
-second Blender start reads back. Without a writable cache (DRT_NUMBA_CACHE=0, and a truly
-read-only user folder where user namespaces allow a read-only bind mount) it still renders.
+second Blender start reads back. Without a writable cache (a truly read-only user folder
+where user namespaces allow a read-only bind mount, else DRT_NUMBA_CACHE=0) it still
+renders.
 
 Blender runs in subprocesses (`python -I -c ...`, cwd outside the repository): this pytest
 process may hold the source-checkout add-on, and Blender cannot register a second engine
@@ -466,29 +467,26 @@ def preimported_session(restart_session, built, user_dir, tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def uncached_session(preimported_session, built, user_dir, tmp_path_factory):
-    """A start with DRT_NUMBA_CACHE=0 (jit.py's switch). Returns (facts, the cache files
-    before, the cache files after)."""
-    before = _cache_files(user_dir)
-    facts = _session(tmp_path_factory.mktemp("session4"), user_dir, built[0], install=False,
-                     env_extra={"DRT_NUMBA_CACHE": "0"})
-    return facts, before, _cache_files(user_dir)
-
-
-@pytest.fixture(scope="module")
-def read_only_session(uncached_session, built, user_dir, tmp_path_factory):
+def read_only_session(preimported_session, built, user_dir, tmp_path_factory):
     """A start in which the whole Blender user folder (the installed extension, its wheels'
-    site-packages and its cache folder) and the home folder are read-only mounts."""
-    tmp = tmp_path_factory.mktemp("session5")
-    if not _read_only_mounts_work(str(tmp)):
-        pytest.skip("no read-only bind mounts here (unshare -rm unavailable); the "
-                    "DRT_NUMBA_CACHE=0 test covers the uncached path")
-    home = os.path.join(user_dir, "home")  # inside the read-only mount
-    os.makedirs(home, exist_ok=True)
+    site-packages and its cache folder) and the home folder are read-only mounts: no
+    writable cache anywhere. Where read-only bind mounts are unavailable, a start with
+    DRT_NUMBA_CACHE=0 (jit.py's switch, which forces the same in-memory path) instead.
+    Returns (facts, whether the folder was mounted read-only, the cache files before and
+    after)."""
+    tmp = tmp_path_factory.mktemp("session4")
     before = _cache_files(user_dir)
-    facts = _session(tmp, user_dir, built[0], install=False, read_only=user_dir,
-                     env_extra={"HOME": home, "XDG_CACHE_HOME": os.path.join(home, ".cache")})
-    return facts, before, _cache_files(user_dir)
+    mounted = _read_only_mounts_work(str(tmp))
+    if mounted:
+        home = os.path.join(user_dir, "home")  # inside the read-only mount
+        os.makedirs(home, exist_ok=True)
+        facts = _session(tmp, user_dir, built[0], install=False, read_only=user_dir,
+                         env_extra={"HOME": home,
+                                    "XDG_CACHE_HOME": os.path.join(home, ".cache")})
+    else:
+        facts = _session(tmp, user_dir, built[0], install=False,
+                         env_extra={"DRT_NUMBA_CACHE": "0"})
+    return facts, mounted, before, _cache_files(user_dir)
 
 
 def _check_session(facts, user_dir):
@@ -584,21 +582,14 @@ def test_numba_imported_before_the_addon_still_uses_the_extension_cache(preimpor
     assert facts["cache_hits"] > 0
 
 
-def test_renders_without_a_kernel_cache(uncached_session, user_dir):
-    """DRT_NUMBA_CACHE=0: kernels compile in memory, nothing is read or written on disk."""
-    facts, before, after = uncached_session
-    _check_session(facts, user_dir)
-    assert facts["jit_cache"] is False
-    assert facts["cache_paths"] == [] and facts["cache_hits"] == 0
-    assert after == before
-
-
 def test_renders_from_a_read_only_user_folder(read_only_session, user_dir):
     """The installed extension, its cache folder and the home folder all read-only (a
     read-only bind mount, which binds root too): jit.py finds no writable cache location,
-    kernels compile in memory, and the render works."""
-    facts, before, after = read_only_session
-    assert facts["cache_dir_writable"] is False  # the mount really is read-only
+    kernels compile in memory, nothing is read or written on disk, and the render works.
+    (DRT_NUMBA_CACHE=0 alone is tested in-process by tests/test_kernel_cache.py.)"""
+    facts, mounted, before, after = read_only_session
+    if mounted:
+        assert facts["cache_dir_writable"] is False  # the mount really is read-only
     _check_session(facts, user_dir)
     assert facts["jit_cache"] is False
     assert facts["cache_paths"] == [] and facts["cache_hits"] == 0
