@@ -3,6 +3,8 @@
     python -m drt_addon render SCENE.blend -o OUT.png [--samples N] [--seed S] [--frame F]
     python -m drt_addon package [-o DIR] [--platform P]   (build the extension zips;
                                                            see docs/install.md)
+    python -m drt_addon compare A.exr B.exr [-o DIFF.png]  (compare_images.py)
+    python -m drt_addon converge SCENE.blend [-o DIR] ...  (converge.py; docs/convergence.md)
 
 Exit codes: 0 success, 2 bad arguments, 3 file missing or not a .blend, 4 render or package failed.
 Errors go to stderr as one line; no traceback reaches the user.
@@ -55,6 +57,9 @@ def build_parser() -> argparse.ArgumentParser:
     pk.add_argument("--platform", action="append", dest="platforms", metavar="PLATFORM",
                     help="build only this platform's zip (one of the manifest's platforms, "
                          "e.g. linux-x64; repeatable; default: every platform)")
+    from . import compare_images, converge
+    for command in (compare_images, converge):
+        command.add_parser(sub)
     return p
 
 
@@ -113,6 +118,8 @@ def run(argv) -> int:
     args = build_parser().parse_args(argv)
     if args.command == "package":
         return run_package(args)
+    if getattr(args, "run", None) is not None:      # compare, converge
+        return args.run(args)
     ext = os.path.splitext(args.output)[1].lower()
     if ext not in FORMATS:
         raise CliError(EXIT_USAGE, f"drt: error: unsupported output extension {ext or '(none)'!r};"
