@@ -203,22 +203,35 @@ def run_converge(args) -> int:
     return EXIT_OK
 
 
-def _fmt(v, spec):
-    return "n/a" if v is None else format(v, spec)
+COLUMNS = ("curve", "spp", "seconds", "relMSE", "RMSE", "FLIP", "relMSE slope/spp",
+           "relMSE slope/s", "RMSE slope/spp", "FLIP slope/spp")
+
+
+def _slope(v):
+    return "n/a" if v is None else f"{v:+.2f}"
+
+
+def summary_rows(result: dict) -> list:
+    """Per curve, the COLUMNS as text: its last rung and its fitted slopes."""
+    rows = []
+    for c in result["curves"]:
+        s = c["slopes"]
+        rows.append([c["label"], str(c["samples"][-1]), f"{c['seconds'][-1]:.2f}",
+                     f"{c['relmse'][-1]:.2e}", f"{c['rmse'][-1]:.2e}", f"{c['flip'][-1]:.4f}",
+                     _slope(s["samples"]["relmse"]), _slope(s["seconds"]["relmse"]),
+                     _slope(s["samples"]["rmse"]), _slope(s["samples"]["flip"])])
+    return rows
 
 
 def summary(result: dict) -> str:
     ref = result["reference"]
+    rows = [list(COLUMNS)] + summary_rows(result)
+    widths = [max(len(r[i]) for r in rows) for i in range(len(COLUMNS))]
     lines = [f"reference: {ref['engine']} {ref['samples']} spp, {ref['seconds']:.1f} s"
              f"{' (cached)' if ref['cached'] else ''}; its noise floor relMSE "
-             f"{ref['noise_floor']['relmse']:.2e}",
-             f"{'curve':<28} {'spp':>5} {'seconds':>8} {'relMSE':>9} {'RMSE':>9} "
-             f"{'FLIP':>7} {'slope/spp':>9} {'slope/s':>8}"]
-    for c in result["curves"]:
-        s = c["slopes"]
-        lines.append(f"{c['label']:<28} {c['samples'][-1]:>5} {c['seconds'][-1]:>8.2f} "
-                     f"{c['relmse'][-1]:>9.2e} {c['rmse'][-1]:>9.2e} {c['flip'][-1]:>7.4f} "
-                     f"{_fmt(s['samples']['relmse'], '+9.2f')} "
-                     f"{_fmt(s['seconds']['relmse'], '+8.2f')}")
-    lines.append("(slopes of relMSE; -1 is plain Monte Carlo)")
+             f"{ref['noise_floor']['relmse']:.2e}"]
+    for r in rows:
+        lines.append("  ".join([r[0].ljust(widths[0])] +
+                               [v.rjust(w) for v, w in zip(r[1:], widths[1:])]))
+    lines.append("(plain Monte Carlo: relMSE slope -1, RMSE -0.5)")
     return "\n".join(lines)
