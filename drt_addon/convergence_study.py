@@ -32,6 +32,7 @@ class Study:
         self.bpy, self.description, self.settings = bpy, description, settings
         self.scene = bpy.context.scene
         self.cache, self.on_paths = cache, on_paths
+        self._warm = set()
         self.identity = {**file_identity(blend_path),
                          "resolution": [description.width, description.height],
                          "frame": self.scene.frame_current,
@@ -50,10 +51,12 @@ class Study:
             return (convergence.Reference(hit["image"], hit["variance_of_mean"],
                                           m["samples"], m["seconds"]), key, True)
         if engine_name == "drt":
+            self._warm_up("drt", self.settings)
             ref = convergence.reference(self.description, self.settings, samples,
                                         on_paths=self.on_paths)
         else:
             from .cycles_ladder import cycles_reference
+            self._warm_up("cycles")
             ref = cycles_reference(self.bpy, self.scene, samples, on_paths=self.on_paths)
         self.cache.save_arrays(key, {"samples": ref.samples, "seconds": ref.seconds},
                                image=ref.image.astype(np.float32),
@@ -73,6 +76,7 @@ class Study:
             self._skip(ladder_paths(rungs, sampler))
             return {**cached, "cached": True}
         setup = {}
+        self._warm_up("drt", settings)
         rung_iter = convergence.ladder(self.description, settings, rungs,
                                        on_paths=self.on_paths, setup=setup)
         curve = measure_curve(rung_iter, ref, floor)
@@ -91,6 +95,7 @@ class Study:
         if cached is not None:
             self._skip(sum(rungs))
             return {**cached, "cached": True}
+        self._warm_up("cycles")
         curve = measure_curve(cycles_ladder(self.bpy, self.scene, rungs, self.on_paths),
                               ref, floor)
         curve = {"label": f"Cycles ({self.scene.cycles.sampling_pattern.lower()})",
@@ -99,6 +104,19 @@ class Study:
                  "progressive": False, "setup_seconds": None, **curve}
         self.cache.save_json(key, curve)
         return {**curve, "cached": False}
+
+    def _warm_up(self, engine_name, settings=None):
+        """Once per engine and integrator, before anything is timed: a 1-sample render
+        (kernel compilation, Cycles' kernel loading)."""
+        key = (engine_name, getattr(settings, "integrator", None))
+        if key in self._warm:
+            return
+        self._warm.add(key)
+        if engine_name == "drt":
+            convergence.warm_up(self.description, settings)
+        else:
+            from .cycles_ladder import render_cycles
+            render_cycles(self.bpy, self.scene, 1, self.scene.cycles.seed)
 
     def _skip(self, samples_per_pixel):
         """A cached curve still moves the progress bar by the work it stands for."""

@@ -14,7 +14,8 @@ own, costing twice the samples of the progressive ladder in all.
 Every rung takes all its samples: the settings turn adaptive sampling and time limits
 off where they have them, and a film with fewer samples in any pixel is an error.
 Seconds are the render's own (work units on the thread pool); building the render
-context (acceleration structure) is reported apart as `setup_seconds`.
+context (acceleration structure) is reported apart as `setup_seconds`, and `warm_up`
+keeps kernel compilation out of them.
 """
 from __future__ import annotations
 
@@ -123,6 +124,17 @@ def _progressive(scene, settings, rungs, on_paths, setup):
             start = k
             _check_complete(total, k)
             yield Rung(k, seconds, total.mean())
+    finally:
+        ctx.close()
+
+
+def warm_up(scene, settings) -> None:
+    """One sample of every pixel, discarded: compiles (or loads from Numba's cache) the
+    kernels these settings use, so that no rung's seconds include that."""
+    s = every_sample(settings, samples=1)
+    ctx = RenderContext(scene, s)
+    try:
+        render(scene, s, context=ctx)
     finally:
         ctx.close()
 
