@@ -61,6 +61,11 @@ def scene_section(result, image_name):
              f"![convergence of {result['scene']}](images/{image_name})", "",
              "| " + " | ".join(COLUMNS) + " |", "|---" * len(COLUMNS) + "|"]
     lines += ["| " + " | ".join(row) + " |" for row in summary_rows(result)]
+    reasons = {}
+    for s in result.get("skipped", []):
+        reasons.setdefault(s["reason"], []).append(s["label"])
+    lines += [""] + [f"Not measured: {', '.join(labels)} ({reason})."
+                     for reason, labels in reasons.items()] if reasons else []
     return lines + [""]
 
 

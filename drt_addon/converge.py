@@ -160,19 +160,32 @@ def run_converge(args) -> int:
     with _progress_bar(spp_total * pixels) as bar:
         study = Study(bpy, args.blend, description, settings, cache, on_paths=bar.update)
         bar.set_description(f"reference {ref_engine}:{ref_samples}")
-        ref, ref_key, ref_cached = study.reference(ref_engine, ref_samples)
+        try:
+            ref, ref_key, ref_cached = study.reference(ref_engine, ref_samples)
+        except ValueError as e:
+            raise CliError(EXIT_RENDER, f"drt: error: cannot render the reference: {e}") \
+                from None
         if ref_cached:
             bar.update(ref_samples * pixels)
         floor = image_error.noise_floor(ref.variance_of_mean, ref.image)
-        curves = []
+        curves, skipped = [], []
         for integrator in integrators:
             for sampler in samplers:
                 bar.set_description(f"DRT {integrator} {sampler}")
-                curves.append(study.drt_curve(sampler, integrator, rungs, ref, ref_key,
-                                              floor))
+                curve = study.drt_curve(sampler, integrator, rungs, ref, ref_key, floor)
+                if "skipped" in curve:
+                    if not any(s["reason"] == curve["skipped"] for s in skipped):
+                        bar.write(f"drt: warning: {curve['label']} skipped: "
+                                  f"{curve['skipped']}", file=sys.stderr)
+                    skipped.append({"label": curve["label"], "reason": curve["skipped"]})
+                else:
+                    curves.append(curve)
         if args.with_cycles:
             bar.set_description("Cycles")
             curves.append(study.cycles_curve(rungs, ref, ref_key, floor))
+    if not curves:
+        raise CliError(EXIT_RENDER, f"drt: error: no curve could be rendered: "
+                                    f"{skipped[0]['reason']}")
     result = {
         "scene": stem, "file": os.path.abspath(args.blend),
         "resolution": [description.width, description.height],
@@ -189,6 +202,7 @@ def run_converge(args) -> int:
                               "log(seconds); MSE-like errors less the reference's noise "
                               "floor, over rungs above twice it (RMSE through its square)"},
         "curves": curves,
+        "skipped": skipped,
         "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                     "platform": platform.platform()},
         "total_seconds": time.perf_counter() - t_start,
@@ -234,4 +248,6 @@ def summary(result: dict) -> str:
         lines.append("  ".join([r[0].ljust(widths[0])] +
                                [v.rjust(w) for v, w in zip(r[1:], widths[1:])]))
     lines.append("(plain Monte Carlo: relMSE slope -1, RMSE -0.5)")
+    for s in result.get("skipped", []):
+        lines.append(f"skipped {s['label']}: {s['reason']}")
     return "\n".join(lines)

@@ -32,7 +32,7 @@ class Study:
         self.bpy, self.description, self.settings = bpy, description, settings
         self.scene = bpy.context.scene
         self.cache, self.on_paths = cache, on_paths
-        self._warm = set()
+        self._warm = {}
         self.identity = {**file_identity(blend_path),
                          "resolution": [description.width, description.height],
                          "frame": self.scene.frame_current,
@@ -51,7 +51,9 @@ class Study:
             return (convergence.Reference(hit["image"], hit["variance_of_mean"],
                                           m["samples"], m["seconds"]), key, True)
         if engine_name == "drt":
-            self._warm_up("drt", self.settings)
+            why = self._warm_up("drt", self.settings)
+            if why is not None:
+                raise ValueError(why)
             ref = convergence.reference(self.description, self.settings, samples,
                                         on_paths=self.on_paths)
         else:
@@ -75,8 +77,11 @@ class Study:
         if cached is not None:
             self._skip(ladder_paths(rungs, sampler))
             return {**cached, "cached": True}
+        why = self._warm_up("drt", settings)
+        if why is not None:              # e.g. volumes and the distribution integrator
+            self._skip(ladder_paths(rungs, sampler))
+            return {"label": label, "skipped": why}
         setup = {}
-        self._warm_up("drt", settings)
         rung_iter = convergence.ladder(self.description, settings, rungs,
                                        on_paths=self.on_paths, setup=setup)
         curve = measure_curve(rung_iter, ref, floor)
@@ -107,16 +112,20 @@ class Study:
 
     def _warm_up(self, engine_name, settings=None):
         """Once per engine and integrator, before anything is timed: a 1-sample render
-        (kernel compilation, Cycles' kernel loading)."""
+        (kernel compilation, Cycles' kernel loading). Returns why DRT cannot render the
+        scene with these settings (the engine's ValueError), or None."""
         key = (engine_name, getattr(settings, "integrator", None))
-        if key in self._warm:
-            return
-        self._warm.add(key)
-        if engine_name == "drt":
-            convergence.warm_up(self.description, settings)
-        else:
-            from .cycles_ladder import render_cycles
-            render_cycles(self.bpy, self.scene, 1, self.scene.cycles.seed)
+        if key not in self._warm:
+            self._warm[key] = None
+            if engine_name == "drt":
+                try:
+                    convergence.warm_up(self.description, settings)
+                except ValueError as e:
+                    self._warm[key] = str(e)
+            else:
+                from .cycles_ladder import render_cycles
+                render_cycles(self.bpy, self.scene, 1, self.scene.cycles.seed)
+        return self._warm[key]
 
     def _skip(self, samples_per_pixel):
         """A cached curve still moves the progress bar by the work it stands for."""

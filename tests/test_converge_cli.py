@@ -139,3 +139,18 @@ def test_converge_against_a_cycles_reference(bpy_drt, tmp_path, capsys):
     assert ref["noise_floor"]["relmse"] > 0          # from its two independent halves
     for c in result["curves"]:
         assert c["relmse"][-1] < c["relmse"][0] / 2
+
+
+def test_an_integrator_that_cannot_render_the_scene_is_skipped_with_its_reason(
+        bpy_drt, tmp_path, capsys):
+    code, out, err = drt(capsys, "converge", os.path.join(SAMPLES_DIR, "fog_room.blend"),
+                         "-o", str(tmp_path), "--percentage", "25", "--reference", "drt:16",
+                         "--samplers", "random", "--integrators", "path,distribution",
+                         "--max-samples", "2", "--cache-dir", str(tmp_path / "cache"))
+    assert code == 0, err
+    with open(tmp_path / "convergence.json") as f:
+        result = json.load(f)
+    assert [c["label"] for c in result["curves"]] == ["DRT path random"]
+    assert result["skipped"][0]["label"] == "DRT distribution random"
+    assert "volumes" in result["skipped"][0]["reason"]
+    assert "skipped DRT distribution random" in out
