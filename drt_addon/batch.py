@@ -4,6 +4,8 @@
                                            [--skip-existing] [overrides] [Dask options]
     python -m drt_addon package [-o DIR] [--platform P]   (build the extension zips;
                                                            see docs/install.md)
+    python -m drt_addon compare A.exr B.exr [-o DIFF.png]  (compare_images.py)
+    python -m drt_addon converge SCENE.blend [-o DIR] ...  (converge.py; docs/convergence.md)
 
 One machine renders the frames one after the other through Blender's render pipeline
 (the DRT RenderEngine); `--workers N` or `--cluster ADDRESS` hands them to Dask
@@ -92,6 +94,9 @@ def build_parser() -> argparse.ArgumentParser:
     pk.add_argument("--platform", action="append", dest="platforms", metavar="PLATFORM",
                     help="build only this platform's zip (one of the manifest's platforms, "
                          "e.g. linux-x64; repeatable; default: every platform)")
+    from . import compare_images, converge
+    for command in (compare_images, converge):
+        command.add_parser(sub)
     return p
 
 
@@ -303,6 +308,8 @@ def run(argv) -> int:
     args = build_parser().parse_args(argv)
     if args.command == "package":
         return run_package(args)
+    if getattr(args, "run", None) is not None:      # compare, converge
+        return args.run(args)
     return run_render(args)
 
 

@@ -1,0 +1,134 @@
+"""Runs `python -m drt_addon converge` on each sample scene and writes docs/convergence.md
+(per scene: the fitted convergence slope of every sampler and integrator, and Cycles')
+and the plots docs/images/convergence_<scene>.png.
+
+    .venv/bin/python docs/make_convergence_docs.py [SCENE ...] [--fresh]
+
+Every scene renders 128 pixels wide, ladders of 1..MAX_SAMPLES samples for the three
+samplers and the path and distribution integrators, and Cycles' ladder, all against a
+DRT reference of REFERENCE_SAMPLES independent samples. References and curves are cached
+in ~/.cache/drt/converge (a rerun only measures what changed; --fresh uses an empty
+cache). Takes about 20 minutes on 2 cores from an empty cache.
+"""
+from __future__ import annotations
+
+import json
+import os
+import platform
+import shutil
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+DOCS = os.path.join(ROOT, "docs")
+IMAGES = os.path.join(DOCS, "images")
+SAMPLES = os.path.join(ROOT, "sample_blends")
+
+# (scene, resolution percentage): 128 pixels wide
+SCENES = [("cornell_box", 50), ("metals", 200), ("glass", 200), ("glossy_dielectric", 200),
+          ("dof", 200), ("motion_cube", 200), ("hdri_world", 200), ("fog_room", 200)]
+MAX_SAMPLES = 64
+REFERENCE_SAMPLES = 1024
+SAMPLERS = "jittered,sobol,random"
+INTEGRATORS = "path,distribution"
+
+
+def run_scene(name, percentage, out_dir, cache_dir):
+    from drt_addon.batch import main
+    args = ["converge", os.path.join(SAMPLES, name + ".blend"), "-o", out_dir,
+            "--percentage", str(percentage), "--reference", f"drt:{REFERENCE_SAMPLES}",
+            "--samplers", SAMPLERS, "--integrators", INTEGRATORS,
+            "--max-samples", str(MAX_SAMPLES), "--with-cycles"]
+    if cache_dir:
+        args += ["--cache-dir", cache_dir]
+    code = main(args)
+    if code != 0:
+        raise SystemExit(f"converge failed on {name} (exit {code})")
+    with open(os.path.join(out_dir, "convergence.json")) as f:
+        return json.load(f)
+
+
+def scene_section(result, image_name):
+    from drt_addon.converge import COLUMNS, summary_rows
+    ref = result["reference"]
+    w, h = result["resolution"]
+    lines = [f"## {result['scene']}", "",
+             f"{w} x {h} pixels; reference: DRT {ref['samples']} samples "
+             f"({ref['seconds']:.0f} s; its own noise, relMSE {ref['noise_floor']['relmse']:.1e}, "
+             f"is taken off before fitting). Errors and seconds at the last rung.", "",
+             f"![convergence of {result['scene']}](images/{image_name})", "",
+             "| " + " | ".join(COLUMNS) + " |", "|---" * len(COLUMNS) + "|"]
+    lines += ["| " + " | ".join(row) + " |" for row in summary_rows(result)]
+    reasons = {}
+    for s in result.get("skipped", []):
+        reasons.setdefault(s["reason"], []).append(s["label"])
+    lines += [""] + [f"Not measured: {', '.join(labels)} ({reason})."
+                     for reason, labels in reasons.items()] if reasons else []
+    return lines + [""]
+
+
+HEADER = """# Convergence: error against samples and seconds
+
+Written by `docs/make_convergence_docs.py` with `python -m drt_addon converge`; rerun it
+to reproduce. Machine: {machine}; load average {load} when it started (the cores may have
+been shared with other work, which slows every curve's seconds alike). Whole run
+{minutes:.1f} minutes.
+
+For every sample scene, each DRT sampler (jittered, Sobol, random) with the path and the
+distribution integrator renders 1, 2, 4, ... {max_spp} samples per pixel, and Cycles
+renders the same ladder with the file's settings (dashed in the plots). Every rung is
+measured against one long DRT path-traced reference of independent samples and another
+seed (so its noise is independent of every curve's):
+
+- **relMSE**: mean((a - b)^2 / (b^2 + 0.01)) over pixels and channels; **RMSE**; and
+  **FLIP** (NVIDIA's perceptual metric, `flip-evaluator`; LDR-FLIP of the images clipped
+  to [0, 1]). Definitions in `engine/image_error.py`.
+- **Slope**: the least-squares slope of log(error) against log(samples) or
+  log(seconds), after taking off the error the reference's own noise adds to every
+  measurement. Plain Monte Carlo gives -1 for relMSE (-0.5 for RMSE); steeper is better
+  (stratified and quasi-Monte Carlo samples can beat -1 where the integrand is smooth).
+  A curve that converges to another image than the reference flattens towards 0: the
+  distribution integrator leaves out diffuse interreflection, and Cycles differs from
+  DRT by the small amounts [comparisons.md](comparisons.md) measures.
+- **Seconds**: DRT's render time of the rung (cumulative for random and Sobol, whose
+  ladder is one progressive render; jittered renders each rung on its own, since its
+  strata depend on the sample count), without the scene export and acceleration
+  structure build; Cycles' seconds are whole render calls, its sync and BVH build
+  included, so at these small sizes its first rungs are mostly overhead.
+
+Rerun one scene yourself: `python -m drt_addon converge sample_blends/SCENE.blend
+--with-cycles -o DIR` (see `python -m drt_addon converge --help`).
+
+"""
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    fresh = "--fresh" in argv
+    names = [a for a in argv if not a.startswith("--")]
+    scenes = [(n, p) for n, p in SCENES if not names or n in names]
+    load = os.getloadavg()[0]
+    t0 = time.perf_counter()
+    sections = []
+    with tempfile.TemporaryDirectory() as tmp:
+        cache_dir = os.path.join(tmp, "cache") if fresh else None
+        for name, percentage in scenes:
+            out_dir = os.path.join(tmp, name)
+            result = run_scene(name, percentage, out_dir, cache_dir)
+            image_name = f"convergence_{name}.png"
+            shutil.copyfile(os.path.join(out_dir, "convergence.png"),
+                            os.path.join(IMAGES, image_name))
+            sections += scene_section(result, image_name)
+    machine = f"{platform.machine()}, {os.cpu_count()} cores, Python " \
+              f"{platform.python_version()}"
+    text = HEADER.format(machine=machine, load=f"{load:.2f}", max_spp=MAX_SAMPLES,
+                         minutes=(time.perf_counter() - t0) / 60) + "\n".join(sections)
+    with open(os.path.join(DOCS, "convergence.md"), "w") as f:
+        f.write(text.rstrip() + "\n")
+    print(f"wrote docs/convergence.md ({(time.perf_counter() - t0) / 60:.1f} min)")
+
+
+if __name__ == "__main__":
+    main()
