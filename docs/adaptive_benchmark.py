@@ -58,11 +58,11 @@ METRICS = {"relative MSE": rel_mse, "display MSE": display_mse}
 
 def measure(blend: str, long_side: int = 96, ref_spp: int = 2048,
             ladder=(16, 64, 256), threshold: float = 0.02, max_spp: int = 1024,
-            threads: int = 0) -> dict:
+            threads: int = 0, sampler: str | None = None) -> dict:
     from engine import render
     scene, base = export(blend, long_side)
     base = dataclasses.replace(base, threads=threads, adaptive_sampling=False,
-                               time_limit=0.0)
+                               time_limit=0.0, sampler=sampler or base.sampler)
     n_pixels = scene.width * scene.height
 
     def run(**changes):
@@ -84,6 +84,7 @@ def measure(blend: str, long_side: int = 96, ref_spp: int = 2048,
     secs = np.array([u[1] for u in uniform])
     per, fixed = np.polyfit(spp, secs, 1)                       # seconds = fixed + per n
     out = dict(scene=os.path.basename(blend), size=(scene.width, scene.height),
+               sampler=base.sampler,
                threshold=threshold, max_spp=max_spp, ref_spp=ref_spp, ladder=list(ladder),
                adaptive_spp=a_spp, adaptive_seconds=a_secs, min_spp=int(film.count.min()),
                metrics={})
@@ -112,16 +113,24 @@ def table(rows) -> list:
            f"fitted to uniform renders at {', '.join(map(str, r0['ladder']))} samples. "
            "The saving is that over the adaptive render's (above 1x: adaptive sampling "
            "is cheaper for the same error).", "",
-           "| scene | adaptive: mean spp (min) | seconds | samples saved, rel. MSE | "
-           "time saved, rel. MSE | samples saved, display MSE | time saved, display MSE |",
-           "|---|---|---|---|---|---|---|"]
+           "| scene | sampler | adaptive: mean spp (min) | seconds | samples saved, rel. MSE "
+           "| time saved, rel. MSE | samples saved, display MSE | time saved, display MSE |",
+           "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         rel, ab = r["metrics"]["relative MSE"], r["metrics"]["display MSE"]
-        out.append(f"| {r['scene']} | {r['adaptive_spp']:.0f} ({r['min_spp']}) | "
+        out.append(f"| {r['scene']} | {r['sampler']} | {r['adaptive_spp']:.0f} "
+                   f"({r['min_spp']}) | "
                    f"{r['adaptive_seconds']:.1f} | {rel['sample_saving']:.2f}x | "
                    f"{rel['time_saving']:.2f}x | {ab['sample_saving']:.2f}x | "
                    f"{ab['time_saving']:.2f}x |")
-    return out + ["", "Display MSE is the error of what the screen shows (clipped to [0, 1], "
+    return out + ["", "The jittered sampler stratifies a pixel's samples over all of Samples "
+                  "(its strata are a permutation of that many): a pixel that stops after "
+                  "its first 52 of 1024 samples holds a random subset of the strata, which "
+                  "is little better than random sampling, while a uniform render of 52 "
+                  "samples is stratified over exactly those 52. Sobol points are "
+                  "progressive (every prefix is well spread), as Cycles' samplers are: use "
+                  "the Sobol sampler with a Noise Threshold.", "",
+                  "Display MSE is the error of what the screen shows (clipped to [0, 1], "
                   "sRGB-encoded), which is what Cycles' stopping rule (DRT's) aims at: it "
                   "weighs a pixel's error by the square root of its brightness below 1 and "
                   "by its brightness above, so dark pixels stop with a larger relative error "

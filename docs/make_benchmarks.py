@@ -335,10 +335,11 @@ def main():
         from adaptive_benchmark import measure, table
         rows = []
         for blend in ADAPTIVE_SCENES:
-            rows.append(measure(os.path.join(SAMPLES, blend), long_side=32 if q else 96,
-                                ref_spp=256 if q else 2048,
-                                ladder=(4, 16, 64) if q else (16, 64, 256)))
-            print(blend, rows[-1]["metrics"], flush=True)
+            for sampler in ("jittered", "sobol"):
+                rows.append(measure(os.path.join(SAMPLES, blend), long_side=32 if q else 96,
+                                    ref_spp=256 if q else 2048, sampler=sampler,
+                                    ladder=(4, 16, 64) if q else (16, 64, 256)))
+                print(blend, sampler, rows[-1]["metrics"], flush=True)
         lines += table(rows)
         done("6")
     _write_page(saved)
