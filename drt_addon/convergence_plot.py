@@ -27,7 +27,7 @@ def plot_study(study: dict, path: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(len(ROWS), 2, figsize=(11, 3.4 * len(ROWS)), squeeze=False)
+    fig, axes = plt.subplots(len(ROWS), 2, figsize=(15, 3.3 * len(ROWS)), squeeze=False)
     floor = study["reference"].get("noise_floor", {})
     for row, (metric, name) in enumerate(ROWS):
         for col, axis in enumerate(("samples", "seconds")):
@@ -48,7 +48,8 @@ def plot_study(study: dict, path: str) -> None:
             ax.grid(True, which="both", alpha=0.25)
             ax.set_xlabel("samples per pixel" if axis == "samples" else "render seconds")
             ax.set_ylabel(name)
-            ax.legend(fontsize=7, title=f"slope vs {axis}", title_fontsize=7)
+            ax.legend(fontsize=7, title=f"slope vs {axis}", title_fontsize=7,
+                      loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0)
     ref = study["reference"]
     fig.suptitle(f"{study['scene']} at {study['resolution'][0]}x{study['resolution'][1]}: "
                  f"error against {ref['engine']} {ref['samples']} spp", fontsize=11)

@@ -5,12 +5,15 @@ log-log slopes. The result is a plain dict, written as convergence.json.
 
 Slopes are fitted to the errors less the floor the reference's own noise adds to every
 measurement (engine.image_error.noise_floor), over the rungs whose error is more than
-twice that floor; FLIP is fitted as measured. A curve whose image converges to something else than the
-reference (the distribution integrator leaves out diffuse interreflection; Cycles
-against a DRT reference) flattens at that bias: its slope then says so.
+twice that floor; FLIP is fitted as measured. A curve whose image converges to
+something else than the reference (the distribution integrator leaves out diffuse
+interreflection; Cycles against a DRT reference) flattens at that bias: its slope then
+says so. Each curve records the 1-minute load average (the larger of before and after
+it): on shared cores its seconds are pessimistic.
 """
 from __future__ import annotations
 
+import os
 from dataclasses import asdict
 from importlib import import_module
 
@@ -84,8 +87,10 @@ class Study:
         setup = {}
         rung_iter = convergence.ladder(self.description, settings, rungs,
                                        on_paths=self.on_paths, setup=setup)
+        load = os.getloadavg()[0]
         curve = measure_curve(rung_iter, ref, floor)
-        curve = {"label": label, "engine": "DRT", "sampler": sampler,
+        load = max(load, os.getloadavg()[0])      # the 1-minute load, before and after
+        curve = {"label": label, "load_average": load, "engine": "DRT", "sampler": sampler,
                  "integrator": integrator, "seed": settings.seed,
                  "progressive": sampler in convergence.PREFIX_SAMPLERS,
                  "setup_seconds": setup.get("setup_seconds"), **curve}
@@ -101,10 +106,13 @@ class Study:
             self._skip(sum(rungs))
             return {**cached, "cached": True}
         self._warm_up("cycles")
+        load = os.getloadavg()[0]
         curve = measure_curve(cycles_ladder(self.bpy, self.scene, rungs, self.on_paths),
                               ref, floor)
+        load = max(load, os.getloadavg()[0])
         curve = {"label": f"Cycles ({self.scene.cycles.sampling_pattern.lower()})",
-                 "engine": "Cycles", "sampler": self.scene.cycles.sampling_pattern.lower(),
+                 "load_average": load, "engine": "Cycles",
+                 "sampler": self.scene.cycles.sampling_pattern.lower(),
                  "integrator": "path", "seed": self.scene.cycles.seed,
                  "progressive": False, "setup_seconds": None, **curve}
         self.cache.save_json(key, curve)
