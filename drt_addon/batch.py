@@ -169,7 +169,7 @@ def _check_arguments(args, overrides: Overrides) -> None:
         raise CliError(EXIT_USAGE, "drt: error: --workers and --cluster render with DRT only")
 
 
-def _open_blend(bpy, path: str) -> None:
+def open_blend(bpy, path: str) -> None:
     try:
         bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
     except RuntimeError as e:
@@ -265,7 +265,7 @@ def run_render(args) -> int:
 
     from . import register
     register()
-    _open_blend(bpy, args.blend)
+    open_blend(bpy, args.blend)
     scene = bpy.context.scene
     for message in apply_overrides(scene, overrides):
         print(f"drt: warning: {message}", file=sys.stderr)

@@ -23,7 +23,7 @@ import sys
 import time
 from importlib import import_module
 
-from .batch import EXIT_FILE, EXIT_OK, EXIT_RENDER, EXIT_USAGE, CliError, check_blend
+from .batch import EXIT_OK, EXIT_RENDER, EXIT_USAGE, CliError, check_blend, open_blend
 
 DEFAULT_REFERENCE = "drt:512"
 DEFAULT_MAX_SAMPLES = 32
@@ -92,14 +92,6 @@ def _validate(args):
     if args.percentage is not None and not 1 <= args.percentage <= 10000:
         raise CliError(EXIT_USAGE, "drt: error: --percentage must be in 1..10000")
     return ref, samplers, integrators
-
-
-def open_blend(bpy, path: str) -> None:
-    try:
-        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
-    except RuntimeError as e:
-        first = str(e).strip().splitlines()[0] if str(e).strip() else "unreadable file"
-        raise CliError(EXIT_FILE, f"drt: error: cannot open {path}: {first}") from None
 
 
 def _export(bpy):
