@@ -22,9 +22,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 if ROOT not in sys.path:
     sys.path.insert(0, ROOT)
 
-
-def rel_mse(img, ref):
-    return float(np.mean((img - ref) ** 2 / (ref ** 2 + 1e-2)))
+from engine.image_error import display_image, relmse  # noqa: E402
+from engine.textures import linear_to_srgb  # noqa: E402
 
 
 def export(blend: str, long_side: int):
@@ -43,17 +42,14 @@ def export(blend: str, long_side: int):
     return description, scene.drt.to_engine_settings()
 
 
-def _display(img):
-    """What the screen shows: clipped to [0, 1] and sRGB-encoded (Blender's Standard view)."""
-    x = np.clip(img, 0.0, 1.0)
-    return np.where(x <= 0.0031308, 12.92 * x, 1.055 * x ** (1 / 2.4) - 0.055)
-
-
 def display_mse(img, ref):
-    return float(np.mean((_display(img) - _display(ref)) ** 2))
+    """MSE of what the screen shows: clipped to [0, 1] and sRGB-encoded (Blender's
+    Standard view)."""
+    return float(np.mean((linear_to_srgb(display_image(img))
+                          - linear_to_srgb(display_image(ref))) ** 2))
 
 
-METRICS = {"relative MSE": rel_mse, "display MSE": display_mse}
+METRICS = {"relative MSE": relmse, "display MSE": display_mse}
 
 
 def measure(blend: str, long_side: int = 96, ref_spp: int = 2048,

@@ -30,6 +30,7 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [ROOT, os.path.join(ROOT, "tests")]
+from engine.image_error import relmse  # noqa: E402
 DOCS = os.path.join(ROOT, "docs")
 SAMPLES = os.path.join(ROOT, "sample_blends")
 
@@ -102,10 +103,6 @@ def _read_exr(path):
     return px.reshape(h, w, 4)[..., :3].astype(np.float64)
 
 
-def rel_mse(img, ref):
-    return float(np.mean((img - ref) ** 2 / (ref ** 2 + 1e-2)))
-
-
 def equal_error(blend, percentage, ref_spp, ladder, cycles_spp=64):
     """Each engine against its own long render (noise, not bias: the bias between the two
     engines is measured in docs/comparisons.md). Time for DRT to reach the relative MSE
@@ -121,7 +118,7 @@ def equal_error(blend, percentage, ref_spp, ladder, cycles_spp=64):
         for spp in spps:
             out = os.path.join(tmp, f"{engine}_{spp}.exr")
             secs = _cli_render(blend, engine, spp, out, percentage)
-            rows.append((spp, secs, rel_mse(_read_exr(out), ref_img)))
+            rows.append((spp, secs, relmse(_read_exr(out), ref_img)))
         result[engine] = rows
     (_, t_c, e_c), = result["CYCLES"]
     spp, secs, err = (np.array(c, dtype=np.float64) for c in zip(*result["DRT"]))

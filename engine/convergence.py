@@ -11,8 +11,8 @@ The jittered sampler stratifies over the sample count it is given (a prefix of i
 samples covers a random subset of the N strata), so each of its rungs is a render of its
 own, costing twice the samples of the progressive ladder in all.
 
-Every rung takes all its samples: the settings turn adaptive sampling and time limits
-off where they have them, and a film with fewer samples in any pixel is an error.
+Every rung takes all its samples: adaptive sampling and the time limit are turned off,
+and a film with fewer samples in any pixel is an error.
 Seconds are the render's own (work units on the thread pool); building the render
 context (acceleration structure) is reported apart as `setup_seconds`, and `warm_up`
 keeps kernel compilation out of them.
@@ -20,7 +20,7 @@ keeps kernel compilation out of them.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -32,9 +32,6 @@ PREFIX_SAMPLERS = ("random", "sobol")
 # noise is independent of theirs and its per-pixel variance estimate is unbiased.
 REFERENCE_SAMPLER = "random"
 REFERENCE_SEED_OFFSET = 1_000_003
-# Settings that would let a render stop before its sample count, and their "off" value.
-_STOPPING_SETTINGS = (("use_adaptive_sampling", False), ("adaptive_sampling", False),
-                      ("time_limit", 0.0))
 
 
 def sample_ladder(max_samples: int) -> list[int]:
@@ -50,11 +47,8 @@ def sample_ladder(max_samples: int) -> list[int]:
 
 def every_sample(settings, **changes):
     """`settings` with `changes` and every sample taken (adaptive sampling and a time
-    limit off, for the settings that have them)."""
-    names = {f.name for f in fields(settings)}
-    off = {name: value for name, value in _STOPPING_SETTINGS if name in names}
-    return replace(settings, **off, **changes)
-
+    limit off)."""
+    return replace(settings, adaptive_sampling=False, time_limit=0.0, **changes)
 
 @dataclass
 class Rung:

@@ -84,12 +84,8 @@ class Film:
     def merge(self, other: "Film") -> "Film":
         if (other.width, other.height) != (self.width, self.height):
             raise ValueError("cannot merge films of different sizes")
-        self.count += other.count
-        self.sum += other.sum
-        self.sum_sq += other.sum_sq
-        self.alpha_sum += other.alpha_sum
-        self.count_odd += other.count_odd
-        self.sum_odd += other.sum_odd
+        for name in self.STATISTICS:
+            getattr(self, name).__iadd__(getattr(other, name))
         return self
 
     def mean(self) -> np.ndarray:

@@ -145,8 +145,8 @@ def camera_rays(ctx: RenderContext, pixel: np.ndarray, index: np.ndarray):
 
 def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sample_end: int):
     """Radiance of samples [sample_start, sample_end) of each pixel in `pixels`.
-    Returns (pixel ids, radiance (n, 3) float64, alpha (n,) or None when the film is
-    opaque)."""
+    Returns (pixel ids, sample indices, radiance (n, 3) float64, alpha (n,) or None when
+    the film is opaque)."""
     k = sample_end - sample_start
     pixel = np.repeat(pixels.astype(np.int64), k)
     index = np.tile(np.arange(sample_start, sample_end, dtype=np.int64), len(pixels))
@@ -154,7 +154,7 @@ def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sampl
     alpha = np.ones(len(pixel)) if ctx.scene.needs_alpha() else None
     radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
                                        time=time, alpha_out=alpha)
-    return pixel, radiance, alpha
+    return pixel, index, radiance, alpha
 
 
 def plan_passes(total: int, first: int = 1, growth: float = 2.0, largest: int = 64):
@@ -202,7 +202,7 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
                 return 0
             running[0] += 1
         try:
-            pix, rad, alpha = render_unit(ctx, pixels, a, b)
+            pix, index, rad, alpha = render_unit(ctx, pixels, a, b)
         finally:
             with lock:
                 running[0] -= 1
@@ -211,7 +211,6 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
             rad[bad] = 0.0
         if settings.film_exposure != 1.0:
             rad *= settings.film_exposure      # Film > Exposure, on the way into the film
-        index = np.tile(np.arange(a, b, dtype=np.int64), len(pixels))
         with lock:
             film.add(pix, rad, alpha, index=index)
             stats.paths += len(pix)
