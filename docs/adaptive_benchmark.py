@@ -119,13 +119,14 @@ def table(rows) -> list:
                    f"{r['adaptive_seconds']:.1f} | {rel['sample_saving']:.2f}x | "
                    f"{rel['time_saving']:.2f}x | {ab['sample_saving']:.2f}x | "
                    f"{ab['time_saving']:.2f}x |")
-    return out + ["", "The jittered sampler stratifies a pixel's samples over all of Samples "
-                  "(its strata are a permutation of that many): a pixel that stops after "
-                  "its first 52 of 1024 samples holds a random subset of the strata, which "
-                  "is little better than random sampling, while a uniform render of 52 "
-                  "samples is stratified over exactly those 52. Sobol points are "
-                  "progressive (every prefix is well spread), as Cycles' samplers are: use "
-                  "the Sobol sampler with a Noise Threshold.", "",
+    return out + ["", "Under adaptive sampling the jittered sampler stratifies a pixel's "
+                  "first Min Samples on their own and later samples in generations that "
+                  "double (52, 52, 104, 208, ...): a pixel that stops early holds whole "
+                  "stratified sets, as a uniform render of that many samples does (with "
+                  "strata over all of Samples, as before, it held a random subset of 1024 "
+                  "strata, and adaptive sampling lost to uniform on every sample scene: "
+                  "0.23x to 0.99x). Sobol points are progressive (every prefix is well "
+                  "spread), as Cycles' samplers are.", "",
                   "Display MSE is the error of what the screen shows (clipped to [0, 1], "
                   "sRGB-encoded), which is what Cycles' stopping rule (DRT's) aims at: it "
                   "weighs a pixel's error by the square root of its brightness below 1 and "

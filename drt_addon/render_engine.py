@@ -170,13 +170,6 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             settings.validate()
         except ValueError as e:
             raise ExportError(f"DRT: invalid render settings: {e}") from e
-        if settings.adaptive_sampling and settings.sampler == "jittered":
-            # measured in docs/benchmarks.md (section 6): jittered strata span all of
-            # Samples, so pixels that stop early are barely stratified
-            reporter.warn("DRT: Noise Threshold with the Jittered sampler: a pixel that "
-                          "stops early holds a random subset of its strata, so adaptive "
-                          "sampling can cost more than it saves; use the Sobol sampler",
-                          key="adaptive_jittered")
         export_seconds = time.perf_counter() - t0
         last_render.update(scene=description, export_stats=export_stats, region=region)
         self.update_stats("", "DRT: building acceleration structure")

@@ -79,6 +79,9 @@ class RenderContext:
         self.camera = CameraModel(scene.camera, scene.width, scene.height, scene.pixel_aspect)
         self.filter = PixelFilter(settings.filter_type, settings.filter_width)
         self.sampler = make_sampler(settings.sampler, settings.seed, settings.samples)
+        adaptive = AdaptiveSampling.from_settings(settings)
+        if adaptive is not None:
+            self.sampler.follow_stops(adaptive.min_samples, adaptive.step)
         self.has_motion = scene.has_motion()
         self.accel = Accelerator(scene.meshes, threads=1, time_enabled=self.has_motion)
         self.surfaces = SurfaceBuilder(self.accel, scene.meshes)
@@ -128,7 +131,7 @@ def camera_rays(ctx: RenderContext, pixel: np.ndarray, index: np.ndarray):
         o, d, tmax = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
         pixel = np.ascontiguousarray(pixel, dtype=np.int64)
         generate_camera_rays(*ctx.camera_kernel, ctx.sampler.kind,
-                             ctx.sampler.samples_per_pixel,
+                             ctx.sampler.pattern,
                              pixel_keys(np.uint64(ctx.sampler.seed), pixel), pixel,
                              np.ascontiguousarray(index, dtype=np.int64), o, d, tmax)
         return CameraRays(o, d, tmax), None

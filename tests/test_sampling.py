@@ -113,3 +113,23 @@ def test_jittered_beyond_planned_count_stays_stratified_per_generation():
     for gen in range(2):
         strata = np.sort(np.floor(u[gen * 16:(gen + 1) * 16] * 16).astype(int))
         assert np.array_equal(strata, np.arange(16))
+
+
+def test_jittered_under_adaptive_sampling_stratifies_up_to_each_stopping_point():
+    """Adaptive sampling stops pixels after min_samples + k * step samples: the jittered
+    sampler's first generation ends at min samples (52), and later ones double (52, 104,
+    208, ...), so a pixel holds whole stratified sets and part of one more, in the
+    compiled dispatch every kernel uses."""
+    s = make_sampler("jittered", seed=9, samples_per_pixel=1024)
+    s.follow_stops(52, 16)
+    for dim in (0, 5):
+        u = s.get_1d(dim, np.full(416, 7), np.arange(416))
+        bounds = [(0, 52), (52, 104), (104, 208), (208, 416)]
+        for a, b in bounds:
+            strata = np.sort(np.floor(u[a:b] * (b - a)).astype(int))
+            assert np.array_equal(strata, np.arange(b - a)), (dim, a, b)
+        xy = s.get_2d(dim, np.full(52, 3), np.arange(52))
+        assert np.array_equal(np.sort(np.floor(xy[:, 1] * 52).astype(int)), np.arange(52))
+    plain = make_sampler("jittered", seed=9, samples_per_pixel=1024).get_1d(0, np.zeros(52, int),
+                                                                          np.arange(52))
+    assert len(np.unique(np.floor(plain * 52))) < 52   # without: a subset of 1024 strata

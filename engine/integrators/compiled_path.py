@@ -64,7 +64,7 @@ class CompiledPathIntegrator:
             else np.zeros(0)
         self.transparent_limit = s.transparent_bounces
         self._mode = "mis"
-        self.cfg = np.array([ctx.sampler.kind, ctx.sampler.samples_per_pixel, s.max_bounces,
+        self.cfg = np.array([ctx.sampler.kind, ctx.sampler.pattern, s.max_bounces,
                              s.diffuse_bounces, s.glossy_bounces, s.transmission_bounces,
                              s.clamp_direct, s.clamp_indirect, MIS, ctx.scene_radius,
                              float(ctx.scene.film_transparent), s.filter_glossy,

@@ -24,6 +24,14 @@ class Sampler:
             raise ValueError("samples_per_pixel must be at least 1")
         self.seed = int(seed) & 0xFFFFFFFFFFFFFFFF
         self.samples_per_pixel = int(samples_per_pixel)
+        # what the compiled dispatch receives as `spp`: how a pixel's sample indices group
+        # into generations (only the jittered sampler has any; see stratified.pattern)
+        self.pattern = self.samples_per_pixel
+
+    def follow_stops(self, first: int, step: int):
+        """Adaptive sampling stops pixels after `first` + k * `step` samples; samplers
+        whose point sets are not progressive regroup them to match (default: nothing to
+        do, every prefix is well distributed)."""
 
     def _arrays(self, pixel, index):
         pixel, index = np.broadcast_arrays(np.asarray(pixel, dtype=np.int64),
@@ -33,11 +41,11 @@ class Sampler:
     def get_1d(self, dim: int, pixel: np.ndarray, index: np.ndarray) -> np.ndarray:
         from .dispatch import batch_1d
         shape, p, i = self._arrays(pixel, index)
-        return batch_1d(self.kind, np.uint64(self.seed), self.samples_per_pixel, dim, p,
+        return batch_1d(self.kind, np.uint64(self.seed), self.pattern, dim, p,
                         i).reshape(shape)
 
     def get_2d(self, dim: int, pixel: np.ndarray, index: np.ndarray) -> np.ndarray:
         from .dispatch import batch_2d
         shape, p, i = self._arrays(pixel, index)
-        return batch_2d(self.kind, np.uint64(self.seed), self.samples_per_pixel, dim, p,
+        return batch_2d(self.kind, np.uint64(self.seed), self.pattern, dim, p,
                         i).reshape(shape + (2,))

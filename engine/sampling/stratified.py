@@ -12,7 +12,15 @@ column and row sub-stratum, and the y projection is stratified into N strata; it
 any N, not only squares.
 
 Sample indices past N start a fresh, independently permuted generation of N, so
-progressive and adaptive rendering can ask for more samples without breaking anything.
+progressive rendering can ask for more samples without breaking anything.
+
+Adaptive sampling stops a pixel after min_samples + k * step samples. A pixel stopped at
+52 of 1024 would hold a random subset of 1024 strata, little better than random samples;
+so under adaptive sampling the generations grow with the pixel instead: the first holds
+min_samples samples, and each later one as many as all before it (52, 52, 104, 208, ...).
+A pixel that stops holds whole stratified generations and part of one more, at most half
+of its samples; one that runs on is stratified in ever larger sets. (`pattern(first,
+doubling)` packs this into the one integer the kernels pass around as `spp`.)
 
 `pkey` is the path's `hashing.pixel_key(seed, pixel)`; the key of one (pixel, dimension,
 generation) continues that chain.
@@ -28,24 +36,47 @@ from .hashing import H0, chain, permute, unit_float
 from .sampler import ONE_MINUS_EPSILON, Sampler
 
 
+_LOW32 = (1 << 32) - 1
+
+
+def pattern(first: int, doubling: bool = False) -> int:
+    """Generations of `first` samples, or (doubling) of `first` and then each as large as
+    all before it."""
+    if not 1 <= first <= _LOW32:
+        raise ValueError(f"bad stratification pattern ({first}, {doubling})")
+    return first | (int(doubling) << 32)
+
+
 @kernel
 def _key(pkey, spp, index, dim):
-    n = np.uint64(spp)
+    """(key of the generation of sample `index` in dimension `dim`, the sample's place in
+    its generation, the generation's size), for the pattern `spp`."""
+    packed = np.uint64(spp)
+    first = packed & np.uint64(_LOW32)
     index = np.uint64(index)
-    return chain(chain(pkey, dim), index // n), index % n
+    if (packed >> np.uint64(32)) == 0 or index < first:
+        gen, s, n = index // first, index % first, first
+    else:
+        q = index // first                  # in [2^(g-1), 2^g) for generation g
+        gen = np.uint64(0)
+        while (np.uint64(1) << gen) <= q:
+            gen += np.uint64(1)
+        n = first << (gen - np.uint64(1))
+        s = index - n
+    return chain(chain(pkey, dim), gen), s, int(n)
 
 
 @kernel
 def stratified_1d(pkey, spp, index, dim):
-    key, s = _key(pkey, spp, index, dim)
-    stratum = permute(s, spp, key)
+    key, s, n = _key(pkey, spp, index, dim)
+    stratum = permute(s, n, key)
     jitter = unit_float(chain(chain(chain(H0, key), s), 11))
-    return min((np.float64(stratum) + jitter) / spp, ONE_MINUS_EPSILON)
+    return min((np.float64(stratum) + jitter) / n, ONE_MINUS_EPSILON)
 
 
 @kernel
 def stratified_2d(pkey, spp, index, dim):
-    key, s = _key(pkey, spp, index, dim)
+    key, s, spp = _key(pkey, spp, index, dim)
     m = max(1, int(math.floor(math.sqrt(spp))))
     n = (spp + m - 1) // m
     s = permute(s, spp, key)                               # Cook's ray-id chaining
@@ -62,3 +93,7 @@ def stratified_2d(pkey, spp, index, dim):
 class StratifiedSampler(Sampler):
     name = "jittered"
     kind = 0
+
+    def follow_stops(self, first: int, step: int):
+        """Stratify the first `first` samples on their own, then in doubling generations."""
+        self.pattern = pattern(max(1, min(first, self.samples_per_pixel)), doubling=True)
