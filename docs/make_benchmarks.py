@@ -223,13 +223,13 @@ def _fmt_equal_error(name, r):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller renders, for a smoke run")
-    ap.add_argument("--skip", default="", help="comma-separated sections to skip (1..6)")
-    ap.add_argument("--only", default="", help="comma-separated sections to run (1..6); the "
+    ap.add_argument("--skip", default="", help="comma-separated sections to skip (1..7)")
+    ap.add_argument("--only", default="", help="comma-separated sections to run (1..7); the "
                     "others keep their last measured figures (docs/benchmarks.json)")
     args = ap.parse_args()
     skip = set(args.skip.split(",")) - {""}
     if args.only:
-        skip |= set(map(str, range(1, 7))) - set(args.only.split(","))
+        skip |= set(map(str, range(1, 8))) - set(args.only.split(","))
     saved = _load_sections()
     q = args.quick
     cores = os.cpu_count() or 1
@@ -339,6 +339,10 @@ def main():
                 print(blend, sampler, rows[-1]["metrics"], flush=True)
         lines += table(rows)
         done("6")
+    if "7" not in skip:      # the convergence studies (cached in ~/.cache/drt/converge)
+        import make_convergence_docs as studies
+        lines += studies.benchmark_section(studies.main(["cornell_box"] if q else []))
+        done("7")
     _write_page(saved)
 
 

@@ -32,6 +32,9 @@ MAX_SAMPLES = 64
 REFERENCE_SAMPLES = 1024
 SAMPLERS = "jittered,sobol,random"
 INTEGRATORS = "path,distribution"
+# Clamp Direct:Indirect curves besides the file's own clamps (DRT's default: 0:10), all
+# against an unclamped reference: their bias traded for noise
+CLAMPS = "0:0,0:1"
 
 
 def run_scene(name, percentage, out_dir, cache_dir):
@@ -39,7 +42,7 @@ def run_scene(name, percentage, out_dir, cache_dir):
     args = ["converge", os.path.join(SAMPLES, name + ".blend"), "-o", out_dir,
             "--percentage", str(percentage), "--reference", f"drt:{REFERENCE_SAMPLES}",
             "--samplers", SAMPLERS, "--integrators", INTEGRATORS,
-            "--max-samples", str(MAX_SAMPLES), "--with-cycles"]
+            "--max-samples", str(MAX_SAMPLES), "--with-cycles", "--clamps", CLAMPS]
     if cache_dir:
         args += ["--cache-dir", cache_dir]
     code = main(args)
@@ -98,7 +101,11 @@ less when references and curves came from the cache).
 
 For every sample scene, each DRT sampler (jittered, Sobol, random) with the path and the
 distribution integrator renders 1, 2, 4, ... {max_spp} samples per pixel, and Cycles
-renders the same ladder with the file's settings (dashed in the plots). Every rung is
+renders the same ladder with the file's settings (dashed in the plots). The clamps are
+measured as what they are, bias traded for noise: the reference is unclamped, and besides
+the file's clamps (DRT's defaults: Direct off, Indirect 10) the jittered path tracer
+renders with no clamp (0:0) and with Clamp Indirect 1 (0:1), the triangles in the plots.
+A clamped curve starts lower (less noise) and flattens at its bias. Every rung is
 measured against one long DRT path-traced reference of independent samples and another
 seed (so its noise is independent of every curve's):
 
@@ -131,12 +138,13 @@ def main(argv=None):
     scenes = [(n, p) for n, p in SCENES if not names or n in names]
     loads = []
     t0 = time.perf_counter()
-    sections, render_seconds = [], 0.0
+    sections, render_seconds, results = [], 0.0, []
     with tempfile.TemporaryDirectory() as tmp:
         cache_dir = os.path.join(tmp, "cache") if fresh else None
         for name, percentage in scenes:
             out_dir = os.path.join(tmp, name)
             result = run_scene(name, percentage, out_dir, cache_dir)
+            results.append(result)
             image_name = f"convergence_{name}.png"
             save_small_png(os.path.join(out_dir, "convergence.png"),
                            os.path.join(IMAGES, image_name))
@@ -152,6 +160,41 @@ def main(argv=None):
     with open(os.path.join(DOCS, "convergence.md"), "w") as f:
         f.write(text.rstrip() + "\n")
     print(f"wrote docs/convergence.md ({(time.perf_counter() - t0) / 60:.1f} min)")
+    return results
+
+
+def benchmark_section(results) -> list:
+    """Section 7 of docs/benchmarks.md: every curve's fitted slopes per sample scene, and
+    what the clamps trade (from the studies `main` made)."""
+    labels = list(dict.fromkeys(c["label"] for r in results for c in r["curves"]))
+    out = ["## 7. Convergence per sampler and integrator", "",
+           f"From the convergence studies ([convergence.md](convergence.md), "
+           f"`docs/make_convergence_docs.py`: 128 pixels wide, 1 to {MAX_SAMPLES} samples, "
+           f"against an unclamped DRT reference of {REFERENCE_SAMPLES} samples). Each cell: "
+           "the fitted slope of relative MSE against samples / against seconds (plain Monte "
+           "Carlo: -1; steeper is better; near 0: the curve converges to another image, "
+           "its bias).", "",
+           "| curve | " + " | ".join(r["scene"] for r in results) + " |",
+           "|---" * (len(results) + 1) + "|"]
+    for label in labels:
+        cells = []
+        for r in results:
+            c = next((c for c in r["curves"] if c["label"] == label), None)
+            s = c and c["slopes"]
+            cells.append("n/a" if not s or s["samples"]["relmse"] is None else
+                         f"{s['samples']['relmse']:+.2f} / {s['seconds']['relmse']:+.2f}")
+        out.append(f"| {label} | " + " | ".join(cells) + " |")
+    out += ["", "Clamps, bias for noise: relative MSE at 1 and at "
+            f"{MAX_SAMPLES} samples (jittered path tracer).", "",
+            "| scene | no clamp | file's clamps | Clamp Indirect 1 |", "|---|---|---|---|"]
+    for r in results:
+        by = {c["label"]: c for c in r["curves"]}
+        row = [by.get(f"DRT path jittered clamp {CLAMPS.split(',')[0]}"), by.get(
+            "DRT path jittered"), by.get(f"DRT path jittered clamp {CLAMPS.split(',')[1]}")]
+        out.append(f"| {r['scene']} | " + " | ".join(
+            "n/a" if c is None else f"{c['relmse'][0]:.2e} -> {c['relmse'][-1]:.2e}"
+            for c in row) + " |")
+    return out + [""]
 
 
 if __name__ == "__main__":

@@ -2,7 +2,8 @@
 
     python -m drt_addon converge SCENE.blend [-o DIR] [--reference drt:N | cycles:N]
         [--samplers jittered,sobol,random] [--integrators path,distribution]
-        [--max-samples N] [--with-cycles] [--percentage P] [--cache-dir DIR]
+        [--max-samples N] [--with-cycles] [--clamps D:I,...] [--percentage P]
+        [--cache-dir DIR]
 
 Renders the scene at 1, 2, 4, ... --max-samples samples per pixel with each sampler and
 integrator (engine/convergence.py: one progressive render per random or Sobol curve,
@@ -11,12 +12,16 @@ relative MSE, FLIP: engine/image_error.py) and writes DIR/convergence.json (per 
 samples, seconds, the three errors, the fitted log-log slopes against samples and
 against seconds) and DIR/convergence.png (convergence_plot.py). The reference and each
 curve are cached on disk (convergence_cache.py), so a rerun renders only what changed.
-The defaults (DRT reference of 512 samples, ladders to 32 samples, three samplers, the
+With --clamps, the clamps are measured as what they are, bias traded for noise: the
+reference is rendered unclamped, and each Clamp Direct:Indirect pair adds a curve (the
+first sampler and integrator) that flattens at its bias while its early rungs are less
+noisy. The defaults (DRT reference of 512 samples, ladders to 32 samples, three samplers, the
 scene's integrator) take about 4 minutes for the 256x256 Cornell box on 2 cores.
 """
 from __future__ import annotations
 
 import json
+import math
 import os
 import platform
 import sys
@@ -52,6 +57,10 @@ def add_parser(sub) -> None:
                         f"{DEFAULT_MAX_SAMPLES})")
     c.add_argument("--with-cycles", action="store_true",
                    help="add Cycles' own curve (the file's Cycles settings, dashed)")
+    c.add_argument("--clamps",
+                   help="comma-separated Clamp Direct:Indirect pairs (0 = off), each a "
+                        "curve of the first sampler and integrator; the reference is then "
+                        "rendered unclamped, so the clamps show their bias (e.g. 0:0,0:1)")
     c.add_argument("--percentage", type=int,
                    help="resolution percentage, 1..10000 (default: the scene's)")
     c.add_argument("--cache-dir", help="where references and curves are cached (default: "
@@ -91,7 +100,28 @@ def _validate(args):
                                    f"1..{MAX_SAMPLES_LIMIT}")
     if args.percentage is not None and not 1 <= args.percentage <= 10000:
         raise CliError(EXIT_USAGE, "drt: error: --percentage must be in 1..10000")
-    return ref, samplers, integrators
+    return ref, samplers, integrators, parse_clamps(args.clamps, ref[0])
+
+
+def parse_clamps(text, reference_engine: str) -> list:
+    """[(direct, indirect), ...] of --clamps."""
+    if not text:
+        return []
+    pairs = []
+    for item in text.split(","):
+        d, sep, i = item.strip().partition(":")
+        try:
+            pair = (float(d), float(i))
+        except ValueError:
+            pair = None
+        if not sep or pair is None or min(pair) < 0 or not all(map(math.isfinite, pair)):
+            raise CliError(EXIT_USAGE, f"drt: error: --clamps takes Direct:Indirect pairs of "
+                                       f"numbers >= 0 (0 = off), got {item.strip()!r}")
+        pairs.append(pair)
+    if reference_engine != "drt":
+        raise CliError(EXIT_USAGE, "drt: error: --clamps measures bias against an unclamped "
+                                   "DRT reference: use --reference drt:N")
+    return list(dict.fromkeys(pairs))
 
 
 def _export(bpy):
@@ -115,7 +145,7 @@ def _progress_bar(total: int):
 
 
 def run_converge(args) -> int:
-    (ref_engine, ref_samples), samplers, integrators = _validate(args)
+    (ref_engine, ref_samples), samplers, integrators, clamps = _validate(args)
     check_blend(args.blend)
     stem = os.path.splitext(os.path.basename(args.blend))[0]
     out_dir = args.output_dir or f"convergence_{stem}"
@@ -147,13 +177,14 @@ def run_converge(args) -> int:
     rungs = convergence.sample_ladder(args.max_samples)
     pixels = description.width * description.height
     spp_total = ref_samples + sum(ladder_paths(rungs, s) for s in samplers) * len(integrators) \
-        + (sum(rungs) if args.with_cycles else 0)
+        + ladder_paths(rungs, samplers[0]) * len(clamps) + (sum(rungs) if args.with_cycles else 0)
     cache = ConvergeCache(args.cache_dir or default_cache_dir())
     with _progress_bar(spp_total * pixels) as bar:
         study = Study(bpy, args.blend, description, settings, cache, on_paths=bar.update)
         bar.set_description(f"reference {ref_engine}:{ref_samples}")
         try:
-            ref, ref_key, ref_cached = study.reference(ref_engine, ref_samples)
+            ref, ref_key, ref_cached = study.reference(ref_engine, ref_samples,
+                                                       unclamped=bool(clamps))
         except ValueError as e:
             raise CliError(EXIT_RENDER, f"drt: error: cannot render the reference: {e}") \
                 from None
@@ -172,6 +203,10 @@ def run_converge(args) -> int:
                     skipped.append({"label": curve["label"], "reason": curve["skipped"]})
                 else:
                     curves.append(curve)
+        for direct, indirect in clamps:
+            bar.set_description(f"DRT clamp {direct:g}:{indirect:g}")
+            curves.append(study.drt_curve(samplers[0], integrators[0], rungs, ref, ref_key,
+                                          floor, clamp=(direct, indirect)))
         if args.with_cycles:
             bar.set_description("Cycles")
             curves.append(study.cycles_curve(rungs, ref, ref_key, floor))
@@ -184,6 +219,7 @@ def run_converge(args) -> int:
         "reference": {"spec": f"{ref_engine}:{ref_samples}",
                       "engine": "DRT" if ref_engine == "drt" else "Cycles",
                       "samples": ref.samples, "seconds": ref.seconds, "cached": ref_cached,
+                      "clamps": "off" if clamps else "the file's",
                       "sampler": convergence.REFERENCE_SAMPLER if ref_engine == "drt"
                       else scene.cycles.sampling_pattern.lower(),
                       "noise_floor": floor},

@@ -6,14 +6,20 @@ floor the reference's own noise puts under every measurement.
 """
 from __future__ import annotations
 
+import zlib
+
 ROWS = (("relmse", "relative MSE"), ("rmse", "RMSE"), ("flip", "FLIP (LDR)"))
 SAMPLER_COLOURS = {"jittered": "tab:blue", "sobol": "tab:orange", "random": "tab:green"}
+CLAMP_COLOURS = ("tab:red", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 INTEGRATOR_STYLES = {"path": "-", "distribution": ":", "whitted": "-."}
 
 
 def _style(curve):
     if curve["engine"] == "Cycles":
         return {"color": "black", "linestyle": "--", "marker": "s"}
+    if " clamp " in curve["label"]:          # a clamp curve of converge --clamps
+        return {"color": CLAMP_COLOURS[zlib.crc32(curve["label"].encode()) % len(CLAMP_COLOURS)],
+                "linestyle": "-", "marker": "^"}
     return {"color": SAMPLER_COLOURS.get(curve["sampler"], "tab:gray"),
             "linestyle": INTEGRATOR_STYLES.get(curve["integrator"], "-"), "marker": "o"}
 

@@ -14,7 +14,7 @@ it): on shared cores its seconds are pessimistic.
 from __future__ import annotations
 
 import os
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from importlib import import_module
 
 import numpy as np
@@ -43,10 +43,13 @@ class Study:
 
     # --- the reference ------------------------------------------------------------------
 
-    def reference(self, engine_name: str, samples: int):
-        """(convergence.Reference, cache key, was cached)."""
+    def reference(self, engine_name: str, samples: int, unclamped: bool = False):
+        """(convergence.Reference, cache key, was cached); `unclamped`: DRT's reference
+        with Clamp Direct and Indirect off, to measure clamps' bias against."""
+        settings = replace(self.settings, clamp_direct=0.0, clamp_indirect=0.0) \
+            if unclamped else self.settings
         key = self.cache.key(kind="reference", engine=engine_name, samples=samples,
-                             settings=asdict(self.settings) if engine_name == "drt" else None,
+                             settings=asdict(settings) if engine_name == "drt" else None,
                              **self.identity)
         hit = self.cache.load_arrays(key)
         if hit is not None:
@@ -54,10 +57,10 @@ class Study:
             return (convergence.Reference(hit["image"], hit["variance_of_mean"],
                                           m["samples"], m["seconds"]), key, True)
         if engine_name == "drt":
-            why = self._warm_up("drt", self.settings)
+            why = self._warm_up("drt", settings)
             if why is not None:
                 raise ValueError(why)
-            ref = convergence.reference(self.description, self.settings, samples,
+            ref = convergence.reference(self.description, settings, samples,
                                         on_paths=self.on_paths)
         else:
             from .cycles_ladder import cycles_reference
@@ -70,10 +73,13 @@ class Study:
 
     # --- curves -------------------------------------------------------------------------
 
-    def drt_curve(self, sampler, integrator, rungs, ref, ref_key, floor):
+    def drt_curve(self, sampler, integrator, rungs, ref, ref_key, floor, clamp=None):
+        """One DRT ladder; `clamp` (direct, indirect) replaces the file's clamps."""
+        changes = {} if clamp is None else dict(clamp_direct=clamp[0], clamp_indirect=clamp[1])
         settings = convergence.every_sample(self.settings, sampler=sampler,
-                                            integrator=integrator)
-        label = f"DRT {integrator} {sampler}"
+                                            integrator=integrator, **changes)
+        label = f"DRT {integrator} {sampler}" + \
+            ("" if clamp is None else f" clamp {clamp[0]:g}:{clamp[1]:g}")
         key = self.cache.key(kind="curve", engine="drt", rungs=list(rungs),
                              settings=asdict(settings), reference=ref_key, **self.identity)
         cached = self.cache.load_json(key)
@@ -92,6 +98,7 @@ class Study:
         load = max(load, os.getloadavg()[0])      # the 1-minute load, before and after
         curve = {"label": label, "load_average": load, "engine": "DRT", "sampler": sampler,
                  "integrator": integrator, "seed": settings.seed,
+                 "clamp": [settings.clamp_direct, settings.clamp_indirect],
                  "progressive": sampler in convergence.PREFIX_SAMPLERS,
                  "setup_seconds": setup.get("setup_seconds"), **curve}
         self.cache.save_json(key, curve)
