@@ -173,7 +173,9 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         export_seconds = time.perf_counter() - t0
         last_render.update(scene=description, export_stats=export_stats, region=region)
         self.update_stats("", "DRT: building acceleration structure")
+        t_build = time.perf_counter()
         ctx = engine.RenderContext(description, settings)
+        last_render["build_seconds"] = time.perf_counter() - t_build
         result = self.begin_result(0, 0, region.width, region.height, layer=view_layer.name)
         layer = result.layers[0]
         combined = layer.passes["Combined"]
