@@ -16,7 +16,8 @@ scene (docs/adaptive_benchmark.py) and 7. every sampler's and integrator's conve
 slopes and the clamps' bias for noise (docs/make_convergence_docs.py). Where a target is
 not met, the section measures why: a stage-by-stage profile (docs/stage_profile.py), the
 GIL-held share of a thread's time, DRT's fixed cost per process, the big mesh's export,
-build and first sample.
+build and first sample. 8. times the README's first command against the last commit
+before the compiled kernels (docs/readme_speed.py).
 Every figure in docs/benchmarks.md is printed by this script.
 """
 from __future__ import annotations
@@ -153,13 +154,13 @@ def _fmt_equal_error(name, r):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller renders, for a smoke run")
-    ap.add_argument("--skip", default="", help="comma-separated sections to skip (1..7)")
-    ap.add_argument("--only", default="", help="comma-separated sections to run (1..7); the "
+    ap.add_argument("--skip", default="", help="comma-separated sections to skip (1..8)")
+    ap.add_argument("--only", default="", help="comma-separated sections to run (1..8); the "
                     "others keep their last measured figures (docs/benchmarks.json)")
     args = ap.parse_args()
     skip = set(args.skip.split(",")) - {""}
     if args.only:
-        skip |= set(map(str, range(1, 8))) - set(args.only.split(","))
+        skip |= set(map(str, range(1, 9))) - set(args.only.split(","))
     saved = _load_sections()
     q = args.quick
     cores = os.cpu_count() or 1
@@ -308,6 +309,10 @@ def main():
         import make_convergence_docs as studies
         lines += studies.benchmark_section(studies.main(["cornell_box"] if q else []))
         done("7")
+    if "8" not in skip:
+        import readme_speed
+        lines += readme_speed.table(readme_speed.measure())
+        done("8")
     _write_page(saved)
 
 
