@@ -31,9 +31,13 @@ bpy.ops.render.render()
 t_end = time.perf_counter()
 from drt_addon import render_engine
 last = render_engine.last_render if engine == "DRT" else {}
+desc = last.get("scene")
+arrays = sum(getattr(a, "nbytes", 0) for m in (desc.meshes if desc else [])
+             for a in vars(m).values()) / 2**20
 print(json.dumps(dict(load=t_load - t0, render=t_end - t_load, whole=t_end - t0,
                       first_sample=last.get("first_sample_seconds"),
                       export=last.get("export_seconds"), build=last.get("build_seconds"),
+                      scene_mb=arrays,
                       maxrss_mb=resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)))
 """
 

@@ -281,6 +281,7 @@ def main():
                   f"| ... the first sample (s) | | "
                   f"{(d['first_sample'] or 0) - (d['export'] or 0) - (d['build'] or 0):.2f} |",
                   f"| peak resident memory (MB) | {c['maxrss_mb']:.0f} | {d['maxrss_mb']:.0f} |",
+                  f"| DRT: the exported scene's arrays (MB) | | {d['scene_mb']:.0f} |",
                   ""]
         done("4")
     if "5" not in skip:
