@@ -174,7 +174,17 @@ def open_blend(bpy, path: str) -> None:
         bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
     except RuntimeError as e:
         first = str(e).strip().splitlines()[0] if str(e).strip() else "unreadable file"
+        first = first.removeprefix("Error: ")       # Blender's report level
         raise CliError(EXIT_FILE, f"drt: error: cannot open {path}: {first}") from None
+
+
+def say_warnings(progress, warnings) -> None:
+    """The render's warnings (the RenderEngine's reports) on stderr, one line each, each
+    once per job."""
+    for message in warnings:
+        if message not in progress.warned:
+            progress.warned.add(message)
+            progress.say(f"drt: warning: {message.removeprefix('DRT: ')}", file=sys.stderr)
 
 
 def _frame_list(args, scene) -> list[int]:
@@ -224,6 +234,8 @@ def render_frame_here(bpy, scene, frame: int, path: str, overrides, progress) ->
     t0 = time.perf_counter()
     bpy.ops.render.render(write_still=False)
     seconds = time.perf_counter() - t0
+    if drt:
+        say_warnings(progress, render_engine.last_render.get("warnings") or ())
     if drt and not render_engine.last_render.get("ok"):
         raise CliError(EXIT_RENDER, f"drt: error: render of frame {frame} failed: "
                                     f"{render_engine.last_render.get('error') or 'unknown'}")
