@@ -224,6 +224,13 @@ def _make_folders(jobs) -> None:
                                        f"{folder}: {e.strerror}") from None
 
 
+def _frame_failed(frame: int, error: str) -> CliError:
+    """The one line of a frame whose render failed (the engine's message without its
+    'DRT: render failed:' prefix)."""
+    reason = error.removeprefix("DRT: ").removeprefix("render failed: ")
+    return CliError(EXIT_RENDER, f"drt: error: render of frame {frame} failed: {reason}")
+
+
 def render_frame_here(bpy, scene, frame: int, path: str, overrides, progress) -> FrameResult:
     """One frame through Blender's render pipeline, written to `path` atomically."""
     from . import render_engine
@@ -232,13 +239,18 @@ def render_frame_here(bpy, scene, frame: int, path: str, overrides, progress) ->
     asked = scene.drt.samples if drt else scene.cycles.samples
     progress.start_frame(f"frame {frame}", asked)
     t0 = time.perf_counter()
-    bpy.ops.render.render(write_still=False)
+    failed = None
+    try:
+        bpy.ops.render.render(write_still=False)
+    except RuntimeError as e:   # an engine's error report (DRT's is in last_render too)
+        failed = str(e).strip().removeprefix("Error: ") or "unknown"
     seconds = time.perf_counter() - t0
     if drt:
         say_warnings(progress, render_engine.last_render.get("warnings") or ())
-    if drt and not render_engine.last_render.get("ok"):
-        raise CliError(EXIT_RENDER, f"drt: error: render of frame {frame} failed: "
-                                    f"{render_engine.last_render.get('error') or 'unknown'}")
+        if not render_engine.last_render.get("ok"):
+            failed = render_engine.last_render.get("error") or failed or "unknown"
+    if failed:
+        raise _frame_failed(frame, failed)
     try:
         save_render_result(bpy, scene, path)
     except (RuntimeError, OSError) as e:
