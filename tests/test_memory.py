@@ -1,4 +1,5 @@
-"""Memory is bounded by the work-unit size, never by samples x pixels."""
+"""Memory is bounded by the film and the work-unit size, never by samples x pixels; absurd
+settings (1e6 samples at 1920 x 1080) are accepted, rendered pass by pass and cancel."""
 import tracemalloc
 
 from engine import RenderSettings, render
@@ -7,6 +8,7 @@ from engine_scenes import cornell_box
 
 def _peak_bytes(samples, chunk_paths=4096):
     scene = cornell_box(48, 48)
+    render(cornell_box(8, 8), RenderSettings(samples=1, threads=1))  # kernels loaded first
     tracemalloc.start()
     try:
         render(scene, RenderSettings(samples=samples, chunk_paths=chunk_paths, threads=1))
@@ -25,3 +27,92 @@ def test_peak_memory_does_not_grow_with_samples():
 def test_peak_memory_follows_the_chunk_size():
     small, large = _peak_bytes(8, chunk_paths=1024), _peak_bytes(8, chunk_paths=16384)
     assert large > 2 * small      # the chunk, not the image, is what memory scales with
+
+
+# Beyond the film (Film: 96 bytes per pixel) and the list of pixels still sampled (8 per
+# pixel), a render holds one work unit per thread: at most chunk_paths paths, about 530
+# bytes each (measured: 3.6 MB at 2048 paths, 11.2 MB at 16384, one thread). The bounds
+# below allow 1 KB per path and 2 MB of constants.
+PER_PIXEL = 96 + 8
+PER_PATH = 1024
+
+
+def _traced_peak(scene, settings, cancelled=None):
+    render(cornell_box(8, 8), RenderSettings(samples=1, threads=1))     # warm (kernels)
+    tracemalloc.start()
+    try:
+        _, stats = render(scene, settings, cancelled=cancelled)
+        return tracemalloc.get_traced_memory()[1], stats
+    finally:
+        tracemalloc.stop()
+
+
+def test_a_large_frame_with_a_small_chunk_stays_within_film_plus_chunk():
+    w = h = 512
+    chunk = 2048
+    peak, stats = _traced_peak(cornell_box(w, h),
+                               RenderSettings(samples=1, chunk_paths=chunk, threads=1))
+    bound = PER_PIXEL * w * h + PER_PATH * chunk + 2e6
+    print(f"{w}x{h}, chunk {chunk}: peak traced {peak / 1e6:.1f} MB, bound {bound / 1e6:.1f} MB "
+          f"(film {96 * w * h / 1e6:.1f} MB)")
+    assert stats.paths == w * h
+    assert peak < bound
+
+
+def test_absurd_settings_render_progressively_and_cancel(bpy_drt):
+    """1e6 samples at 1920 x 1080 (2e12 paths): accepted by DRT's Samples property, and
+    rendered pass by pass; cancelled after two work units, memory held the film and a
+    work unit, never samples x pixels."""
+    bpy_drt.ops.wm.read_factory_settings(use_empty=True)
+    bpy_drt.context.scene.drt.samples = 1_000_000           # within the property's range
+    settings = bpy_drt.context.scene.drt.to_engine_settings()
+    assert settings.samples == 1_000_000
+    settings.threads, settings.chunk_paths = 1, 1 << 15
+    settings.validate()
+    w, h = 1920, 1080
+    polls = []
+
+    def cancel_after_two_units():
+        polls.append(1)
+        return len(polls) > 2
+
+    peak, stats = _traced_peak(cornell_box(w, h), settings, cancelled=cancel_after_two_units)
+    bound = PER_PIXEL * w * h + PER_PATH * settings.chunk_paths + 2e6
+    print(f"1e6 spp at {w}x{h}, cancelled after {stats.units_done} units: peak traced "
+          f"{peak / 1e6:.1f} MB, bound {bound / 1e6:.1f} MB")
+    assert stats.cancelled and stats.units_done <= 3
+    assert stats.paths <= 3 * settings.chunk_paths
+    assert peak < bound
+
+
+def test_absurd_settings_in_blender_cancel_after_the_first_units(bpy_drt, monkeypatch):
+    """The same through Blender's render (F12): the RenderEngine adds Blender's result
+    buffers (the image as RGBA float32 and its float64 mean: 48 bytes per pixel)."""
+    from hostile_cases import _scene
+    from drt_addon.render_engine import DRTRenderEngine, last_render
+    scene = _scene(bpy_drt)
+    scene.render.resolution_x, scene.render.resolution_y = 1920, 1080
+    scene.drt.samples = 1_000_000
+    scene.drt.threads = 1
+    polls = []
+
+    def cancel_in_tracing(self):
+        polls.append(last_render["phase"])
+        return polls.count("tracing") > 2
+
+    monkeypatch.setattr(DRTRenderEngine, "_cancel_requested", cancel_in_tracing)
+    tracemalloc.start()
+    try:
+        bpy_drt.ops.render.render()
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    stats = last_render["stats"]
+    n = 1920 * 1080
+    bound = (PER_PIXEL + 48) * n + PER_PATH * (1 << 15) + 8e6
+    print(f"F12, 1e6 spp at 1920x1080, cancelled after {stats.units_done} units: peak traced "
+          f"{peak / 1e6:.1f} MB, bound {bound / 1e6:.1f} MB")
+    assert last_render["cancelled_in"] == "tracing" and stats.samples_done == 0
+    assert stats.paths <= 3 * (1 << 15)
+    assert last_render["pixels"].shape == (1080, 1920, 3)
+    assert peak < bound
