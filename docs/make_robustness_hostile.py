@@ -35,8 +35,26 @@ as `drt: warning:` lines), 2 bad arguments, 3 the file is missing or not a reada
 
 """
 
+MEMORY = """
+## Memory
+
+DRT renders in work units of at most `chunk_paths` paths (32768 by default) over passes
+of 1, 2, 4 ... samples, so memory follows the image size and the chunk, never samples x
+pixels: any Samples value DRT's property allows (up to 16777216) is accepted and rendered
+progressively, and Esc stops it within a work unit. The film keeps 96 bytes per pixel
+(sums, squared sums, counts and alpha for the running mean and its noise estimate);
+Blender's render result and the image handed to it add about 48 bytes per pixel in an
+F12 render. Peak memory measured by `docs/make_robustness_hostile.py` (tracemalloc, one
+thread, the Cornell box; bound: 104 bytes per pixel + 1 KB per path of a work unit + 2 MB,
+which `tests/test_memory.py` asserts):
+
+"""
+
 TAIL = """
-Notes:
+By the same per-pixel sizes, a 7680 x 4320 frame needs about 3.2 GB of film and 1.6 GB
+more inside Blender, whatever the sample count.
+
+## Notes
 
 - A node loop: Blender marks one link of every loop of nodes invalid (drawn red in the
   node editor); Cycles ignores those links and so does DRT, which reads the rest of the
@@ -54,7 +72,8 @@ Notes:
 - Cancel (Esc) is looked at before each object of the export, before and after the
   acceleration structure is built, between work units of the tracing and before the
   extra passes; after it Blender renders again normally. Twenty renders in one session
-  do not grow its memory (`tests/test_render_side_effects.py`).
+  do not grow its memory: the test bounds the growth over the last fifteen by three
+  times the size of the exported scene (`tests/test_render_side_effects.py`).
 """
 
 
@@ -63,11 +82,13 @@ def main() -> None:
 
     import drt_addon
     from hostile_cases import markdown_table, run_cases
+    from memory_probe import memory_table
     drt_addon.register()
     with tempfile.TemporaryDirectory() as folder:
         outcomes = run_cases(bpy, folder)
+    memory = memory_table()
     with open(OUT, "w") as f:
-        f.write(HEAD + markdown_table(outcomes) + TAIL)
+        f.write(HEAD + markdown_table(outcomes) + MEMORY + memory + TAIL)
     print(f"wrote {OUT}")
 
 

@@ -126,6 +126,26 @@ def _nan_vertices(bpy):
     verts[1].co.z = float("inf")
 
 
+def _empty_as_camera(bpy):
+    scene = _scene(bpy, camera=False)
+    empty = bpy.data.objects.new("Empty", None)
+    scene.collection.objects.link(empty)
+    scene.camera = empty                 # Blender allows any object as the camera
+
+
+def _missing_image(bpy):
+    """The cube's Base Color from an Image Texture whose file does not exist."""
+    _scene(bpy)
+    tree, out = _cube_material(bpy)
+    bsdf = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    tex = tree.nodes.new("ShaderNodeTexImage")
+    image = bpy.data.images.new("gone.png", 4, 4)       # load() refuses a missing file
+    image.source, image.filepath = "FILE", "//textures/gone.png"
+    tex.image = image
+    tree.links.new(bsdf.outputs[0], out.inputs["Surface"])
+    tree.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
+
+
 def _behind(bpy):
     scene = _scene(bpy, world=SKY)
     scene.camera.rotation_euler = (math.radians(90.0), 0.0, math.radians(180.0))  # along -y
@@ -153,6 +173,7 @@ CASES = [
     ("a file that is not a .blend", "notes.blend", "no image", "text"),
     ("a truncated .blend", "truncated.blend", "no image", "truncated"),
     ("a scene with no camera", "no_camera.blend", "no image", lambda bpy: _scene(bpy, camera=False)),
+    ("an Empty as the scene's camera", "empty_camera.blend", "no image", _empty_as_camera),
     ("an empty scene (a camera, nothing else)", "empty.blend", "a black image",
      lambda bpy: _scene(bpy, cube=False, sun=False)),
     ("a camera that looks away from everything", "away.blend", "the world's colour",
@@ -167,6 +188,8 @@ CASES = [
      _dangling_reroute),
     ("a material whose output has nothing linked to Surface", "no_surface.blend", "the object is black, as in "
      "Cycles", _unlinked_surface),
+    ("an image texture whose file is missing", "image.blend", "the texture is pink, as in "
+     "Cycles", _missing_image),
     ("a linked library that cannot be found", "linked.blend", "the scene without the missing data",
      "library"),
 ]

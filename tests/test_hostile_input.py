@@ -13,7 +13,7 @@ from hostile_cases import CASES, SKY, markdown_table, run_cases
 DOC = os.path.join(ROOT, "docs", "robustness_hostile.md")
 # the documented exit codes (drt_addon/batch.py): 3 the file, 4 the render
 EXIT = {"missing file": 3, "a file that is not a .blend": 3, "a truncated .blend": 3,
-        "a scene with no camera": 4}
+        "a scene with no camera": 4, "an Empty as the scene's camera": 4}
 
 
 @pytest.fixture(scope="module")
@@ -65,6 +65,13 @@ def test_broken_node_trees_render_what_is_left(outcomes):
     nan = outcomes["NaN and infinite vertex coordinates"]
     assert np.isfinite(nan.pixels).all() and nan.pixels.max() > 0.05
     assert "skipped" in nan.warnings[0]
+
+
+def test_a_missing_image_is_pink(outcomes):
+    """Cycles' colour for an image without pixels: magenta (it rendered black before)."""
+    px = outcomes["an image texture whose file is missing"].pixels.reshape(-1, 3)
+    r, g, b = px[px.sum(axis=1).argmax()]
+    assert r > 0.05 and b > 0.05 and g < 0.3 * r, (r, g, b)
 
 
 def test_a_missing_library_names_what_is_missing(outcomes):

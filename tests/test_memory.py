@@ -2,19 +2,14 @@
 settings (1e6 samples at 1920 x 1080) are accepted, rendered pass by pass and cancel."""
 import tracemalloc
 
-from engine import RenderSettings, render
+from engine import RenderSettings
 from engine_scenes import cornell_box
+from memory_probe import CASES, bound, cancel_after, measure, traced_peak
 
 
 def _peak_bytes(samples, chunk_paths=4096):
-    scene = cornell_box(48, 48)
-    render(cornell_box(8, 8), RenderSettings(samples=1, threads=1))  # kernels loaded first
-    tracemalloc.start()
-    try:
-        render(scene, RenderSettings(samples=samples, chunk_paths=chunk_paths, threads=1))
-        return tracemalloc.get_traced_memory()[1]
-    finally:
-        tracemalloc.stop()
+    settings = RenderSettings(samples=samples, chunk_paths=chunk_paths, threads=1)
+    return traced_peak(cornell_box(48, 48), settings)[0]
 
 
 def test_peak_memory_does_not_grow_with_samples():
@@ -29,34 +24,13 @@ def test_peak_memory_follows_the_chunk_size():
     assert large > 2 * small      # the chunk, not the image, is what memory scales with
 
 
-# Beyond the film (Film: 96 bytes per pixel) and the list of pixels still sampled (8 per
-# pixel), a render holds one work unit per thread: at most chunk_paths paths, about 530
-# bytes each (measured: 3.6 MB at 2048 paths, 11.2 MB at 16384, one thread). The bounds
-# below allow 1 KB per path and 2 MB of constants.
-PER_PIXEL = 96 + 8
-PER_PATH = 1024
-
-
-def _traced_peak(scene, settings, cancelled=None):
-    render(cornell_box(8, 8), RenderSettings(samples=1, threads=1))     # warm (kernels)
-    tracemalloc.start()
-    try:
-        _, stats = render(scene, settings, cancelled=cancelled)
-        return tracemalloc.get_traced_memory()[1], stats
-    finally:
-        tracemalloc.stop()
-
-
 def test_a_large_frame_with_a_small_chunk_stays_within_film_plus_chunk():
-    w = h = 512
-    chunk = 2048
-    peak, stats = _traced_peak(cornell_box(w, h),
-                               RenderSettings(samples=1, chunk_paths=chunk, threads=1))
-    bound = PER_PIXEL * w * h + PER_PATH * chunk + 2e6
-    print(f"{w}x{h}, chunk {chunk}: peak traced {peak / 1e6:.1f} MB, bound {bound / 1e6:.1f} MB "
-          f"(film {96 * w * h / 1e6:.1f} MB)")
+    _, w, h, samples, chunk, units = CASES[0]
+    peak, stats = measure(w, h, samples, chunk, units)
+    print(f"{w}x{h}, chunk {chunk}: peak traced {peak / 1e6:.1f} MB, bound "
+          f"{bound(w, h, chunk) / 1e6:.1f} MB (film {96 * w * h / 1e6:.1f} MB)")
     assert stats.paths == w * h
-    assert peak < bound
+    assert peak < bound(w, h, chunk)
 
 
 def test_absurd_settings_render_progressively_and_cancel(bpy_drt):
@@ -70,19 +44,12 @@ def test_absurd_settings_render_progressively_and_cancel(bpy_drt):
     settings.threads, settings.chunk_paths = 1, 1 << 15
     settings.validate()
     w, h = 1920, 1080
-    polls = []
-
-    def cancel_after_two_units():
-        polls.append(1)
-        return len(polls) > 2
-
-    peak, stats = _traced_peak(cornell_box(w, h), settings, cancelled=cancel_after_two_units)
-    bound = PER_PIXEL * w * h + PER_PATH * settings.chunk_paths + 2e6
+    peak, stats = traced_peak(cornell_box(w, h), settings, cancelled=cancel_after(2))
     print(f"1e6 spp at {w}x{h}, cancelled after {stats.units_done} units: peak traced "
-          f"{peak / 1e6:.1f} MB, bound {bound / 1e6:.1f} MB")
+          f"{peak / 1e6:.1f} MB, bound {bound(w, h, settings.chunk_paths) / 1e6:.1f} MB")
     assert stats.cancelled and stats.units_done <= 3
     assert stats.paths <= 3 * settings.chunk_paths
-    assert peak < bound
+    assert peak < bound(w, h, settings.chunk_paths)
 
 
 def test_absurd_settings_in_blender_cancel_after_the_first_units(bpy_drt, monkeypatch):
@@ -109,10 +76,10 @@ def test_absurd_settings_in_blender_cancel_after_the_first_units(bpy_drt, monkey
         tracemalloc.stop()
     stats = last_render["stats"]
     n = 1920 * 1080
-    bound = (PER_PIXEL + 48) * n + PER_PATH * (1 << 15) + 8e6
+    limit = bound(1920, 1080, 1 << 15) + 48 * n + 6e6
     print(f"F12, 1e6 spp at 1920x1080, cancelled after {stats.units_done} units: peak traced "
-          f"{peak / 1e6:.1f} MB, bound {bound / 1e6:.1f} MB")
+          f"{peak / 1e6:.1f} MB, bound {limit / 1e6:.1f} MB")
     assert last_render["cancelled_in"] == "tracing" and stats.samples_done == 0
     assert stats.paths <= 3 * (1 << 15)
     assert last_render["pixels"].shape == (1080, 1920, 3)
-    assert peak < bound
+    assert peak < limit
