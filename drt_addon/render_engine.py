@@ -29,7 +29,7 @@ import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
 from .engine_link import engine
-from .export import ExportError, Reporter, export_scene, render_region
+from .export import BLACK_IMAGE, ExportError, Reporter, export_scene, render_region
 
 aov = import_module(engine.__name__ + ".aov")   # engine.aov, in either package layout
 
@@ -256,6 +256,11 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         finally:
             ctx.close()
             self.end_result(result)
+        held_out = description.film_transparent or description.has_holdouts()
+        if not stats.cancelled and not np.any(image) and not held_out:
+            reporter.warn("DRT: the image is black: no light from the scene reaches the "
+                          "camera (check where the camera looks, its clipping range, and "
+                          "the lights)", key=BLACK_IMAGE)
         if stats.nonfinite_samples:
             reporter.warn(f"DRT: {stats.nonfinite_samples} samples were NaN or infinite and "
                           "were dropped")

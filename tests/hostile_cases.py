@@ -113,8 +113,9 @@ def _dangling_reroute(bpy):
 
 
 def _unlinked_surface(bpy):
-    """A Principled BSDF beside the Material Output, not linked to it."""
-    _scene(bpy)
+    """A Principled BSDF beside the Material Output, not linked to it (the cube is seen
+    against a lit world)."""
+    _scene(bpy, world=SKY)
     _, out = _cube_material(bpy)
     out.id_data.nodes.new("ShaderNodeBsdfPrincipled")
 
@@ -146,19 +147,19 @@ def _missing_image(bpy):
     tree.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
 
 
-def _behind(bpy):
-    scene = _scene(bpy, world=SKY)
+def _behind(bpy, world=SKY):
+    scene = _scene(bpy, world=world)
     scene.camera.rotation_euler = (math.radians(90.0), 0.0, math.radians(180.0))  # along -y
 
 
 def _missing_library(bpy, folder):
-    """A cube linked from lib.blend, which is then deleted."""
+    """A cube linked from lib.blend (beside the scene's own), then lib.blend is deleted."""
     lib = os.path.join(folder, "lib.blend")
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.mesh.primitive_cube_add(size=1.0)
     bpy.context.active_object.name = "LibCube"
     bpy.ops.wm.save_as_mainfile(filepath=lib)
-    scene = _scene(bpy, cube=False)
+    scene = _scene(bpy)
     with bpy.data.libraries.load(lib, link=True, relative=True) as (_, linked):
         linked.objects = ["LibCube"]
     for o in linked.objects:
@@ -178,6 +179,8 @@ CASES = [
      lambda bpy: _scene(bpy, cube=False, sun=False)),
     ("a camera that looks away from everything", "away.blend", "the world's colour",
      _behind),
+    ("a camera that looks away from everything, a black world", "away_black.blend",
+     "a black image", lambda bpy: _behind(bpy, world=None)),
     ("objects but no light", "unlit.blend", "a black image",
      lambda bpy: _scene(bpy, sun=False)),
     ("NaN and infinite vertex coordinates", "nan.blend", "the mesh without the triangles that touch them",

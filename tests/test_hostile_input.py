@@ -51,7 +51,9 @@ def test_no_image_is_silently_black(outcomes):
     """An image with no light in it comes with a warning that says why."""
     black = [o for o in outcomes.values() if o.pixels is not None and o.pixels.max() == 0.0]
     assert {o.name for o in black} >= {"an empty scene (a camera, nothing else)",
-                                       "objects but no light"}
+                                       "objects but no light",
+                                       "a camera that looks away from everything, a black "
+                                       "world"}
     for o in black:
         assert o.warnings, o.name
 
@@ -65,6 +67,12 @@ def test_broken_node_trees_render_what_is_left(outcomes):
     nan = outcomes["NaN and infinite vertex coordinates"]
     assert np.isfinite(nan.pixels).all() and nan.pixels.max() > 0.05
     assert "skipped" in nan.warnings[0]
+
+
+def test_an_unlinked_surface_is_black_before_the_world(outcomes):
+    px = outcomes["a material whose output has nothing linked to Surface"].pixels
+    lum = px.mean(axis=2)
+    assert lum.min() == 0.0 and lum.max() > 0.2          # the black cube, the sky
 
 
 def test_a_missing_image_is_pink(outcomes):

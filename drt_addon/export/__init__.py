@@ -16,8 +16,8 @@ from .object_info import object_info
 from .volumes import world_volume
 from .world import export_world
 
-__all__ = ["ExportError", "RenderRegion", "Reporter", "export_scene", "render_region",
-           "render_size"]
+__all__ = ["BLACK_IMAGE", "ExportError", "RenderRegion", "Reporter", "export_scene",
+           "render_region", "render_size"]
 
 
 def render_size(scene):
@@ -133,7 +133,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     shutter = tracker.finish(meshes, camera, lights) if tracker is not None else None
     dark = dark_scene_message(meshes, materials, lights, world)
     if dark:
-        reporter.warn(dark)
+        reporter.warn(dark, key=BLACK_IMAGE)
     if stats is not None:
         stats.update(mesh_evaluations=cache.evaluations, mesh_reuses=cache.reuses,
                      meshes=len(meshes), lights=len(lights), holdouts=holdouts,
@@ -144,6 +144,10 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     return engine.Scene(camera, region.width, region.height, meshes, materials, lights, world,
                         pixel_aspect=aspect, shutter=shutter,
                         film_transparent=bool(scene.render.film_transparent))
+
+
+# the key of the one warning about a black image (said by the export, or after the render)
+BLACK_IMAGE = "black image"
 
 
 def _emits(material) -> bool:
