@@ -19,8 +19,8 @@ def missing_library_messages(data=None) -> list:
         path = bpy.path.abspath(lib.filepath, library=lib.library)
         if not getattr(lib, "is_missing", False) and os.path.exists(path):
             continue
-        lost = sorted(f"{type(i).__name__} {i.name!r}" for i in lib.users_id
-                      if getattr(i, "is_missing", False))
+        lost = sorted(f"{type(i).__name__} {i.name!r}" for i in getattr(lib, "users_id", ())
+                      if getattr(i, "is_missing", False))       # users_id: Blender 4.2+
         shown = ", ".join(lost[:5]) + (f" and {len(lost) - 5} more" if len(lost) > 5 else "")
         messages.append(f"linked library {lib.filepath!r} not found ({os.path.normpath(path)})"
                         f"; {len(lost)} linked data-block(s) from it are missing from the "
