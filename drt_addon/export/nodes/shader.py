@@ -278,13 +278,20 @@ def _plastic(a: _Closure, b: _Closure, ior, fac, ctx):
                     _lin([(1.0 - fac, a.emission), (fac, b.emission)], ctx, "emission"))
 
 
+MAX_SHADER_READS = 2048
+
+
 def _closure(socket, ctx, depth=0) -> _Closure:
     """The closure feeding a shader socket."""
     found = _link(socket)
     if found is None:
         return _Closure([(1.0, NULL_COMP)])       # no closure: black
     node = found[0]
-    if depth > 32:
+    # a tree is read node by node along every path to the output: shared sub-trees are
+    # read again for each path, so a long chain of shaders feeding both inputs of the
+    # next Mix would take 2^length reads; past MAX_SHADER_READS the rest is cut off
+    ctx.shader_reads = getattr(ctx, "shader_reads", 0) + 1
+    if depth > 32 or ctx.shader_reads > MAX_SHADER_READS:
         ctx.issue("the shader tree is too deep; rendering the rest as the viewport colour")
         return _Closure([(1.0, ctx.viewport_comp())])
     kind = node.bl_idname
