@@ -142,7 +142,9 @@ def test_mesh_without_faces_and_objects_scaled_to_zero():
     flat.positions = flat.positions * (1, 1, 0) + (0, 0, 1.0)
     base = _render(_lit_floor_scene([]))
     no_op = _render(_lit_floor_scene([empty, point]))
-    np.testing.assert_allclose(no_op, base, rtol=1e-12, atol=0)
+    # (their vertices move the middle of the bounds Embree sees the scene around, so
+    # float32 rounding differs: 1e-7)
+    np.testing.assert_allclose(no_op, base, rtol=1e-6, atol=0)
     squashed = _render(_lit_floor_scene([flat]))
     square = _render(_lit_floor_scene([quad((0, 0, 1.0), (0.2, 0, 0), (0, 0.2, 0))]))
     print(f"squashed cube vs square: mean {squashed.mean():.5f} vs {square.mean():.5f}, "
