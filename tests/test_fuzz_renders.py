@@ -66,6 +66,16 @@ def _case(fuzz_scene, **changes):
     return case
 
 
+def _render_again(bpy):
+    """The current scene exported and rendered again (1 sample): its film."""
+    from drt_addon.engine_link import engine
+    from drt_addon.export import Reporter, export_scene
+    film, _ = engine.render(export_scene(bpy.context.evaluated_depsgraph_get(), Reporter(),
+                                         size=(fuzz.SIZE, fuzz.SIZE)),
+                            engine.RenderSettings(samples=1))
+    return film
+
+
 @pytest.mark.parametrize("changes", [
     {"camera.clip_start": 10.0, "camera.clip_end": 1.0},
     {"camera.clip_start": 5.0, "camera.clip_end": 5.0},
@@ -80,11 +90,7 @@ def test_camera_that_sees_nothing_renders_the_world(fresh, changes):
     case[("world", "Color", "")] = (0.2, 0.3, 0.4)
     case[("world", "Strength", "")] = 1.0
     assert fuzz.render_case(bpy, scene, case) == []
-    from drt_addon.engine_link import engine
-    from drt_addon.export import Reporter, export_scene
-    film, _ = engine.render(export_scene(bpy.context.evaluated_depsgraph_get(), Reporter(),
-                                         size=(fuzz.SIZE, fuzz.SIZE)),
-                            engine.RenderSettings(samples=1))
+    film = _render_again(bpy)
     assert abs(film.mean()[..., 0] - 0.2).max() < 1e-6
     assert abs(film.mean()[..., 2] - 0.4).max() < 1e-6
 
@@ -114,3 +120,19 @@ def test_fuzzed_render_is_finite_and_non_negative(fuzz_scene, data):
     case = data.draw(fuzz.case_strategy(params))
     problems = fuzz.render_case(bpy, scene, case)
     assert problems == [], f"{problems}: {fuzz.describe(case)}"
+
+
+@pytest.mark.parametrize("scale", [(0.0, 0.0, 0.0), (1.0, 1.0, 0.0), (1e-30, 1e-30, 1e-30)])
+def test_object_scaled_to_zero_in_blender(fresh, scale):
+    """A smooth-shaded sphere scaled to a point or flattened to a disc: its split normals
+    go through the (singular) object transform at export; the render stays finite, and
+    the floor still renders (the image is not black)."""
+    bpy, scene, _ = fresh
+    sphere = next(o for o in scene.objects if o.type == "MESH" and len(o.data.polygons) > 1)
+    for poly in sphere.data.polygons:
+        poly.use_smooth = True
+    sphere.scale = scale
+    case = _case(fresh)
+    case[("light", "energy", "")] = 1000.0
+    assert fuzz.render_case(bpy, scene, case) == []
+    assert _render_again(bpy).mean().max() > 0
