@@ -29,8 +29,8 @@ All Embree scenes share one Embree device: one device per scene crashes Embree p
 about a thousand scenes.
 
 Precision: Embree takes float32. Triangles are uploaded once in float32; ray origins and
-directions are rounded per query. The static scene is uploaded relative to `center`, the
-middle of its bounding box, and every ray's origin is moved by the same amount (in
+directions are rounded per query. The static scene is uploaded relative to `center`, its
+median vertex, and every ray's origin is moved by the same amount (in
 float64) before rounding: a scene far from the world origin then keeps the float32
 precision it would have at the origin (tests/test_extremes_scale.py: the Cornell box
 moved by 1e6 renders as at the origin; before, a box 1e5 from the origin lost 14% of its
@@ -147,8 +147,10 @@ class Accelerator:
         self.positions = np.concatenate(positions) if positions else np.zeros((0, 3))
         self.triangles = np.concatenate(triangles) if triangles else np.zeros((0, 3), np.int64)
         self.static_count = len(self.triangles)
-        self.center = (0.5 * (self.positions.min(axis=0) + self.positions.max(axis=0))
-                       if len(self.positions) else np.zeros(3))
+        # the median vertex, not the middle of the bounds: a few far vertices (a mesh
+        # with a vertex at 3.4e38, tests/test_degenerate_input.py) do not move it off
+        # the bulk of the geometry
+        self.center = np.median(self.positions, axis=0) if len(self.positions) else np.zeros(3)
         self.threads = threads or min(os.cpu_count() or 1, 8)
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
         self._scene = (_embree_scene(self.positions - self.center, self.triangles)
