@@ -59,3 +59,35 @@ def test_the_z_test_sees_a_10_percent_brighter_light(reference):
     z = z_test(_render(brighter, seed=2), ref)
     print(f"10% brighter light: {z}")
     assert z.mean_z > MEAN_Z
+
+
+@pytest.mark.parametrize("d", [1e5, 1e7])
+def test_no_acne_and_no_leak_far_from_the_origin(d):
+    """The acne and leak checks of tests/test_robustness.py, 1e5 and 1e7 from the origin:
+    a plane under a sun at 85 degrees is exactly rho / pi E cos(85 deg) in every pixel
+    (direct light); a box with walls 1e-3 of its size thick, a point light just above
+    its roof, is black inside (full global illumination)."""
+    from engine import Camera, Material, PointLight, Scene, SunLight, World
+    from engine_scenes import box, look_at, quad
+    o = np.array([d, -d, d])
+    theta = np.radians(85.0)
+    plane = Scene(Camera(look_at(o + (0, -0.5, 2.0), o), lens=50, clip_start=1e-2),
+                  24, 24, [quad(o, (1, 0, 0), (0, 1, 0))],
+                  [Material("m", (0.8,) * 3, specular_ior_level=0.0)],
+                  [SunLight((-np.sin(theta), 0.0, -np.cos(theta)), (3.0,) * 3)],
+                  World((0, 0, 0)))
+    film, _ = render(plane, RenderSettings(samples=4, diffuse_bounces=0, filter_type="BOX",
+                                           filter_width=0.1))
+    np.testing.assert_allclose(film.mean()[..., 0], 0.8 / np.pi * 3.0 * np.cos(theta),
+                               rtol=1e-6)
+    t = 1e-3
+    walls = [box(o + lo, o + hi) for lo, hi in (
+        ((-1, -1, -1), (1, 1, -1 + t)), ((-1, -1, 1 - t), (1, 1, 1)),
+        ((-1, -1, -1), (-1 + t, 1, 1)), ((1 - t, -1, -1), (1, 1, 1)),
+        ((-1, -1, -1), (1, -1 + t, 1)), ((-1, 1 - t, -1), (1, 1, 1)))]
+    closed = Scene(Camera(look_at(o + (0, -0.8, 0.5), o + (0, 0, -0.9)), lens=18,
+                          clip_start=1e-3, clip_end=10),
+                   24, 24, walls, [Material("w", (0.9,) * 3, specular_ior_level=0.0)],
+                   [PointLight(tuple(o + (0, 0, 1.05)), (1e3,) * 3)], World((0, 0, 0)))
+    film, _ = render(closed, RenderSettings(samples=8))
+    assert film.count.sum() == 24 * 24 * 8 and film.sum.max() == 0.0
