@@ -137,6 +137,9 @@ world-space offset.
 Acne and leaks at every scale (`tests/test_robustness.py`, scales 1e-3, 1, 1e2, 1e4):
 a plane under a sun at 85 degrees has no self-shadowed pixel; a closed box with walls 1%
 or 0.01% of its size thick lets no light in; a sheet 1e-4 above a table leaves it black.
+The plane and a box with walls 1e-3 thick also 1e5 and 1e7 from the origin
+(`tests/test_extremes_scale.py`; before the median-vertex origin, the box let light in
+at 1e5 and 37.5% of the plane's pixels were self-shadowed at 1e7).
 
 ## Materials at their limits
 
