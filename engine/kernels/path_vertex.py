@@ -311,8 +311,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             alive, br, bg, bb = roulette(u_rr, br, bg, bb)
             if not alive:
                 continue
-        if not max(br, bg, bb) > 0.0:
-            continue
+        if not max(br, bg, bb) > 0.0 or not (br < _INF and bg < _INF and bb < _INF):
+            continue       # nothing left, or overflowed (or NaN): the path ends here
         beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
         counts[p, skind] += 1
         bounce[p] = b + 1
