@@ -354,6 +354,22 @@ def _plane(bpy, name, x=0.0, half=1.0, uv=((0, 0), (1, 0), (1, 1), (0, 1))):
     return obj
 
 
+def test_bump_map_correction_off_warns(bpy_drt):
+    """Cycles' Bump Map Correction (on by default) shapes how a bent normal is lit; DRT
+    always applies it, so a material that turns it off and bends its normal is warned."""
+    bpy = bpy_drt
+    mat, nt = _material(bpy, "Mapped", keep_principled=True)
+    nmap = nt.nodes.new("ShaderNodeNormalMap")
+    nt.links.new(nmap.outputs[0], nt.nodes["Principled BSDF"].inputs["Normal"])
+    assert _export(mat)[1] == []
+    mat.cycles.use_bump_map_correction = False
+    warnings = _export(mat)[1]
+    assert len(warnings) == 1 and "Bump Map Correction" in warnings[0], warnings
+    for link in list(nt.nodes["Principled BSDF"].inputs["Normal"].links):
+        nt.links.remove(link)
+    assert _export(mat)[1] == []            # no bent normal: nothing to correct
+
+
 def test_unsupported_nodes_warn_once_per_material_and_render(bpy_drt):
     from drt_addon import render_engine
     bpy = bpy_drt

@@ -174,6 +174,10 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
             ctx.issue("its displacement is not rendered")
         result = _material(_closure(out.inputs["Surface"], ctx), ctx, name)
         _attach_programs(result, ctx, ctx.nodes.build())
+        cycles = getattr(mat, "cycles", None)
+        if ctx.normal is not None and not getattr(cycles, "use_bump_map_correction", True):
+            ctx.issue("Settings > Bump Map Correction is off, which DRT does not honour "
+                      "(its bent normals are always corrected, Cycles' default)")
         # a volume inside its meshes; with no surface shader, the surface is its boundary
         result.volume = export_volume(out.inputs.get("Volume"), ctx)
         result.surface = result.volume is None or _link(out.inputs["Surface"]) is not None
