@@ -154,13 +154,13 @@ def _fmt_equal_error(name, r):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller renders, for a smoke run")
-    ap.add_argument("--skip", default="", help="comma-separated sections to skip (1..8)")
-    ap.add_argument("--only", default="", help="comma-separated sections to run (1..8); the "
+    ap.add_argument("--skip", default="", help="comma-separated sections to skip (1..9)")
+    ap.add_argument("--only", default="", help="comma-separated sections to run (1..9); the "
                     "others keep their last measured figures (docs/benchmarks.json)")
     args = ap.parse_args()
     skip = set(args.skip.split(",")) - {""}
     if args.only:
-        skip |= set(map(str, range(1, 9))) - set(args.only.split(","))
+        skip |= set(map(str, range(1, 10))) - set(args.only.split(","))
     saved = _load_sections()
     q = args.quick
     cores = os.cpu_count() or 1
@@ -314,6 +314,17 @@ def main():
         import readme_speed
         lines += readme_speed.table(readme_speed.measure())
         done("8")
+    if "9" not in skip:
+        import make_batch_benchmark as frames_bench
+        table, speedup = frames_bench.measure(4 if q else 8)
+        frames_bench.write_doc(table)
+        targets.append(("frames on 2 Dask workers over 1 (batch renderer)", ">= 1.8x",
+                        f"{speedup:.2f}x", speedup >= 1.8))
+        lines += ["## 9. A frame range on Dask workers", "",
+                  "`python -m drt_addon render --workers N` on a local Dask cluster "
+                  "(`docs/make_batch_benchmark.py`; also in [batch.md](batch.md)).", "",
+                  *table.splitlines(), ""]
+        done("9")
     _write_page(saved)
 
 
