@@ -78,6 +78,13 @@ def _clock(seconds: float) -> str:
     return f"{int(m):02d}:{sec:05.2f}"
 
 
+def _threads_label(threads: int) -> str:
+    """The engine's thread count as the background log shows it (0: the engine's default)."""
+    if not threads:
+        return "all cores"
+    return f"{threads} thread" + ("s" if threads > 1 else "")
+
+
 def _bottom_up(image: np.ndarray) -> np.ndarray:
     """(h, w[, c]) top-down image to Blender's flat bottom-up float32 buffer."""
     return np.ascontiguousarray(image[::-1], dtype=np.float32).reshape(-1)
@@ -198,7 +205,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 if bpy.app.background:
                     # the line render-farm managers parse (Deadline: `Sample ([0-9]+)/([0-9]+)`)
                     print(f"Fra:{scene.frame_current} | Time:{_clock(time.perf_counter() - t0)}"
-                          f" | {line}", flush=True)
+                          f" | {line} | {_threads_label(settings.threads)}", flush=True)
 
             film, stats = engine.render(description, settings, context=ctx, progress=progress,
                                         cancelled=self._cancel_requested)
