@@ -27,6 +27,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
+from .blender_compat import set_pass_pixels
 from .engine_link import engine
 from .export import ExportError, Reporter, export_scene, render_region
 
@@ -190,7 +191,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 if last_render.get("first_sample_seconds") is None:
                     # depsgraph to first sample: export, BVH build, first pass
                     last_render["first_sample_seconds"] = time.perf_counter() - t0
-                combined.rect.foreach_set(_rgba_bottom_up(film.mean(), film.mean_alpha()))
+                set_pass_pixels(combined, _rgba_bottom_up(film.mean(), film.mean_alpha()))
                 self.update_result(result)
                 self.update_progress(fraction)
                 last_render["progress"].append((stats.samples_done, fraction))
@@ -210,7 +211,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             film, stats = engine.render(description, settings, context=ctx, progress=progress,
                                         cancelled=self._cancel_requested)
             image, alpha = film.mean(), film.mean_alpha()
-            combined.rect.foreach_set(_rgba_bottom_up(image, alpha))
+            set_pass_pixels(combined, _rgba_bottom_up(image, alpha))
             if not stats.cancelled:
                 self._write_passes(layer, ctx, film, view_layer, description)
         finally:
@@ -238,5 +239,5 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
         for name in wanted:
-            layer.passes[name].rect.foreach_set(_bottom_up(images[name]))
+            set_pass_pixels(layer.passes[name], _bottom_up(images[name]))
             last_render["passes"][name] = images[name]
