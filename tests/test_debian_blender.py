@@ -66,7 +66,8 @@ def _link(target: str, link: str) -> None:
 
 
 class LegacyBlender:
-    """The blender binary with DRT as a legacy add-on, in a throwaway user folder."""
+    """The blender binary with DRT as a legacy add-on: throwaway preferences and packages
+    folder per test module; the add-on link and its kernel cache kept per checkout."""
 
     def __init__(self, blender: str, home):
         self.blender, self.home = blender, home
