@@ -28,6 +28,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
+from .blender_compat import set_pass_pixels
 from .engine_link import engine
 from .export import BLACK_IMAGE, ExportError, Reporter, export_scene, render_region
 
@@ -82,6 +83,13 @@ def _clock(seconds: float) -> str:
     """Blender's time format in its render log: MM:SS.hh."""
     m, sec = divmod(max(seconds, 0.0), 60.0)
     return f"{int(m):02d}:{sec:05.2f}"
+
+
+def _threads_label(threads: int) -> str:
+    """The engine's thread count as the background log shows it (0: the engine's default)."""
+    if not threads:
+        return "all cores"
+    return f"{threads} thread" + ("s" if threads > 1 else "")
 
 
 def _bottom_up(image: np.ndarray) -> np.ndarray:
@@ -219,7 +227,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 if last_render.get("first_sample_seconds") is None:
                     # depsgraph to first sample: export, BVH build, first pass
                     last_render["first_sample_seconds"] = time.perf_counter() - t0
-                combined.rect.foreach_set(_rgba_bottom_up(film.mean(), film.mean_alpha()))
+                set_pass_pixels(combined, _rgba_bottom_up(film.mean(), film.mean_alpha()))
                 self.update_result(result)
                 self.update_progress(fraction)
                 last_render["progress"].append((stats.samples_done, fraction))
@@ -234,12 +242,12 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 if bpy.app.background:
                     # the line render-farm managers parse (Deadline: `Sample ([0-9]+)/([0-9]+)`)
                     print(f"Fra:{scene.frame_current} | Time:{_clock(time.perf_counter() - t0)}"
-                          f" | {line}", flush=True)
+                          f" | {line} | {_threads_label(settings.threads)}", flush=True)
 
             film, stats = engine.render(description, settings, context=ctx, progress=progress,
                                         cancelled=lambda: self._polled("tracing"))
             image, alpha = film.mean(), film.mean_alpha()
-            combined.rect.foreach_set(_rgba_bottom_up(image, alpha))
+            set_pass_pixels(combined, _rgba_bottom_up(image, alpha))
             if not stats.cancelled and enabled_passes(view_layer) and \
                     self._polled("passes"):
                 stats.cancelled = True             # cancelled before the extra passes
@@ -278,5 +286,5 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
         for name in wanted:
-            layer.passes[name].rect.foreach_set(_bottom_up(images[name]))
+            set_pass_pixels(layer.passes[name], _bottom_up(images[name]))
             last_render["passes"][name] = images[name]
