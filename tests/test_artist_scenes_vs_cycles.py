@@ -14,12 +14,15 @@ hammered Voronoi -> Bump finish on a bevelled metal pedestal with a Noise -> Bum
 finish, a Noise -> Color Ramp backdrop, an Environment Texture world with a small,
 very bright sun, a soft area key lamp). Measured (64 x 48, DRT 512 against Cycles 1024):
 mean -0.06 %, block MAD 0.24 %, worst block 2.1 %. The worst block is the sun's glint in
-the bumped rough metal of the pedestal's rim, and it is noise: DRT is noisier there
-than Cycles (DRT 512 at seeds 0-3: worst block 2.1 %, 4.0 %, 2.5 %, 4.5 %, all in the
-glint; Cycles 1024 against Cycles 4096: 0.6 %) and it shrinks with samples (DRT 2048
-against Cycles 4096: 0.9 %, mean -0.06 %). So this scene's worst block is allowed 6 %
-and its block MAD 1 %. The control, both Bump nodes left out (DRT 128), fails both:
-worst block 9.6 %, block MAD 1.3 %."""
+the bumped rough metal of the pedestal's rim, which is noisy in both engines: against
+Cycles at 4096 samples, at 512 samples and seeds 0-3, DRT's worst block is 1.6, 3.4, 2.8
+and 3.9 % and Cycles' own 1.7, 1.8, 1.0 and 4.4 %, both in the glint. DRT's renders of
+4096 samples in all (seeds 0-3 at 512 and seed 0 at 2048) are there 1.6 % darker than
+Cycles' 4096 (mean -0.08 %, every other block within 0.7 %): about 2.4 standard
+deviations of the two references' (heavy-tailed) noise there, so a bias of that size in
+that one block is possible and not resolved. This scene's worst block is allowed 6 % and
+its block MAD 1 %. The control, both Bump nodes left out (DRT 128), fails both: worst
+block 9.6 %, block MAD 1.3 %."""
 import os
 
 import numpy as np
@@ -32,7 +35,7 @@ CYCLES_SAMPLES = 1024
 DRT_SAMPLES = 512
 MEAN_TOLERANCE = 0.01
 BLOCK_TOLERANCE = 0.03
-PRODUCT_BLOCK_TOLERANCE = 0.06       # DRT's noise in the pedestal's sun glint (above)
+PRODUCT_BLOCK_TOLERANCE = 0.06       # the noise of the pedestal's sun glint (above)
 PRODUCT_BLOCK_MAD_TOLERANCE = 0.01
 
 _renders = {}
