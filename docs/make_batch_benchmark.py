@@ -90,6 +90,13 @@ def main():
                     help="runs of each configuration; the fastest counts (other jobs may "
                          "share the cores)")
     args = ap.parse_args()
+    table, _ = measure(args.frames, args.samples, args.repeat)
+    print(table)
+    write_doc(table)
+
+
+def measure(n_frames: int = 8, samples: int = 32, repeat: int = 2):
+    """(the table for docs/batch.md, the speed-up of 2 workers over 1)."""
     import bpy
 
     import drt_addon
@@ -100,13 +107,13 @@ def main():
     work = tempfile.mkdtemp(prefix="drt-batch-bench-")
     blend = build_animated_cornell(bpy, os.path.join(work, "anim.blend"))
     bpy.ops.wm.open_mainfile(filepath=blend, load_ui=False)
-    bpy.context.scene.frame_end = args.frames
+    bpy.context.scene.frame_end = n_frames
     bpy.ops.wm.save_as_mainfile(filepath=blend)
-    frames = list(range(1, args.frames + 1))
-    overrides = Overrides(samples=args.samples, percentage=PERCENTAGE)
-    one, busy1, start1 = time_dask(bpy, blend, frames, overrides, 1, work, args.repeat)
-    two, busy2, start2 = time_dask(bpy, blend, frames, overrides, 2, work, args.repeat)
-    here = time_single_machine(blend, frames, args.samples, work, args.repeat)
+    frames = list(range(1, n_frames + 1))
+    overrides = Overrides(samples=samples, percentage=PERCENTAGE)
+    one, busy1, start1 = time_dask(bpy, blend, frames, overrides, 1, work, repeat)
+    two, busy2, start2 = time_dask(bpy, blend, frames, overrides, 2, work, repeat)
+    here = time_single_machine(blend, frames, samples, work, repeat)
     w, h = 32 * PERCENTAGE // 100, 24 * PERCENTAGE // 100
     rows = [
         "| configuration | seconds for the range | per frame | tasks running at once "
@@ -119,8 +126,8 @@ def main():
         f"| one machine, no Dask (engine threads on both cores) | {here:.1f} | "
         f"{here / len(frames):.2f} | - | {one / here:.2f} |",
     ]
-    note = (f"\n{len(frames)} frames of {w} x {h} pixels at {args.samples} samples, written "
-            f"as PNG; fastest of {args.repeat} runs each; {os.cpu_count()} cores (the machine "
+    note = (f"\n{len(frames)} frames of {w} x {h} pixels at {samples} samples, written "
+            f"as PNG; fastest of {repeat} runs each; {os.cpu_count()} cores (the machine "
             f"has 2), load average {load:.1f} when the run started and "
             f"{os.getloadavg()[0]:.1f} at its end (other jobs shared the cores). Starting the "
             f"local cluster and warming its workers (import bpy, open the file, load the "
@@ -133,9 +140,7 @@ def main():
                  "second core, not what a second core gives; compare the one-machine row, "
                  "whose engine threads had both cores too. Rerun on an idle machine.")
     note += " Written by `docs/make_batch_benchmark.py`."
-    table = "\n".join(rows) + "\n" + note
-    print(table)
-    write_doc(table)
+    return "\n".join(rows) + "\n" + note, one / two
 
 
 if __name__ == "__main__":

@@ -45,16 +45,26 @@ KNOWN = """## Known differences
 - **Normal Map in a lit scene.** The node's value matches Cycles per pixel (the
   `normal_map` tiles). Cycles' Principled BSDF lights its diffuse lobe by the map's
   normal and its specular lobes by that normal made a valid reflector for the view;
-  DRT does the same and applies Cycles' bump shadowing term. A plane tilted by its map
-  under an overhead sun agrees to 0.5%; with the sun off the vertical DRT is 2 to 4%
-  brighter, and a normal-mapped diffuse sphere 5 to 12%. The cause is not found yet.
+  DRT does the same, with Cycles 5.0's bump shadowing: light from under the surface's
+  own smooth normal is refused to every lobe, and the diffuse lobe's light fades
+  towards the smooth surface's terminator by a GGX shadowing whose roughness grows with
+  the bend (Conty Estevez et al.). A plane tilted by its map agrees with Cycles to
+  0.00% under an overhead sun and suns off the vertical
+  (`tests/test_nodes_vs_cycles.py`); a normal-mapped diffuse sphere under a low sun to
+  0.02% in the mean and 0.7% of the image mean in its largest 8 x 8 block
+  (`tests/test_bump_vs_cycles.py`; 52% with the shadowing term of Cycles 3 and 4).
+  On a coarser sphere (32 x 16 faces) DRT is darker than Cycles on a few pixels by
+  the lit silhouette: DRT takes no light from below a triangle's own plane, while
+  Cycles does when the light is above the smooth normal. Material > Settings > Bump Map Correction turned off is not honoured
+  (warned): DRT always corrects, Cycles' default.
 - **Bump.** Evaluated as Cycles 5.0 does: the Height's nodes run again at the hit moved
   by Filter Width pixel steps along two tangents, the steps from each ray's footprint
   (Cycles' compact ray differentials: a cone from the camera's pixel that keeps growing
   with the path's length after bounces). The normals match Cycles per pixel (the
-  `bump` tiles; on a perspective view of a bumped floor to 0.2%), so the lit gap of
-  Normal Map above applies to Bump as well: a bumped lit floor is 0.7% darker than
-  Cycles (`tests/test_bump_vs_cycles.py`), a bumped sphere up to 8% per 8 x 8 block.
+  `bump` tiles; on a perspective view of a bumped floor to 0.2%) and are lit as Normal
+  Map's above: a bumped lit floor agrees with Cycles to 0.08% in the mean and 0.17%
+  in its largest block, a bumped glossy sphere under a low sun to 0.09% and 0.6%
+  (`tests/test_bump_vs_cycles.py`).
   Texture Coordinate's Normal is not moved at the offset hits (Cycles moves it with
   the interpolated normal), and the NumPy reference integrator has no footprints
   (its bumps are flat).

@@ -174,7 +174,17 @@ def open_blend(bpy, path: str) -> None:
         bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False)
     except RuntimeError as e:
         first = str(e).strip().splitlines()[0] if str(e).strip() else "unreadable file"
+        first = first.removeprefix("Error: ")       # Blender's report level
         raise CliError(EXIT_FILE, f"drt: error: cannot open {path}: {first}") from None
+
+
+def say_warnings(progress, warnings) -> None:
+    """The render's warnings (the RenderEngine's reports) on stderr, one line each, each
+    once per job."""
+    for message in warnings:
+        if message not in progress.warned:
+            progress.warned.add(message)
+            progress.say(f"drt: warning: {message.removeprefix('DRT: ')}", file=sys.stderr)
 
 
 def _frame_list(args, scene) -> list[int]:
@@ -214,6 +224,13 @@ def _make_folders(jobs) -> None:
                                        f"{folder}: {e.strerror}") from None
 
 
+def _frame_failed(frame: int, error: str) -> CliError:
+    """The one line of a frame whose render failed (the engine's message without its
+    'DRT: render failed:' prefix)."""
+    reason = error.removeprefix("DRT: ").removeprefix("render failed: ")
+    return CliError(EXIT_RENDER, f"drt: error: render of frame {frame} failed: {reason}")
+
+
 def render_frame_here(bpy, scene, frame: int, path: str, overrides, progress) -> FrameResult:
     """One frame through Blender's render pipeline, written to `path` atomically."""
     from . import render_engine
@@ -222,11 +239,18 @@ def render_frame_here(bpy, scene, frame: int, path: str, overrides, progress) ->
     asked = scene.drt.samples if drt else scene.cycles.samples
     progress.start_frame(f"frame {frame}", asked)
     t0 = time.perf_counter()
-    bpy.ops.render.render(write_still=False)
+    failed = None
+    try:
+        bpy.ops.render.render(write_still=False)
+    except RuntimeError as e:   # an engine's error report (DRT's is in last_render too)
+        failed = str(e).strip().removeprefix("Error: ") or "unknown"
     seconds = time.perf_counter() - t0
-    if drt and not render_engine.last_render.get("ok"):
-        raise CliError(EXIT_RENDER, f"drt: error: render of frame {frame} failed: "
-                                    f"{render_engine.last_render.get('error') or 'unknown'}")
+    if drt:
+        say_warnings(progress, render_engine.last_render.get("warnings") or ())
+        if not render_engine.last_render.get("ok"):
+            failed = render_engine.last_render.get("error") or failed or "unknown"
+    if failed:
+        raise _frame_failed(frame, failed)
     try:
         save_render_result(bpy, scene, path)
     except (RuntimeError, OSError) as e:

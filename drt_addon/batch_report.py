@@ -32,6 +32,7 @@ class Progress:
         self.frames = tqdm(total=n_frames, desc="frames", unit="frame", file=sys.stderr,
                            position=0, disable=not enabled, dynamic_ncols=True)
         self.samples = None
+        self.warned = set()                 # warnings said (each once per job)
 
     def say(self, message: str, file=None) -> None:
         self._tqdm.write(message, file=file or sys.stdout)

@@ -61,8 +61,9 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
     filter_type: EnumProperty(name="Filter", items=FILTER_ITEMS, default="BLACKMAN_HARRIS")
     filter_width: FloatProperty(name="Width", description="Pixel filter width in pixels",
                                 default=1.5, min=0.01, max=10.0, subtype="PIXEL")
-    threads: IntProperty(name="Threads", description="Worker threads (0 = all cores)",
-                         default=0, min=0, max=256)
+    threads: IntProperty(name="Threads", description="Worker threads (0: Blender's own "
+                         "fixed thread count (Performance > Threads, or `blender -t N`) "
+                         "when set, else all cores)", default=0, min=0, max=256)
 
     def to_engine_settings(self):
         """The engine's settings: DRT's own, and the file's Cycles settings DRT shares
@@ -86,7 +87,19 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
             transparent_bounces=self.transparent_bounces,
             volume_bounces=self.volume_bounces, clamp_direct=self.clamp_direct,
             clamp_indirect=self.clamp_indirect, filter_type=self.filter_type,
-            filter_width=self.filter_width, threads=self.threads)
+            filter_width=self.filter_width, threads=self.engine_threads())
+
+    def engine_threads(self) -> int:
+        """DRT's Threads; at 0, Blender's fixed thread count when there is one: Render
+        Properties > Performance > Threads set to Fixed, or `blender -t N` on the command
+        line, which Blender reports as Fixed with N threads (render farms: Deadline passes
+        -t). Else 0, every core (up to 8)."""
+        if self.threads:
+            return self.threads
+        render = getattr(self.id_data, "render", None)
+        if render is not None and render.threads_mode == "FIXED":
+            return render.threads
+        return 0
 
 
 def register():

@@ -19,6 +19,7 @@ Region).
 """
 from __future__ import annotations
 
+import os
 import time
 import traceback
 from importlib import import_module
@@ -27,8 +28,9 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
+from .blender_compat import set_pass_pixels
 from .engine_link import engine
-from .export import ExportError, Reporter, export_scene, render_region
+from .export import BLACK_IMAGE, ExportError, Reporter, export_scene, render_region
 
 aov = import_module(engine.__name__ + ".aov")   # engine.aov, in either package layout
 
@@ -36,10 +38,15 @@ aov = import_module(engine.__name__ + ".aov")   # engine.aov, in either package 
 # FINISHED even when an engine reported an error). "scene" is the exported description,
 # "passes" the extra passes written (top-down float arrays by pass name).
 last_render = {"ok": None, "error": None, "warnings": [], "stats": None, "pixels": None,
-               "scene": None, "export_stats": None, "passes": {}, "region": None}
+               "scene": None, "export_stats": None, "passes": {}, "region": None,
+               "cancelled_in": None, "phase": None}
 # Callables told (samples done, samples asked) after every progressive pass (the batch
 # renderer's progress bar).
 progress_listeners: list = []
+
+
+class RenderCancelled(Exception):
+    """The user cancelled the render before tracing began (the message: the phase)."""
 
 
 class DRTViewLayerSettings(bpy.types.PropertyGroup):
@@ -76,6 +83,13 @@ def _clock(seconds: float) -> str:
     """Blender's time format in its render log: MM:SS.hh."""
     m, sec = divmod(max(seconds, 0.0), 60.0)
     return f"{int(m):02d}:{sec:05.2f}"
+
+
+def _threads_label(threads: int) -> str:
+    """The engine's thread count as the background log shows it (0: the engine's default)."""
+    if not threads:
+        return "all cores"
+    return f"{threads} thread" + ("s" if threads > 1 else "")
 
 
 def _bottom_up(image: np.ndarray) -> np.ndarray:
@@ -133,18 +147,39 @@ class DRTRenderEngine(bpy.types.RenderEngine):
 
     def render(self, depsgraph):
         last_render.update(ok=False, error=None, warnings=[], stats=None, pixels=None,
-                           scene=None, export_stats=None, passes={}, region=None, progress=[])
+                           scene=None, export_stats=None, passes={}, region=None, progress=[],
+                           cancelled_in=None, phase=None)
         try:
             self._render(depsgraph)
+        except RenderCancelled as e:
+            last_render.update(ok=False, error="cancelled", cancelled_in=str(e))
+            self.update_stats("", "DRT: cancelled")
         except ExportError as e:
             self._fail(str(e))
         except Exception as e:  # never let an exception escape into Blender
-            traceback.print_exc()
+            # the traceback is for bug reports: on Blender's console, not in the batch
+            # renderer's stderr (one line there; DRT_TRACEBACK=1 shows it)
+            last_render["traceback"] = traceback.format_exc()
+            if not bpy.app.background or os.environ.get("DRT_TRACEBACK"):
+                traceback.print_exc()
             self._fail(f"DRT: render failed: {type(e).__name__}: {e}")
 
     def _cancel_requested(self) -> bool:
-        """Esc in Blender (polled between work units, so a cancel lands within one unit)."""
+        """Esc in Blender (polled before each object of the export, before and after the
+        acceleration structure, between work units of the tracing and before the extra
+        passes, so a cancel lands within one of those steps)."""
         return self.test_break()
+
+    def _polled(self, phase: str) -> bool:
+        """Whether the user cancelled, asked during `phase` (kept in last_render["phase"]:
+        'export', 'acceleration structure', 'tracing' or 'passes')."""
+        last_render["phase"] = phase
+        return self._cancel_requested()
+
+    def _check_cancel(self, phase: str) -> None:
+        """Stop the render here (raises RenderCancelled) if the user cancelled it."""
+        if self._polled(phase):
+            raise RenderCancelled(phase)
 
     def _fail(self, message):
         last_render.update(ok=False, error=message)
@@ -162,7 +197,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         last_render["first_sample_seconds"] = None
         export_stats = {}
         description = export_scene(depsgraph, reporter, region=region, stats=export_stats,
-                                   render_engine=self)
+                                   render_engine=self,
+                                   check_cancel=lambda: self._check_cancel("export"))
         settings = scene.drt.to_engine_settings()
         if self.is_preview:
             settings = preview_settings(settings)
@@ -172,8 +208,16 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             raise ExportError(f"DRT: invalid render settings: {e}") from e
         export_seconds = time.perf_counter() - t0
         last_render.update(scene=description, export_stats=export_stats, region=region)
+        self._check_cancel("export")
         self.update_stats("", "DRT: building acceleration structure")
+        t_build = time.perf_counter()
         ctx = engine.RenderContext(description, settings)
+        last_render["build_seconds"] = time.perf_counter() - t_build
+        try:
+            self._check_cancel("acceleration structure")
+        except RenderCancelled:
+            ctx.close()
+            raise
         result = self.begin_result(0, 0, region.width, region.height, layer=view_layer.name)
         layer = result.layers[0]
         combined = layer.passes["Combined"]
@@ -183,7 +227,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 if last_render.get("first_sample_seconds") is None:
                     # depsgraph to first sample: export, BVH build, first pass
                     last_render["first_sample_seconds"] = time.perf_counter() - t0
-                combined.rect.foreach_set(_rgba_bottom_up(film.mean(), film.mean_alpha()))
+                set_pass_pixels(combined, _rgba_bottom_up(film.mean(), film.mean_alpha()))
                 self.update_result(result)
                 self.update_progress(fraction)
                 last_render["progress"].append((stats.samples_done, fraction))
@@ -198,17 +242,28 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 if bpy.app.background:
                     # the line render-farm managers parse (Deadline: `Sample ([0-9]+)/([0-9]+)`)
                     print(f"Fra:{scene.frame_current} | Time:{_clock(time.perf_counter() - t0)}"
-                          f" | {line}", flush=True)
+                          f" | {line} | {_threads_label(settings.threads)}", flush=True)
 
             film, stats = engine.render(description, settings, context=ctx, progress=progress,
-                                        cancelled=self._cancel_requested)
+                                        cancelled=lambda: self._polled("tracing"))
             image, alpha = film.mean(), film.mean_alpha()
-            combined.rect.foreach_set(_rgba_bottom_up(image, alpha))
+            set_pass_pixels(combined, _rgba_bottom_up(image, alpha))
+            if not stats.cancelled and enabled_passes(view_layer) and \
+                    self._polled("passes"):
+                stats.cancelled = True             # cancelled before the extra passes
+                last_render["cancelled_in"] = "passes"
+            elif stats.cancelled:
+                last_render["cancelled_in"] = "tracing"
             if not stats.cancelled:
                 self._write_passes(layer, ctx, film, view_layer, description)
         finally:
             ctx.close()
             self.end_result(result)
+        held_out = description.film_transparent or description.has_holdouts()
+        if not stats.cancelled and not np.any(image) and not held_out:
+            reporter.warn("DRT: the image is black: no light from the scene reaches the "
+                          "camera (check where the camera looks, its clipping range, and "
+                          "the lights)", key=BLACK_IMAGE)
         if stats.nonfinite_samples:
             reporter.warn(f"DRT: {stats.nonfinite_samples} samples were NaN or infinite and "
                           "were dropped")
@@ -231,5 +286,5 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
         for name in wanted:
-            layer.passes[name].rect.foreach_set(_bottom_up(images[name]))
+            set_pass_pixels(layer.passes[name], _bottom_up(images[name]))
             last_render["passes"][name] = images[name]

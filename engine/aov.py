@@ -74,8 +74,10 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16) -> F
     for start in range(0, n_pix, chunk):
         pix = np.arange(start, min(start + chunk, n_pix))
         xy = np.stack([pix % width + 0.5, pix // width + 0.5], axis=1).astype(np.float64)
-        rays = pinhole.generate(xy)
-        hits = ctx.accel.intersect(rays.origins, rays.directions, rays.tmax)
+        # with motion blur, the scene at the shutter's middle (the frame itself)
+        middle = np.full(len(pix), 0.5) if ctx.has_motion else None
+        rays = pinhole.generate(xy, time=middle)
+        hits = _intersect(ctx, rays.origins, rays.directions, rays.tmax, middle)
         hit = np.nonzero(hits.hit)[0]
         if hit.size:
             p = rays.origins[hit] + rays.directions[hit] * hits.t[hit, None]

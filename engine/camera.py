@@ -40,8 +40,13 @@ class CameraModel:
         if camera.kind not in ("PERSP", "ORTHO"):
             raise ValueError(f"unsupported camera type {camera.kind!r} (perspective and "
                              "orthographic are supported)")
-        if camera.clip_end <= camera.clip_start:
-            raise ValueError("camera clip end must be beyond clip start")
+        # A clip end not beyond the clip start, or an orthographic scale of 0: Cycles
+        # renders the world alone (measured; tests/test_fuzz_renders.py), and so do these
+        # rays, of length 0.
+        self.sees_nothing = bool(camera.clip_end <= camera.clip_start or
+                                 (camera.kind == "ORTHO" and not camera.ortho_scale > 0))
+        self.clip_start = float(camera.clip_start)
+        self.clip_end = self.clip_start if self.sees_nothing else float(camera.clip_end)
 
         x_ratio = self.width * pixel_aspect
         y_ratio = float(self.height)
@@ -61,9 +66,7 @@ class CameraModel:
                 raise ValueError("camera lens and sensor size must be positive")
             half_fit = 0.5 * sensor / camera.lens           # on the plane z = -1
         else:
-            if camera.ortho_scale <= 0:
-                raise ValueError("orthographic scale must be positive")
-            half_fit = 0.5 * camera.ortho_scale
+            half_fit = 0.5 * max(camera.ortho_scale, 0.0)
         if horizontal:
             self.half_x, self.half_y = half_fit, half_fit * y_ratio / x_ratio
         else:
@@ -115,8 +118,8 @@ class CameraModel:
             d_cam = np.tile([0.0, 0.0, -1.0], (n, 1))
         d_cam /= np.linalg.norm(d_cam, axis=1, keepdims=True)
         cos_axis = -d_cam[:, 2]                           # > 0 for every camera ray
-        t_near = cam.clip_start / cos_axis
-        t_far = cam.clip_end / cos_axis
+        t_near = self.clip_start / cos_axis
+        t_far = self.clip_end / cos_axis
         if time is not None and cam.motion is not None:
             m = cam.motion.at(time)
             rot = m[:, :3, :3] / np.linalg.norm(m[:, :3, :3], axis=1, keepdims=True)

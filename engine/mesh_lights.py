@@ -41,7 +41,7 @@ from .surface import RELATIVE_OFFSET
 
 
 class EmissiveTriangles:
-    def __init__(self, v0, v1, v2, radiance, prim_ids, n_prims_total: int):
+    def __init__(self, v0, v1, v2, radiance, prim_ids, n_prims_total: int, center=None):
         v0, v1, v2 = (np.asarray(v, dtype=np.float64).reshape(-1, 3) for v in (v0, v1, v2))
         radiance = np.asarray(radiance, dtype=np.float64).reshape(-1, 3)
         prim_ids = np.asarray(prim_ids, dtype=np.int64).reshape(-1)
@@ -57,7 +57,9 @@ class EmissiveTriangles:
         self.radiance = radiance[keep]
         self.power = power[keep]
         self.prim = prim_ids[keep]
-        self.tri_scale = np.max(np.abs(np.stack([v0, v1, v2], 1)), axis=(1, 2))[keep] \
+        # the offset scale relative to the static scene's centre (engine.accel, surface)
+        c = np.zeros(3) if center is None else np.asarray(center, np.float64)
+        self.tri_scale = np.max(np.abs(np.stack([v0 - c, v1 - c, v2 - c], 1)), axis=(1, 2))[keep] \
             if len(v0) else np.zeros(0)
         self.entry = np.full(max(int(n_prims_total), 1), -1, dtype=np.int64)
         self.entry[self.prim] = np.arange(len(self.prim))
@@ -86,7 +88,7 @@ class EmissiveTriangles:
         p = accel.positions
         t = tri[emissive]
         return cls(p[t[:, 0]], p[t[:, 1]], p[t[:, 2]], emission[mat[emissive]], emissive,
-                   len(tri))
+                   len(tri), getattr(accel, "center", None))
 
     def __len__(self):
         return len(self.area)
@@ -122,7 +124,7 @@ class EmissiveTriangles:
         # Shadow rays stop before the plane offset from the triangle by the same relative
         # amount as ray origins (engine.surface), measured along the ray: Embree rounds
         # the triangle and the ray to float32, so the light must not occlude itself.
-        scale = np.maximum(np.max(np.abs(q), axis=1), self.tri_scale[tri])
+        scale = self.tri_scale[tri]          # bounds q's coordinates (relative to the centre)
         margin = np.where(ok, RELATIVE_OFFSET * scale / np.where(ok, cos_l, 1.0), 0.0)
         return LightSample(wi, dist, rad, pdf, False, margin)
 

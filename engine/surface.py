@@ -6,7 +6,9 @@ leaving the surface starts at the hit point pushed along the geometric normal, t
 side it leaves from, by an amount proportional to the magnitude of the coordinates
 involved: that bounds the float32 rounding Embree applies to origins and triangles, so
 there is no self-intersection (acne) and, the offset being relative, no leaking through
-thin geometry at any scene scale from 1e-3 to 1e4.
+thin geometry at any scene scale from 1e-3 to 1e4. The magnitude is measured from the
+centre Embree sees the static scene around (engine.accel), so it does not grow when the
+whole scene is far from the world origin.
 """
 from __future__ import annotations
 
@@ -58,8 +60,10 @@ class SurfaceBuilder:
         self.v0, self.v1, self.v2 = (np.concatenate([a] + e) if e else a
                                      for a, e in zip((v0, v1, v2), extra))
         self.normal = _unit_normals(self.v0, self.v1, self.v2)
-        self.tri_scale = np.max(np.abs(np.stack([self.v0, self.v1, self.v2], 1)), axis=(1, 2)) \
-            if len(self.v0) else np.zeros(0)
+        # the offset scale: the magnitude of the coordinates Embree rounds, relative to the
+        # static scene's centre (engine.accel) for static triangles
+        self.tri_scale = triangle_scale(self.v0, self.v1, self.v2, accel.center,
+                                        accel.static_count)
         self.material = (np.concatenate([m.material_indices for m in ordered]).astype(np.int64)
                          if ordered else np.zeros(0, np.int64))
         # Holdout triangles (None when the scene has none): camera rays end there.
@@ -160,7 +164,8 @@ class SurfaceBuilder:
         if self.accel.moving and (prim >= self.accel.static_count).any():
             v0, v1, v2, normal_m = self._moving_vertices(prim, time[index])
             ng = _unit_normals(v0, v1, v2)
-            tri_scale = np.max(np.abs(np.stack([v0, v1, v2], 1)), axis=(1, 2))
+            tri_scale = np.where(prim < self.accel.static_count, self.tri_scale[prim],
+                                 np.max(np.abs(np.stack([v0, v1, v2], 1)), axis=(1, 2)))
         else:
             v0, v1, v2 = self.v0[prim], self.v1[prim], self.v2[prim]
             ng = self.normal[prim]
@@ -184,7 +189,7 @@ class SurfaceBuilder:
             ns[bad] = ng_f[bad]
         else:
             ns = ng_f
-        scale = np.maximum(np.max(np.abs(pos), axis=1), tri_scale)
+        scale = tri_scale              # bounds the hit point's coordinates too
         uv = None
         if self.corner_uvs is not None:
             # the same barycentric weights as the position: w vertex 0, u vertex 1, v vertex 2
@@ -227,6 +232,17 @@ def _object_table(ordered):
                                  info.texspace_size)
     counts = [len(m.triangles) for m in ordered]
     return np.repeat(np.arange(len(ordered), dtype=np.int32), counts), rows
+
+
+def triangle_scale(v0, v1, v2, center, static_count) -> np.ndarray:
+    """Per triangle, the largest coordinate magnitude of its corners: relative to `center`
+    for the first static_count (static) triangles, absolute for the rest (moving objects,
+    traced in their own spaces)."""
+    if not len(v0):
+        return np.zeros(0)
+    c = np.zeros((len(v0), 3))
+    c[:static_count] = center
+    return np.max(np.abs(np.stack([v0 - c, v1 - c, v2 - c], 1)), axis=(1, 2))
 
 
 def _unit_normals(v0, v1, v2):

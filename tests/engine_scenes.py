@@ -114,3 +114,21 @@ def scaled(scene: Scene, s: float) -> Scene:
     out.camera.focus_distance *= s
     out.camera.aperture_radius *= s
     return out
+
+
+def translated(scene: Scene, offset) -> Scene:
+    """The same scene moved by `offset` (geometry, lights and camera): the same image."""
+    import copy
+    out = copy.deepcopy(scene)
+    t = np.asarray(offset, dtype=np.float64)
+    for m in out.meshes:
+        m.positions = m.positions + t
+    for l in out.lights:
+        if isinstance(l, AreaLight):
+            l.matrix = l.matrix.copy()
+            l.matrix[:3, 3] += t
+        elif isinstance(l, PointLight):
+            l.position = tuple(np.asarray(l.position) + t)
+    out.camera.matrix = out.camera.matrix.copy()
+    out.camera.matrix[:3, 3] += t
+    return out

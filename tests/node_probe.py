@@ -90,6 +90,20 @@ def build_scene(bpy, cases, columns=None, shape="plane", tile=TILE):
     return scene, columns, rows
 
 
+def sun_and_top_camera(bpy, scene, sun_rotation, sun_angle, ortho_scale, height):
+    """A sun of strength 3 turned by `sun_rotation` (Euler, radians) and an orthographic
+    camera `height` above the origin looking down, made the scene's camera."""
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy, sun.data.angle = 3.0, sun_angle
+    sun.rotation_euler = sun_rotation
+    scene.collection.objects.link(sun)
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.data.type, cam.data.ortho_scale = "ORTHO", ortho_scale
+    cam.location = (0.0, 0.0, height)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+
+
 def render(bpy, scene, engine, samples):
     use_engine(scene, engine, samples)
     return render_current(bpy, scene)

@@ -49,7 +49,9 @@ def test_skip_existing_resumes_a_job(anim_blend, tmp_path, capsys):
     for f in (1, 3):
         assert (tmp_path / f"f_000{f}.png").read_bytes().startswith(PNG_MAGIC)
     assert "(exists, skipped)" in out and "2 frame(s) rendered" in out and "1 skipped" in out
-    assert err == ""                                        # --no-progress: quiet stderr
+    # --no-progress: no bars on stderr, only the render's warnings (one line each)
+    assert all(l.startswith("drt: warning:") for l in err.splitlines()), err
+    assert "Max Samples is 64, not used" in err
 
 
 def test_without_o_the_blend_output_path_and_format(bpy_drt, anim_blend, tmp_path, capsys):

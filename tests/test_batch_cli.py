@@ -129,3 +129,18 @@ def test_a_file_with_video_output_renders_stills(tmp_path, movie_output_blend, e
     assert proc.returncode == 0, proc.stderr
     assert out.read_bytes().startswith(_MAGIC[ext])
     assert movie_output_blend.read_bytes() == before
+
+
+def test_a_missing_library_is_one_warning_line_in_a_real_process(bpy_drt, tmp_path):
+    """In a process of its own, Blender's own notes about the missing library go to
+    stdout; stderr holds DRT's one warning line (tests/hostile_cases.py has the rest)."""
+    from hostile_cases import CASES, _write_case
+    kind = next(k for name, *_, k in CASES if name.startswith("a linked library"))
+    blend = str(tmp_path / "linked.blend")
+    _write_case(bpy_drt, kind, blend, str(tmp_path))
+    proc = drt("render", blend, "-o", str(tmp_path / "x.png"), "--no-progress")
+    assert proc.returncode == 0, proc.stderr
+    lines = [l for l in proc.stderr.splitlines() if l.strip()]
+    assert len(lines) == 1 and lines[0].startswith("drt: warning: linked library"), lines
+    assert "Object 'LibCube'" in lines[0]
+    assert (tmp_path / "x.png").exists()

@@ -26,7 +26,8 @@ tiny and finite angles, area SQUARE / RECTANGLE / DISK / ELLIPSE scaled, rotated
 sheared and mirrored with normalize on and off, world, emissive triangles), tiny lights,
 all together, and an empty set. Shading points: a box about each light, close to it
 (1e-8 .. 3), near an area light's plane, inside sphere lights, at a light's centre and
-1e4 away. A negative control checks that the comparison does fail on a 1e-6 change.
+1e4 away. A negative control checks that the comparison does fail on a 1e-5 change of a
+value three rows see, and on a 1e-6 change every row sees.
 """
 from __future__ import annotations
 
@@ -250,21 +251,43 @@ def close(kernel, numpy, what, rtol=RTOL, atol=0.0):
                            f"{np.atleast_1d(numpy)[bad][:2]}")
 
 
+# A row NumPy evaluates alone goes through BLAS too ((1, 3) @ (3,)): a plain sum on some
+# CPUs' OpenBLAS kernels, fused multiply-adds on others (seen on AMD EPYC), so such a row
+# may still differ from the kernel by the amplified ulp the module docstring measures
+# (wi 8e-12, pdf 6e-7 relative near a lamp's plane), and a ray through a lamp's rim may
+# hit in one and miss in the other (a pdf of 0 against one that is not), and a direction
+# along a lamp's plane has a pdf (d^2 / (A cos)) above PLANE that the last ulp of the
+# cosine decides: at most MAX_TIES of the rows.
+REDO_VALUE, REDO_DIRECTION = (1e-6, 0.0), (0.0, 1e-10)
+PLANE = 1e12
+MAX_TIES = 0.005
+
+
 def agree(what, names, tols, kernel, numpy, numpy_row):
     """The kernel's arrays equal NumPy's batch results to the tolerances, or, for the
-    rows where they do not, NumPy's result for that row alone (`numpy_row(i)`); see the
-    module docstring."""
+    rows where they do not, NumPy's result for that row alone (`numpy_row(i)`) to
+    REDO_* tolerances (exact fields stay exact), or are a rim tie; see above."""
     redo = np.zeros(len(kernel[0]), dtype=bool)
     for k, n, (rtol, atol) in zip(kernel, numpy, tols):
         redo |= mismatched(k, n, rtol, atol)
     assert redo.mean() <= MAX_REDONE, \
         f"{what}: {redo.sum()} of {len(redo)} rows differ from NumPy's batch"
+    ties = 0
     for i in np.nonzero(redo)[0]:
         one = numpy_row(i)
-        for name, k, n, o, (rtol, atol) in zip(names, kernel, numpy, one, tols):
-            assert not mismatched(k[i:i + 1], o, rtol, atol)[0], (
-                f"{what}, row {i}, {name}: kernel {k[i]} vs NumPy {o[0]} "
-                f"(in a batch {n[i]})")
+        for name, k, n, o, tol in zip(names, kernel, numpy, one, tols):
+            rtol, atol = tol if tol == EXACT else (REDO_DIRECTION if tol == DIRECTION
+                                                   else REDO_VALUE)
+            if not mismatched(k[i:i + 1], o, rtol, atol)[0]:
+                continue
+            mine, theirs = np.atleast_1d(k[i]), np.atleast_1d(o[0])
+            if tol == VALUE and (((mine == 0) != (theirs == 0)).any()
+                                 or np.abs(np.concatenate([mine, theirs])).max() > PLANE):
+                ties += 1              # a ray through a lamp's rim or along its plane
+                continue
+            raise AssertionError(f"{what}, row {i}, {name}: kernel {k[i]} vs NumPy {o[0]} "
+                                 f"(in a batch {n[i]})")
+    assert ties <= max(1, MAX_TIES * len(redo)), f"{what}: {ties} rim ties"
 
 
 SAMPLE_FIELDS = ("entry", "wi", "dist", "radiance", "pdf", "delta", "margin")
@@ -482,7 +505,7 @@ def test_moving_lamp_is_not_packed():
 
 
 def test_negative_control_comparison_fails():
-    """The comparison must fail on a 1e-6 change: one lamp's radiance seen by 3 rows only
+    """The comparison must fail on a small change: one lamp's radiance seen by 3 rows only
     (caught by the one-row re-evaluation), one pick probability on every row (caught by
     the batch comparison), and a kernel fed another scene's lamps."""
     ls, anchors = light_set("all")
@@ -496,7 +519,7 @@ def test_negative_control_comparison_fails():
     up_few = np.where(np.arange(len(p)) < 3, in_area, ls.cdf[0] * 0.5)   # lamp 0 else
     compare_sample(L, ls, p, up_few, u)
     bad = tuple(a.copy() for a in L)
-    bad[LAMPS][k_area, C_RAD] *= 1.0 + 1e-6
+    bad[LAMPS][k_area, C_RAD] *= 1.0 + 1e-5
     with pytest.raises(AssertionError, match="row [012], radiance"):
         compare_sample(bad, ls, p, up_few, u)
     bad = tuple(a.copy() for a in L)

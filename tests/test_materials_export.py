@@ -59,6 +59,28 @@ def close(a, b, tol=1e-6):
     return np.allclose(np.asarray(a, float), np.asarray(b, float), atol=tol)
 
 
+def test_constant_nodes_feed_their_value(bpy_drt):
+    """An RGB, a Value and a muted Math node straight into the BSDF: a graph of constants
+    only (no instruction), folded at export to the nodes' values (it folded to 0, a black
+    and smooth surface, before)."""
+    _reset(bpy_drt)
+    mat, nt = _material(bpy_drt, "Constants", keep_principled=True)
+    bsdf = nt.nodes["Principled BSDF"]
+    rgb = nt.nodes.new("ShaderNodeRGB")
+    rgb.outputs[0].default_value = (0.2, 0.5, 0.8, 1.0)
+    value = nt.nodes.new("ShaderNodeValue")
+    value.outputs[0].default_value = 0.3
+    muted = nt.nodes.new("ShaderNodeMath")
+    muted.inputs[0].default_value = 0.7
+    muted.mute = True
+    nt.links.new(rgb.outputs[0], bsdf.inputs["Base Color"])
+    nt.links.new(value.outputs[0], bsdf.inputs["Roughness"])
+    nt.links.new(muted.outputs[0], bsdf.inputs["Metallic"])
+    m, warnings = _export(mat)
+    assert close(m.base_color, (0.2, 0.5, 0.8)) and warnings == []
+    assert m.roughness == pytest.approx(0.3) and m.metallic == pytest.approx(0.7)
+
+
 # --------------------------------------------------------------------------- node kinds
 def test_principled_values(bpy_drt):
     bpy = bpy_drt
@@ -330,6 +352,22 @@ def _plane(bpy, name, x=0.0, half=1.0, uv=((0, 0), (1, 0), (1, 1), (0, 1))):
     obj = bpy.data.objects.new(name, mesh)
     bpy.context.scene.collection.objects.link(obj)
     return obj
+
+
+def test_bump_map_correction_off_warns(bpy_drt):
+    """Cycles' Bump Map Correction (on by default) shapes how a bent normal is lit; DRT
+    always applies it, so a material that turns it off and bends its normal is warned."""
+    bpy = bpy_drt
+    mat, nt = _material(bpy, "Mapped", keep_principled=True)
+    nmap = nt.nodes.new("ShaderNodeNormalMap")
+    nt.links.new(nmap.outputs[0], nt.nodes["Principled BSDF"].inputs["Normal"])
+    assert _export(mat)[1] == []
+    mat.cycles.use_bump_map_correction = False
+    warnings = _export(mat)[1]
+    assert len(warnings) == 1 and "Bump Map Correction" in warnings[0], warnings
+    for link in list(nt.nodes["Principled BSDF"].inputs["Normal"].links):
+        nt.links.remove(link)
+    assert _export(mat)[1] == []            # no bent normal: nothing to correct
 
 
 def test_unsupported_nodes_warn_once_per_material_and_render(bpy_drt):

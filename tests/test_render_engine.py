@@ -40,7 +40,8 @@ def test_cancel_stops_within_one_work_unit_and_keeps_a_valid_image(bpy_drt):
     polls = []
 
     def cancel_after_a_few_polls(self):
-        polls.append(1)
+        if last_render["phase"] == "tracing":
+            polls.append(1)
         return len(polls) > 6
 
     original = DRTRenderEngine._cancel_requested
@@ -113,3 +114,19 @@ def test_noise_threshold_and_time_limit_reach_the_engine(bpy_drt):
     scene.drt.use_adaptive_sampling = False
     scene.drt.time_limit = 0.5
     assert scene.drt.to_engine_settings().time_limit == pytest.approx(0.5)
+
+
+def test_blender_fixed_threads_reach_the_engine_when_drt_threads_is_0(bpy_drt):
+    """Blender's Performance > Threads set to Fixed (what `blender -t N` reports, as
+    render farms start Blender) gives the engine that many threads when DRT's own
+    Threads is 0; DRT's own setting wins when set; Auto leaves the engine's default."""
+    scene = _open(bpy_drt, samples=1)
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = 3
+    scene.drt.threads = 0
+    assert scene.drt.to_engine_settings().threads == 3
+    scene.drt.threads = 2
+    assert scene.drt.to_engine_settings().threads == 2
+    scene.render.threads_mode = "AUTO"
+    scene.drt.threads = 0
+    assert scene.drt.to_engine_settings().threads == 0

@@ -7,7 +7,7 @@ from engine import (Camera, Material, PointLight, RenderSettings, Scene, SunLigh
                     World, render)
 from engine_scenes import box, cornell_box, look_at, quad, scaled
 
-SCALES = [1e-3, 1.0, 1e4]
+SCALES = [1e-3, 1.0, 1e2, 1e4]
 
 
 @pytest.fixture(scope="module")

@@ -6,6 +6,7 @@ import time
 from ..engine_link import engine
 from .camera import RenderRegion, export_camera, render_region, window_camera
 from .errors import ExportError, Reporter
+from .libraries import missing_library_messages
 from .settings_check import check as check_file_settings
 from .lights import export_light, object_visibility
 from .materials import export_material
@@ -15,8 +16,8 @@ from .object_info import object_info
 from .volumes import world_volume
 from .world import export_world
 
-__all__ = ["ExportError", "RenderRegion", "Reporter", "export_scene", "render_region",
-           "render_size"]
+__all__ = ["BLACK_IMAGE", "ExportError", "RenderRegion", "Reporter", "export_scene",
+           "render_region", "render_size"]
 
 
 def render_size(scene):
@@ -40,7 +41,7 @@ def _is_holdout(inst, obj, view_layer) -> bool:
 
 def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
                  region: RenderRegion | None = None, stats: dict | None = None,
-                 render_engine=None) -> "engine.Scene":
+                 render_engine=None, check_cancel=None) -> "engine.Scene":
     """The scene as DRT's description.
 
     region: the pixels to render (default: Blender's render size and border, see
@@ -54,18 +55,22 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
     is restored afterwards.
 
     The file's render settings DRT does not honour are warned about through `reporter`
-    (export.file_settings)."""
+    (export.file_settings). check_cancel, if given, is called before each object is
+    exported (the RenderEngine's cancel: it raises to stop the export)."""
     reporter = reporter or Reporter()
     check_file_settings(depsgraph.scene, depsgraph.view_layer, reporter)
+    for message in missing_library_messages():
+        reporter.warn(f"DRT: {message}")
     blur = read_settings(depsgraph.scene)
     if blur is None:
-        return _export_scene(depsgraph, reporter, size, region, stats, None)
+        return _export_scene(depsgraph, reporter, size, region, stats, None, check_cancel)
     with MotionExport(depsgraph, blur, reporter, render_engine) as tracker:
         return _export_scene(depsgraph, reporter, size, region, stats,
-                             tracker if tracker.usable else None)
+                             tracker if tracker.usable else None, check_cancel)
 
 
-def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.Scene":
+def _export_scene(depsgraph, reporter, size, region, stats, tracker,
+                  check_cancel=None) -> "engine.Scene":
     t0 = time.perf_counter()
     scene = depsgraph.scene
     if region is None:
@@ -91,6 +96,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
     meshes, lights = [], []
     holdouts = 0
     for k, inst in enumerate(depsgraph.object_instances):
+        if check_cancel is not None:
+            check_cancel()
         obj = inst.object
         if obj.type in GEOMETRY_TYPES:
             if not inst.is_instance and not inst.show_self:
@@ -124,6 +131,9 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
     if scene.world is not None:
         world.volume = world_volume(scene.world, reporter)
     shutter = tracker.finish(meshes, camera, lights) if tracker is not None else None
+    dark = dark_scene_message(meshes, materials, lights, world)
+    if dark:
+        reporter.warn(dark, key=BLACK_IMAGE)
     if stats is not None:
         stats.update(mesh_evaluations=cache.evaluations, mesh_reuses=cache.reuses,
                      meshes=len(meshes), lights=len(lights), holdouts=holdouts,
@@ -134,3 +144,29 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker) -> "engine.
     return engine.Scene(camera, region.width, region.height, meshes, materials, lights, world,
                         pixel_aspect=aspect, shutter=shutter,
                         film_transparent=bool(scene.render.film_transparent))
+
+
+# the key of the one warning about a black image (said by the export, or after the render)
+BLACK_IMAGE = "black image"
+
+
+def _emits(material) -> bool:
+    volume = getattr(material, "volume", None)
+    return (material.is_emissive() or (volume is not None and any(v > 0 for v in volume.emission))
+            or any(_emits(side) for side in (material.mix or ())))
+
+
+def dark_scene_message(meshes, materials, lights, world) -> str | None:
+    """Why the image will be black, when nothing in the scene gives light (no lamp, no
+    emissive material, a black world): said once, so that a black render is never a
+    silent surprise. None when something may light the scene."""
+    world_lit = (world.texture is not None or world.sun is not None
+                 or max(world.color) * max(world.strength) > 0
+                 or (world.volume is not None and any(v > 0 for v in world.volume.emission)))
+    if lights or world_lit or any(_emits(m) for m in materials):
+        return None
+    if not meshes:
+        return ("DRT: the scene is empty (no visible objects, no lights, a black world); "
+                "the image is black")
+    return ("DRT: nothing lights the scene (no lights, no emissive material, a black "
+            "world); the image is black")

@@ -76,7 +76,9 @@ def export_camera(cam_obj, depsgraph) -> "engine.Camera":
         raise ExportError("the scene has no active camera: add a camera and make it active "
                           "(Scene Properties > Camera)")
     if cam_obj.type != "CAMERA":
-        raise ExportError(f"the active camera {cam_obj.name!r} is a {cam_obj.type}, not a camera")
+        raise ExportError(f"the scene's camera {cam_obj.name!r} is an object of type "
+                          f"{cam_obj.type}, not a camera; set a camera object as the "
+                          f"scene's camera")
     ev = cam_obj.evaluated_get(depsgraph)
     cam = ev.data
     m = to_numpy(ev.matrix_world)

@@ -360,7 +360,8 @@ SETTINGS: list[FileSetting] = [
                  "debug_use_metal_adaptive_compile"],
                 "Cycles' debugging and devices; DRT uses Embree on the CPU"),
     _s("scene.render.threads_mode", "Performance > Threads", NO_EFFECT,
-       "DRT's own Threads setting (Sampling) decides"),
+       "speed only: DRT's own Threads setting (Sampling) decides; at 0, Fixed (or "
+       "`blender -t N`) gives DRT that many threads"),
     _s("scene.render.use_persistent_data", "Performance > Final Render > Persistent Data",
        NO_EFFECT, "DRT exports the scene for every render"),
     _s("scene.render.filter_size", "Film > Filter Size (EEVEE, Workbench)", NO_EFFECT,

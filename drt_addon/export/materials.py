@@ -82,7 +82,7 @@ from .closures import _Comp, _reduce, program_outputs
 from .errors import Reporter
 from .images import image_cache
 from .nodes import NodeCompiler
-from .nodes.links import _all_nodes, _link, _output_node, uses_nodes
+from .nodes.links import _all_nodes, _link, _output_node, tree_problems, uses_nodes
 from .nodes.shader import _closure
 from .volumes import export_volume
 
@@ -162,6 +162,8 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
                                glossy_model="MULTI_GGX")
     if not uses_nodes(mat):
         return fallback
+    for problem in tree_problems(mat.node_tree):
+        ctx.issue(problem)
     out = _output_node(mat.node_tree)
     if out is None:
         ctx.issue("it has no Material Output node; using its viewport colour")
@@ -172,9 +174,16 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
             ctx.issue("its displacement is not rendered")
         result = _material(_closure(out.inputs["Surface"], ctx), ctx, name)
         _attach_programs(result, ctx, ctx.nodes.build())
+        cycles = getattr(mat, "cycles", None)
+        if ctx.normal is not None and not getattr(cycles, "use_bump_map_correction", True):
+            ctx.issue("Settings > Bump Map Correction is off, which DRT does not honour "
+                      "(its bent normals are always corrected, Cycles' default)")
         # a volume inside its meshes; with no surface shader, the surface is its boundary
         result.volume = export_volume(out.inputs.get("Volume"), ctx)
         result.surface = result.volume is None or _link(out.inputs["Surface"]) is not None
+        if result.volume is None and _link(out.inputs["Surface"]) is None:
+            ctx.issue("no shader reaches its Material Output's Surface; it renders black, "
+                      "as in Cycles")
     if ctx.issues and reporter is not None:
         reporter.warn(f"DRT: material {name!r}: " + "; ".join(ctx.issues),
                       key=(name, "material"))

@@ -15,6 +15,7 @@ import numpy as np
 from ..engine_link import engine
 from .errors import ExportError
 from . import tangents as tangent_space
+from ..blender_compat import prepare_corner_normals
 from .matrices import to_numpy
 from .tangents import mesh_tangents, uv_layer, wants_tangents
 from .vertex_colors import color_request, mesh_colors
@@ -50,6 +51,7 @@ def mesh_arrays(mesh):
     mesh.loop_triangles.foreach_get("material_index", mat)
     normals = None
     if nt and _has_smooth_faces(mesh):
+        prepare_corner_normals(mesh)
         normals = np.empty(nt * 9, dtype=np.float32)
         mesh.loop_triangles.foreach_get("split_normals", normals)
         normals = normals.reshape(nt, 3, 3)

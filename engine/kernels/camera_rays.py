@@ -39,7 +39,7 @@ def pack_camera(model, pixel_filter) -> tuple:
     cam[C_LENS] = model.has_lens
     cam[C_APERTURE], cam[C_FOCUS] = c.aperture_radius, c.focus_distance
     cam[C_BLADES], cam[C_ROTATION], cam[C_RATIO] = c.blades, c.blade_rotation, c.aperture_ratio
-    cam[C_CLIP_START], cam[C_CLIP_END] = c.clip_start, c.clip_end
+    cam[C_CLIP_START], cam[C_CLIP_END] = model.clip_start, model.clip_end
     cam[C_ROT:C_ROT + 9] = model.rotation.reshape(-1)
     cam[C_POS:C_POS + 3] = model.position
     if pixel_filter.kind == "BOX":

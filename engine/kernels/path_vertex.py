@@ -36,8 +36,8 @@ from ..nodes.context import N_HIT, path_fields
 from ..nodes.differentials import cone_at, cone_moves
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import (apply_rows, bent_diffuse, pick_closure, program_emission,
-                             program_hit, program_normal)
+from ..nodes.shading import (apply_rows, bent_diffuse, bump_rejects, pick_closure,
+                             program_emission, program_hit, program_normal)
 
 @kernel
 def prepare_closures(cfg, row, min_pdf, ray_bit):
@@ -256,6 +256,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 # the diffuse lobe on the raw normal with bump shadowing (Cycles)
                 fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, False, see_g,
                                             see_t)
+                if bump_rejects(n0x, n0y, n0z, nx, ny, nz, wx, wy, wz):
+                    cosine = 0.0
                 fr, fg, fb = fr * cosine, fg * cosine, fb * cosine
                 if see_d:
                     dr, dg, db = bent_diffuse(state, wox, woy, woz, n0x, n0y, n0z, rx, ry,
@@ -311,8 +313,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             alive, br, bg, bb = roulette(u_rr, br, bg, bb)
             if not alive:
                 continue
-        if not max(br, bg, bb) > 0.0:
-            continue
+        if not max(br, bg, bb) > 0.0 or not (br < _INF and bg < _INF and bb < _INF):
+            continue       # nothing left, or overflowed (or NaN): the path ends here
         beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
         counts[p, skind] += 1
         bounce[p] = b + 1

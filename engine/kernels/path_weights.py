@@ -54,13 +54,21 @@ def clamp_scale(r, g, b, limit):
     """Cycles' clamp: the factor that scales (r, g, b) so no channel exceeds limit."""
     m = max(r, g, b)
     if limit > 0.0 and m > limit:
-        return limit / max(m, 1e-300)
+        return limit / max(m, 1e-300)   # 0 for an infinite m: see _add
     return 1.0
 
 
 @kernel
 def _add(L, p, r, g, b, limit):
-    s = clamp_scale(r, g, b, limit)
+    if limit > 0.0 and max(r, g, b) == _INF:
+        # an overflowed contribution (parameters near float32's limit, multiplied over
+        # bounces), clamped: the limit of the clamp as the channel grows, the other
+        # channels 0
+        r, g, b = (limit if r == _INF else 0.0), (limit if g == _INF else 0.0), \
+            (limit if b == _INF else 0.0)
+        s = 1.0
+    else:
+        s = clamp_scale(r, g, b, limit)
     L[p, 0] += r * s
     L[p, 1] += g * s
     L[p, 2] += b * s

@@ -45,8 +45,9 @@ def rebuild(v0, v1, v2, normal, tri_scale, corner_normals, prim, u, v, dx, dy, d
         # a shading normal bent past the geometric one is replaced by it
         if dot(nx, ny, nz, fx, fy, fz) > 0.0:
             sx, sy, sz = nx, ny, nz
-    scale = max(max(abs(px), abs(py), abs(pz)), tri_scale[prim])
-    return px, py, pz, fx, fy, fz, sx, sy, sz, front, scale
+    # the triangle's scale, relative to the static scene's centre (engine.surface), bounds
+    # the hit point's
+    return px, py, pz, fx, fy, fz, sx, sy, sz, front, tri_scale[prim]
 
 
 @kernel

@@ -79,6 +79,11 @@ class _OneProgram:
 
 def evaluate_registers(program, hits) -> np.ndarray:
     """Every register of `program` after running it on each hit row: (n, n_regs)."""
+    if len(program.ops) == 0:
+        # constants only (an RGB or Value node, a missing image's pink): `run` skips a
+        # material without instructions, so its registers are the initial values
+        init = np.asarray(program.init, np.float64) if program.n_regs else np.zeros(1)
+        return np.tile(init, (len(hits), 1))
     T = pack_shading(_OneProgram(program))
     hits = np.ascontiguousarray(hits, np.float64)
     return _registers_loop(T, np.zeros(len(hits), np.int64), hits, max(program.n_regs, 1))

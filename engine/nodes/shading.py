@@ -171,24 +171,39 @@ def bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz):
 
 
 @kernel
-def bump_shadowing(gx, gy, gz, nx, ny, nz, lx, ly, lz):
-    """Cycles' bump_shadowing_term ("Taming the Shadow Terminator", Chiang et al.) for a
-    diffuse lobe whose normal n is not the surface's shading normal g: fades light
-    towards the surface's terminator instead of the bent normal's, with
-    t = (g.L) / ((n.L)(g.n)) (g flipped when n.L < 0); 1 for t >= 1, 0 for t < 0,
-    smoothed between."""
-    ndl = nx * lx + ny * ly + nz * lz
-    if ndl < 0.0:
-        gx, gy, gz = -gx, -gy, -gz
-    gdn = gx * nx + gy * ny + gz * nz
-    den = ndl * gdn
-    g = (gx * lx + gy * ly + gz * lz) / den if den != 0.0 else 0.0
-    if g >= 1.0:
+def bump_rejects(sx, sy, sz, nx, ny, nz, lx, ly, lz):
+    """Cycles 5.0's test of a lobe on a normal n that is not the surface's own shading
+    normal s: light from direction l is refused when l and n lie on opposite sides of
+    the surface s describes in a way the lobe cannot bridge, i.e. when
+    (s.l)(s.n)(n.l) < 0 (a reflection reaching under s, or a refraction staying above).
+    It applies to every lobe Cycles evaluates towards a light, and to the directions its
+    diffuse lobes sample."""
+    s_l = sx * lx + sy * ly + sz * lz
+    s_n = sx * nx + sy * ny + sz * nz
+    n_l = nx * lx + ny * ly + nz * lz
+    return s_l * s_n * n_l < 0.0
+
+
+@kernel
+def bump_shadowing(sx, sy, sz, nx, ny, nz, lx, ly, lz):
+    """Cycles 5.0's bump_shadowing_term for a diffuse lobe on a normal n bent away from the
+    surface's shading normal s (Conty Estevez, Lecocq and Stein, "A Microfacet-Based
+    Shadowing Function to Solve the Bump Terminator Problem"): 0 where bump_rejects,
+    else the GGX shadowing G1 of the light's angle to s, for a roughness that grows with
+    the bend: alpha^2 = min(tan^2(s, n) / 8, 1). 1 when n is s."""
+    if sx == nx and sy == ny and sz == nz:
         return 1.0
-    if g < 0.0:
+    if bump_rejects(sx, sy, sz, nx, ny, nz, lx, ly, lz):
         return 0.0
-    g2 = g * g
-    return -g2 * g + g2 + g
+    cos_i = abs(sx * lx + sy * ly + sz * lz)
+    cos_d = abs(sx * nx + sy * ny + sz * nz)
+    if cos_d >= 1.0 or cos_i >= 1.0:
+        return 1.0
+    if cos_i < 1e-6:
+        return 0.0
+    alpha2 = min(max(0.125 * (1.0 / (cos_d * cos_d) - 1.0), 0.0), 1.0)
+    tan2_i = max(1.0 / (cos_i * cos_i) - 1.0, 0.0)
+    return 2.0 / (1.0 + math.sqrt(1.0 + alpha2 * tan2_i))
 
 
 @kernel

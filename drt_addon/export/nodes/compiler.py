@@ -25,6 +25,7 @@ import importlib
 from ...engine_link import engine
 from . import color, converter, input, procedural, texture, vector
 from .errors import Unsupported
+from .links import usable_link
 
 program = importlib.import_module(engine.__name__ + ".nodes.program")
 cv = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
@@ -83,14 +84,16 @@ class NodeCompiler:
     def _source(self, sock):
         """(node, output socket) linked into input `sock`, through reroutes and groups'
         inputs; None when unlinked."""
+        seen = set()
         while True:
-            if not sock.is_linked:
-                return None
-            link = sock.links[0]
-            if getattr(link, "is_muted", False) or not getattr(link, "is_valid", True):
+            link = usable_link(sock)
+            if link is None:
                 return None
             node, out = link.from_node, link.from_socket
             if node.bl_idname == "NodeReroute":
+                if node.as_pointer() in seen:       # a loop of reroutes
+                    return None
+                seen.add(node.as_pointer())
                 sock = node.inputs[0]
                 continue
             if node.bl_idname == "NodeGroupInput":

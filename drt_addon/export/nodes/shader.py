@@ -8,6 +8,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ...blender_compat import node_input
 from ...engine_link import engine
 from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _Layers, _sum
 from ..material_params import TOL, NodeParam, _is_tex, _lin, _mean, _same, _scale
@@ -31,7 +32,7 @@ def _input(node, name, ctx, color, default, texturable=True):
     graph linked to it, compiled into the material's program (engine.nodes): a constant
     when the graph does not depend on the hit (folded now), otherwise a NodeParam that
     the program evaluates at every hit (texturable inputs), or its average (reported)."""
-    sock = node.inputs.get(name)
+    sock = node_input(node, name)
     if sock is None:
         return default
     if _link(sock) is None:
@@ -69,13 +70,13 @@ def _principled(node, ctx) -> _Closure:
     for sock, what in (("Subsurface Weight", "subsurface"), ("Anisotropic", "anisotropy"),
                        ("Thin Film Thickness", "thin film"),
                        ("Diffuse Roughness", "diffuse roughness")):
-        s = node.inputs.get(sock)
+        s = node_input(node, sock)
         if s is not None and (s.is_linked or float(s.default_value) > 0.0):
             ignored.append(what)
-    s = node.inputs.get("Specular Tint")
-    if s is not None and (s.is_linked or any(abs(x - 1.0) > TOL for x in s.default_value[:3])):
+    s = node_input(node, "Specular Tint")
+    if s is not None and (s.is_linked or _tinted(s.default_value)):
         ignored.append("specular tint")
-    s = node.inputs.get("Tangent")
+    s = node_input(node, "Tangent")
     if s is not None and s.is_linked:
         ignored.append("the tangent input")
     _normal(node, ctx)
@@ -93,6 +94,14 @@ def _principled(node, ctx) -> _Closure:
     return _Closure([(a, comp)], 1.0 - a, (1.0 - a,) * 3, _scale(emission, a))
 
 
+def _tinted(tint) -> bool:
+    """Specular Tint is not white (a colour since Blender 4.0; before, a float amount of
+    the base colour, 0 for none)."""
+    if isinstance(tint, float):
+        return tint > 0.0
+    return any(abs(x - 1.0) > TOL for x in tint[:3])
+
+
 def _principled_layers(node, ctx):
     """Principled's coat and sheen (constants; a per-hit input is replaced by its
     average, reported), or None when both weights are 0."""
@@ -102,7 +111,7 @@ def _principled_layers(node, ctx):
     sheen = max(float(const("Sheen Weight", 0.0)), 0.0)
     if coat <= 0.0 and sheen <= 0.0:
         return None
-    s = node.inputs.get("Coat Normal")
+    s = node_input(node, "Coat Normal")
     if coat > 0.0 and s is not None and s.is_linked:
         ctx.issue(f"the Coat Normal of {node.name!r} is not rendered; DRT's coat uses the "
                   f"surface's normal")
@@ -136,7 +145,7 @@ def _translucent(node, ctx) -> _Closure:
 def _normal(node, ctx):
     """A BSDF's linked Normal input: the material's per-hit shading normal (one per
     material: a second, different one in a mix is reported and left out)."""
-    sock = node.inputs.get("Normal")
+    sock = node_input(node, "Normal")
     if sock is None or _link(sock) is None:
         return
     value = ctx.nodes.socket(sock, "vector")
@@ -172,7 +181,7 @@ def _distribution(node, ctx) -> str:
 def _glossy(node, ctx) -> _Closure:
     _normal(node, ctx)
     distribution = _distribution(node, ctx)
-    s = node.inputs.get("Anisotropy")
+    s = node_input(node, "Anisotropy")
     if s is not None and (s.is_linked or float(s.default_value) != 0.0):
         ctx.issue(f"{node.name!r} is anisotropic; DRT renders it isotropic")
     color = _input(node, "Color", ctx, True, (0.8,) * 3)
@@ -193,7 +202,7 @@ def _glass(node, ctx, refraction=False) -> _Closure:
         ctx.issue(f"the colour of {node.name!r} is textured; DRT tints its refraction "
                   f"with the texture's average")
         color = color.mean()
-    s = node.inputs.get("Thin Film Thickness")
+    s = node_input(node, "Thin Film Thickness")
     if s is not None and (s.is_linked or float(s.default_value) > 0.0):
         ctx.issue(f"{node.name!r} uses thin film, which DRT does not render (left out)")
     comp = _Comp(base=color, transmission=1.0,
@@ -278,13 +287,20 @@ def _plastic(a: _Closure, b: _Closure, ior, fac, ctx):
                     _lin([(1.0 - fac, a.emission), (fac, b.emission)], ctx, "emission"))
 
 
+MAX_SHADER_READS = 2048
+
+
 def _closure(socket, ctx, depth=0) -> _Closure:
     """The closure feeding a shader socket."""
     found = _link(socket)
     if found is None:
         return _Closure([(1.0, NULL_COMP)])       # no closure: black
     node = found[0]
-    if depth > 32:
+    # a tree is read node by node along every path to the output: shared sub-trees are
+    # read again for each path, so a long chain of shaders feeding both inputs of the
+    # next Mix would take 2^length reads; past MAX_SHADER_READS the rest is cut off
+    ctx.shader_reads = getattr(ctx, "shader_reads", 0) + 1
+    if depth > 32 or ctx.shader_reads > MAX_SHADER_READS:
         ctx.issue("the shader tree is too deep; rendering the rest as the viewport colour")
         return _Closure([(1.0, ctx.viewport_comp())])
     kind = node.bl_idname

@@ -39,11 +39,8 @@ def sample_triangle(L, j, px, py, pz, u0, u1):
     pdf = dist * dist / (L[TRI_AREA][j] * cos_l)
     rad = L[TRI_RADIANCE]
     # shadow rays stop this far before q (engine.mesh_lights: float32 self-occlusion)
-    scale = max(max(abs(qx), abs(qy)), abs(qz))
-    ts = L[TRI_SCALE][j]
-    if not scale >= ts:
-        scale = ts
-    margin = RELATIVE_OFFSET * scale / cos_l
+    # (the triangle's scale, relative to the static scene's centre, bounds q's)
+    margin = RELATIVE_OFFSET * L[TRI_SCALE][j] / cos_l
     return wx, wy, wz, dist, rad[j, 0], rad[j, 1], rad[j, 2], pdf, margin
 
 
