@@ -275,10 +275,13 @@ def main():
         r = big_mesh()
         c, d = r["CYCLES"], r["DRT"]
         targets.append(("4. 1M triangles: whole process, DRT over Cycles", "<= 1.5x",
-                        f"{d['whole'] / c['whole']:.2f}x", d["whole"] / c["whole"] <= 1.5))
+                        f"{d['whole'] / c['whole']:.2f}x (DRT's acceleration structure and "
+                        f"set-up {d['build'] or 0:.1f} s of its {d['render']:.1f} s render "
+                        "call)", bool(d["whole"] / c["whole"] <= 1.5)))
         targets.append(("4. ... peak memory, DRT over Cycles", "<= 1.2x",
-                        f"{d['maxrss_mb'] / c['maxrss_mb']:.2f}x",
-                        d["maxrss_mb"] / c["maxrss_mb"] <= 1.2))
+                        f"{d['maxrss_mb'] / c['maxrss_mb']:.2f}x (the exported arrays: "
+                        f"{d['scene_mb']:.0f} of the {d['maxrss_mb'] - c['maxrss_mb']:.0f} MB "
+                        "more)", bool(d["maxrss_mb"] / c["maxrss_mb"] <= 1.2)))
         lines += ["## 4. A big mesh", "",
                   f"Suzanne subdivided to {r['triangles']:,} triangles, 320x240, 1 sample, "
                   "each engine in a fresh process.", "",
