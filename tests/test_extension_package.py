@@ -146,7 +146,8 @@ def test_zip_holds_the_addon_tracer_and_wheels_only(built):
     for required in ("blender_manifest.toml", "__init__.py", "drt_addon/__init__.py",
                      "drt_addon/render_engine.py", "drt_addon/engine_link.py",
                      "engine/__init__.py", "engine/accel.py", "engine/render.py",
-                     "engine/bsdf/data/ggx_energy.npz"):   # the multiscatter tables
+                     "engine/bsdf/data/ggx_energy.npz",    # the multiscatter tables
+                     "engine/bsdf/data/specular_albedo.npz"):   # the layering tables
         assert required in names, required
     zipped_wheels = sorted(n for n in names if n.endswith(".whl"))
     assert zipped_wheels == sorted(os.path.normpath(w).replace(os.sep, "/") for w in wheels)

@@ -230,3 +230,18 @@ def test_plain_materials_never_touch_the_layer_slots():
                 a, b = fn(nan_state, *args), fn(zero_state, *args)
                 assert np.array_equal(np.asarray(a, float), np.asarray(b, float))
                 assert np.all(np.isfinite(np.atleast_1d(np.asarray(a, float))[:7]))
+
+
+def test_stored_specular_albedo_tables_are_what_the_build_computes(tmp_path, monkeypatch):
+    """engine/bsdf/data/specular_albedo.npz holds exactly what the quadrature builds (so
+    loading it instead of building, a second saved per process, changes nothing), and a
+    file made on other grids is ignored."""
+    from engine.bsdf import layer_albedo as la
+    stored = la._stored()
+    assert stored is not None, "the tables file is missing or on other grids"
+    for side in (0, 1):
+        assert np.array_equal(stored[side], la._build_specular_albedo_table(side)), side
+    other = tmp_path / "other.npz"
+    np.savez(other, side0=stored[0], side1=stored[1], **{**la._grids(), "strata": [8]})
+    monkeypatch.setattr(la, "PATH", str(other))
+    assert la._stored() is None

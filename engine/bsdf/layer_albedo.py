@@ -7,9 +7,19 @@ rest (engine/bsdf/principled.py). The tables are built lazily (thread-safe) over
 (cos theta_o, roughness, F0^(1/4), side of eta; for eta < 1 the cos axis is aligned on
 the critical angle) by stratified visible-normal quadrature, and interpolated
 trilinearly; engine/kernels/bsdf/albedo.py is the compiled twin of the lookup.
+
+Building both tables takes about a second, once per process; they are kept in
+`engine/bsdf/data/specular_albedo.npz` with their grids, and loaded from there (a file
+whose grids are not the ones below is rebuilt in memory). Rebuild the file after
+changing the lobe, the Fresnel term or a grid:
+
+    python -m engine.bsdf.layer_albedo
+
+tests/test_layered_bsdf.py checks that the file holds what the build computes.
 """
 from __future__ import annotations
 
+import os
 import threading
 
 import numpy as np
@@ -24,6 +34,7 @@ TABLE_S = np.linspace(0.0, 0.95 ** 0.5, 25)  # F0^(1/4) = sqrt(|eta - 1| / (eta 
 TABLE_STRATA = 16                            # 16 x 16 stratified visible normals per entry
 _tables = [None, None]                       # eta >= 1, eta < 1; each built on first use
 _table_lock = threading.Lock()
+PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "specular_albedo.npz")
 
 
 def _critical_cos(eta):
@@ -83,12 +94,40 @@ def _build_specular_albedo_table(side):
     return np.clip(table, 0.0, 1.0)
 
 
+def _grids() -> dict:
+    return {"grid_t": TABLE_T, "grid_r": TABLE_R, "grid_s": TABLE_S,
+            "strata": np.array([TABLE_STRATA])}
+
+
+def _stored():
+    """The two tables from PATH, or None when it is missing or made on other grids."""
+    try:
+        with np.load(PATH) as f:
+            if all(k in f.files and np.array_equal(f[k], g) for k, g in _grids().items()):
+                return [np.ascontiguousarray(f[f"side{i}"], dtype=np.float64)
+                        for i in (0, 1)]
+    except (OSError, KeyError, ValueError):
+        pass
+    return None
+
+
 def get_table(side):
     if _tables[side] is None:
         with _table_lock:
             if _tables[side] is None:
-                _tables[side] = _build_specular_albedo_table(side)
+                stored = _stored()
+                if stored is not None:
+                    _tables[0], _tables[1] = stored
+                else:
+                    _tables[side] = _build_specular_albedo_table(side)
     return _tables[side]
+
+
+def save(path=PATH):
+    """Build both tables and write them with their grids."""
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    np.savez(path, side0=_build_specular_albedo_table(0),
+             side1=_build_specular_albedo_table(1), **_grids())
 
 
 def _lerp_coords(grid, v):
@@ -123,3 +162,8 @@ def specular_albedo(cos_o, alpha, eta) -> np.ndarray:
                     acc = acc + wi_ * wj * wk * table[i + di, j + dj, k + dk]
         out[sel] = acc
     return out
+
+
+if __name__ == "__main__":
+    save()
+    print(f"wrote {PATH}")
