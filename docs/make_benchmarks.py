@@ -188,6 +188,9 @@ def _fmt_equal_error(name, r):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller renders, for a smoke run")
+    ap.add_argument("--adaptive-scenes", default="",
+                    help="section 6 for these sample scenes only (comma-separated .blend "
+                         "names): their rows replace or join the last run's")
     ap.add_argument("--skip", default="", help="comma-separated sections to skip (1..9)")
     ap.add_argument("--only", default="", help="comma-separated sections to run (1..9); the "
                     "others keep their last measured figures (docs/benchmarks.json)")
@@ -313,13 +316,15 @@ def main():
     if "6" not in skip:
         from adaptive_benchmark import measure, table
         rows = []
-        for blend in ADAPTIVE_SCENES:
+        chosen = [b for b in args.adaptive_scenes.split(",") if b] or ADAPTIVE_SCENES
+        for blend in chosen:
             for sampler in ("jittered", "sobol"):
                 rows.append(measure(os.path.join(SAMPLES, blend), long_side=32 if q else 96,
                                     ref_spp=256 if q else 2048, sampler=sampler,
                                     ladder=(4, 16, 64) if q else (16, 64, 256)))
                 print(blend, sampler, rows[-1]["metrics"], flush=True)
-        lines += table(rows)
+        lines += table(rows) if chosen == ADAPTIVE_SCENES else \
+            _join_rows(saved["6"]["lines"], table(rows), chosen)
         done("6")
     if "7" not in skip:      # the convergence studies (cached in ~/.cache/drt/converge)
         import make_convergence_docs as studies
@@ -345,8 +350,19 @@ def main():
 
 ADAPTIVE_SCENES = ("cornell_box.blend", "metals.blend", "glass.blend",
                    "glossy_dielectric.blend", "dof.blend", "motion_cube.blend",
-                   "hdri_world.blend", "fog_room.blend")
+                   "hdri_world.blend", "fog_room.blend", "product_shot.blend")
 SECTIONS_JSON = os.path.join(DOCS, "benchmarks.json")
+
+
+def _join_rows(old: list, new: list, scenes) -> list:
+    """Section 6's lines with the table rows of `scenes` taken from `new` (replacing
+    theirs in `old`, or added after its last row)."""
+    fresh = [line for line in new if line.startswith("| ") and line.split(" | ")[0][2:]
+             in scenes]
+    kept = [line for line in old if not (line.startswith("| ") and
+                                         line.split(" | ")[0][2:] in scenes)]
+    last = max(i for i, line in enumerate(kept) if line.startswith("| "))
+    return kept[:last + 1] + fresh + kept[last + 1:]
 
 
 def _load_sections() -> dict:

@@ -27,7 +27,8 @@ SAMPLES = os.path.join(ROOT, "sample_blends")
 
 # (scene, resolution percentage): 128 pixels wide
 SCENES = [("cornell_box", 50), ("metals", 200), ("glass", 200), ("glossy_dielectric", 200),
-          ("dof", 200), ("motion_cube", 200), ("hdri_world", 200), ("fog_room", 200)]
+          ("dof", 200), ("motion_cube", 200), ("hdri_world", 200), ("fog_room", 200),
+          ("product_shot", 200)]
 MAX_SAMPLES = 64
 REFERENCE_SAMPLES = 1024
 SAMPLERS = "jittered,sobol,random"
