@@ -37,7 +37,7 @@ from __future__ import annotations
 import numpy as np
 
 from .lights import LightSample, luminance
-from .surface import RELATIVE_OFFSET
+from .surface import RELATIVE_OFFSET, triangle_scale
 
 
 class EmissiveTriangles:
@@ -59,8 +59,7 @@ class EmissiveTriangles:
         self.prim = prim_ids[keep]
         # the offset scale relative to the static scene's centre (engine.accel, surface)
         c = np.zeros(3) if center is None else np.asarray(center, np.float64)
-        self.tri_scale = np.max(np.abs(np.stack([v0 - c, v1 - c, v2 - c], 1)), axis=(1, 2))[keep] \
-            if len(v0) else np.zeros(0)
+        self.tri_scale = triangle_scale(v0, v1, v2, c, len(v0))[keep]
         self.entry = np.full(max(int(n_prims_total), 1), -1, dtype=np.int64)
         self.entry[self.prim] = np.arange(len(self.prim))
 
