@@ -55,8 +55,8 @@ KNOWN = """## Known differences
   (`tests/test_bump_vs_cycles.py`; 52% with the shadowing term of Cycles 3 and 4).
   On a coarser sphere (32 x 16 faces) DRT is darker than Cycles on a few pixels by
   the lit silhouette: DRT takes no light from below a triangle's own plane, while
-  Cycles does when the light is above the smooth normal. Material > Settings > Bump Map Correction turned off is not honoured
-  (warned): DRT always corrects, Cycles' default.
+  Cycles does when the light is above the smooth normal. Material > Settings > Bump Map
+  Correction turned off is not honoured (warned): DRT always corrects, Cycles' default.
 - **Bump.** Evaluated as Cycles 5.0 does: the Height's nodes run again at the hit moved
   by Filter Width pixel steps along two tangents, the steps from each ray's footprint
   (Cycles' compact ray differentials: a cone from the camera's pixel that keeps growing
