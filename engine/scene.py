@@ -89,7 +89,7 @@ class Material:
     alpha_texture: Optional[object] = None
     shader: Optional[object] = None
     mix: Optional[tuple] = None
-    volume: Optional[object] = None      # Volume: the homogeneous medium inside its meshes
+    volume: Optional[object] = None      # Volume: the medium inside its meshes
     surface: bool = True                 # False: no surface shader, a volume's boundary
 
     TEXTURED = ("base_color", "metallic", "roughness", "emission", "alpha")
@@ -127,7 +127,13 @@ class Volume:
     Henyey-Greenstein `anisotropy` g of the scattering (-1 back, 0 isotropic, 1 forward)
     and `emission`, radiance emitted per metre of path. A material's volume fills the
     inside of its (closed) meshes; the world's fills all space outside them. See
-    engine.kernels.volume."""
+    engine.kernels.volume.
+
+    A material whose shader program has the outputs volume_absorption,
+    volume_scattering and volume_emission (engine.nodes.program.OUTPUTS) has a
+    heterogeneous volume: the program, run at each point inside the medium, gives its
+    coefficients there (engine.kernels.medium_density), and these fields are then
+    summaries (its averages)."""
     absorption: tuple = (0.0, 0.0, 0.0)
     scattering: tuple = (0.0, 0.0, 0.0)
     anisotropy: float = 0.0

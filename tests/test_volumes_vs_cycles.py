@@ -2,13 +2,15 @@
 grey floor and a red block under an area lamp, black world, 48 x 32 pixels), one scene
 per kind of volume: fog in a box (Principled Volume, a volume-only material), tinted
 forward-scattering fog (Color, Absorption Color, Anisotropy), multiple scattering
-(Volume Scatter, 4 volume bounces), an emitting volume, a world volume, the camera
+(Volume Scatter, 4 volume bounces), fog in blobs (a Noise Texture through a Color Ramp
+on Density: a heterogeneous volume), an emitting volume, a world volume, the camera
 inside the fog, and coloured glass (a Glass BSDF with Volume Absorption inside).
 
 Checks (tests/test_multiscatter_vs_cycles.py's `compare`): image means within 1 % per
 channel and every 8 x 8 block within 3 % of the image mean. Controls show each check
 can fail: the fog left out, no volume bounces against Cycles' four, the Absorption
-Color left out.
+Color left out, the noise fog's density replaced by its average (what DRT rendered
+before it rendered heterogeneous volumes).
 
 Coloured glass: the clear glass cube alone differs from Cycles by about -0.9 % (mean)
 and 6 % (blocks around its caustic and shadow): issue 8's glass gap, measured in
@@ -56,8 +58,8 @@ def _check(case, drt, cycles):
     return bool(np.all(np.abs(means) < MEAN_TOLERANCE)) and block < BLOCK_TOLERANCE
 
 
-@pytest.mark.parametrize("case", ["scatter", "tinted", "multiple", "emission", "world",
-                                  "camera_inside"])
+@pytest.mark.parametrize("case", ["scatter", "tinted", "multiple", "noise", "emission",
+                                  "world", "camera_inside"])
 def test_volume_matches_cycles(bpy_drt, case):
     assert _check(case, *_pair(bpy_drt, case))
 
@@ -94,9 +96,23 @@ def _no_absorption_color(bpy, scene):
     node.inputs["Absorption Color"].default_value = (0.0, 0.0, 0.0, 1.0)
 
 
+def _averaged_density(bpy, scene):
+    """The noise fog's Density unlinked and set to the average of its graph, as DRT's
+    exporter replaced a density varying in space before (the Volume's summary)."""
+    from drt_addon.export.errors import Reporter
+    from drt_addon.export.materials import export_material
+    mat = bpy.data.materials["Fog"]
+    average = export_material(mat, Reporter()).volume.scattering[0] / 0.5   # Color 0.5
+    node = mat.node_tree.nodes["Principled Volume"]
+    for link in list(node.inputs["Density"].links):
+        mat.node_tree.links.remove(link)
+    node.inputs["Density"].default_value = average
+
+
 @pytest.mark.parametrize("case,setup", [("scatter", _no_fog),
                                         ("multiple", _no_volume_bounces),
-                                        ("tinted", _no_absorption_color)])
+                                        ("tinted", _no_absorption_color),
+                                        ("noise", _averaged_density)])
 def test_controls_fail(bpy_drt, case, setup):
     drt = _render(bpy_drt, case, "DRT", 128, setup, tag=setup.__name__)
     assert not _check(case + " control " + setup.__name__, drt,
@@ -118,3 +134,25 @@ def test_volume_only_material_warns_nothing_and_surface_is_a_boundary(bpy_drt):
     glass = export_material(bpy_drt.data.materials["TintedGlass"], rep)
     assert glass.surface and glass.transmission == 1.0
     np.testing.assert_allclose(glass.volume.absorption, (1.2, 0.6, 0.15), rtol=1e-6)
+
+
+def test_varying_density_joins_the_program_and_warns_only_for_the_world(bpy_drt):
+    """The exporter: a Density driven by a Noise Texture becomes the material's program
+    outputs (no warning); the world, which runs no program, takes its average (warned)."""
+    from drt_addon.export.errors import Reporter
+    from drt_addon.export.materials import export_material
+    from drt_addon.export.volumes import is_heterogeneous, world_volume
+    volume_scenes.build(bpy_drt, "noise", SIZE)
+    rep = Reporter()
+    fog = export_material(bpy_drt.data.materials["Fog"], rep)
+    assert is_heterogeneous(fog) and not fog.surface
+    assert set(fog.shader.outputs) >= {"volume_absorption", "volume_scattering"}
+    assert rep.warnings == []
+    world = bpy_drt.context.scene.world
+    v = world.node_tree.nodes.new("ShaderNodeVolumePrincipled")
+    world.node_tree.links.new(v.outputs[0],
+                              world.node_tree.nodes["World Output"].inputs["Volume"])
+    volume_scenes.noise_density(bpy_drt, world, v.name)
+    vol = world_volume(world, rep)
+    assert vol is not None and vol.scattering[0] > 0.0
+    assert any("'Density'" in w and "average" in w for w in rep.warnings)

@@ -57,6 +57,21 @@ def volume_material(bpy, name, node_type, inputs, surface=None):
     return mat
 
 
+def noise_density(bpy, mat, node_name, scale=2.5):
+    """Drive the Density of `mat`'s node `node_name` by a Noise Texture (Generated
+    coordinates, the default) through a Color Ramp from 0 at Fac 0.42 to 0.6 at 0.58:
+    fog in blobs, clear between them."""
+    nt = mat.node_tree
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = scale
+    ramp = nt.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].position = 0.42
+    ramp.color_ramp.elements[1].position = 0.58
+    ramp.color_ramp.elements[1].color = (0.6, 0.6, 0.6, 1.0)
+    nt.links.new(noise.outputs["Fac"], ramp.inputs["Fac"])
+    nt.links.new(ramp.outputs["Color"], nt.nodes[node_name].inputs["Density"])
+
+
 def build(bpy, case, size=(WIDTH, HEIGHT)):
     """A fresh file with the fog scene and the variation `case` names."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -112,6 +127,10 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
         glass = volume_material(bpy, "ClearGlass", "ShaderNodeVolumeAbsorption",
                                 {"Density": 0.0}, surface="ShaderNodeBsdfGlass")
         cube(bpy, scene, "Glass", (0.2, -1.0, 0.01), (1.4, 0.2, 1.2), glass)
+    elif case == "noise":
+        fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled", {})
+        noise_density(bpy, fog, "Principled Volume")
+        cube(bpy, scene, "Fog", fog_box[0], (2.0, 2.0, 2.2), fog)
     elif case == "emission":
         glow = volume_material(bpy, "Glow", "ShaderNodeEmission",
                                {"Strength": 1.5, "Color": (1.0, 0.5, 0.2, 1.0)})
@@ -129,5 +148,5 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
     return scene
 
 
-CASES = ("scatter", "tinted", "multiple", "absorption_glass", "clear_glass", "emission",
-         "world", "camera_inside")
+CASES = ("scatter", "tinted", "multiple", "noise", "absorption_glass", "clear_glass",
+         "emission", "world", "camera_inside")

@@ -1,6 +1,7 @@
 """From Blender's evaluated depsgraph to DRT's scene description (engine.scene)."""
 from __future__ import annotations
 
+import copy
 import time
 
 from ..engine_link import engine
@@ -13,7 +14,7 @@ from .materials import export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
 from .motion import MotionExport, read_settings
 from .object_info import object_info
-from .volumes import world_volume
+from .volumes import is_heterogeneous, world_volume
 from .world import export_world
 
 __all__ = ["BLACK_IMAGE", "ExportError", "RenderRegion", "Reporter", "export_scene",
@@ -85,12 +86,23 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     view_layer = depsgraph.view_layer
     materials, material_index = [], {}
 
-    def material_id(mat):
+    def material_id(mat, owner=None):
+        """The index of `mat` for object `owner`: a material whose volume varies in space
+        gets one copy per object (the engine evaluates it in that object's coordinates)."""
         key = mat.name_full if mat is not None else None
         if key not in material_index:
             material_index[key] = len(materials)
             materials.append(export_material(mat, reporter))
-        return material_index[key]
+            het_owner[key] = owner
+        index = material_index[key]
+        if is_heterogeneous(materials[index]) and het_owner[key] != owner:
+            if (key, owner) not in material_index:
+                material_index[(key, owner)] = len(materials)
+                materials.append(copy.copy(materials[index]))
+            index = material_index[(key, owner)]
+        return index
+
+    het_owner = {}
 
     cache = MeshCache(reporter)
     meshes, lights = [], []
@@ -107,7 +119,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             local = cache.local(obj)
             if local is None:
                 continue
-            slots = [material_id(s.material) for s in obj.material_slots] or [material_id(None)]
+            slots = ([material_id(s.material, k) for s in obj.material_slots]
+                     or [material_id(None)])
             name = f"{obj.name}#{k}" if inst.is_instance else obj.name
             meshes.append(instance_mesh(local, inst.matrix_world.copy(), slots, name))
             meshes[-1].holdout = holdout

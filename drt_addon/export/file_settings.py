@@ -64,9 +64,10 @@ def _no_effect(names, how, prefix="scene.cycles"):
     return [_s(f"{prefix}.{name}", name, NO_EFFECT, how) for name in names]
 
 
-_NO_VOLUMES = "DRT renders homogeneous volumes only (a varying density by its average)"
-_HOMOGENEOUS = ("DRT renders homogeneous volumes exactly, without ray marching steps "
-                "(a varying density is replaced by its average, with a warning)")
+_NO_VOLUMES = "DRT renders the volumes of materials and the world, not Volume objects (grids)"
+_NULL_SCATTERING = ("DRT renders volumes without ray marching steps: homogeneous ones exactly, "
+                    "ones that vary in space (a texture on Density) by null scattering, "
+                    "unbiased as Cycles' default")
 _SIMPLIFY = ("scene.render.use_simplify", (True,))
 _ADAPTIVE = ("scene.cycles.use_adaptive_sampling", (True,))
 WRITTEN_PASSES = "Combined, Depth, Normal, Denoising Data and DRT Noise"
@@ -258,8 +259,8 @@ SETTINGS: list[FileSetting] = [
         "guiding_roughness_threshold"]),
     _own("volume_bounces", "Light Paths > Max Bounces > Volume", "volume_bounces",
          "Volume bounces (DRT's Light Paths panel)", 0),
-    *_no_effect(["volume_step_rate", "volume_max_steps"], _HOMOGENEOUS),
-    _ignored("scene.cycles.volume_biased", "Volumes > Biased", _HOMOGENEOUS, False),
+    *_no_effect(["volume_step_rate", "volume_max_steps"], _NULL_SCATTERING),
+    _ignored("scene.cycles.volume_biased", "Volumes > Biased", _NULL_SCATTERING, False),
     _ignored("scene.render.simplify_volumes", "Simplify > Volume Resolution", _NO_VOLUMES,
              1.0, when=_SIMPLIFY),
     _ignored("scene.cycles.use_fast_gi", "Light Paths > Fast GI Approximation",

@@ -99,6 +99,8 @@ class _Ctx:
         self.cache = image_cache(reporter)
         self.nodes = NodeCompiler(self)
         self.normal = None          # the per-hit shading normal (a program Value), if any
+        self.volume_programs = True     # a volume varying in space joins the program
+        self.volume_outputs = {}        # ... as these outputs (export/volumes.py)
 
     def issue(self, text):
         if text not in self.issues:
@@ -173,13 +175,18 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
         if disp is not None and _link(disp) is not None:
             ctx.issue("its displacement is not rendered")
         result = _material(_closure(out.inputs["Surface"], ctx), ctx, name)
+        # a volume inside its meshes (its program outputs, when it varies in space, join
+        # the surface's); with no surface shader, the surface is its boundary
+        result.volume = export_volume(out.inputs.get("Volume"), ctx)
         _attach_programs(result, ctx, ctx.nodes.build())
+        if ctx.volume_outputs:
+            program = result.shader or ctx.nodes.build()
+            result.shader = dataclasses.replace(
+                program, outputs={**program.outputs, **ctx.volume_outputs})
         cycles = getattr(mat, "cycles", None)
         if ctx.normal is not None and not getattr(cycles, "use_bump_map_correction", True):
             ctx.issue("Settings > Bump Map Correction is off, which DRT does not honour "
                       "(its bent normals are always corrected, Cycles' default)")
-        # a volume inside its meshes; with no surface shader, the surface is its boundary
-        result.volume = export_volume(out.inputs.get("Volume"), ctx)
         result.surface = result.volume is None or _link(out.inputs["Surface"]) is not None
         if result.volume is None and _link(out.inputs["Surface"]) is None:
             ctx.issue("no shader reaches its Material Output's Surface; it renders black, "

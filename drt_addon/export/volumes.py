@@ -1,4 +1,4 @@
-"""Volume shaders (a Material Output's or World Output's Volume socket) to a homogeneous
+"""Volume shaders (a Material Output's or World Output's Volume socket) to an
 `engine.Volume`, with Cycles' meaning of each node (intern/cycles/kernel/svm/closure.h,
 read for meaning only):
 
@@ -20,83 +20,169 @@ Add Shader, Mix Shader
     the coefficients add, or mix by the factor (the anisotropy is the
     scattering-weighted mean).
 
-Inputs that vary in space (a texture on Density: a heterogeneous volume) are replaced by
-their average, reported: DRT renders homogeneous volumes.
+Inputs that vary in space (a texture on Density, Color, the emission or a Mix Shader's
+Fac: a heterogeneous volume) are compiled into the material's shader program, whose
+outputs volume_absorption, volume_scattering and volume_emission the engine evaluates
+at points inside the medium (engine.kernels.medium_density); the Volume's own
+coefficients are then their averages (a summary). Anisotropy is taken as its average
+where it varies (reported). The world's volume has no program: a world volume that
+varies is replaced by its average (reported).
 """
 from __future__ import annotations
+
+import importlib
 
 import numpy as np
 
 from ..engine_link import engine
+from .material_params import _is_tex
 from .nodes.links import _link
-from .nodes.shader import _constant
+from .nodes.shader import _constant, _input
 from .world import _WorldCtx, world_output
+
+program = importlib.import_module(engine.__name__ + ".nodes.program")
+cv = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
+ve = importlib.import_module(engine.__name__ + ".nodes.vector_nodes")
+VOLUME_OUTPUTS = importlib.import_module(engine.__name__ + ".kernels.volume").VOLUME_OUTPUTS
 
 _ZERO = np.zeros(3)
 
 
+def _varies(x) -> bool:
+    return isinstance(x, program.Value)
+
+
+class _Algebra:
+    """Arithmetic on coefficients that are constants (floats, RGB arrays) or values of
+    the material's program (engine.nodes.program.Value): constants are computed now,
+    anything involving a Value becomes program instructions (vector results)."""
+
+    def __init__(self, nodes):
+        self.nodes = nodes
+
+    def vector(self, x):
+        if _varies(x):
+            return self.nodes.convert(x, "vector")
+        c = np.broadcast_to(np.asarray(x, np.float64), (3,))
+        return self.nodes.const(tuple(float(v) for v in c), "vector")
+
+    def _op(self, name, a, b):
+        va, vb = self.vector(a), self.vector(b)
+        return self.nodes.emit(ve.VEC_MATH, "vector", [va, vb, va, self.nodes.const(1.0),
+                                                       ve.VECTOR_OPS.index(name)])
+
+    def mul(self, a, b):
+        if _varies(a) or _varies(b):
+            return self._op("MULTIPLY", a, b)
+        return np.asarray(a, np.float64) * np.asarray(b, np.float64)
+
+    def add(self, a, b):
+        if _varies(a) or _varies(b):
+            return self._op("ADD", a, b)
+        return np.asarray(a, np.float64) + np.asarray(b, np.float64)
+
+    def one_minus(self, a):
+        if _varies(a):
+            return self._op("SUBTRACT", 1.0, a)
+        return 1.0 - np.asarray(a, np.float64)
+
+    def max0(self, a):
+        if _varies(a):
+            return self._op("MAXIMUM", a, 0.0)
+        return np.maximum(np.asarray(a, np.float64), 0.0)
+
+    def sqrt0(self, a):
+        if _varies(a):
+            return self._op("POWER", self.max0(a), 0.5)
+        return np.sqrt(np.maximum(np.asarray(a, np.float64), 0.0))
+
+    def clamp01(self, f):
+        if _varies(f):
+            return self.nodes.emit(cv.CV_CLAMP, "float", [self.nodes.convert(f, "float"),
+                                                          self.nodes.const(0.0),
+                                                          self.nodes.const(1.0), 0])
+        return min(max(float(f), 0.0), 1.0)
+
+    def mean(self, x):
+        """A constant's value, or a Value's average (as engine.nodes.program.mean_value)."""
+        if _varies(x):
+            return np.asarray(self.nodes.mean(self.vector(x)), np.float64)
+        return np.broadcast_to(np.asarray(x, np.float64), (3,)).copy()
+
+
+def _read(node, name, ctx, default, color=False):
+    """Input `name` of `node`: its own value, a folded constant, or (linked to a graph
+    that varies) its program Value; the world, which runs no program, takes the average
+    (reported)."""
+    x = _input(node, name, ctx, color, default,
+               texturable=getattr(ctx, "volume_programs", False))
+    return x.value if _is_tex(x) else x
+
+
 class _Coeffs:
     def __init__(self, sa=_ZERO, ss=_ZERO, gs=0.0, em=_ZERO):
-        self.sa, self.ss, self.gs, self.em = (np.asarray(sa, float), np.asarray(ss, float),
-                                              float(gs), np.asarray(em, float))
+        self.sa, self.ss, self.gs, self.em = sa, ss, float(gs), em
 
-    def scaled(self, f):
-        return _Coeffs(self.sa * f, self.ss * f, self.gs * f, self.em * f)
+    def scaled(self, f, alg):
+        return _Coeffs(alg.mul(self.sa, f), alg.mul(self.ss, f), self.gs * float(alg.mean(f)[0]),
+                       alg.mul(self.em, f))
 
-    def plus(self, o):
-        return _Coeffs(self.sa + o.sa, self.ss + o.ss, self.gs + o.gs, self.em + o.em)
+    def plus(self, o, alg):
+        return _Coeffs(alg.add(self.sa, o.sa), alg.add(self.ss, o.ss), self.gs + o.gs,
+                       alg.add(self.em, o.em))
+
+    def varies(self) -> bool:
+        return any(_varies(x) for x in (self.sa, self.ss, self.em))
 
 
-def _scatter(color, density, g):
-    ss = np.maximum(np.asarray(color, float), 0.0) * density
-    return ss, float(ss.mean()) * g
+def _scatter(alg, color, density, g):
+    ss = alg.mul(alg.max0(color), density)
+    return ss, float(alg.mean(ss).mean()) * g
 
 
-def _principled(node, ctx):
-    def c(name, d, color=False):
-        return _constant(node, name, ctx, d, color=color)
-    density = max(c("Density", 1.0), 0.0)
-    color = np.maximum(np.asarray(c("Color", (0.5,) * 3, True), float), 0.0)
-    ss, gs = _scatter(color, density, c("Anisotropy", 0.0))
-    absorb = np.asarray(c("Absorption Color", (0.0,) * 3, True), float)
-    sa = np.maximum(1.0 - color, 0.0) * np.maximum(1.0 - np.sqrt(np.maximum(absorb, 0.0)),
-                                                    0.0) * density
-    em = np.asarray(c("Emission Color", (1.0,) * 3, True), float) * c("Emission Strength", 0.0)
-    if c("Blackbody Intensity", 0.0) > 1e-3:
+def _principled(node, ctx, alg):
+    density = alg.max0(_read(node, "Density", ctx, 1.0))
+    color = alg.max0(_read(node, "Color", ctx, (0.5,) * 3, True))
+    ss, gs = _scatter(alg, color, density, _constant(node, "Anisotropy", ctx, 0.0))
+    absorb = _read(node, "Absorption Color", ctx, (0.0,) * 3, True)
+    sa = alg.mul(alg.mul(alg.max0(alg.one_minus(color)),
+                         alg.max0(alg.one_minus(alg.sqrt0(absorb)))), density)
+    em = alg.max0(alg.mul(_read(node, "Emission Color", ctx, (1.0,) * 3, True),
+                          _read(node, "Emission Strength", ctx, 0.0)))
+    if _constant(node, "Blackbody Intensity", ctx, 0.0) > 1e-3:
         ctx.issue(f"{node.name!r}: blackbody emission is not rendered")
-    return _Coeffs(sa, ss, gs, np.maximum(em, 0.0))
+    return _Coeffs(sa, ss, gs, em)
 
 
-def _volume_scatter(node, ctx):
+def _volume_scatter(node, ctx, alg):
     phase = getattr(node, "phase", "HENYEY_GREENSTEIN")
     if phase != "HENYEY_GREENSTEIN":
         ctx.issue(f"{node.name!r}: the {phase.replace('_', ' ').title()} phase function is "
                   f"rendered as Henyey-Greenstein")
-    density = max(_constant(node, "Density", ctx, 1.0), 0.0)
-    color = _constant(node, "Color", ctx, (0.8,) * 3, color=True)
-    ss, gs = _scatter(color, density, _constant(node, "Anisotropy", ctx, 0.0))
+    density = alg.max0(_read(node, "Density", ctx, 1.0))
+    color = _read(node, "Color", ctx, (0.8,) * 3, True)
+    ss, gs = _scatter(alg, color, density, _constant(node, "Anisotropy", ctx, 0.0))
     return _Coeffs(ss=ss, gs=gs)
 
 
-def _absorption(node, ctx):
-    density = max(_constant(node, "Density", ctx, 1.0), 0.0)
-    color = np.asarray(_constant(node, "Color", ctx, (0.8,) * 3, color=True), float)
-    return _Coeffs(sa=np.maximum(1.0 - color, 0.0) * density)
+def _absorption(node, ctx, alg):
+    density = alg.max0(_read(node, "Density", ctx, 1.0))
+    color = _read(node, "Color", ctx, (0.8,) * 3, True)
+    return _Coeffs(sa=alg.mul(alg.max0(alg.one_minus(color)), density))
 
 
-def _coefficients(node, ctx):
+def _coefficients(node, ctx, alg):
     def v(name):
-        return np.maximum(np.asarray(_constant(node, name, ctx, (0.0,) * 3, color=True),
-                                     float), 0.0)
+        return alg.max0(_read(node, name, ctx, (0.0,) * 3, True))
     ss = v("Scatter Coefficients")
     g = _constant(node, "Anisotropy", ctx, 0.0)
-    return _Coeffs(v("Absorption Coefficients"), ss, float(ss.mean()) * g,
+    return _Coeffs(v("Absorption Coefficients"), ss, float(alg.mean(ss).mean()) * g,
                    v("Emission Coefficients"))
 
 
-def _emission(node, ctx):
-    color = np.asarray(_constant(node, "Color", ctx, (1.0,) * 3, color=True), float)
-    return _Coeffs(em=np.maximum(color * _constant(node, "Strength", ctx, 1.0), 0.0))
+def _emission(node, ctx, alg):
+    color = _read(node, "Color", ctx, (1.0,) * 3, True)
+    return _Coeffs(em=alg.max0(alg.mul(color, _read(node, "Strength", ctx, 1.0))))
 
 
 _NODES = {"ShaderNodeVolumePrincipled": _principled,
@@ -106,34 +192,50 @@ _NODES = {"ShaderNodeVolumePrincipled": _principled,
           "ShaderNodeEmission": _emission}
 
 
-def _coeffs(socket, ctx, depth=0):
+def _coeffs(socket, ctx, alg, depth=0):
     found = _link(socket)
     if found is None or depth > 32:
         return _Coeffs()
     node = found[0]
     kind = node.bl_idname
     if kind in _NODES:
-        return _NODES[kind](node, ctx)
+        return _NODES[kind](node, ctx, alg)
     if kind == "ShaderNodeAddShader":
-        return _coeffs(node.inputs[0], ctx, depth + 1).plus(
-            _coeffs(node.inputs[1], ctx, depth + 1))
+        return _coeffs(node.inputs[0], ctx, alg, depth + 1).plus(
+            _coeffs(node.inputs[1], ctx, alg, depth + 1), alg)
     if kind == "ShaderNodeMixShader":
-        f = min(max(_constant(node, "Fac", ctx, 0.5), 0.0), 1.0)
-        return _coeffs(node.inputs[1], ctx, depth + 1).scaled(1.0 - f).plus(
-            _coeffs(node.inputs[2], ctx, depth + 1).scaled(f))
+        f = alg.clamp01(_read(node, "Fac", ctx, 0.5))
+        return _coeffs(node.inputs[1], ctx, alg, depth + 1).scaled(alg.one_minus(f), alg).plus(
+            _coeffs(node.inputs[2], ctx, alg, depth + 1).scaled(f, alg), alg)
     ctx.issue(f"its volume uses the {node.bl_label!r} node, which DRT does not render in "
               f"volumes; that part is left out")
     return _Coeffs()
 
 
+def is_heterogeneous(material) -> bool:
+    """Whether an engine Material's volume varies in space (its program computes it)."""
+    shader = getattr(material, "shader", None)
+    return shader is not None and any(k in shader.outputs for k in VOLUME_OUTPUTS)
+
+
 def export_volume(socket, ctx) -> "engine.Volume | None":
-    """The homogeneous Volume behind a Volume socket (None: nothing linked or empty)."""
+    """The Volume behind a Volume socket (None: nothing linked or empty). When it varies
+    in space (a material's, ctx.volume_programs), its coefficients are also left in
+    ctx.volume_outputs ({VOLUME_OUTPUTS name: program Value}) for the material's
+    program, and the Volume holds their averages."""
     if socket is None or _link(socket) is None:
         return None
-    c = _coeffs(socket, ctx)
-    ss_mean = float(c.ss.mean())
+    alg = _Algebra(ctx.nodes)
+    c = _coeffs(socket, ctx, alg)
+    sa, ss, em = alg.mean(c.sa), alg.mean(c.ss), alg.mean(c.em)
+    ss_mean = float(ss.mean())
     g = c.gs / ss_mean if ss_mean > 0 else 0.0
-    v = engine.Volume(tuple(c.sa), tuple(c.ss), min(max(g, -1.0), 1.0), tuple(c.em))
+    v = engine.Volume(tuple(np.maximum(sa, 0.0)), tuple(np.maximum(ss, 0.0)),
+                      min(max(g, -1.0), 1.0), tuple(np.maximum(em, 0.0)))
+    if c.varies():
+        ctx.volume_outputs = {name: alg.vector(x) for name, x in
+                              zip(VOLUME_OUTPUTS, (c.sa, c.ss, c.em))}
+        return v
     return None if v.is_empty() else v
 
 

@@ -28,7 +28,8 @@ from ..kernels.path_vertex import shade
 from ..kernels.path_weights import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
                                     add_unoccluded)
 from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
-from ..kernels.volume import STACK, pack_volumes
+from ..kernels.medium_density import bound_majorants, shadow_keys
+from ..kernels.volume import STACK, V_HET, pack_volumes
 from ..nodes.context import N_OBJ
 from ..nodes.differentials import camera_cones
 from ..sampling.dispatch import pixel_keys
@@ -104,6 +105,14 @@ class CompiledPathIntegrator:
         self.vol = pack_volumes(flatten_mixes(ctx.scene.materials)[0],
                                 ctx.scene.world.volume)
         self.has_volumes = self.vol.shape[0] > 0
+        # heterogeneous volumes (engine.kernels.medium_density): their objects and
+        # majorants; `het_runs` counts their program runs (0 in any other scene)
+        self.heterogeneous = self.has_volumes and bool(self.vol[:, V_HET].any())
+        if self.heterogeneous:
+            bound_majorants(self.vol, self.textures, surf.material,
+                            self.geometry[10], self.geometry[11],
+                            (surf.v0, surf.v1, surf.v2), self.camera)
+        self.het_runs = np.zeros(1, np.int64)
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
                             else np.full(STACK, -1, np.int32))
 
@@ -148,10 +157,11 @@ class CompiledPathIntegrator:
             layer += 1
         return t_all, prim_all, u_all, v_all, factor, stopped
 
-    def _transmittance(self, org, dirs, far, time, stacks):
+    def _transmittance(self, org, dirs, far, time, stacks, keys):
         """Transmittance (n, 3) of shadow rays through transparent layers and volumes
         (stacks: each ray's volume stack, updated as it crosses boundaries; (0, STACK)
-        without volumes); time: their shutter times (None when nothing moves)."""
+        without volumes); time: their shutter times (None when nothing moves); keys:
+        their random streams in heterogeneous media (empty without)."""
         n = len(org)
         trans = np.ones((n, 3))
         rows = np.arange(n, dtype=np.int64)
@@ -162,9 +172,10 @@ class CompiledPathIntegrator:
         while rows.size:
             h = self.ctx.accel.intersect(o, dirs[rows], remaining,
                                          None if time is None else time[rows])
-            k = shadow_pass(layer, self.transparent_limit, rows, dirs, ray_time, remaining,
-                            h.t, h.prim, h.u, h.v, trans, self.geometry, self.materials,
-                            self.vol, stacks, out_rows, out_org, out_far)
+            k = shadow_pass(layer, self.transparent_limit, rows, o, dirs, ray_time,
+                            remaining, h.t, h.prim, h.u, h.v, trans, self.geometry,
+                            self.materials, self.vol, stacks, (keys, self.het_runs),
+                            out_rows, out_org, out_far)
             rows = out_rows[:k].copy()
             o, remaining = out_org[:k].copy(), out_far[:k].copy()
             layer += 1
@@ -194,7 +205,8 @@ class CompiledPathIntegrator:
         stacks = np.ascontiguousarray(np.tile(self.start_stack, (k, 1)), np.int32)
         sh_stack = np.full((k, STACK), -1, np.int32)
         sh_bounce = np.empty(n, np.int64)
-        media = (bounce, vbounce, self.vol, stacks, sh_stack, sh_bounce)
+        media = (bounce, vbounce, self.vol, stacks, sh_stack, sh_bounce, self.het_runs)
+        no_keys = np.zeros(0, np.uint64)
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(dirs, dtype=np.float64)
         tm = np.ascontiguousarray(np.broadcast_to(tmax, (n,)), dtype=np.float64)
@@ -231,8 +243,10 @@ class CompiledPathIntegrator:
                 sh_time = path_time[sh_path[:ns]] if moving else None
                 clamps = (sh_bounce[:ns], s.clamp_direct, s.clamp_indirect)
                 if self.any_transparent or self.skips_shadows or self.has_volumes:
+                    keys = (shadow_keys(pkey, index, sh_path[:ns], depth)
+                            if self.heterogeneous else no_keys)
                     trans = self._transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns], sh_time,
-                                                sh_stack[:ns] if k else sh_stack)
+                                                sh_stack[:ns] if k else sh_stack, keys)
                     add_transmitted(L, sh_path[:ns], sh_contrib[:ns], trans, *clamps)
                 else:
                     blocked = ctx.accel.occluded(sh_org[:ns], sh_dir[:ns], sh_far[:ns],

@@ -15,22 +15,22 @@ from . import ray_queues
 from .jit import kernel
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, nee_weight,
                            roulette)
-from .volume import hg_phase, hg_sample, medium
+from .volume import hg_phase, hg_sample
 
 C_VOLUME_BOUNCES = 14      # cfg entry: Cycles' max volume bounces
 
 
 @kernel
-def scatter(depth, cfg, pkey, index, p, px, py, pz, dx, dy, dz, br, bg, bb, bounce,
+def scatter(depth, cfg, pkey, index, p, px, py, pz, dx, dy, dz, br, bg, bb, g, bounce,
             vbounce, beta, prev_pdf, prev_pos, ray_bits, L, lights, vol, stacks,
             sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns,
             nx_path, nx_org, nx_dir, nn):
     """Path p (throughput b, after the segment's weight) scattered at point x moving
-    along d. Writes at most one shadow ray (returned count ns) and one next ray (nn)."""
+    along d, by a Henyey-Greenstein phase function of anisotropy g. Writes at most one
+    shadow ray (returned count ns) and one next ray (nn)."""
     kind, spp = int(cfg[0]), int(cfg[1])
     mode = int(cfg[8])
     clamp = cfg[6] if bounce[p] == 0 else cfg[7]
-    g = medium(vol, stacks, p)[6]
     base = D.FIRST_BOUNCE + depth * D.PER_BOUNCE
     # whether the phase function samples a next ray; if not, light sampling alone finds
     # the light (its MIS weight is then 1, as a BSDF's at the last bounce)

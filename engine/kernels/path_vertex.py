@@ -28,7 +28,9 @@ from .medium_vertex import scatter
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
                            TRANSMISSION_BIT, _add, _INF, hit_weight, nee_weight, roulette,
                            uncovered)
-from .volume import V_BOUNDARY, V_HAS, in_medium, passed, segment, stack_cross, volume_dim
+from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
+from .volume import (V_BOUNDARY, V_HAS, in_medium, medium, passed, segment, stack_cross,
+                     volume_dim)
 from .bsdf.params import P_BASE, P_FILTER_ALPHA, P_METALLIC, P_ROUGHNESS
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import apply_to_row, emission_at
@@ -95,15 +97,19 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     engine.nodes.differentials), what shader programs read of the path; the cone moves
     on to the next ray's origin.
 
-    media: (bounce, volume bounces, VOL, stacks, shadow stacks, shadow bounces): each
-    path's bounces so far (depth counts the wavefront's steps, which include crossings
-    of volume boundaries) and volume scatterings, the volume table and the paths'
-    volume stacks (engine.kernels.volume; empty when the scene has no media) and the
-    shadow rays' copies of them. A ray in a medium first travels through it
-    (`volume.segment`): it may scatter there (`medium_vertex.scatter` shades that
+    media: (bounce, volume bounces, VOL, stacks, shadow stacks, shadow bounces,
+    heterogeneous count): each path's bounces so far (depth counts the wavefront's
+    steps, which include crossings of volume boundaries) and volume scatterings, the
+    volume table and the paths' volume stacks (engine.kernels.volume; empty when the
+    scene has no media), the shadow rays' copies of them and a (1,) int64 counter of
+    the shader program runs inside heterogeneous media. A ray in a medium first travels
+    through it (`volume.segment`, or `medium_density.tracked_segment` when a medium of
+    its stack is heterogeneous): it may scatter there (`medium_vertex.scatter` shades that
     point), emission along it is added, and what it reaches beyond is weighted by its
     transmittance. A hit on a volume's boundary surface is crossed without a bounce."""
-    bounce, vbounce, vol, stacks, sh_stack, sh_bounce = media
+    bounce, vbounce, vol, stacks, sh_stack, sh_bounce, het_count = media
+    het_scene = has_heterogeneous(vol)
+    vhit = np.zeros(N_HIT)
     tri_material, holdout, corner_uvs = geometry[5], geometry[7], geometry[8]
     any_textures = textures[1].shape[0] > 0
     film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
@@ -134,18 +140,40 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         b0r, b0g, b0b = br, bg, bb
         vmode, scattered, t_end = 0, False, t_geom
         str_ = stg = stb = wcr = wcg = wcb = 0.0
+        g_phase = 0.0
+        mfr = mfg = mfb = 1.0                    # a heterogeneous segment's factor at a lamp
         if in_medium(stacks, p):
-            vmode, scattered, t_end, br, bg, bb, str_, stg, stb, wcr, wcg, wcb, er, eg, eb = \
-                segment(vol, stacks, p, br, bg, bb, t_geom,
-                        sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 0)),
-                        sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 1)))
+            if het_scene and heterogeneous_in(vol, stacks, p):
+                # null-scattering tracking (engine.kernels.medium_density); the factor
+                # is also taken at the nearest lamp in front of the geometry
+                t_lamp = _INF
+                if n_lights > 0:
+                    t_lamp = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_geom,
+                                          ray_bits[p])[0]
+                vmode = 3
+                scattered, t_end, fr, fg, fb, mfr, mfg, mfb, er, eg, eb, g_phase = \
+                    tracked_segment(vol, stacks, p, textures, geometry[11], geometry[14],
+                                    ox, oy, oz, dx, dy, dz, t_geom, t_lamp, br, bg, bb,
+                                    ray_bits[p], b, path_key(pkey[p], index[p], depth),
+                                    vhit, regs, het_count)
+                br, bg, bb = br * fr, bg * fg, bb * fb
+            else:
+                vmode, scattered, t_end, br, bg, bb, str_, stg, stb, wcr, wcg, wcb, er, eg, \
+                    eb = segment(vol, stacks, p, br, bg, bb, t_geom,
+                                 sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 0)),
+                                 sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 1)))
+                if scattered:
+                    g_phase = medium(vol, stacks, p)[6]
             _add(L, p, er, eg, eb, clamp_hit)
         # 1a. area and sphere lamps in front of the geometry; the ray goes on behind them
         if n_lights > 0:
             t_l, k_l, lr, lg, lb = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_end,
                                                 ray_bits[p])
             if k_l >= 0:
-                fr, fg, fb = passed(vmode, str_, stg, stb, wcr, wcg, wcb, t_l)
+                if vmode == 3:
+                    fr, fg, fb = mfr, mfg, mfb
+                else:
+                    fr, fg, fb = passed(vmode, str_, stg, stb, wcr, wcg, wcb, t_l)
                 if vol.shape[0] > 0:
                     # the ray may start past volume boundaries: the lamp's distance is
                     # from the path's last vertex
@@ -159,10 +187,10 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             cone_moves(path_info[1], p, t_end)
             ns_out, nn_out = scatter(depth, cfg, pkey, index, p, ox + dx * t_end,
                                      oy + dy * t_end, oz + dz * t_end, dx, dy, dz, br, bg, bb,
-                                     bounce, vbounce, beta, prev_pdf, prev_pos, ray_bits, L,
-                                     lights, vol, stacks, sh_path, sh_org, sh_dir, sh_far,
-                                     sh_contrib, sh_bounce, sh_stack, ns_out, nx_path, nx_org, nx_dir,
-                                     nn_out)
+                                     g_phase, bounce, vbounce, beta, prev_pdf, prev_pos,
+                                     ray_bits, L, lights, vol, stacks, sh_path, sh_org, sh_dir,
+                                     sh_far, sh_contrib, sh_bounce, sh_stack, ns_out, nx_path,
+                                     nx_org, nx_dir, nn_out)
             continue
         # 1b. escaped rays: the world and sun discs (or, for camera rays on a transparent
         # film, no colour and the coverage left)

@@ -21,7 +21,9 @@ from ..sampling.dispatch import sample_1d
 from .jit import kernel
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .textures import alpha_at
+from .medium_density import attenuate_tracked, has_heterogeneous, heterogeneous_in
 from .volume import V_BOUNDARY, attenuate, stack_cross
+from ..sampling.hashing import chain
 from ..nodes.context import N_HIT
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
@@ -127,21 +129,34 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
 
 
 @kernel
-def shadow_pass(layer, limit, rows, sd, ray_time, remaining, cur_t, cur_prim, cur_u, cur_v,
-                trans, geometry, materials, vol, stacks, out_rows, out_org, out_far):
+def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur_t, cur_prim, cur_u,
+                cur_v, trans, geometry, materials, vol, stacks, tracking, out_rows, out_org,
+                out_far):
     """One layer of transparent shadows for the shadow rays `rows`: an opaque surface (or
     one past `limit` transparent layers) blocks; a transparent one multiplies the
     transmittance by (1 - alpha) x its transparent colour and the ray goes on; through a
     surface whose object casts no shadow it goes on unchanged. With volumes (vol, the
     rays' stacks; engine.kernels.volume) the medium between layers attenuates the ray,
-    and a volume's boundary is crossed (the stack updated) without counting a layer."""
-    tri_material, maybe_transparent, _, tcolor, _, tri_vis = materials
+    and a volume's boundary is crossed (the stack updated) without counting a layer.
+    so: the rows' origins (row i's at so[i]). tracking: (each shadow ray's random key,
+    the heterogeneous program-run counter; engine.kernels.medium_density), used by the
+    rays whose media include a heterogeneous one (ratio tracking)."""
+    tri_material, maybe_transparent, _, tcolor, T, tri_vis = materials
+    keys, het_count = tracking
+    het_scene = stacks.shape[0] > 0 and has_heterogeneous(vol)
+    hit = np.zeros(N_HIT if het_scene else 0)
+    regs = np.zeros(max(T[NREGS][0], 1) if het_scene else 0)
     n_out = 0
     for i in range(rows.shape[0]):
         r = rows[i]
         prim = cur_prim[i]
         reached = prim < 0 or not cur_t[i] < remaining[i]
-        if stacks.shape[0] > 0:
+        if het_scene and heterogeneous_in(vol, stacks, r):
+            attenuate_tracked(vol, stacks, r, trans, T, geometry[11], geometry[14],
+                              so[i, 0], so[i, 1], so[i, 2], sd[r, 0], sd[r, 1], sd[r, 2],
+                              remaining[i] if reached else cur_t[i],
+                              chain(keys[r], layer), hit, regs, het_count)
+        elif stacks.shape[0] > 0:
             attenuate(vol, stacks, r, trans, remaining[i] if reached else cur_t[i])
         if reached:
             continue

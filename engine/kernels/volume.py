@@ -23,9 +23,12 @@ Along a segment of length t in a medium of extinction sigma_t = sigma_a + sigma_
 
 The packed table VOL (materials + 1 rows, the last the world's): absorption RGB,
 scattering RGB, anisotropy g, emission RGB, has-a-volume flag, boundary flag (the
-material has no surface shader). Stacks are (paths, STACK) int32 of material rows,
--1 for empty slots; the world's row sits at the bottom of every stack when it has a
-volume.
+material has no surface shader), heterogeneous flag (the material's program computes
+its coefficients per point: engine.kernels.medium_density, which also fills the
+majorant and object columns; the row's coefficients are then zeros), majorant, object.
+Paths whose media are all homogeneous use this module only.
+Stacks are (paths, STACK) int32 of material rows, -1 for empty slots; the world's row
+sits at the bottom of every stack when it has a volume.
 """
 from __future__ import annotations
 
@@ -37,14 +40,16 @@ from .frame import basis
 from .jit import kernel
 
 STACK = 8                          # media one path can be inside at once (Cycles: 4+)
-V_SA, V_SS, V_G, V_EM, V_HAS, V_BOUNDARY, NV = 0, 3, 6, 7, 10, 11, 12
+V_SA, V_SS, V_G, V_EM, V_HAS, V_BOUNDARY = 0, 3, 6, 7, 10, 11
+V_HET, V_MAJ, V_OBJ, NV = 12, 13, 14, 15
+VOLUME_OUTPUTS = ("volume_absorption", "volume_scattering", "volume_emission")
 VOLUME_DIM = 1 << 25               # the volume decisions' own sampler dimensions
 _INV_4PI = 1.0 / (4.0 * math.pi)
 
 
 def pack_volumes(materials, world_volume) -> np.ndarray:
-    """The VOL table of engine.scene materials (with .volume, .surface) and the world's
-    Volume (or None); an empty (0, NV) table when nothing has a volume, so scenes without
+    """The VOL table of engine.scene materials (with .volume, .surface, .shader) and the
+    world's Volume (or None); an empty (0, NV) table when nothing has a volume, so scenes without
     media skip every volume step."""
     rows = list(materials) + [None]
     if all(m.volume is None and m.surface for m in materials) and world_volume is None:
@@ -56,11 +61,16 @@ def pack_volumes(materials, world_volume) -> np.ndarray:
             vol[i, V_BOUNDARY] = 1.0
         if v is None:
             continue
+        vol[i, V_G] = min(max(float(v.anisotropy), -0.999), 0.999)
+        vol[i, V_HAS] = 1.0
+        vol[i, V_OBJ] = -1.0
+        shader = getattr(m, "shader", None) if m is not None else None
+        if shader is not None and any(k in shader.outputs for k in VOLUME_OUTPUTS):
+            vol[i, V_HET] = 1.0       # its coefficients are its program's, not constants
+            continue
         vol[i, V_SA:V_SA + 3] = np.maximum(np.asarray(v.absorption, np.float64)[:3], 0.0)
         vol[i, V_SS:V_SS + 3] = np.maximum(np.asarray(v.scattering, np.float64)[:3], 0.0)
-        vol[i, V_G] = min(max(float(v.anisotropy), -0.999), 0.999)
         vol[i, V_EM:V_EM + 3] = np.maximum(np.asarray(v.emission, np.float64)[:3], 0.0)
-        vol[i, V_HAS] = 1.0
     return vol
 
 

@@ -18,11 +18,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-# MaterialTable.PARAMS, the shading normal (a Normal Map's) and a Mix Shader's factor
-# (the probability of its second shader, Material.mix)
-OUTPUTS = ("base_color", "metallic", "roughness", "emission", "alpha", "normal", "mix")
+# MaterialTable.PARAMS, the shading normal (a Normal Map's), a Mix Shader's factor (the
+# probability of its second shader, Material.mix) and a heterogeneous volume's
+# coefficients at a point (engine.kernels.medium_density)
+OUTPUTS = ("base_color", "metallic", "roughness", "emission", "alpha", "normal", "mix",
+           "volume_absorption", "volume_scattering", "volume_emission")
 OUTPUT_WIDTH = {"base_color": 3, "metallic": 1, "roughness": 1, "emission": 3, "alpha": 1,
-                "normal": 3, "mix": 1}
+                "normal": 3, "mix": 1, "volume_absorption": 3, "volume_scattering": 3,
+                "volume_emission": 3}
 N_OUT = len(OUTPUTS)
 WIDTH = 8            # int32 per instruction: opcode, output register, six operands
 

@@ -20,6 +20,7 @@ from .interpreter import reads_differentials, run
 from .pack import MIX, OUTS
 
 OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_MIX = range(7)
+OUT_VOL_SA, OUT_VOL_SS, OUT_VOL_EM = 7, 8, 9      # engine.kernels.medium_density
 
 
 @kernel
