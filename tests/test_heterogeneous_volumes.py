@@ -1,6 +1,7 @@
 """Heterogeneous volumes in the engine (engine.kernels.medium_density): media whose
 coefficients a shader program computes per point, against closed forms; no Blender.
 
+- Emission varying in space in a uniform absorber integrates exactly.
 - Transmittance: a sphere of absorber whose density grows as (y + 1)^2 along the view
   axis, seen through its centre, transmits exp(-sigma 8/3) (the integral of the density
   along the chord), not the exp(-sigma 2.4) of its average density: ratio tracking
@@ -26,10 +27,13 @@ from engine.render import RenderContext
 from test_volumes import R, _sphere_scene as volume_sphere
 
 
-def _graded(output, coeffs):
+def _graded(output, coeffs, constants=None):
     """A program whose `output` is coeffs x (y + 1)^2, y the object-space height along
-    the view axis (the identity object: world y)."""
+    the view axis (the identity object: world y); `constants`: {output: RGB} more
+    outputs that do not vary."""
     b = ProgramBuilder()
+    for name, value in (constants or {}).items():
+        b.output(name, b.constant(tuple(value), "vector"))
     y = b.emit(I.IN_HIT1, "float", [C.H_OBJECT + 1], varying=True)
     s = b.emit(CV.CV_MATH, "float", [y, b.constant(1.0), b.constant(0.0),
                                      CV.MATH_OPS.index("ADD"), 0])
@@ -64,6 +68,23 @@ def test_graded_absorber_transmits_exp_minus_integral():
     np.testing.assert_allclose(got, expected, rtol=0.035)
     # a control: the averaged density's transmittance is outside the tolerance
     assert np.all(np.abs(averaged - got) > 0.06 * got)
+
+
+def test_graded_emission_through_an_absorber_integrates_exactly():
+    """Emission e (y + 1)^2 in a uniform absorber sigma: along the centre chord the
+    camera sees the integral of e u^2 exp(-sigma u) over u = y + 1 in [0, 2] (the
+    emission gathered at the tracking's collisions, attenuated by their null weights)."""
+    e, sigma = np.array([0.2, 0.5, 1.0]), np.array([1.0, 0.5, 0.2])
+    program = _graded("volume_emission", e, {"volume_absorption": sigma})
+    vol = Volume(absorption=tuple(sigma), emission=tuple(e * 1.2))
+    film, _ = render(_sphere_scene(vol, program, world=(0, 0, 0), lens=1000.0),
+                     RenderSettings(samples=256, seed=1))
+    got = film.mean().mean(axis=(0, 1))
+    # the integral of u^2 exp(-s u) over [0, 2]
+    expected = e * (2.0 - np.exp(-2.0 * sigma) * (4.0 * sigma ** 2 + 4.0 * sigma + 2.0)) \
+        / sigma ** 3
+    print("emission", got, "expected", expected)
+    np.testing.assert_allclose(got, expected, rtol=0.03)
 
 
 def test_heterogeneous_white_furnace():
