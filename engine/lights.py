@@ -47,7 +47,7 @@ from . import visibility
 from .light_sample import LightSample, luminance  # noqa: F401 (re-exported)
 from .scene import AreaLight, PointLight, SunLight
 from .warp import concentric_disk, orthonormal_basis, uniform_sphere
-from .world_light import world_model
+from .world_light import EnvironmentLightModel, world_model
 
 INF = np.inf
 TWO_PI = 2.0 * np.pi
@@ -557,7 +557,12 @@ class LightSet:
         # when it is too dark to be a light, for what escaped rays see
         self.world = None if world is None else (
             world if getattr(world, "is_environment", False) else world_model(world))
-        if self.world is not None:
+        # Only a world that varies with direction (an environment map) is sampled as a
+        # light. A uniform one is found by the BSDF rays that escape, as Cycles does (its
+        # LightManager disables the background light unless the world's shader varies in
+        # space): the same light in expectation, except through Cycles' refraction pairs
+        # that only next-event estimation sees (engine/bsdf/dielectric.py's note).
+        if self.world is not None and not isinstance(self.world, EnvironmentLightModel):
             self.models.append(self.world)
         power = np.array([max(m.power(scene_radius), 0.0) for m in self.models], dtype=np.float64)
         power = np.where(np.isfinite(power), power, 0.0)

@@ -73,9 +73,9 @@ def case_rough_dielectric(deg, eta, alpha, below=False, allow_r=True, allow_t=Tr
             allow_r, allow_t)
         return wi, valid
 
-    def pdf(w):
+    def pdf(w):     # the sampler's own density (not Cycles' MIS pdf, see dielectric.py)
         return dielectric.rough_pdf(wo_at(deg, len(w), below), w, eta, full(alpha, len(w)),
-                                    allow_r, allow_t)
+                                    allow_r, allow_t, as_cycles=False)
     return sample, pdf
 
 
@@ -109,11 +109,13 @@ ALLOWED = {
 
 def make_principled(params, n):
     p = params
-    return PrincipledBSDF(np.tile(p["base_color"], (n, 1)), full(p["metallic"], n),
-                          full(p["transmission"], n), full(p["roughness"], n), full(p["ior"], n),
-                          full(p["specular_ior_level"], n), np.full(n, p["front_facing"]),
-                          np.full(n, p.get("blinn_phong", False)),
-                          np.full(n, p.get("multiscatter", False)))
+    b = PrincipledBSDF(np.tile(p["base_color"], (n, 1)), full(p["metallic"], n),
+                       full(p["transmission"], n), full(p["roughness"], n), full(p["ior"], n),
+                       full(p["specular_ior_level"], n), np.full(n, p["front_facing"]),
+                       np.full(n, p.get("blinn_phong", False)),
+                       np.full(n, p.get("multiscatter", False)))
+    b.as_cycles = False     # the sampler's own density (see engine/bsdf/dielectric.py)
+    return b
 
 
 def case_principled(deg, name, allowed="all"):

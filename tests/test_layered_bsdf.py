@@ -58,6 +58,23 @@ def wo_at(deg, n):
     return np.tile([np.sin(t), 0.0, np.cos(t)], (n, 1))
 
 
+def sampler_pairs(params, wo, w):
+    """1 where the sampler can produce w from wo, else 0: the kernels evaluate refraction
+    as Cycles does, also at pairs whose generalised half vector h ~ wo + eta w (eta the
+    IOR on w's side over wo's) is not a microfacet normal that refracts one into the
+    other (wo.h > 0 > w.h fails; engine/bsdf/dielectric.py's note). Those pairs add light
+    only through next-event estimation; sampling never produces them."""
+    if not params.get("transmission"):
+        return np.ones(len(w))
+    ior = Material(name="m", **params).ior
+    eta = np.where(wo[:, 2] > 0, ior, 1.0 / ior)
+    h = wo + eta[:, None] * w
+    h *= np.where(h[:, 2] < 0, -1.0, 1.0)[:, None]
+    refr = wo[:, 2] * w[:, 2] < 0
+    ok = ((wo * h).sum(1) > 0) & ((w * h).sum(1) < 0)
+    return np.where(refr & ~ok, 0.0, 1.0)
+
+
 def case(name, deg, pdf_name=None):
     params = MATERIALS[name]
     pdf_params = MATERIALS[pdf_name or name]
@@ -75,7 +92,8 @@ def case(name, deg, pdf_name=None):
     def pdf(w):
         n = len(w)
         return batch.pdf_batch(rows_of(pdf_params, n), np.ones(n, bool), wo_at(deg, n),
-                               np.ascontiguousarray(w), np.repeat(allowed, n, 0), tables)
+                               np.ascontiguousarray(w), np.repeat(allowed, n, 0), tables
+                               ) * sampler_pairs(pdf_params, wo_at(deg, n), w)
     return sample, pdf
 
 
@@ -125,6 +143,7 @@ def albedo_both_ways(params, deg, n=400_000, seed=1):
     w, dw = sphere_quadrature()
     f = batch.eval_f_batch(rows_of(params, len(w)), np.ones(len(w), bool),
                            wo_at(deg, len(w)), w, tables)
+    f = f * sampler_pairs(params, wo_at(deg, len(w)), w)[:, None]
     quad = (f * (np.abs(w[:, 2]) * dw)[:, None]).sum(0)
     return mc, quad, bool(delta.any())
 

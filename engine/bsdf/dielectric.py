@@ -27,6 +27,18 @@ albedo from the optically denser side may exceed 1 (radiance is concentrated by
 refraction); the flux-conserving quantity is the albedo with the 1/eta_rel^2 removed,
 which is <= 1.
 
+Pairs the sampler never produces (a choice, to match Cycles): Cycles evaluates the
+refraction lobe at every pair of directions on opposite sides from the generalised half
+vector h ~ wo + eta_rel wi alone, with |wo.h|, |wi.h| and F(|wo.h|), without checking that
+h is a microfacet normal that refracts one into the other (wo.h > 0 > wi.h; Walter's
+condition; Cycles' own TODO in bsdf_microfacet_eval). Visible-normal sampling never
+produces those pairs, so only next-event estimation sees them, with their MIS weight:
+a rough glass lit through by a lamp gains light (the rough glass sphere of
+docs/comparisons.md: +0.7% of its image at roughness 0.67). `rough_eval` and `rough_pdf`
+follow Cycles by default (`as_cycles=True`); with `as_cycles=False` they are Walter's
+BTDF and the sampler's own density (what the chi-square tests check), which agree with
+the default on every pair the sampler produces.
+
 Units: f in 1/sr, pdf in 1/sr (inf for the delta choices of the smooth interface),
 sample weights dimensionless. Directions are unit (n, 3) float64, local frame
 (normal = +Z), pointing away from the surface; wi_z < 0 for refraction when wo_z > 0.
@@ -93,8 +105,10 @@ def smooth_sample(wo, eta, u, allow_reflect=True, allow_refract=True):
 
 # --- rough interface -------------------------------------------------------------------
 
-def _refraction_half(wo_c, wi_c, eta_rel):
-    """Generalised half vector h ~ wo + eta wi (Walter eq. 16), facing +Z, and validity."""
+def _refraction_half(wo_c, wi_c, eta_rel, as_cycles=False):
+    """Generalised half vector h ~ wo + eta wi (Walter eq. 16), facing +Z, wo.h, wi.h,
+    |wo + eta wi|^2 and validity: Walter's (wo.h > 0 > wi.h), or with `as_cycles` any
+    h (the cosines then made |wo.h| and -|wi.h|, as Cycles evaluates them)."""
     h = wo_c + eta_rel[:, None] * wi_c
     n = np.sqrt((h * h).sum(1))
     ok = n > 1e-12
@@ -102,12 +116,18 @@ def _refraction_half(wo_c, wi_c, eta_rel):
     h = np.where((h[:, 2] < 0)[:, None], -h, h)
     cos_oh = (wo_c * h).sum(1)
     cos_ih = (wi_c * h).sum(1)
-    ok &= (cos_oh > 0) & (cos_ih < 0) & (h[:, 2] > 0)
-    return h, cos_oh, cos_ih, ok
+    den = (cos_oh + eta_rel * cos_ih) ** 2
+    if as_cycles:
+        cos_oh, cos_ih = np.abs(cos_oh), -np.abs(cos_ih)
+    else:
+        ok &= (cos_oh > 0) & (cos_ih < 0)
+    ok &= h[:, 2] > 0
+    return h, cos_oh, cos_ih, den, ok
 
 
-def rough_eval(wo, wi, eta, alpha):
-    """(f_reflect, f_refract), each (n,) in 1/sr; one of them is zero for each pair.
+def rough_eval(wo, wi, eta, alpha, as_cycles=True):
+    """(f_reflect, f_refract), each (n,) in 1/sr; one of them is zero for each pair
+    (`as_cycles`: see the module's note on pairs the sampler never produces).
 
     f_reflect = F D G2 / (4 |wo_z wi_z|); f_refract (Walter eq. 21 times 1/eta_rel^2):
     (1 - F) D G2 |wi.h| |wo.h| / (|wo_z wi_z| (wo.h + eta_rel wi.h)^2).
@@ -121,13 +141,12 @@ def rough_eval(wo, wi, eta, alpha):
     F_r = fresnel.dielectric(np.maximum((wo_c * h_r).sum(1), 0.0), eta_rel)
     f_r = np.where(upper, F_r * base_r, 0.0)
     # refraction
-    h, cos_oh, cos_ih, ok = _refraction_half(wo_c, wi_c, eta_rel)
+    h, cos_oh, cos_ih, den, ok = _refraction_half(wo_c, wi_c, eta_rel, as_cycles)
     ok &= (wo_c[:, 2] > 0) & (wi_c[:, 2] < 0)
     F_t = fresnel.dielectric(np.where(ok, cos_oh, 1.0), eta_rel)
     a2 = a * a
     zo, zi = wo_c[:, 2], -wi_c[:, 2]
     g_den = zi * mf._r(wo_c, a2) + zo * mf._r(wi_c, a2)     # G2 / (zo zi) = 2 / g_den
-    den = (cos_oh + eta_rel * cos_ih) ** 2
     ok &= (g_den > 0) & (den > 0)
     val = (2.0 * mf.D(h, a) * (1.0 - F_t) * (-cos_ih) * cos_oh
            / np.where(ok, g_den * den, 1.0))
@@ -135,8 +154,9 @@ def rough_eval(wo, wi, eta, alpha):
     return f_r, f_t
 
 
-def rough_pdf(wo, wi, eta, alpha, allow_reflect=True, allow_refract=True):
-    """pdf over wi (1/sr) of `rough_sample` with the same allow flags."""
+def rough_pdf(wo, wi, eta, alpha, allow_reflect=True, allow_refract=True, as_cycles=True):
+    """pdf over wi (1/sr) of `rough_sample` with the same allow flags; with `as_cycles`
+    also on the pairs it never produces, as Cycles' MIS weights see them (module note).""" 
     a = mf.clamp_alpha(alpha)
     wo_c, eta_rel, sign = _canonical(wo, eta)
     wi_c = _zflip(wi, sign)
@@ -149,11 +169,10 @@ def rough_pdf(wo, wi, eta, alpha, allow_reflect=True, allow_refract=True):
     pr, _ = _choice_probs(F_r, allow_reflect, allow_refract)
     pdf_r = np.where(ok_r, pr * 0.25 * g1c * mf.D(h_r, a), 0.0)
     # refraction: P(refract | h) D_wo(h) |dh/dwi|, dh/dwi = eta^2 |wi.h| / (wo.h + eta wi.h)^2
-    h, cos_oh, cos_ih, ok = _refraction_half(wo_c, wi_c, eta_rel)
+    h, cos_oh, cos_ih, den, ok = _refraction_half(wo_c, wi_c, eta_rel, as_cycles)
     ok &= (wo_c[:, 2] > 0) & ~upper
     F_t = fresnel.dielectric(np.where(ok, cos_oh, 1.0), eta_rel)
     _, pt = _choice_probs(F_t, allow_reflect, allow_refract)
-    den = (cos_oh + eta_rel * cos_ih) ** 2
     ok &= den > 0
     jac = eta_rel * eta_rel * (-cos_ih) / np.where(ok, den, 1.0)
     pdf_t = np.where(ok, pt * g1c * cos_oh * mf.D(h, a) * jac, 0.0)

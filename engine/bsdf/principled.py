@@ -118,6 +118,10 @@ class PrincipledBSDF:
         front = (np.ones(n, bool) if front_facing is None
                  else np.broadcast_to(np.asarray(front_facing, bool), (n,)))
 
+        # Refraction also on the pairs the sampler never produces, as Cycles evaluates it
+        # (engine/bsdf/dielectric.py's note); False: Walter's BTDF and the sampler's own
+        # density (the chi-square tests)
+        self.as_cycles = True
         self.base = np.maximum(base_color, 0.0)         # Cycles: diffuse is not clamped
         self.base_clamped = np.minimum(self.base, 1.0)  # ... metal F0 and glass tint are
         # GGX alpha of the material, from which the energy compensation and the layering
@@ -374,7 +378,7 @@ class PrincipledBSDF:
                     gr = rr if g is None else g[rr]
                     lr = rr if loc is None else loc[rr]
                     f_r, f_t = dielectric.rough_eval(wo[lr], wi[lr], self.eta_glass[gr],
-                                                     self.alpha[gr])
+                                                     self.alpha[gr], self.as_cycles)
                     val = (f_r[:, None] * keep[lr, 1:2]
                            + f_t[:, None] * self.tint_t[gr] * keep[lr, 2:3]) \
                         * self.weight[gr, L_GLASS][:, None]
@@ -410,7 +414,8 @@ class PrincipledBSDF:
             if len(r):
                 g = r if idx is None else idx[r]
                 p[r] += q[r, L_GLASS] * dielectric.rough_pdf(
-                    wo[r], wi[r], self.eta_glass[g], self.alpha[g], a_g[r], a_t[r])
+                    wo[r], wi[r], self.eta_glass[g], self.alpha[g], a_g[r], a_t[r],
+                    self.as_cycles)
         return p
 
     def pdf(self, wo, wi, allowed=None):

@@ -4,7 +4,9 @@ compiled twin of engine/bsdf/dielectric.py.
 `eta` is the material IOR relative to the outside; a direction wo below the surface is
 mirrored to the upper side ("canonical") with relative index 1/eta, and the results are
 mirrored back, as in the NumPy module (see there for the sources, the radiance scaling
-1/eta^2 of refraction and the allow flags of the reflect/refract choice).
+1/eta^2 of refraction and the allow flags of the reflect/refract choice). Refraction is
+evaluated as Cycles does, also on pairs the sampler never produces (the NumPy module's
+`as_cycles=True`, its default; see its note).
 """
 from __future__ import annotations
 
@@ -123,15 +125,17 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only):
         F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
         return F_r * base_r, 0.0
     hx, hy, hz, cos_oh, cos_ih, ok = refraction_half(ox, oy, oz, ix, iy, iz, eta_rel)
-    if not (ok and oz > 0.0 and iz < 0.0):
+    if not (oz > 0.0 and iz < 0.0 and hz > 0.0):
         return 0.0, 0.0
+    # Cycles' pairs: any h, |wo.h| and -|wi.h| (ok, Walter's condition, is not required)
+    s = cos_oh + eta_rel * cos_ih      # +-|wo + eta wi|
+    cos_oh, cos_ih = abs(cos_oh), -abs(cos_ih)
     F_t = fresnel.dielectric(cos_oh, eta_rel)
     if refract_only:
         F_t = 1.0 if F_t >= 1.0 else 0.0
     a2 = a * a
     zo, zi = oz, -iz
     g_den = zi * mf.r_len(ox, oy, oz, a2) + zo * mf.r_len(ix, iy, iz, a2)
-    s = cos_oh + eta_rel * cos_ih
     den = s * s
     if not (g_den > 0.0 and den > 0.0):
         return 0.0, 0.0
@@ -158,11 +162,12 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract):
         return pr * 0.25 * g1c * mf.D(hx, hy, hz, a)
     # refraction: P(refract | h) D_wo(h) |dh/dwi|
     hx, hy, hz, cos_oh, cos_ih, ok = refraction_half(ox, oy, oz, ix, iy, iz, eta_rel)
-    if not (ok and oz > 0.0):
+    if not (oz > 0.0 and hz > 0.0):
         return 0.0
+    s = cos_oh + eta_rel * cos_ih      # as in rough_eval_lobes: Cycles' pairs
+    cos_oh, cos_ih = abs(cos_oh), -abs(cos_ih)
     F_t = fresnel.dielectric(cos_oh, eta_rel)
     _, pt = choice_probs(F_t, allow_reflect, allow_refract)
-    s = cos_oh + eta_rel * cos_ih
     den = s * s
     if not den > 0.0:
         return 0.0
