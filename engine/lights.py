@@ -558,11 +558,13 @@ class LightSet:
         self.world = None if world is None else (
             world if getattr(world, "is_environment", False) else world_model(world))
         # Only a world that varies with direction (an environment map) is sampled as a
-        # light. A uniform one is found by the BSDF rays that escape, as Cycles does (its
-        # LightManager disables the background light unless the world's shader varies in
-        # space): the same light in expectation, except through Cycles' refraction pairs
-        # that only next-event estimation sees (engine/bsdf/dielectric.py's note).
-        if self.world is not None and not isinstance(self.world, EnvironmentLightModel):
+        # light, unless its Sampling Method is None. A uniform one is found by the BSDF
+        # rays that escape, as Cycles does (its LightManager disables the background
+        # light unless the world's shader varies in space): the same light in
+        # expectation, except through Cycles' refraction pairs that only next-event
+        # estimation sees (engine/bsdf/dielectric.py's note).
+        if (self.world is not None and not isinstance(self.world, EnvironmentLightModel)
+                and getattr(self.world, "light_sampling", True)):
             self.models.append(self.world)
         power = np.array([max(m.power(scene_radius), 0.0) for m in self.models], dtype=np.float64)
         power = np.where(np.isfinite(power), power, 0.0)

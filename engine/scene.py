@@ -308,7 +308,10 @@ class World:
     visibility: the ray kinds that see it (engine.visibility; Blender's World > Ray
     Visibility); see `engine.world_light`.
     sun: a `SunLight` that belongs to the world (a Sky Texture's sun disc,
-    `engine.sky_texture`), rendered as one more lamp; None = none."""
+    `engine.sky_texture`), rendered as one more lamp; None = none.
+    light_sampling: whether next-event estimation samples a world that varies with
+    direction (Blender's World > Settings > Sampling Method, not None); a uniform world
+    never is (engine.lights.LightSet), as in Cycles."""
     color: tuple = (0.0, 0.0, 0.0)
     texture: Optional[object] = None
     strength: tuple = (1.0, 1.0, 1.0)
@@ -316,6 +319,7 @@ class World:
     visibility: int = 31
     volume: Optional[object] = None      # Volume filling the space outside every mesh
     sun: Optional[SunLight] = None
+    light_sampling: bool = True
 
 
 @dataclass

@@ -95,6 +95,8 @@ def world_model(world):
     texture = getattr(world, "texture", None)
     seen_by = getattr(world, "visibility", vis.ALL)
     if texture is not None:
-        return EnvironmentMapLightModel(EnvironmentMap(texture, world.strength, world.mapping),
-                                        seen_by)
+        model = EnvironmentMapLightModel(EnvironmentMap(texture, world.strength, world.mapping),
+                                         seen_by)
+        model.light_sampling = bool(getattr(world, "light_sampling", True))
+        return model
     return EnvironmentLightModel(getattr(world, "color", world), seen_by)

@@ -318,6 +318,7 @@ def test_quiet_values_are_blenders_defaults(bpy_drt):
     from drt_addon.export.file_settings import IGNORED, OWN, SETTINGS
     from drt_addon.export.settings_check import _MISSING, is_quiet, read
     scene = bpy_drt.data.scenes.new("defaults")
+    scene.world = bpy_drt.data.worlds.new("defaults")   # as in Blender's new files
     try:
         layer = scene.view_layers[0]
         loud = []

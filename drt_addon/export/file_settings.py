@@ -147,6 +147,13 @@ SETTINGS: list[FileSetting] = [
        "start, centre or end on the frame"),
     _s("scene.render.motion_blur_shutter_curve", "Motion Blur > Shutter Curve", READ,
        "the shutter's openness over time, sampled as Cycles samples it"),
+    _s("scene.world.cycles.sampling_method", "World > Settings > Surface > Sampling Method",
+       READ, "None: an environment is not sampled as a light (only escaping rays find "
+       "it); Auto and Manual: it is, by its own importance map. A uniform world never "
+       "is, as in Cycles"),
+    _s("scene.world.cycles.sample_map_resolution", "World > Settings > Surface > Map "
+       "Resolution", NO_EFFECT, "DRT's importance map has the image's own resolution: "
+       + NOISE_ONLY),
     _s("view_layer.use_pass_combined", "Passes > Combined", READ, "written"),
     _s("view_layer.use_pass_z", "Passes > Z", READ, "written: camera-space depth"),
     _s("view_layer.use_pass_normal", "Passes > Normal", READ, "written: world-space normal"),

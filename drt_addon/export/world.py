@@ -73,6 +73,16 @@ def _visibility(world) -> int:
 
 
 def export_world(world, reporter: Reporter) -> "engine.World":
+    """The world's background; World > Settings > Sampling Method None (Cycles'
+    `world.cycles.sampling_method`) keeps an environment from being sampled as a light."""
+    out = _export_background(world, reporter)
+    settings = getattr(world, "cycles", None)
+    if settings is not None and getattr(settings, "sampling_method", "AUTOMATIC") == "NONE":
+        out.light_sampling = False
+    return out
+
+
+def _export_background(world, reporter: Reporter) -> "engine.World":
     if world is None:
         return engine.World(BLACK)
     vis = _visibility(world)
