@@ -119,7 +119,7 @@ def test_bent_sphere_without_bump_map_correction_matches_cycles(bpy_drt, kind,
     the bent normal as it is (not made a valid reflector for the view) and lets the
     diffuse light end abruptly at the smooth surface's terminator (no GGX fade).
     Measured, of the image mean: normal map mean 0.03%, largest block 0.7%; bump mean
-    0.20%, largest block 1.0%. Correcting anyway (DRT before it read the setting):
+    0.07%, largest block 0.6%. Correcting anyway (DRT before it read the setting):
     normal map mean 6.9%, largest block 43%; bump mean 0.5%, largest block 3.1%."""
     bpy = bpy_drt
     scene = _bent_sphere(bpy, kind)
