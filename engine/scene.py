@@ -54,6 +54,12 @@ class Material:
       translucent_color   a Translucent BSDF (diffuse transmission), its weight included;
       refraction_only     the glass lobe refracts without reflecting (Refraction BSDF).
 
+    bump_correction: Cycles' Material > Settings > Bump Map Correction (on by default),
+    for a normal bent by the shader (Normal Map, Bump): its specular lobes on the bent
+    normal made a valid reflector for the view, and its diffuse light faded towards the
+    smooth surface's terminator (engine.nodes.shading). Off: both on the bent normal as
+    it is, the diffuse lobe only refusing light from under the smooth surface.
+
     alpha: coverage, Cycles' Principled Alpha or 1 - the weight of a Transparent BSDF in
     a Mix Shader. Where alpha < 1 the integrators let rays through with probability
     1 - alpha, tinted by `transparent_color` (the Transparent BSDF's colour), counted
@@ -82,6 +88,7 @@ class Material:
     sheen_layered: bool = True
     translucent_color: tuple = (0.0, 0.0, 0.0)
     refraction_only: bool = False
+    bump_correction: bool = True
     base_color_texture: Optional[object] = None
     metallic_texture: Optional[object] = None
     roughness_texture: Optional[object] = None
@@ -188,6 +195,9 @@ class TriangleMesh:
     object_info: Optional[object] = None   # ObjectInfo, what shader nodes read of it
     tangents: Optional[np.ndarray] = None  # (T, 3, 4) float32: tangent, bitangent sign
     colors: Optional[np.ndarray] = None    # (T, 3, 4) float32: a color attribute, RGBA
+    # Shadow Terminator > Geometry Offset (Cycles' per-object setting; 0 = off): how far
+    # shadow rays start from the curved surface of a smooth mesh (engine.kernels.terminator)
+    terminator_offset: float = 0.1
 
     def __post_init__(self):
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)

@@ -90,6 +90,7 @@ class SurfaceBuilder:
                     parts.append(np.repeat(flat[:, None, :], 3, axis=1))
                 offset += t
             self.corner_normals = np.concatenate(parts)
+        self.terminator_cutoff = _terminator_cutoff(ordered, accel.static_count)
         # Texture coordinates per triangle corner (Blender's UV map), for the meshes that
         # have them; triangles of meshes without UVs read (0, 0), as in Cycles.
         self.corner_uvs = None
@@ -208,6 +209,19 @@ def _corner_attribute(ordered, name):
                            if getattr(m, name, None) is not None
                            else np.zeros((len(m.triangles), 3, 4), np.float32)
                            for m in ordered])
+
+
+def _terminator_cutoff(ordered, static_count):
+    """Each triangle's Shadow Terminator Geometry Offset (engine.kernels.terminator), 0
+    where there is no curved surface to start shadow rays from: flat meshes and moving
+    objects' triangles (from static_count on); None when no triangle has one."""
+    if not any(m.corner_normals is not None for m in ordered):
+        return None
+    cut = np.concatenate([np.full(len(m.triangles), getattr(m, "terminator_offset", 0.1)
+                                  if m.corner_normals is not None else 0.0)
+                          for m in ordered])
+    cut[static_count:] = 0.0
+    return cut if (cut > 0.0).any() else None
 
 
 def _object_table(ordered):

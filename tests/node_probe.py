@@ -140,3 +140,42 @@ def tile_errors(drt, cycles):
     diff = (drt - cycles).mean(axis=2)[:h // 8 * 8, :w // 8 * 8]
     blocks = np.abs(diff.reshape(h // 8, 8, w // 8, 8).mean(axis=(1, 3)))
     return mean, mad, float(blocks.max()) / ref
+
+
+def image_errors(drt, cycles):
+    """(|mean ratio - 1|, largest 8 x 8 block difference over the image mean)."""
+    h, w, _ = cycles.shape
+    d = (drt - cycles).mean(axis=2).reshape(h // 8, 8, w // 8, 8).mean(axis=(1, 3))
+    return abs(drt.mean() / cycles.mean() - 1.0), float(np.abs(d).max() / cycles.mean())
+
+
+def new_scene(bpy, size=64):
+    """An empty scene of size x size pixels with a new (default) world."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.resolution_x = scene.render.resolution_y = size
+    scene.render.resolution_percentage = 100
+    scene.world = bpy.data.worlds.new("World")
+    return scene
+
+
+def new_material(bpy, name):
+    """A new node material (Principled BSDF into the Material Output) and its tree."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    return mat, mat.node_tree
+
+
+def smooth_sphere_scene(bpy, segments, rings, material):
+    """A 32 x 32 scene with a black world and a smooth-shaded UV sphere (radius 1) of a
+    new grey (0.8) Principled material: (scene, sphere, node tree, Principled node)."""
+    scene = new_scene(bpy, 32)
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=segments, ring_count=rings)
+    bpy.ops.object.shade_smooth()
+    sphere = bpy.context.object
+    mat, nt = new_material(bpy, material)
+    bsdf = nt.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1.0)
+    sphere.data.materials.append(mat)
+    return scene, sphere, nt, bsdf

@@ -19,44 +19,22 @@ a different mix. With the depths unlinked the colour is the sockets' own value a
 comparison fails."""
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 import node_probe
+from node_probe import image_errors, new_material, new_scene
 
 BUMP_SAMPLES = 256
 DEPTH_SAMPLES = 64
 SPHERE_SAMPLES = 64
 
 
-def _image_errors(drt, cycles):
-    """(|mean ratio - 1|, largest 8 x 8 block difference over the image mean)."""
-    h, w, _ = cycles.shape
-    d = (drt - cycles).mean(axis=2).reshape(h // 8, 8, w // 8, 8).mean(axis=(1, 3))
-    return abs(drt.mean() / cycles.mean() - 1.0), float(np.abs(d).max() / cycles.mean())
-
-
-def _new_scene(bpy, size=64):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    scene = bpy.context.scene
-    scene.render.resolution_x = scene.render.resolution_y = size
-    scene.render.resolution_percentage = 100
-    scene.world = bpy.data.worlds.new("World")
-    return scene
-
-
-def _material(bpy, name):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    return mat, mat.node_tree
-
-
 def _bump_scene(bpy):
-    scene = _new_scene(bpy)
+    scene = new_scene(bpy)
     scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.1
     bpy.ops.mesh.primitive_plane_add(size=12.0)
     floor = bpy.context.object
-    mat, nt = _material(bpy, "Bumpy")
+    mat, nt = new_material(bpy, "Bumpy")
     bsdf = nt.nodes["Principled BSDF"]
     bsdf.inputs["Base Color"].default_value = (0.7, 0.5, 0.3, 1.0)
     bsdf.inputs["Roughness"].default_value = 0.3
@@ -87,11 +65,11 @@ def test_bump_lit_matches_cycles(bpy_drt):
     scene, nt, bump = _bump_scene(bpy)
     cycles = node_probe.render(bpy, scene, "CYCLES", BUMP_SAMPLES)
     drt = node_probe.render(bpy, scene, "DRT", BUMP_SAMPLES)
-    mean, block = _image_errors(drt, cycles)
+    mean, block = image_errors(drt, cycles)
     print(f"bump lit: mean {mean:.2%}, largest block {block:.2%}")
     for link in list(bump.inputs["Height"].links):
         nt.links.remove(link)
-    flat_mean, flat_block = _image_errors(node_probe.render(bpy, scene, "DRT", 64), cycles)
+    flat_mean, flat_block = image_errors(node_probe.render(bpy, scene, "DRT", 64), cycles)
     print(f"flat: mean {flat_mean:.2%}, largest block {flat_block:.2%}")
     assert mean < 0.015 and block < 0.03, (mean, block)
     assert flat_block > 0.1, flat_block
@@ -100,13 +78,7 @@ def test_bump_lit_matches_cycles(bpy_drt):
 def _bent_sphere(bpy, kind):
     """A smooth sphere under a low sun, its normal bent by a Normal Map ('normal_map': a
     diffuse Principled) or by a Bump of a Noise texture ('bump': a glossy plastic)."""
-    scene = _new_scene(bpy, 32)
-    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-    bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=64, ring_count=32)
-    bpy.ops.object.shade_smooth()
-    mat, nt = _material(bpy, "Mapped")
-    bsdf = nt.nodes["Principled BSDF"]
-    bsdf.inputs["Base Color"].default_value = (0.8, 0.8, 0.8, 1.0)
+    scene, _, nt, bsdf = node_probe.smooth_sphere_scene(bpy, 64, 32, "Mapped")
     bsdf.inputs["Specular IOR Level"].default_value = 0.0
     if kind == "normal_map":
         bent = nt.nodes.new("ShaderNodeNormalMap")
@@ -120,7 +92,6 @@ def _bent_sphere(bpy, kind):
         bent.inputs["Distance"].default_value = 0.2
         nt.links.new(noise.outputs["Fac"], bent.inputs["Height"])
     nt.links.new(bent.outputs["Normal"], bsdf.inputs["Normal"])
-    bpy.context.object.data.materials.append(mat)
     node_probe.sun_and_top_camera(bpy, scene, (0.0, 1.1, 0.4), 0.01, 2.2, 10.0)
     return scene
 
@@ -131,31 +102,54 @@ def test_bent_sphere_lit_matches_cycles(bpy_drt, kind):
     0.09%, largest block 0.6%. With Cycles 3 and 4's bump shadowing term (Chiang et
     al.'s, which fades the light towards the bent normal's terminator): normal map mean
     7.2%, largest block 52%; bump mean 1.4%, largest block 7.3%. (On a coarser sphere,
-    32 x 16 faces, DRT is darker than Cycles on a few pixels by the lit silhouette:
-    docs/nodes.md.)"""
+    32 x 16 faces, the light by the terminator: test_terminator_vs_cycles.py.)"""
     bpy = bpy_drt
     scene = _bent_sphere(bpy, kind)
     cycles = node_probe.render(bpy, scene, "CYCLES", SPHERE_SAMPLES)
     drt = node_probe.render(bpy, scene, "DRT", SPHERE_SAMPLES)
-    mean, block = _image_errors(drt, cycles)
+    mean, block = image_errors(drt, cycles)
     print(f"{kind} sphere: mean {mean:.2%}, largest block {block:.2%}")
     assert mean < 0.01 and block < 0.03, (mean, block)
+
+
+@pytest.mark.parametrize("kind, corrected_limit", [("normal_map", 0.2), ("bump", 0.02)])
+def test_bent_sphere_without_bump_map_correction_matches_cycles(bpy_drt, kind,
+                                                                corrected_limit):
+    """Material > Settings > Bump Map Correction off: Cycles lights the specular lobes by
+    the bent normal as it is (not made a valid reflector for the view) and lets the
+    diffuse light end abruptly at the smooth surface's terminator (no GGX fade).
+    Measured, of the image mean: normal map mean 0.03%, largest block 0.7%; bump mean
+    0.07%, largest block 0.6%. Correcting anyway (DRT before it read the setting):
+    normal map mean 6.9%, largest block 43%; bump mean 0.5%, largest block 3.1%."""
+    bpy = bpy_drt
+    scene = _bent_sphere(bpy, kind)
+    mat = bpy.data.materials["Mapped"]
+    mat.cycles.use_bump_map_correction = False
+    cycles = node_probe.render(bpy, scene, "CYCLES", SPHERE_SAMPLES)
+    drt = node_probe.render(bpy, scene, "DRT", SPHERE_SAMPLES)
+    mean, block = image_errors(drt, cycles)
+    mat.cycles.use_bump_map_correction = True
+    corrected = image_errors(node_probe.render(bpy, scene, "DRT", SPHERE_SAMPLES), cycles)
+    print(f"{kind} sphere, no correction: mean {mean:.2%}, largest block {block:.2%}; "
+          f"corrected: mean {corrected[0]:.2%}, largest block {corrected[1]:.2%}")
+    assert mean < 0.01 and block < 0.03, (mean, block)
+    assert corrected[1] > corrected_limit, corrected
 
 
 def _pane(bpy, location, name):
     bpy.ops.mesh.primitive_plane_add(size=2.0, location=location, rotation=(1.5708, 0, 0))
     obj = bpy.context.object
-    mat, nt = _material(bpy, name)
+    mat, nt = new_material(bpy, name)
     obj.data.materials.append(mat)
     return nt, nt.nodes["Principled BSDF"]
 
 
 def _depth_scene(bpy):
-    scene = _new_scene(bpy, 32)
+    scene = new_scene(bpy, 32)
     scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
     # the mirror, tilted 45 degrees about x: the camera looking down sees along +y
     bpy.ops.mesh.primitive_plane_add(size=2.0, rotation=(-0.7854, 0.0, 0.0))
-    mirror, nt = _material(bpy, "Mirror")
+    mirror, nt = new_material(bpy, "Mirror")
     bsdf = nt.nodes["Principled BSDF"]
     bsdf.inputs["Metallic"].default_value = 1.0
     bsdf.inputs["Roughness"].default_value = 0.0
@@ -196,13 +190,13 @@ def test_light_path_depths_lit_match_cycles(bpy_drt):
     scene, path = _depth_scene(bpy)
     cycles = node_probe.render(bpy, scene, "CYCLES", DEPTH_SAMPLES)
     drt = node_probe.render(bpy, scene, "DRT", DEPTH_SAMPLES)
-    mean, block = _image_errors(drt, cycles)
+    mean, block = image_errors(drt, cycles)
     print(f"depths: mean {mean:.2%}, largest block {block:.2%}")
     nt = bpy.data.materials["Wall"].node_tree
     for out in path.outputs:
         for link in list(out.links):
             nt.links.remove(link)
-    unlinked = _image_errors(node_probe.render(bpy, scene, "DRT", 16), cycles)[1]
+    unlinked = image_errors(node_probe.render(bpy, scene, "DRT", 16), cycles)[1]
     print(f"depths unlinked: largest block {unlinked:.2%}")
     assert mean < 0.02 and block < 0.05, (mean, block)
     assert unlinked > 0.1, unlinked

@@ -88,6 +88,7 @@ def build_scene(bpy):
     plain = _mesh_object(bpy, "Plain", CUBE_V, CUBE_F)
     plain.data.materials.append(grey)
     plain.location = (4.0, 0.0, 0.0)
+    plain.shadow_terminator_geometry_offset = 0.25     # Object > Shadow Terminator
     dup = _mesh_object(bpy, "PlainDuplicate", None, None, mesh=plain.data)
     dup.location = (4.0, 3.0, 1.0)
     dup.scale = (-1.0, 1.0, 1.0)                # a mirrored instance
@@ -225,6 +226,12 @@ def test_triangles_bounds_normals_and_materials_match_blender(exported):
             assert np.abs(cn[smooth] - cn[smooth][:, :1]).max() > 0.05
         else:
             assert mesh.corner_normals is None
+
+
+def test_shadow_terminator_geometry_offset_is_exported(exported):
+    _, scene, _, _ = exported
+    assert [m.terminator_offset for m in _by_name(scene, "Plain")] == [0.25]
+    assert [m.terminator_offset for m in _by_name(scene, "Modified")] == [pytest.approx(0.1)]
 
 
 def test_modifiers_are_applied(exported):

@@ -354,20 +354,27 @@ def _plane(bpy, name, x=0.0, half=1.0, uv=((0, 0), (1, 0), (1, 1), (0, 1))):
     return obj
 
 
-def test_bump_map_correction_off_warns(bpy_drt):
-    """Cycles' Bump Map Correction (on by default) shapes how a bent normal is lit; DRT
-    always applies it, so a material that turns it off and bends its normal is warned."""
+def test_bump_map_correction_off_is_exported(bpy_drt):
+    """Cycles' Bump Map Correction (on by default) shapes how a bent normal is lit; off,
+    the material and the sides of its per-hit Mix Shader carry it (no warning). The
+    rendering is compared with Cycles in test_bump_vs_cycles.py."""
     bpy = bpy_drt
     mat, nt = _material(bpy, "Mapped", keep_principled=True)
     nmap = nt.nodes.new("ShaderNodeNormalMap")
     nt.links.new(nmap.outputs[0], nt.nodes["Principled BSDF"].inputs["Normal"])
-    assert _export(mat)[1] == []
+    m, warnings = _export(mat)
+    assert warnings == [] and m.bump_correction
     mat.cycles.use_bump_map_correction = False
-    warnings = _export(mat)[1]
-    assert len(warnings) == 1 and "Bump Map Correction" in warnings[0], warnings
-    for link in list(nt.nodes["Principled BSDF"].inputs["Normal"].links):
-        nt.links.remove(link)
-    assert _export(mat)[1] == []            # no bent normal: nothing to correct
+    m, warnings = _export(mat)
+    assert warnings == [] and not m.bump_correction
+    mix = nt.nodes.new("ShaderNodeMixShader")
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    nt.links.new(noise.outputs["Fac"], mix.inputs["Fac"])
+    nt.links.new(nt.nodes["Principled BSDF"].outputs[0], mix.inputs[1])
+    nt.links.new(nt.nodes.new("ShaderNodeBsdfDiffuse").outputs[0], mix.inputs[2])
+    nt.links.new(mix.outputs[0], _out(nt))
+    m, warnings = _export(mat)
+    assert m.mix is not None and [side.bump_correction for side in m.mix] == [False, False]
 
 
 def test_unsupported_nodes_warn_once_per_material_and_render(bpy_drt):

@@ -124,6 +124,9 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             name = f"{obj.name}#{k}" if inst.is_instance else obj.name
             meshes.append(instance_mesh(local, inst.matrix_world.copy(), slots, name))
             meshes[-1].holdout = holdout
+            # Object > Shadow Terminator > Geometry Offset (engine.kernels.terminator)
+            meshes[-1].terminator_offset = float(getattr(
+                obj, "shadow_terminator_geometry_offset", 0.1))
             if any(materials[i].shader is not None for i in slots):
                 meshes[-1].object_info = object_info(inst, obj, inst.matrix_world)
             # an instance is seen by the rays that see both it and its instancer (Cycles)

@@ -133,6 +133,9 @@ def _material(cl, ctx, name) -> "engine.Material":
     Material shading each hit by one of its two sides (Material.mix), picked with the
     Fac's probability; anywhere else in the tree it mixes by the Fac's average."""
     m = _reduce(cl, ctx, name)
+    # Settings > Bump Map Correction: how a bent normal is lit (engine.Material)
+    m.bump_correction = bool(getattr(getattr(ctx.mat, "cycles", None),
+                                     "use_bump_map_correction", True))
     if cl.mix is not None:
         a, b, fac = cl.mix
         program_outputs(m)["mix"] = fac
@@ -183,10 +186,6 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
             program = result.shader or ctx.nodes.build()
             result.shader = dataclasses.replace(
                 program, outputs={**program.outputs, **ctx.volume_outputs})
-        cycles = getattr(mat, "cycles", None)
-        if ctx.normal is not None and not getattr(cycles, "use_bump_map_correction", True):
-            ctx.issue("Settings > Bump Map Correction is off, which DRT does not honour "
-                      "(its bent normals are always corrected, Cycles' default)")
         result.surface = result.volume is None or _link(out.inputs["Surface"]) is not None
         if result.volume is None and _link(out.inputs["Surface"]) is None:
             ctx.issue("no shader reaches its Material Output's Surface; it renders black, "

@@ -1,7 +1,9 @@
 """Lambertian reflection: f = albedo / pi, sampled by the cosine-weighted hemisphere.
 
 All directions are in the local shading frame (normal = +Z), pointing away from the
-surface. Reflection only: wi below the surface gives zero.
+surface. Reflection only: wi below the surface gives zero. wo may be below it too (the
+view at a smooth mesh's silhouette, under the interpolated normal): as Cycles' diffuse
+closure, only wi's side counts.
 """
 from __future__ import annotations
 
@@ -11,12 +13,11 @@ from ..warp import INV_PI, cosine_hemisphere
 
 
 def eval_f(albedo: np.ndarray, wo: np.ndarray, wi: np.ndarray) -> np.ndarray:
-    same_side = (wo[:, 2] > 0) & (wi[:, 2] > 0)
-    return np.where(same_side[:, None], albedo * INV_PI, 0.0)
+    return np.where((wi[:, 2] > 0)[:, None], albedo * INV_PI, 0.0)
 
 
 def pdf(wo: np.ndarray, wi: np.ndarray) -> np.ndarray:
-    return np.where((wo[:, 2] > 0) & (wi[:, 2] > 0), wi[:, 2] * INV_PI, 0.0)
+    return np.where(wi[:, 2] > 0, wi[:, 2] * INV_PI, 0.0)
 
 
 def sample(wo: np.ndarray, u: np.ndarray) -> np.ndarray:

@@ -149,6 +149,8 @@ class MaterialTable:
                                          for m in materials], bool)
         self.sheen_layered = np.array([bool(getattr(m, "sheen_layered", True))
                                        for m in materials], bool)
+        self.bump_correction = np.array([bool(getattr(m, "bump_correction", True))
+                                         for m in materials], bool)
         self.layered = ((self.coat_weight > 1e-5) | (self.sheen_weight > 1e-5)
                         | (self.translucent_color.max(1) > 0.0) | self.refraction_only)
         for name in ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",
@@ -250,7 +252,8 @@ class MaterialTable:
         out = ns.copy()
         out[rows] = normal_rows(T, index[rows], regs, np.ascontiguousarray(ns[rows]),
                                 np.ascontiguousarray(ng[rows]),
-                                np.ascontiguousarray(hits[rows, H_I:H_I + 3]))
+                                np.ascontiguousarray(hits[rows, H_I:H_I + 3]),
+                                self.bump_correction[index[rows]])
         return out
 
     def emission_at(self, index, uv=None, hits=None) -> np.ndarray:

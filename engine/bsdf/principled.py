@@ -466,7 +466,6 @@ class PrincipledBSDF:
         r = np.nonzero(ok & (lobe == L_DIFFUSE))[0]
         if len(r):
             wi[r] = cosine_hemisphere(u_dir[r])
-            ok[r] &= wo[r, 2] > 0
         r = np.nonzero(ok & ((lobe == L_SPECULAR) | (lobe == L_METAL)))[0]
         if len(r):
             w, v = reflection.sample(wo[r], u_dir[r], *self._reflection(r))

@@ -81,7 +81,8 @@ class CompiledPathIntegrator:
                          _or_empty(surf.objects, (0, N_OBJ), np.float64),
                          _or_empty(surf.corner_tangents, (0, 3, 4), np.float32),
                          _or_empty(surf.corner_colors, (0, 3, 4), np.float32),
-                         self.camera)
+                         self.camera,
+                         _or_empty(surf.terminator_cutoff, 0, np.float64))
         self.params = kbsdf.pack_materials(mats)
         self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)
         self.textures = mats.shading()

@@ -54,6 +54,21 @@ def _clamp(values, limit):
     return np.where(m > limit, values * (limit / np.maximum(m, 1e-300)), values)
 
 
+def _shadow_origins(surfaces, si, sel, wi):
+    """The shadow rays' origins of the hits sel of si towards wi (engine.kernels.terminator)."""
+    cut = surfaces.terminator_cutoff
+    if cut is None:
+        return offset_origin(si.position[sel], si.geometric_normal[sel], si.scale[sel], wi)
+    from ..kernels.terminator import shadow_origins
+    return shadow_origins(surfaces.v0, surfaces.v1, surfaces.v2, surfaces.corner_normals, cut,
+                          si.prim[sel], np.ascontiguousarray(si.bary[sel]),
+                          np.ascontiguousarray(si.position[sel]),
+                          np.ascontiguousarray(si.geometric_normal[sel]),
+                          np.ascontiguousarray(si.shading_normal[sel]),
+                          np.ascontiguousarray(si.scale[sel], dtype=np.float64),
+                          np.ascontiguousarray(wi))
+
+
 # Sampler dimensions of the pass-through decisions at transparent surfaces: outside the
 # per-bounce layout of engine.sampling.dimensions (so no other effect's numbers shift),
 # one per (path vertex, transparent layer).
@@ -326,15 +341,12 @@ class PathIntegrator:
                 ls, _, delta = lights.sample(si.position, u_pick, u_pt, t_live)
                 wi_local = to_local(ls.wi, ns)
                 f = bsdf.eval_f(wo, wi_local)
-                # Lights behind the surface count only through materials that transmit
-                # (rough refraction), as Cycles samples both sides of those.
-                front_side = (ls.wi * ng).sum(1) > 0
-                through = mats.transmission[si.material] * (1.0 - mats.metallic[si.material]) > 0
-                ok = ((ls.pdf > 0) & (ls.radiance.max(1) > 0) & (f.max(1) > 0)
-                      & (front_side | through))
+                # As in Cycles the lobes alone decide, on the shading normals; a shadow
+                # ray leaves a smooth mesh from its curved surface (kernels.terminator).
+                ok = (ls.pdf > 0) & (ls.radiance.max(1) > 0) & (f.max(1) > 0)
                 if ok.any():
                     sel = np.nonzero(ok)[0]
-                    org = offset_origin(si.position[sel], ng[sel], si.scale[sel], ls.wi[sel])
+                    org = _shadow_origins(ctx.surfaces, si, sel, ls.wi[sel])
                     dist = ls.dist[sel]
                     finite = np.isfinite(dist)
                     # the shadow ray runs from the offset origin to the sampled light point

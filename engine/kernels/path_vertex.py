@@ -31,8 +31,9 @@ from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (V_BOUNDARY, V_HAS, in_medium, medium, passed, segment, stack_cross,
                      volume_dim)
-from .bsdf.params import P_BASE, P_FILTER_ALPHA, P_METALLIC, P_ROUGHNESS
+from .bsdf.params import P_BASE, P_BUMP_CORRECTION, P_FILTER_ALPHA, P_METALLIC, P_ROUGHNESS
 from .surface import hit_uv, offset_origin, rebuild_at_time
+from .terminator import shadow_origin
 from .textures import apply_to_row, emission_at
 from ..nodes.context import N_HIT, path_fields
 from ..nodes.differentials import cone_at, cone_moves
@@ -78,8 +79,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     clamp_direct, clamp_indirect, mis mode, scene radius, film transparent, filter glossy,
     reflective caustics, refractive caustics] (see `prepare_closures`).
     geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout,
-    corner_uvs, moving objects, triangle objects, object table, corner tangents) of every
-    triangle (corner normals, holdout, UVs, objects and tangents may be empty; see
+    corner_uvs, moving objects, triangle objects, object table, corner tangents, corner
+    colours, camera, terminator cutoffs) of every triangle (corner normals, holdout, UVs,
+    objects, tangents, colours and cutoffs may be empty; see
     `surface.rebuild_at_time` and engine.nodes.shading). textures: the packed textures
     and shader programs (engine.nodes.pack.pack_shading); a material with a program
     runs it at each hit, and its outputs replace the parameters they drive. path_time: each path's shutter time (its
@@ -230,7 +232,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             continue
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         programmed = has_program(textures, m)
-        bent = False
+        bent, correct = False, True
         rx, ry, rz = nx, ny, nz
         # the lobe choice's number; a Mix Shader picks its shader with it first
         u_lobe = sample_1d(kind, pkey[p], spp, index[p], base + D.BSDF_LOBE)
@@ -242,8 +244,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                         gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bits[p], b, t_geom,
                         hit_row, regs)
             ms, u_lobe = pick_closure(textures, m, regs, u_lobe)
+            correct = params[ms, P_BUMP_CORRECTION] != 0.0
             sx, sy, sz, rx, ry, rz = program_normal(textures, ms, regs, nx, ny, nz, gx, gy,
-                                                    gz, -dx, -dy, -dz)
+                                                    gz, -dx, -dy, -dz, correct)
             bent = sx != nx or sy != ny or sz != nz or rx != nx or ry != ny or rz != nz
             nx, ny, nz = sx, sy, sz
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
@@ -289,16 +292,20 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 fr, fg, fb = fr * cosine, fg * cosine, fb * cosine
                 if see_d:
                     dr, dg, db = bent_diffuse(state, wox, woy, woz, n0x, n0y, n0z, rx, ry,
-                                              rz, wx, wy, wz)
+                                              rz, wx, wy, wz, correct)
                     fr, fg, fb = fr + dr, fg + dg, fb + db
                 cosine = 1.0
             else:
                 fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, see_d, see_g,
                                             see_t)
-            front_side = dot(wx, wy, wz, gx, gy, gz) > 0.0
-            if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0
-                    and (front_side or bsdf.transmits(state))):
-                sox, soy, soz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
+            # as in Cycles, the lobes alone decide (on the shading normals): a light
+            # under the triangle's own plane but above its smooth normal lights it, its
+            # shadow ray leaving from the curved surface the normals describe
+            if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0:
+                sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[2],
+                                              geometry[6], geometry[15], prim, hit_u[j],
+                                              hit_v[j], px, py, pz, gx, gy, gz, n0x, n0y,
+                                              n0z, scale, wx, wy, wz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy,
                                                          wz, dist, margin, scene_radius)
                 bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
@@ -327,7 +334,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             fd_r, fd_g, fd_b = bsdf.eval_seen(state, wox, woy, woz, 0.0, 0.0, 1.0, True,
                                               False, False)
             dr, dg, db = bent_diffuse(state, wox, woy, woz, n0x, n0y, n0z, rx, ry, rz, wx, wy,
-                                      wz)
+                                      wz, correct)
             c = abs(iz)
             wr = max(wr + (dr - fd_r * c) / spdf, 0.0)
             wg = max(wg + (dg - fd_g * c) / spdf, 0.0)

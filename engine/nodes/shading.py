@@ -127,11 +127,12 @@ def valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z):
 
 
 @kernel
-def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz):
+def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz, correct):
     """The program's shading normal (a Normal Map's or a Bump's), normalised, twice: as Cycles'
     Principled BSDF uses it for its specular lobes, made a valid specular reflector for
-    the view direction I (valid_reflection_normal), then as its diffuse lobe uses it,
-    unchanged. Both are n when the program does not set one."""
+    the view direction I (valid_reflection_normal) when `correct` (the material's Bump
+    Map Correction), then as its diffuse lobe uses it, unchanged. Both are n when the
+    program does not set one."""
     k = T[OUTS][m, OUT_NORMAL]
     if k < 0:
         return nx, ny, nz, nx, ny, nz
@@ -140,34 +141,38 @@ def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz):
     if not ln > 0.0 or not math.isfinite(ln):
         return nx, ny, nz, nx, ny, nz
     x, y, z = x / ln, y / ln, z / ln
+    if not correct:
+        return x, y, z, x, y, z
     vx, vy, vz = valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z)
     return vx, vy, vz, x, y, z
 
 
 @kernel
-def normal_rows(T, material, regs, ns, ng, incoming):
+def normal_rows(T, material, regs, ns, ng, incoming, correct):
     """`program_normal` (its specular normal) for hits given as arrays, for the NumPy
-    reference: (n, 3)."""
+    reference: (n, 3). correct: each hit's Bump Map Correction."""
     out = np.empty_like(ns)
     for i in range(material.shape[0]):
         x, y, z, _, _, _ = program_normal(T, material[i], regs[i], ns[i, 0], ns[i, 1],
                                           ns[i, 2], ng[i, 0], ng[i, 1], ng[i, 2],
-                                          incoming[i, 0], incoming[i, 1], incoming[i, 2])
+                                          incoming[i, 0], incoming[i, 1], incoming[i, 2],
+                                          correct[i])
         out[i, 0], out[i, 1], out[i, 2] = x, y, z
     return out
 
 
 @kernel
-def bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz):
+def bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz, soften):
     """The diffuse lobe's f x cos towards world direction l under the raw bent normal r
     (Cycles: Lambert on the node's normal, times bump_shadowing against the surface's
-    own shading normal s), with the lobe's (direction-independent) value read from the
-    BSDF set up on the specular frame."""
+    own shading normal s, softened when the material's Bump Map Correction is on), with
+    the lobe's (direction-independent) value read from the BSDF set up on the specular
+    frame."""
     cos_d = rx * lx + ry * ly + rz * lz
     if not cos_d > 0.0:
         return 0.0, 0.0, 0.0
     fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, 0.0, 0.0, 1.0, True, False, False)
-    k = cos_d * bump_shadowing(sx, sy, sz, rx, ry, rz, lx, ly, lz)
+    k = cos_d * bump_shadowing(sx, sy, sz, rx, ry, rz, lx, ly, lz, soften)
     return fr * k, fg * k, fb * k
 
 
@@ -186,16 +191,19 @@ def bump_rejects(sx, sy, sz, nx, ny, nz, lx, ly, lz):
 
 
 @kernel
-def bump_shadowing(sx, sy, sz, nx, ny, nz, lx, ly, lz):
+def bump_shadowing(sx, sy, sz, nx, ny, nz, lx, ly, lz, soften):
     """Cycles 5.0's bump_shadowing_term for a diffuse lobe on a normal n bent away from the
     surface's shading normal s (Conty Estevez, Lecocq and Stein, "A Microfacet-Based
     Shadowing Function to Solve the Bump Terminator Problem"): 0 where bump_rejects,
     else the GGX shadowing G1 of the light's angle to s, for a roughness that grows with
-    the bend: alpha^2 = min(tan^2(s, n) / 8, 1). 1 when n is s."""
+    the bend: alpha^2 = min(tan^2(s, n) / 8, 1). 1 when n is s, and (where not refused)
+    when not `soften` (Bump Map Correction off)."""
     if sx == nx and sy == ny and sz == nz:
         return 1.0
     if bump_rejects(sx, sy, sz, nx, ny, nz, lx, ly, lz):
         return 0.0
+    if not soften:
+        return 1.0
     cos_i = abs(sx * lx + sy * ly + sz * lz)
     cos_d = abs(sx * nx + sy * ny + sz * nz)
     if cos_d >= 1.0 or cos_i >= 1.0:

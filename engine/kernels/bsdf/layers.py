@@ -166,4 +166,4 @@ def sample(state, wox, woy, woz, lobe, u1, u2):
                                state[S_SHEEN_A], state[S_SHEEN_B])
         return x, y, z, z > 0.0 and woz > 0.0
     x, y, z = translucent.sample(u1, u2)
-    return x, y, z, z < 0.0 and woz > 0.0
+    return x, y, z, z < 0.0

@@ -35,7 +35,9 @@ P_SHEEN_TINT = 27        # 3 columns
 P_TRANSLUCENT = 30       # 3 columns: the Translucent BSDF's colour (weight included)
 P_REFRACT_ONLY = 33      # 0 / 1: the glass lobe refracts only (Refraction BSDF)
 P_SHEEN_LAYERED = 34     # 0 / 1: the sheen dims the lobes below it (Principled's)
-NPARAM = 35
+P_BUMP_CORRECTION = 35   # 0 / 1: Cycles' Bump Map Correction for a bent normal
+#                          (engine.nodes.shading.program_normal, bump_shadowing)
+NPARAM = 36
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -70,5 +72,6 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_TRANSLUCENT:P_TRANSLUCENT + 3] = table.translucent_color
     rows[:, P_REFRACT_ONLY] = table.refraction_only
     rows[:, P_SHEEN_LAYERED] = table.sheen_layered
+    rows[:, P_BUMP_CORRECTION] = table.bump_correction
     rows[:, P_LAYERS] = table.layered
     return rows

@@ -213,7 +213,10 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
     fr = 0.0
     fg = 0.0
     fb = 0.0
-    if see_d and woz > 0.0 and wiz > 0.0:         # Lambert under the specular layer
+    # Lambert under the specular layer; as Cycles' diffuse closure it asks only that the
+    # light be above the shading normal, not the view (which a smooth mesh's silhouette
+    # can put under it)
+    if see_d and wiz > 0.0:
         fr = state[S_DIFFUSE] * INV_PI
         fg = state[S_DIFFUSE + 1] * INV_PI
         fb = state[S_DIFFUSE + 2] * INV_PI
@@ -270,7 +273,7 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
     """sum_i q_i pdf_i over the lobes, for the selection probabilities q (`selection`)."""
     q0, q1, q2, q3, qc, qs, qt = q
     p = 0.0
-    if woz > 0.0 and wiz > 0.0:
+    if wiz > 0.0:
         p += q0 * (wiz * INV_PI)
     q_refl = q1 + q2
     if q_refl > 0.0:
@@ -332,7 +335,6 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
     if lobe == 0:
         wix, wiy, wiz = cosine_hemisphere(u1, u2)
-        ok = woz > 0.0
     elif lobe == 1 or lobe == 2:
         wix, wiy, wiz, ok = reflection_sample(state, wox, woy, woz, u1, u2)
         kind = GLOSSY

@@ -1,6 +1,7 @@
 """Cycles' Translucent BSDF (kernel/closure/bsdf_diffuse.h, its translucent closure):
 Lambertian transmission, f = colour / pi for wi on the other side of the surface than
-wo, sampled by the cosine-weighted hemisphere below. Local shading frame, wo_z > 0.
+wo, sampled by the cosine-weighted hemisphere below. Local shading frame, wo_z > 0 but
+for a smooth mesh's silhouette, where, as Cycles, only wi's side counts.
 """
 from __future__ import annotations
 
@@ -10,13 +11,13 @@ from ..warp import INV_PI, cosine_hemisphere
 
 @kernel
 def eval_unit(woz, wiz):
-    """f / colour (1/sr): 1/pi where wi is below the surface and wo above."""
-    return INV_PI if (woz > 0.0 and wiz < 0.0) else 0.0
+    """f / colour (1/sr): 1/pi where wi is below the surface."""
+    return INV_PI if wiz < 0.0 else 0.0
 
 
 @kernel
 def pdf(woz, wiz):
-    return -wiz * INV_PI if (woz > 0.0 and wiz < 0.0) else 0.0
+    return -wiz * INV_PI if wiz < 0.0 else 0.0
 
 
 @kernel

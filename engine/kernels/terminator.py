@@ -1,0 +1,111 @@
+"""Shadow rays from smooth-shaded triangles, as Cycles starts them (its shadow_ray_offset
+and shadow_ray_smooth_surface_offset; the idea is Hanika's "Hacking the Shadow
+Terminator", Ray Tracing Gems II).
+
+A smooth-shaded mesh is lit by its interpolated normal, so light may come from under a
+triangle's own plane while it is above the smooth normal: by the lit silhouette of a
+coarse sphere, say. A shadow ray leaving the flat triangle there would run into the mesh.
+Cycles instead starts it from the curved surface the normals describe: the hit point
+lifted along the interpolated normal by the height of a parabolic patch through the
+corners (its parabola's coefficients are the corner normals' differences projected on the
+edges), bounded by each corner's tangent plane. The lift fades in as the light nears the
+triangle's plane: fully when the light is under it, not at all once the cosine to the
+plane exceeds the object's Shadow Terminator > Geometry Offset (0.1 by default; 0 turns
+it off). A shadow ray lifted towards a light under the plane may still hit its own
+triangle (Cycles then does not skip it); one towards a light above is pushed off the
+triangle as every ray is (`surface.offset_origin`).
+
+`cutoff` holds each triangle's Geometry Offset, 0 where there is nothing to lift: flat
+shading, a moving object's triangles (their corners are placed per ray elsewhere), an
+object with the offset off.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .frame import dot
+from .jit import kernel
+from .surface import offset_origin
+
+
+@kernel(inline="always")
+def _corner(v0, v1, v2, c, prim, k):
+    """Corner k's position and (raw, unflipped) normal."""
+    src = v0 if k == 0 else (v1 if k == 1 else v2)
+    return (src[prim, 0], src[prim, 1], src[prim, 2], np.float64(c[prim, k, 0]),
+            np.float64(c[prim, k, 1]), np.float64(c[prim, k, 2]))
+
+
+@kernel
+def smooth_lift(v0, v1, v2, c, prim, u, v, px, py, pz, gx, gy, gz):
+    """The vector from the hit p at barycentrics (u, v) of triangle prim to the curved
+    surface its corner normals c describe, on the side of g (the geometric normal facing
+    the light's side): the interpolated normal times the patch's height there."""
+    a0x, a0y, a0z, n0x, n0y, n0z = _corner(v0, v1, v2, c, prim, 0)
+    a1x, a1y, a1z, n1x, n1y, n1z = _corner(v0, v1, v2, c, prim, 1)
+    a2x, a2y, a2z, n2x, n2y, n2z = _corner(v0, v1, v2, c, prim, 2)
+    b0, b1, b2 = 1.0 - u - v, u, v         # the corners' weights
+    nx = b0 * n0x + b1 * n1x + b2 * n2x    # not normalised (as Cycles)
+    ny = b0 * n0y + b1 * n1y + b2 * n2y
+    nz = b0 * n0z + b1 * n1z + b2 * n2z
+    # the parabolic patch
+    a = dot(n2x - n0x, n2y - n0y, n2z - n0z, a0x - a2x, a0y - a2y, a0z - a2z)
+    b = dot(n2x - n1x, n2y - n1y, n2z - n1z, a1x - a2x, a1y - a2y, a1z - a2z)
+    cc = dot(n1x - n0x, n1y - n0y, n1z - n0z, a1x - a0x, a1y - a0y, a1z - a0z)
+    h = a * b0 * (b0 - 1.0) + (a + b + cc) * b0 * b1 + b * b1 * (b1 - 1.0)
+    # each corner's tangent plane, as an envelope
+    s = 1.0 if dot(nx, ny, nz, gx, gy, gz) > 0.0 else -1.0
+    e0 = max(s * dot(a1x - a0x, a1y - a0y, a1z - a0z, n0x, n0y, n0z),
+             s * dot(a2x - a0x, a2y - a0y, a2z - a0z, n0x, n0y, n0z), 0.0)
+    e1 = max(s * dot(a0x - a1x, a0y - a1y, a0z - a1z, n1x, n1y, n1z),
+             s * dot(a2x - a1x, a2y - a1y, a2z - a1z, n1x, n1y, n1z), 0.0)
+    e2 = max(s * dot(a0x - a2x, a0y - a2y, a0z - a2z, n2x, n2y, n2z),
+             s * dot(a1x - a2x, a1y - a2y, a1z - a2z, n2x, n2y, n2z), 0.0)
+    e0 = max(s * dot(a0x - px, a0y - py, a0z - pz, n0x, n0y, n0z) + e0, 0.0)
+    e1 = max(s * dot(a1x - px, a1y - py, a1z - pz, n1x, n1y, n1z) + e1, 0.0)
+    e2 = max(s * dot(a2x - px, a2y - py, a2z - pz, n2x, n2y, n2z) + e2, 0.0)
+    if s > 0.0:
+        h = max(min(e0, e1, e2), 0.5 * h)
+    else:
+        h = min(-min(e0, e1, e2), 0.5 * h)
+    return nx * h, ny * h, nz * h
+
+
+@kernel
+def shadow_origin(v0, v1, v2, corner_normals, cutoff, prim, u, v, px, py, pz, gx, gy, gz,
+                  nx, ny, nz, scale, wx, wy, wz):
+    """The origin of a shadow ray from hit p (barycentrics (u, v) of triangle prim;
+    geometric normal g and the surface's own shading normal n, both facing the incoming
+    ray) towards the light direction w (unit)."""
+    off = cutoff[prim] if cutoff.shape[0] > 0 else 0.0
+    if off > 0.0:
+        nl = dot(nx, ny, nz, wx, wy, wz)
+        sign = 1.0 if nl >= 0.0 else -1.0      # towards a light under n: the back side
+        nl = abs(nl)
+        fx, fy, fz = gx * sign, gy * sign, gz * sign
+        ngl = dot(fx, fy, fz, wx, wy, wz)
+        if nl < off:
+            amount = min(max(2.0 - (ngl + nl) / off, 0.0), 1.0)
+        else:
+            amount = min(max(1.0 - ngl / off, 0.0), 1.0)
+        if amount > 0.0:
+            lx, ly, lz = smooth_lift(v0, v1, v2, corner_normals, prim, u, v, px, py, pz,
+                                     fx, fy, fz)
+            px, py, pz = px + lx * amount, py + ly * amount, pz + lz * amount
+            if not ngl > 0.0:
+                return px, py, pz    # the light is under the plane: its own triangle counts
+    return offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
+
+
+@kernel
+def shadow_origins(v0, v1, v2, corner_normals, cutoff, prim, bary, position, ng, ns, scale,
+                   wi):
+    """`shadow_origin` for hits given as arrays (the NumPy reference): (n, 3)."""
+    out = np.empty_like(position)
+    for i in range(prim.shape[0]):
+        x, y, z = shadow_origin(v0, v1, v2, corner_normals, cutoff, prim[i], bary[i, 0],
+                                bary[i, 1], position[i, 0], position[i, 1], position[i, 2],
+                                ng[i, 0], ng[i, 1], ng[i, 2], ns[i, 0], ns[i, 1], ns[i, 2],
+                                scale[i], wi[i, 0], wi[i, 1], wi[i, 2])
+        out[i, 0], out[i, 1], out[i, 2] = x, y, z
+    return out
