@@ -557,14 +557,13 @@ class LightSet:
         # when it is too dark to be a light, for what escaped rays see
         self.world = None if world is None else (
             world if getattr(world, "is_environment", False) else world_model(world))
-        # Only a world that varies with direction (an environment map) is sampled as a
-        # light, unless its Sampling Method is None. A uniform one is found by the BSDF
-        # rays that escape, as Cycles does (its LightManager disables the background
-        # light unless the world's shader varies in space): the same light in
-        # expectation, except through Cycles' refraction pairs that only next-event
-        # estimation sees (engine/bsdf/dielectric.py's note).
-        if (self.world is not None and not isinstance(self.world, EnvironmentLightModel)
-                and getattr(self.world, "light_sampling", True)):
+        # The world is sampled as a light unless it is an environment whose Sampling
+        # Method is None. Cycles never samples a uniform world (its LightManager disables
+        # a background light that does not vary in space; BSDF rays that escape find
+        # it); DRT does, for less noise, and evaluates refraction towards it on Walter's
+        # pairs only (`uniform_world`; engine/bsdf/dielectric.py's note), which is what
+        # Cycles' escaping rays see.
+        if self.world is not None and getattr(self.world, "light_sampling", True):
             self.models.append(self.world)
         power = np.array([max(m.power(scene_radius), 0.0) for m in self.models], dtype=np.float64)
         power = np.where(np.isfinite(power), power, 0.0)
@@ -584,6 +583,13 @@ class LightSet:
 
     def __len__(self):
         return len(self.select_pdf)
+
+    def uniform_world(self, entries) -> np.ndarray:
+        """Whether each sampled entry is the uniform world (bool array)."""
+        k = self.env_index
+        if k is None or not isinstance(self.models[k], EnvironmentLightModel):
+            return np.zeros(len(entries), bool)
+        return np.asarray(entries) == k
 
     def sample(self, p, u_pick, u_point, time=None):
         """Pick one light per point and sample it (time: the points' shutter times, for

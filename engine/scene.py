@@ -319,9 +319,9 @@ class World:
     Visibility); see `engine.world_light`.
     sun: a `SunLight` that belongs to the world (a Sky Texture's sun disc,
     `engine.sky_texture`), rendered as one more lamp; None = none.
-    light_sampling: whether next-event estimation samples a world that varies with
-    direction (Blender's World > Settings > Sampling Method, not None); a uniform world
-    never is (engine.lights.LightSet), as in Cycles."""
+    light_sampling: whether next-event estimation samples the world (Blender's World >
+    Settings > Sampling Method, not None; see engine.lights.LightSet for a uniform
+    world, which Cycles never samples)."""
     color: tuple = (0.0, 0.0, 0.0)
     texture: Optional[object] = None
     strength: tuple = (1.0, 1.0, 1.0)

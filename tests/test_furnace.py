@@ -12,7 +12,7 @@ at once.
 import numpy as np
 import pytest
 
-from engine import Camera, Material, RenderContext, RenderSettings, Scene, World, render
+from engine import Camera, Material, RenderSettings, Scene, World, render
 from engine_scenes import look_at, uv_sphere
 
 LE = 0.5
@@ -118,23 +118,17 @@ def test_white_furnace_rough_glass_multiscatter(roughness):
     """A closed rough glass sphere of colour 1 in the white furnace: every crossing and
     internal reflection keeps the flux with Multiscatter GGX, so with enough bounces the
     sphere disappears (within 1.5 %: paths still alive after 64 bounces are cut);
-    single-scattering glass is darker. Measured (BSDF sampling alone): roughness 0.3 /
-    0.8: GGX 0.960 / 0.496, MULTI_GGX 0.998 / 1.000."""
+    single-scattering glass is darker. Measured: roughness 0.3 / 0.8: GGX 0.962 / 0.496,
+    MULTI_GGX 1.002 / 1.000."""
     # Filter Glossy off: after an unlikely bounce it widens the lobes but, as in Cycles,
-    # not their compensation (a deliberate bias), which this furnace would measure.
-    # BSDF sampling alone: next-event estimation adds Cycles' refraction pairs that no
-    # sampled path takes (engine/bsdf/dielectric.py's note; 1.15 at roughness 0.8 with
-    # MIS), which are not energy-conserving and not what this furnace is about.
+    # not their compensation (a deliberate bias), which this furnace would measure
     settings = RenderSettings(samples=64, seed=5, clamp_indirect=0.0, max_bounces=64,
                               glossy_bounces=64, transmission_bounces=64, filter_glossy=0.0)
     got = {}
     for model in ("MULTI_GGX", "GGX"):
         mat = Material("glass", (1.0, 1.0, 1.0), transmission=1.0, roughness=roughness,
                        glossy_model=model)
-        scene = white_furnace(mat)
-        ctx = RenderContext(scene, settings)
-        ctx.integrator.mis_mode = "bsdf"
-        got[model] = sphere_mean(render(scene, settings, context=ctx)[0])
+        got[model] = sphere_mean(render(white_furnace(mat), settings)[0])
     print(f"roughness {roughness}: glass sphere mean GGX {got['GGX'].round(4)}, "
           f"MULTI_GGX {got['MULTI_GGX'].round(4)}")
     assert np.all(np.abs(got["MULTI_GGX"] - 1.0) < 0.015)

@@ -238,7 +238,7 @@ def test_plain_materials_never_touch_the_layer_slots():
         zero_state = np.zeros(kb.NSTATE)
         for state in (nan_state, zero_state):
             P.setup(row, True, 0.3, 0.2, np.sqrt(1 - 0.13), tables, state)
-        assert np.isnan(nan_state[layers.S_FIRST:]).all()
+        assert np.isnan(nan_state[layers.S_FIRST:layers.NSTATE]).all()   # the layers' slots
         for _ in range(200):
             wo = np.array([0.3, 0.2, np.sqrt(1 - 0.13)])
             wi = rng.normal(size=3)

@@ -233,10 +233,11 @@ def test_unmodelled_sky_types_are_reported(bpy_drt):
     assert w.texture is not None and w.sun is None and not warnings
 
 
-def test_sampling_method_none_keeps_an_environment_from_being_a_light(bpy_drt):
-    """World > Settings > Sampling Method: Auto samples an environment map as a light,
-    None does not (escaping rays alone find it, as in Cycles); a uniform world is never
-    sampled (Cycles disables a background light that does not vary in space)."""
+def test_sampling_method_none_keeps_the_world_from_being_a_light(bpy_drt):
+    """World > Settings > Sampling Method: Auto samples the world as a light, None does
+    not (escaping rays alone find it, as in Cycles). A uniform world is sampled too (for
+    less noise; Cycles relies on escaping rays alone there), marked so that next-event
+    estimation evaluates refraction towards it as those rays see it."""
     from engine.lights import LightSet
     world, bg = _world(bpy_drt, "sampled")
     _environment(bpy_drt, world, bg, _image(bpy_drt, "hdr_sampled"))
@@ -244,8 +245,9 @@ def test_sampling_method_none_keeps_an_environment_from_being_a_light(bpy_drt):
     world.cycles.sampling_method = "NONE"
     unlit = _export(world)[0]
     assert lit.light_sampling and not unlit.light_sampling
-    assert LightSet([], 10.0, world=lit).env_index is not None
+    lights = LightSet([], 10.0, world=lit)
+    assert lights.env_index is not None and not lights.uniform_world([lights.env_index])[0]
     assert LightSet([], 10.0, world=unlit).env_index is None
     assert LightSet([], 10.0, world=unlit).world is not None       # still seen by rays
-    uniform = _export(_world(bpy_drt, "uniform")[0])[0]
-    assert uniform.light_sampling and LightSet([], 10.0, world=uniform).env_index is None
+    uniform = LightSet([], 10.0, world=_export(_world(bpy_drt, "uniform")[0])[0])
+    assert uniform.env_index is not None and uniform.uniform_world([uniform.env_index])[0]

@@ -148,9 +148,9 @@ SETTINGS: list[FileSetting] = [
     _s("scene.render.motion_blur_shutter_curve", "Motion Blur > Shutter Curve", READ,
        "the shutter's openness over time, sampled as Cycles samples it"),
     _s("scene.world.cycles.sampling_method", "World > Settings > Surface > Sampling Method",
-       READ, "None: an environment is not sampled as a light (only escaping rays find "
-       "it); Auto and Manual: it is, by its own importance map. A uniform world never "
-       "is, as in Cycles"),
+       READ, "None: the world is not sampled as a light (only escaping rays find it); "
+       "Auto and Manual: it is, an environment by its own importance map (a uniform "
+       "world, which Cycles never samples, with the refraction its escaping rays see)"),
     _s("scene.world.cycles.sample_map_resolution", "World > Settings > Surface > Map "
        "Resolution", NO_EFFECT, "DRT's importance map has the image's own resolution: "
        + NOISE_ONLY),

@@ -74,7 +74,7 @@ def _visibility(world) -> int:
 
 def export_world(world, reporter: Reporter) -> "engine.World":
     """The world's background; World > Settings > Sampling Method None (Cycles'
-    `world.cycles.sampling_method`) keeps an environment from being sampled as a light."""
+    `world.cycles.sampling_method`) keeps it from being sampled as a light."""
     out = _export_background(world, reporter)
     settings = getattr(world, "cycles", None)
     if settings is not None and getattr(settings, "sampling_method", "AUTOMATIC") == "NONE":

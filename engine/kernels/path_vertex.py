@@ -21,6 +21,7 @@ from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
 from .bsdf import principled as bsdf
+from .bsdf.state import S_WALTER
 from . import ray_queues
 from .frame import dot, length, to_local, to_world
 from .jit import kernel
@@ -277,6 +278,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
                 lights, px, py, pz, u_pick, u1, u2)
             lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
+            # a uniform world, which Cycles never samples (its escaping rays find it):
+            # refraction towards it on Walter's pairs, as those rays see it
+            state[S_WALTER] = 1.0 if lt.is_uniform_world(lights, k) else 0.0
             seen = lt.entry_visibility(lights, k)
             see_d = (seen & DIFFUSE_BIT) != 0
             see_g = (seen & GLOSSY_BIT) != 0 and keep_g
@@ -319,6 +323,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                                               br * fr * lr * w, bg * fg * lg * w,
                                               bb * fb * lb * w, sh_path, sh_org, sh_dir,
                                               sh_far, sh_contrib, sh_bounce, stacks, sh_stack)
+            state[S_WALTER] = 0.0
         # 3. continue by BSDF sampling
         if not (ad or ag or at):
             continue

@@ -6,7 +6,7 @@ mirrored to the upper side ("canonical") with relative index 1/eta, and the resu
 mirrored back, as in the NumPy module (see there for the sources, the radiance scaling
 1/eta^2 of refraction and the allow flags of the reflect/refract choice). Refraction is
 evaluated as Cycles does, also on pairs the sampler never produces (the NumPy module's
-`as_cycles=True`, its default; see its note).
+`as_cycles=True`, its default; see its note), unless `walter` is set.
 """
 from __future__ import annotations
 
@@ -106,14 +106,15 @@ def refraction_half(ox, oy, oz, ix, iy, iz, eta_rel):
 @kernel
 def rough_eval(ox, oy, oz, ix, iy, iz, eta, alpha):
     """(f_reflect, f_refract) in 1/sr; one of them is zero for each pair."""
-    return rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, False)
+    return rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, False, False)
 
 
 @kernel
-def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only):
+def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter):
     """`rough_eval`, or with `refract_only` Cycles' Refraction BSDF: no reflection and
     the refraction without its Fresnel factor 1 - F (zero under total internal
-    reflection)."""
+    reflection). `walter`: refraction on Walter's pairs only (the NumPy module's
+    as_cycles=False)."""
     a = mf.clamp_alpha(alpha)
     sign, eta_rel = canonical(oz, eta)
     oz = oz * sign
@@ -125,7 +126,7 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only):
         F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
         return F_r * base_r, 0.0
     hx, hy, hz, cos_oh, cos_ih, ok = refraction_half(ox, oy, oz, ix, iy, iz, eta_rel)
-    if not (oz > 0.0 and iz < 0.0 and hz > 0.0):
+    if not (oz > 0.0 and iz < 0.0 and hz > 0.0) or (walter and not ok):
         return 0.0, 0.0
     # Cycles' pairs: any h, |wo.h| and -|wi.h| (ok, Walter's condition, is not required)
     s = cos_oh + eta_rel * cos_ih      # +-|wo + eta wi|
@@ -145,8 +146,9 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only):
 
 
 @kernel
-def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract):
-    """pdf over wi (1/sr) of `rough_sample` with the same allow flags."""
+def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, walter):
+    """pdf over wi (1/sr) of `rough_sample` with the same allow flags, also on Cycles'
+    pairs unless `walter` (see rough_eval_lobes)."""
     a = mf.clamp_alpha(alpha)
     sign, eta_rel = canonical(oz, eta)
     oz = oz * sign
@@ -162,7 +164,7 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract):
         return pr * 0.25 * g1c * mf.D(hx, hy, hz, a)
     # refraction: P(refract | h) D_wo(h) |dh/dwi|
     hx, hy, hz, cos_oh, cos_ih, ok = refraction_half(ox, oy, oz, ix, iy, iz, eta_rel)
-    if not (oz > 0.0 and hz > 0.0):
+    if not (oz > 0.0 and hz > 0.0) or (walter and not ok):
         return 0.0
     s = cos_oh + eta_rel * cos_ih      # as in rough_eval_lobes: Cycles' pairs
     cos_oh, cos_ih = abs(cos_oh), -abs(cos_ih)

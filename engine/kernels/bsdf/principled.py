@@ -33,7 +33,7 @@ from .compensation import compensate
 from .state import (NSTATE, S_ALPHA, S_BLINN, S_DIFFUSE, S_EST, S_ETA_GLASS,  # noqa: F401
                     S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH, S_LAYERED, S_METAL_F0, S_MS_E,
                     S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY, S_TINT, S_W_GLASS,
-                    S_W_METAL, S_W_SPEC)
+                    S_W_METAL, S_W_SPEC, S_WALTER)
 from .params import (GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
                      NPARAM, P_BASE,
                      P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
@@ -65,6 +65,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     layered = row[P_LAYERS] != 0.0
     state[S_LAYERED] = 1.0 if layered else 0.0
     state[S_REFRACT_ONLY] = row[P_REFRACT_ONLY]
+    state[S_WALTER] = 0.0       # Cycles' refraction pairs (path_vertex sets it per light)
     if layered:
         layers.setup(row, wox, woy, woz, tables, state)
     alpha = mf.clamp_alpha(rough * rough)
@@ -255,7 +256,8 @@ def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
     if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0 and (see_g if wiz > 0.0 else see_t):
         f_r, f_t = dielectric.rough_eval_lobes(wox, woy, woz, wix, wiy, wiz,
                                                state[S_ETA_GLASS], state[S_ALPHA],
-                                               state[S_REFRACT_ONLY] != 0.0)
+                                               state[S_REFRACT_ONLY] != 0.0,
+                                               state[S_WALTER] != 0.0)
         fr += (f_r + f_t * state[S_TINT]) * w_glass * state[S_MS_GLASS]
         fg += (f_r + f_t * state[S_TINT + 1]) * w_glass * state[S_MS_GLASS + 1]
         fb += (f_r + f_t * state[S_TINT + 2]) * w_glass * state[S_MS_GLASS + 2]
@@ -281,7 +283,7 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
     if q3 > 0.0 and state[S_GLASS_SMOOTH] == 0.0:
         p += q3 * dielectric.rough_pdf(wox, woy, woz, wix, wiy, wiz, state[S_ETA_GLASS],
                                        state[S_ALPHA], allow_g and state[S_REFRACT_ONLY] == 0.0,
-                                       allow_t)
+                                       allow_t, state[S_WALTER] != 0.0)
     if qc > 0.0 or qs > 0.0 or qt > 0.0:
         p += layers.mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt)
     return p

@@ -15,10 +15,10 @@ lamps are not ported: pack_lights raises NotImplementedError("moving lamps") and
 caller keeps the NumPy path. Array drivers for tests: `batch`.
 """
 from .light_set import (environment_pdf, environment_radiance, hit_lamps,
-                        lamp_pdf, entry_visibility, mesh_pdf, n_entries, n_suns, sample,
-                        sun_escaped, world_escaped)
+                        is_uniform_world, lamp_pdf, entry_visibility, mesh_pdf, n_entries,
+                        n_suns, sample, sun_escaped, world_escaped)
 from .pack import pack_lights
 
 __all__ = ["pack_lights", "n_entries", "sample", "hit_lamps", "entry_visibility",
            "lamp_pdf", "mesh_pdf", "environment_pdf", "environment_radiance", "n_suns",
-           "sun_escaped", "world_escaped"]
+           "sun_escaped", "world_escaped", "is_uniform_world"]

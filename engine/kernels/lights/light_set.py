@@ -9,7 +9,7 @@ from .area import intersect_area, pdf_area, sample_area
 from .environment import pdf_environment, sample_environment
 from .environment_map import has_map, map_radiance, pdf_map, sample_environment_map
 from .pack import (C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, ENV, LAMPS, SELECT_PDF, SUNS,
-                   TRI_VISIBILITY, T_AREA, T_DISC, T_ENV_MAP, T_POINT, T_SPHERE, T_SUN,
+                   TRI_VISIBILITY, T_AREA, T_DISC, T_ENV, T_ENV_MAP, T_POINT, T_SPHERE, T_SUN,
                    T_SUN_DELTA)
 from .point import intersect_point, pdf_point, sample_point
 from .sun import escaped_sun, pdf_sun, sample_sun
@@ -165,6 +165,13 @@ def environment_pdf(L, dx, dy, dz):
     if lamps[k, C_TYPE] == T_ENV_MAP:
         return pdf_map(L, dx, dy, dz) * L[SELECT_PDF][k]
     return pdf_environment(lamps, k) * L[SELECT_PDF][k]
+
+
+@kernel
+def is_uniform_world(L, k):
+    """Whether entry k is the uniform world (LightSet.uniform_world): next-event
+    estimation towards it evaluates refraction on Walter's pairs only."""
+    return k >= 0 and int(L[ENV][0]) == k and L[LAMPS][k, C_TYPE] == T_ENV
 
 
 @kernel
