@@ -9,7 +9,6 @@
   rendered by DRT matches Cycles (direct light only): per-channel means within
   MEAN_TOLERANCE and a per-pixel mean absolute difference within MAD_TOLERANCE of the mean.
 """
-import os
 
 import numpy as np
 import pytest
