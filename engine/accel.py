@@ -128,6 +128,14 @@ def _static_world_positions(mesh: TriangleMesh) -> np.ndarray:
     return mesh.positions
 
 
+def _joined(parts: list, empty_shape, dtype) -> np.ndarray:
+    """The arrays one after the other (one array: itself, not a copy)."""
+    if len(parts) == 1:
+        return np.ascontiguousarray(parts[0], dtype=dtype)
+    return np.concatenate(parts).astype(dtype, copy=False) if parts else \
+        np.zeros(empty_shape, dtype)
+
+
 class Accelerator:
     """All triangles of a scene: static ones in one Embree scene, moving ones apart."""
 
@@ -139,13 +147,17 @@ class Accelerator:
         static = [m for m in meshes if not _is_moving(m, time_enabled)]
         moving = [m for m in meshes if _is_moving(m, time_enabled)]
         self.ordered_meshes = static + moving          # the global triangle order
-        positions, triangles, base = [], [], 0
-        for m in static:
-            positions.append(_static_world_positions(m))
-            triangles.append(m.triangles.astype(np.int64) + base)
-            base += len(m.positions)
-        self.positions = np.concatenate(positions) if positions else np.zeros((0, 3))
-        self.triangles = np.concatenate(triangles) if triangles else np.zeros((0, 3), np.int64)
+        # Every static vertex in world space, and every static triangle's corners as
+        # int32 rows of them (Embree's index format); a single static mesh's own arrays
+        # are used as they are, not copied (the tracer never writes them).
+        positions = [_static_world_positions(m) for m in static]
+        n_vertices = sum(len(p) for p in positions)
+        index = np.int32 if n_vertices < 2**31 else np.int64
+        bases = np.cumsum([0] + [len(p) for p in positions[:-1]])
+        triangles = [m.triangles.astype(index, copy=False) + index(b) if b else
+                     m.triangles.astype(index, copy=False) for m, b in zip(static, bases)]
+        self.positions = _joined(positions, (0, 3), np.float64)
+        self.triangles = _joined(triangles, (0, 3), index)
         self.static_count = len(self.triangles)
         # the median vertex, not the middle of the bounds: a few far vertices (a mesh
         # with a vertex at 3.4e38, tests/test_degenerate_input.py) do not move it off
@@ -155,6 +167,12 @@ class Accelerator:
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
         self._scene = (_embree_scene(self.positions - self.center, self.triangles)
                        if len(self.triangles) else None)
+        if self._scene is not None:
+            # Embree builds its hierarchy on a scene's first query: here, so that it is
+            # part of building the accelerator (and a cancel after it), not of the
+            # first sample
+            empty = np.zeros((0, 3), np.float32)
+            self._scene.run(empty, empty, dists=np.zeros(0, np.float32), query="OCCLUDED")
         self.moving: list[MovingObject] = []
         offset = self.static_count
         for m in moving:
@@ -248,7 +266,7 @@ class Accelerator:
         n = len(origins)
         o = np.ascontiguousarray(origins, np.float64)
         d = np.ascontiguousarray(dirs, np.float64)
-        tm = np.ascontiguousarray(np.broadcast_to(time, (n,)), np.float64)
+        tm = np.array(np.broadcast_to(time, (n,)), np.float64)   # writable: one kernel type
         hit_unit = np.full(n, -1, np.int64)
         cap = 2 * n + 256 if self._embree_units else 0
         while True:

@@ -59,7 +59,9 @@ class EmissiveTriangles:
         self.prim = prim_ids[keep]
         # the offset scale relative to the static scene's centre (engine.accel, surface)
         c = np.zeros(3) if center is None else np.asarray(center, np.float64)
-        self.tri_scale = triangle_scale(v0, v1, v2, c, len(v0))[keep]
+        corners = np.arange(3 * len(v0)).reshape(3, -1).T     # rows of v0, then v1, v2
+        self.tri_scale = triangle_scale(np.concatenate([v0, v1, v2]), corners, c,
+                                        3 * len(v0))[keep]
         self.entry = np.full(max(int(n_prims_total), 1), -1, dtype=np.int64)
         self.entry[self.prim] = np.arange(len(self.prim))
 
@@ -82,8 +84,8 @@ class EmissiveTriangles:
         # (getattr: an accelerator without motion support has all meshes, in scene order)
         ordered = list(getattr(accel, "ordered_meshes", scene.meshes))
         static_meshes = ordered[:len(ordered) - len(getattr(accel, "moving", ()))]
-        mat = np.concatenate([m.material_indices for m in static_meshes]).astype(np.int64)
-        emissive = np.nonzero(emission[mat].max(axis=1) > 0)[0]
+        mat = np.concatenate([m.material_indices for m in static_meshes])
+        emissive = np.nonzero((emission.max(axis=1) > 0)[mat])[0]
         p = accel.positions
         t = tri[emissive]
         return cls(p[t[:, 0]], p[t[:, 1]], p[t[:, 2]], emission[mat[emissive]], emissive,

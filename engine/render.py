@@ -117,8 +117,9 @@ def _scene_radius(scene: Scene, accel: Accelerator) -> float:
         elif hasattr(l, "matrix"):
             pts.append(np.asarray(l.matrix, dtype=np.float64)[None, :3, 3])
     pts.append(np.asarray(scene.camera.matrix, dtype=np.float64)[None, :3, 3])
-    allp = np.concatenate(pts)
-    lo, hi = allp.min(0), allp.max(0)
+    # bounds of each part, then of the parts (the positions are not copied into one array)
+    lo = np.min([p.min(0) for p in pts], axis=0)
+    hi = np.max([p.max(0) for p in pts], axis=0)
     return float(max(np.linalg.norm(hi - lo) * 0.5, 1e-6))
 
 

@@ -41,29 +41,30 @@ class SurfaceHit:
 
 class SurfaceBuilder:
     """Precomputes per-triangle data in the accelerator's global triangle order; for
-    moving objects it places the triangle at each ray's own time."""
+    moving objects it places the triangle at each ray's own time.
+
+    Triangles are kept as vertex rows, not as per-corner copies: `positions` (V, 3)
+    float64 holds the accelerator's static world vertices (the same array, not a copy),
+    then each moving object's own vertices (object space for a rigid one, its first time
+    slice for a deforming one: placeholders, its hits are rebuilt at the ray's time in
+    build()); `corners` (T, 3) holds each triangle's three rows of it."""
 
     def __init__(self, accel: Accelerator, meshes=None):
         self.accel = accel
         ordered = accel.ordered_meshes
-        tri = accel.triangles                      # static triangles, world space
-        p = accel.positions
-        v0, v1, v2 = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
-        # Moving objects: object-space (rigid) or frame (deform) vertices as placeholders;
-        # their hits are rebuilt at the ray's time in build().
-        extra = [[], [], []]
+        positions, corners, base = [accel.positions], [accel.triangles], len(accel.positions)
         for obj in accel.moving:
             m = obj.mesh
-            base = m.positions if obj.rigid else obj.slice_positions[0]
-            for k in range(3):
-                extra[k].append(base[m.triangles[:, k]])
-        self.v0, self.v1, self.v2 = (np.concatenate([a] + e) if e else a
-                                     for a, e in zip((v0, v1, v2), extra))
-        self.normal = _unit_normals(self.v0, self.v1, self.v2)
+            positions.append(m.positions if obj.rigid else obj.slice_positions[0])
+            corners.append(m.triangles.astype(accel.triangles.dtype) + base)
+            base += len(positions[-1])
+        self.positions = positions[0] if len(positions) == 1 else np.concatenate(positions)
+        self.corners = corners[0] if len(corners) == 1 else np.concatenate(corners)
+        self.normal = _unit_normals(self.positions, self.corners)
         # the offset scale: the magnitude of the coordinates Embree rounds, relative to the
         # static scene's centre (engine.accel) for static triangles
-        self.tri_scale = triangle_scale(self.v0, self.v1, self.v2, accel.center,
-                                        accel.static_count)
+        self.tri_scale = triangle_scale(self.positions, self.corners, accel.center,
+                                        len(accel.positions))
         self.material = (np.concatenate([m.material_indices for m in ordered]).astype(np.int64)
                          if ordered else np.zeros(0, np.int64))
         # Holdout triangles (None when the scene has none): camera rays end there.
@@ -125,9 +126,14 @@ class SurfaceBuilder:
                         si.uv, si.front_facing, ray, depth, None, self.objects, obj, tangent,
                         color)
 
+    def vertices(self, prim) -> tuple:
+        """The three corners (n, 3) of triangles `prim` (moving ones: placeholders)."""
+        c = self.corners[prim]
+        return self.positions[c[:, 0]], self.positions[c[:, 1]], self.positions[c[:, 2]]
+
     def _moving_vertices(self, prim, time):
         """World vertices, normal matrices (or None) of hit triangles at the rays' times."""
-        v0, v1, v2 = self.v0[prim].copy(), self.v1[prim].copy(), self.v2[prim].copy()
+        v0, v1, v2 = self.vertices(prim)
         normal_m = None
         for obj in self.accel.moving:
             lo, hi = obj.prim_offset, obj.prim_offset + len(obj.mesh.triangles)
@@ -164,11 +170,11 @@ class SurfaceBuilder:
         normal_m = None
         if self.accel.moving and (prim >= self.accel.static_count).any():
             v0, v1, v2, normal_m = self._moving_vertices(prim, time[index])
-            ng = _unit_normals(v0, v1, v2)
+            ng = _corner_normals(v0, v1, v2)
             tri_scale = np.where(prim < self.accel.static_count, self.tri_scale[prim],
                                  np.max(np.abs(np.stack([v0, v1, v2], 1)), axis=(1, 2)))
         else:
-            v0, v1, v2 = self.v0[prim], self.v1[prim], self.v2[prim]
+            v0, v1, v2 = self.vertices(prim)
             ng = self.normal[prim]
             tri_scale = self.tri_scale[prim]
         pos = w * v0 + u * v1 + v * v2
@@ -248,18 +254,38 @@ def _object_table(ordered):
     return np.repeat(np.arange(len(ordered), dtype=np.int32), counts), rows
 
 
-def triangle_scale(v0, v1, v2, center, static_count) -> np.ndarray:
-    """Per triangle, the largest coordinate magnitude of its corners: relative to `center`
-    for the first static_count (static) triangles, absolute for the rest (moving objects,
-    traced in their own spaces)."""
-    if not len(v0):
+# Triangles per block of the per-triangle arrays built from vertex rows: temporaries
+# of a block, never of the whole mesh (a 1M-triangle mesh's corners in float64 are 72 MB).
+_BLOCK = 1 << 16
+
+
+def triangle_scale(positions, corners, center, static_vertices: int) -> np.ndarray:
+    """Per triangle (rows `corners` of `positions`), the largest coordinate magnitude of
+    its corners: relative to `center` for the first static_vertices (static) vertices,
+    absolute for the rest (moving objects, traced in their own spaces)."""
+    if not len(corners):
         return np.zeros(0)
-    c = np.zeros((len(v0), 3))
-    c[:static_count] = center
-    return np.max(np.abs(np.stack([v0 - c, v1 - c, v2 - c], 1)), axis=(1, 2))
+    magnitude = np.empty(len(positions))
+    for a in range(0, len(positions), _BLOCK):
+        b = min(a + _BLOCK, len(positions))
+        c = np.zeros((b - a, 3))
+        c[:max(min(static_vertices, b) - a, 0)] = center
+        magnitude[a:b] = np.max(np.abs(positions[a:b] - c), axis=1)
+    return np.maximum(np.maximum(magnitude[corners[:, 0]], magnitude[corners[:, 1]]),
+                      magnitude[corners[:, 2]])
 
 
-def _unit_normals(v0, v1, v2):
+def _unit_normals(positions, corners):
+    """Unit normals (T, 3) of triangles `corners` (rows of positions), block by block."""
+    n = np.empty((len(corners), 3))
+    for a in range(0, len(corners), _BLOCK):
+        c = corners[a:a + _BLOCK]
+        v0 = positions[c[:, 0]]
+        n[a:a + _BLOCK] = _corner_normals(v0, positions[c[:, 1]], positions[c[:, 2]])
+    return n
+
+
+def _corner_normals(v0, v1, v2):
     n = np.cross(v1 - v0, v2 - v0)
     length = np.linalg.norm(n, axis=1)
     ok = length > 0

@@ -72,7 +72,8 @@ class CompiledPathIntegrator:
                              float(s.caustics_reflective), float(s.caustics_refractive),
                              s.volume_bounces],
                             dtype=np.float64)
-        self.geometry = (surf.v0, surf.v1, surf.v2, surf.normal, surf.tri_scale, surf.material,
+        self.geometry = (surf.positions, surf.corners, surf.normal, surf.tri_scale,
+                         surf.material,
                          _or_empty(surf.corner_normals, (0, 3, 3), np.float32),
                          _or_empty(surf.holdout, 0, bool),
                          _or_empty(surf.corner_uvs, (0, 3, 2), np.float32),
@@ -111,8 +112,8 @@ class CompiledPathIntegrator:
         self.heterogeneous = self.has_volumes and bool(self.vol[:, V_HET].any())
         if self.heterogeneous:
             bound_majorants(self.vol, self.textures, surf.material,
-                            self.geometry[10], self.geometry[11],
-                            (surf.v0, surf.v1, surf.v2), self.camera)
+                            self.geometry[9], self.geometry[10],
+                            (surf.positions, surf.corners), self.camera)
         self.het_runs = np.zeros(1, np.int64)
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
                             else np.full(STACK, -1, np.int32))
@@ -210,7 +211,9 @@ class CompiledPathIntegrator:
         no_keys = np.zeros(0, np.uint64)
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(dirs, dtype=np.float64)
-        tm = np.ascontiguousarray(np.broadcast_to(tmax, (n,)), dtype=np.float64)
+        # a writable copy: a read-only view (np.broadcast_to) would be another type to
+        # Numba, and load a second copy of the shading kernel (15 MB, 0.1 s per process)
+        tm = np.array(np.broadcast_to(tmax, (n,)), dtype=np.float64)
         sh_path = np.empty(n, np.int64)
         sh_org, sh_dir = np.empty((n, 3)), np.empty((n, 3))
         sh_far, sh_contrib = np.empty(n), np.empty((n, 3))

@@ -60,7 +60,7 @@ def _shadow_origins(surfaces, si, sel, wi):
     if cut is None:
         return offset_origin(si.position[sel], si.geometric_normal[sel], si.scale[sel], wi)
     from ..kernels.terminator import shadow_origins
-    return shadow_origins(surfaces.v0, surfaces.v1, surfaces.v2, surfaces.corner_normals, cut,
+    return shadow_origins(surfaces.positions, surfaces.corners, surfaces.corner_normals, cut,
                           si.prim[sel], np.ascontiguousarray(si.bary[sel]),
                           np.ascontiguousarray(si.position[sel]),
                           np.ascontiguousarray(si.geometric_normal[sel]),

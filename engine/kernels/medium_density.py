@@ -272,18 +272,19 @@ def _sample_row(vol, m, T, objects, camera, lo, hi, n, seed):
     return top
 
 
-def bound_majorants(vol, T, tri_material, tri_object, objects, corners, camera):
+def bound_majorants(vol, T, tri_material, tri_object, objects, triangles, camera):
     """Fill V_OBJ and V_MAJ of the heterogeneous rows of `vol` (in place): the object of
     the first triangle of the row's material (-1 without object rows) and the majorant
-    of the module's docstring, over the bounds of that material's triangles (corners:
-    (v0, v1, v2) arrays (T, 3)). Returns vol."""
+    of the module's docstring, over the bounds of that material's triangles (triangles:
+    (positions (V, 3), each triangle's corners as rows of them (T, 3))). Returns vol."""
+    positions, corners = triangles
     for m in np.nonzero(vol[:, V_HET] != 0.0)[0]:
         tris = np.nonzero(tri_material == m)[0]
         if tris.size == 0:
             vol[m, V_MAJ] = MU_FLOOR
             continue
         vol[m, V_OBJ] = int(tri_object[tris[0]]) if len(tri_object) else -1
-        pts = np.concatenate([c[tris] for c in corners])
+        pts = positions[corners[tris].ravel()]
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         top = _sample_row(vol, int(m), T, objects, camera, np.ascontiguousarray(lo),
                           np.ascontiguousarray(hi), BOUND_SAMPLES, np.uint64(0x5EED))

@@ -17,15 +17,17 @@ from .motion import I_KIND, I_NVERTS, I_SLICES, I_VERT0, RIGID, adjugate_columns
 
 
 @kernel
-def rebuild(v0, v1, v2, normal, tri_scale, corner_normals, prim, u, v, dx, dy, dz):
-    """The hit of a ray with direction d on static triangle `prim` at barycentrics (u, v).
+def rebuild(positions, corners, normal, tri_scale, corner_normals, prim, u, v, dx, dy, dz):
+    """The hit of a ray with direction d on static triangle `prim` at barycentrics (u, v):
+    its corners are rows corners[prim] of positions (engine.surface.SurfaceBuilder).
     corner_normals is (T, 3, 3) float32, or empty for flat shading everywhere.
     Returns (position, geometric normal facing the ray, shading normal on that side,
     front_facing, offset scale)."""
     w = 1.0 - u - v
-    px = w * v0[prim, 0] + u * v1[prim, 0] + v * v2[prim, 0]
-    py = w * v0[prim, 1] + u * v1[prim, 1] + v * v2[prim, 1]
-    pz = w * v0[prim, 2] + u * v1[prim, 2] + v * v2[prim, 2]
+    i0, i1, i2 = corners[prim, 0], corners[prim, 1], corners[prim, 2]
+    px = w * positions[i0, 0] + u * positions[i1, 0] + v * positions[i2, 0]
+    py = w * positions[i0, 1] + u * positions[i1, 1] + v * positions[i2, 1]
+    pz = w * positions[i0, 2] + u * positions[i1, 2] + v * positions[i2, 2]
     gx, gy, gz = normal[prim, 0], normal[prim, 1], normal[prim, 2]
     front = dot(gx, gy, gz, dx, dy, dz) < 0.0
     sign = 1.0 if front else -1.0
@@ -53,17 +55,17 @@ def rebuild(v0, v1, v2, normal, tri_scale, corner_normals, prim, u, v, dx, dy, d
 @kernel
 def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
     """`rebuild` for any triangle, static or moving, hit at shutter time `time`.
-    geometry: (v0, v1, v2, normal, tri_scale, material, corner_normals, holdout,
+    geometry: (positions, corners, normal, tri_scale, material, corner_normals, holdout,
     corner_uvs, M) in the accelerator's triangle order, M its moving objects
     (engine.kernels.motion.PackedMotion; triangles from M.prim_start[0] on move). A
     moving triangle is placed as SurfaceBuilder.build places it: a rigid object's
     vertices by its transform at `time`, its corner normals by that transform's
     inverse-transpose; a deforming object's vertices from the time slice of `time`."""
-    v0, v1, v2, normal, tri_scale, corner_normals, M = (geometry[0], geometry[1], geometry[2],
-                                                       geometry[3], geometry[4], geometry[6],
-                                                       geometry[9])
+    positions, corners, normal, tri_scale, corner_normals, M = (
+        geometry[0], geometry[1], geometry[2], geometry[3], geometry[5], geometry[8])
     if prim < M.prim_start[0]:
-        return rebuild(v0, v1, v2, normal, tri_scale, corner_normals, prim, u, v, dx, dy, dz)
+        return rebuild(positions, corners, normal, tri_scale, corner_normals, prim, u, v,
+                       dx, dy, dz)
     obj = object_of(M, prim)
     info, verts, tris = M.info, M.verts, M.tris
     local = prim - M.prim_start[0]

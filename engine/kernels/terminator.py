@@ -29,21 +29,22 @@ from .surface import offset_origin
 
 
 @kernel(inline="always")
-def _corner(v0, v1, v2, c, prim, k):
-    """Corner k's position and (raw, unflipped) normal."""
-    src = v0 if k == 0 else (v1 if k == 1 else v2)
-    return (src[prim, 0], src[prim, 1], src[prim, 2], np.float64(c[prim, k, 0]),
+def _corner(positions, corners, c, prim, k):
+    """Corner k's position (row corners[prim, k] of positions) and (raw, unflipped)
+    normal."""
+    i = corners[prim, k]
+    return (positions[i, 0], positions[i, 1], positions[i, 2], np.float64(c[prim, k, 0]),
             np.float64(c[prim, k, 1]), np.float64(c[prim, k, 2]))
 
 
 @kernel
-def smooth_lift(v0, v1, v2, c, prim, u, v, px, py, pz, gx, gy, gz):
+def smooth_lift(positions, corners, c, prim, u, v, px, py, pz, gx, gy, gz):
     """The vector from the hit p at barycentrics (u, v) of triangle prim to the curved
     surface its corner normals c describe, on the side of g (the geometric normal facing
     the light's side): the interpolated normal times the patch's height there."""
-    a0x, a0y, a0z, n0x, n0y, n0z = _corner(v0, v1, v2, c, prim, 0)
-    a1x, a1y, a1z, n1x, n1y, n1z = _corner(v0, v1, v2, c, prim, 1)
-    a2x, a2y, a2z, n2x, n2y, n2z = _corner(v0, v1, v2, c, prim, 2)
+    a0x, a0y, a0z, n0x, n0y, n0z = _corner(positions, corners, c, prim, 0)
+    a1x, a1y, a1z, n1x, n1y, n1z = _corner(positions, corners, c, prim, 1)
+    a2x, a2y, a2z, n2x, n2y, n2z = _corner(positions, corners, c, prim, 2)
     b0, b1, b2 = 1.0 - u - v, u, v         # the corners' weights
     nx = b0 * n0x + b1 * n1x + b2 * n2x    # not normalised (as Cycles)
     ny = b0 * n0y + b1 * n1y + b2 * n2y
@@ -72,9 +73,10 @@ def smooth_lift(v0, v1, v2, c, prim, u, v, px, py, pz, gx, gy, gz):
 
 
 @kernel
-def shadow_origin(v0, v1, v2, corner_normals, cutoff, prim, u, v, px, py, pz, gx, gy, gz,
-                  nx, ny, nz, scale, wx, wy, wz):
-    """The origin of a shadow ray from hit p (barycentrics (u, v) of triangle prim;
+def shadow_origin(positions, corners, corner_normals, cutoff, prim, u, v, px, py, pz, gx,
+                  gy, gz, nx, ny, nz, scale, wx, wy, wz):
+    """The origin of a shadow ray from hit p (barycentrics (u, v) of triangle prim, whose
+    corners are rows corners[prim] of positions (engine.surface.SurfaceBuilder);
     geometric normal g and the surface's own shading normal n, both facing the incoming
     ray) towards the light direction w (unit)."""
     off = cutoff[prim] if cutoff.shape[0] > 0 else 0.0
@@ -89,8 +91,8 @@ def shadow_origin(v0, v1, v2, corner_normals, cutoff, prim, u, v, px, py, pz, gx
         else:
             amount = min(max(1.0 - ngl / off, 0.0), 1.0)
         if amount > 0.0:
-            lx, ly, lz = smooth_lift(v0, v1, v2, corner_normals, prim, u, v, px, py, pz,
-                                     fx, fy, fz)
+            lx, ly, lz = smooth_lift(positions, corners, corner_normals, prim, u, v, px, py,
+                                     pz, fx, fy, fz)
             px, py, pz = px + lx * amount, py + ly * amount, pz + lz * amount
             if not ngl > 0.0:
                 return px, py, pz    # the light is under the plane: its own triangle counts
@@ -98,14 +100,14 @@ def shadow_origin(v0, v1, v2, corner_normals, cutoff, prim, u, v, px, py, pz, gx
 
 
 @kernel
-def shadow_origins(v0, v1, v2, corner_normals, cutoff, prim, bary, position, ng, ns, scale,
-                   wi):
+def shadow_origins(positions, corners, corner_normals, cutoff, prim, bary, position, ng, ns,
+                   scale, wi):
     """`shadow_origin` for hits given as arrays (the NumPy reference): (n, 3)."""
     out = np.empty_like(position)
     for i in range(prim.shape[0]):
-        x, y, z = shadow_origin(v0, v1, v2, corner_normals, cutoff, prim[i], bary[i, 0],
-                                bary[i, 1], position[i, 0], position[i, 1], position[i, 2],
-                                ng[i, 0], ng[i, 1], ng[i, 2], ns[i, 0], ns[i, 1], ns[i, 2],
-                                scale[i], wi[i, 0], wi[i, 1], wi[i, 2])
+        x, y, z = shadow_origin(positions, corners, corner_normals, cutoff, prim[i],
+                                bary[i, 0], bary[i, 1], position[i, 0], position[i, 1],
+                                position[i, 2], ng[i, 0], ng[i, 1], ng[i, 2], ns[i, 0],
+                                ns[i, 1], ns[i, 2], scale[i], wi[i, 0], wi[i, 1], wi[i, 2])
         out[i, 0], out[i, 1], out[i, 2] = x, y, z
     return out

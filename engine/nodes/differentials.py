@@ -109,13 +109,13 @@ def _corner_step(corners, prim, k, b1, b2):
 def _fill_step(hit, block, geometry, prim, obj, camera, sx, sy, sz):
     """One block of differentials (H_DX or H_DY): the change of each field over the
     surface step s."""
-    v0, v1, v2 = geometry[0], geometry[1], geometry[2]
-    corner_uvs, objects, colors = geometry[8], geometry[11], geometry[13]
+    positions, corners = geometry[0], geometry[1]
+    corner_uvs, objects, colors = geometry[7], geometry[10], geometry[12]
     hit[block + H_P], hit[block + H_P + 1], hit[block + H_P + 2] = sx, sy, sz
-    b1, b2 = _barycentric_step(v1[prim, 0] - v0[prim, 0], v1[prim, 1] - v0[prim, 1],
-                               v1[prim, 2] - v0[prim, 2], v2[prim, 0] - v0[prim, 0],
-                               v2[prim, 1] - v0[prim, 1], v2[prim, 2] - v0[prim, 2],
-                               sx, sy, sz)
+    p0, p1, p2 = positions[corners[prim, 0]], positions[corners[prim, 1]], \
+        positions[corners[prim, 2]]
+    b1, b2 = _barycentric_step(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2],
+                               p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2], sx, sy, sz)
     if corner_uvs.shape[0] > 0:
         hit[block + H_UV] = _corner_step(corner_uvs, prim, 0, b1, b2)
         hit[block + H_UV + 1] = _corner_step(corner_uvs, prim, 1, b1, b2)
