@@ -59,9 +59,7 @@ class EmissiveTriangles:
         self.prim = prim_ids[keep]
         # the offset scale relative to the static scene's centre (engine.accel, surface)
         c = np.zeros(3) if center is None else np.asarray(center, np.float64)
-        corners = np.arange(3 * len(v0)).reshape(3, -1).T     # rows of v0, then v1, v2
-        self.tri_scale = triangle_scale(np.concatenate([v0, v1, v2]), corners, c,
-                                        3 * len(v0))[keep]
+        self.tri_scale = triangle_scale(v0, v1, v2, c)[keep]
         self.entry = np.full(max(int(n_prims_total), 1), -1, dtype=np.int64)
         self.entry[self.prim] = np.arange(len(self.prim))
 

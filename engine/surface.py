@@ -60,11 +60,8 @@ class SurfaceBuilder:
             base += len(positions[-1])
         self.positions = positions[0] if len(positions) == 1 else np.concatenate(positions)
         self.corners = corners[0] if len(corners) == 1 else np.concatenate(corners)
-        self.normal = _unit_normals(self.positions, self.corners)
-        # the offset scale: the magnitude of the coordinates Embree rounds, relative to the
-        # static scene's centre (engine.accel) for static triangles
-        self.tri_scale = triangle_scale(self.positions, self.corners, accel.center,
-                                        len(accel.positions))
+        # Unit normals and offset scales are computed per hit (normals(), scales(); the
+        # compiled kernels likewise), not stored per triangle.
         self.material = (np.concatenate([m.material_indices for m in ordered]).astype(np.int64)
                          if ordered else np.zeros(0, np.int64))
         # Holdout triangles (None when the scene has none): camera rays end there.
@@ -87,7 +84,8 @@ class SurfaceBuilder:
                 if m.corner_normals is not None:
                     parts.append(np.asarray(m.corner_normals, np.float32).reshape(-1, 3, 3))
                 else:
-                    flat = self.normal[offset:offset + t].astype(np.float32)
+                    flat = _unit_normals(self.positions, self.corners[offset:offset + t]
+                                         ).astype(np.float32)
                     parts.append(np.repeat(flat[:, None, :], 3, axis=1))
                 offset += t
             self.corner_normals = np.concatenate(parts)
@@ -131,6 +129,18 @@ class SurfaceBuilder:
         c = self.corners[prim]
         return self.positions[c[:, 0]], self.positions[c[:, 1]], self.positions[c[:, 2]]
 
+    def normals(self, prim) -> np.ndarray:
+        """Unit geometric normals (n, 3) of triangles `prim` (moving ones: placeholders)."""
+        return _corner_normals(*self.vertices(prim))
+
+    def scales(self, prim, vertices=None) -> np.ndarray:
+        """The offset scales of triangles `prim`: their coordinates' magnitude, relative to
+        the static scene's centre (engine.accel) for static triangles, absolute for
+        moving ones (at `vertices`, their corners where the ray's time put them)."""
+        v0, v1, v2 = self.vertices(prim) if vertices is None else vertices
+        static = (prim < self.accel.static_count)[:, None]
+        return triangle_scale(v0, v1, v2, np.where(static, self.accel.center, 0.0))
+
     def _moving_vertices(self, prim, time):
         """World vertices, normal matrices (or None) of hit triangles at the rays' times."""
         v0, v1, v2 = self.vertices(prim)
@@ -171,12 +181,11 @@ class SurfaceBuilder:
         if self.accel.moving and (prim >= self.accel.static_count).any():
             v0, v1, v2, normal_m = self._moving_vertices(prim, time[index])
             ng = _corner_normals(v0, v1, v2)
-            tri_scale = np.where(prim < self.accel.static_count, self.tri_scale[prim],
-                                 np.max(np.abs(np.stack([v0, v1, v2], 1)), axis=(1, 2)))
+            tri_scale = self.scales(prim, (v0, v1, v2))
         else:
             v0, v1, v2 = self.vertices(prim)
-            ng = self.normal[prim]
-            tri_scale = self.tri_scale[prim]
+            ng = _corner_normals(v0, v1, v2)
+            tri_scale = self.scales(prim, (v0, v1, v2))
         pos = w * v0 + u * v1 + v * v2
         d = ray_dirs[index]
         front = (ng * d).sum(1) < 0.0
@@ -254,25 +263,17 @@ def _object_table(ordered):
     return np.repeat(np.arange(len(ordered), dtype=np.int32), counts), rows
 
 
-# Triangles per block of the per-triangle arrays built from vertex rows: temporaries
+# Triangles per block of the per-triangle normals built from vertex rows: temporaries
 # of a block, never of the whole mesh (a 1M-triangle mesh's corners in float64 are 72 MB).
 _BLOCK = 1 << 16
 
 
-def triangle_scale(positions, corners, center, static_vertices: int) -> np.ndarray:
-    """Per triangle (rows `corners` of `positions`), the largest coordinate magnitude of
-    its corners: relative to `center` for the first static_vertices (static) vertices,
-    absolute for the rest (moving objects, traced in their own spaces)."""
-    if not len(corners):
+def triangle_scale(v0, v1, v2, center) -> np.ndarray:
+    """Per triangle, the largest coordinate magnitude of its corners relative to `center`
+    ((3,), or (n, 3): one per triangle)."""
+    if not len(v0):
         return np.zeros(0)
-    magnitude = np.empty(len(positions))
-    for a in range(0, len(positions), _BLOCK):
-        b = min(a + _BLOCK, len(positions))
-        c = np.zeros((b - a, 3))
-        c[:max(min(static_vertices, b) - a, 0)] = center
-        magnitude[a:b] = np.max(np.abs(positions[a:b] - c), axis=1)
-    return np.maximum(np.maximum(magnitude[corners[:, 0]], magnitude[corners[:, 1]]),
-                      magnitude[corners[:, 2]])
+    return np.max(np.abs(np.stack([v0 - center, v1 - center, v2 - center], 1)), axis=(1, 2))
 
 
 def _unit_normals(positions, corners):

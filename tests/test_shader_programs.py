@@ -71,8 +71,8 @@ def test_programs_cost_only_the_scenes_that_have_them():
     plain = RenderContext(_box(False), settings)
     assert not plain.materials.any_programs
     integ = plain.integrator
-    assert integ.geometry[9].size == 0 and integ.geometry[10].size == 0      # no objects
-    assert integ.geometry[11].size == 0 and integ.geometry[12].size == 0     # no attributes
+    assert integ.geometry[8].size == 0 and integ.geometry[9].size == 0       # no objects
+    assert integ.geometry[10].size == 0 and integ.geometry[11].size == 0     # no attributes
     assert integ.textures[8][:, 1].sum() == 0                                # no program
     textured = RenderContext(_box(True), settings)
     assert textured.materials.any_programs

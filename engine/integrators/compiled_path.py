@@ -72,8 +72,8 @@ class CompiledPathIntegrator:
                              float(s.caustics_reflective), float(s.caustics_refractive),
                              s.volume_bounces],
                             dtype=np.float64)
-        self.geometry = (surf.positions, surf.corners, surf.normal, surf.tri_scale,
-                         surf.material,
+        self.geometry = (surf.positions, surf.corners,
+                         np.asarray(ctx.accel.center, dtype=np.float64), surf.material,
                          _or_empty(surf.corner_normals, (0, 3, 3), np.float32),
                          _or_empty(surf.holdout, 0, bool),
                          _or_empty(surf.corner_uvs, (0, 3, 2), np.float32),
@@ -112,7 +112,7 @@ class CompiledPathIntegrator:
         self.heterogeneous = self.has_volumes and bool(self.vol[:, V_HET].any())
         if self.heterogeneous:
             bound_majorants(self.vol, self.textures, surf.material,
-                            self.geometry[9], self.geometry[10],
+                            self.geometry[8], self.geometry[9],
                             (surf.positions, surf.corners), self.camera)
         self.het_runs = np.zeros(1, np.int64)
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes

@@ -23,7 +23,6 @@ def camera_stack(ctx, vol: np.ndarray, tri_material: np.ndarray) -> np.ndarray:
         stack[top] = world
         top += 1
     origin = np.asarray(ctx.scene.camera.matrix, np.float64)[:3, 3].copy()
-    normals = ctx.surfaces.normal
     outward = {}
     o = origin[None, :]
     d = _PROBE[None, :]
@@ -36,7 +35,7 @@ def camera_stack(ctx, vol: np.ndarray, tri_material: np.ndarray) -> np.ndarray:
             break
         m = int(tri_material[prim])
         if vol[m, V_HAS]:
-            leaving = float(np.dot(normals[prim], _PROBE)) > 0.0
+            leaving = float(np.dot(ctx.surfaces.normals(h.prim)[0], _PROBE)) > 0.0
             outward[m] = outward.get(m, 0) + (1 if leaving else -1)
         travelled += float(h.t[0])
         step = max(float(h.t[0]), 0.0) + 1e-6 * max(1.0, travelled)

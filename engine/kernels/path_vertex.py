@@ -79,11 +79,11 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     cfg: float64 [sampler kind, spp, max_bounces, diffuse, glossy, transmission limits,
     clamp_direct, clamp_indirect, mis mode, scene radius, film transparent, filter glossy,
     reflective caustics, refractive caustics] (see `prepare_closures`).
-    geometry: (vertex positions, each triangle's corners as rows of them, normal,
-    tri_scale, material, corner_normals, holdout, corner_uvs, moving objects, triangle
-    objects, object table, corner tangents, corner colours, camera, terminator cutoffs)
-    of every triangle (corner normals, holdout, UVs, objects, tangents, colours and
-    cutoffs may be empty; see
+    geometry: (vertex positions, each triangle's corners as rows of them, the static
+    scene's centre, material, corner_normals, holdout, corner_uvs, moving objects,
+    triangle objects, object table, corner tangents, corner colours, camera, terminator
+    cutoffs) of every triangle (corner normals, holdout, UVs, objects, tangents, colours
+    and cutoffs may be empty; see
     `surface.rebuild_at_time` and engine.nodes.shading). textures: the packed textures
     and shader programs (engine.nodes.pack.pack_shading); a material with a program
     runs it at each hit, and its outputs replace the parameters they drive. path_time: each path's shutter time (its
@@ -114,7 +114,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     bounce, vbounce, vol, stacks, sh_stack, sh_bounce, het_count = media
     het_scene = has_heterogeneous(vol)
     vhit = np.zeros(N_HIT)
-    tri_material, holdout, corner_uvs = geometry[4], geometry[6], geometry[7]
+    tri_material, holdout, corner_uvs = geometry[3], geometry[5], geometry[6]
     any_textures = textures[1].shape[0] > 0
     film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
     kind, spp = int(cfg[0]), int(cfg[1])
@@ -156,7 +156,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                                           ray_bits[p])[0]
                 vmode = 3
                 scattered, t_end, fr, fg, fb, mfr, mfg, mfb, er, eg, eb, g_phase = \
-                    tracked_segment(vol, stacks, p, textures, geometry[10], geometry[13],
+                    tracked_segment(vol, stacks, p, textures, geometry[9], geometry[12],
                                     ox, oy, oz, dx, dy, dz, t_geom, t_lamp, br, bg, bb,
                                     ray_bits[p], b, path_key(pkey[p], index[p], depth),
                                     vhit, regs, het_count)
@@ -307,8 +307,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             # under the triangle's own plane but above its smooth normal lights it, its
             # shadow ray leaving from the curved surface the normals describe
             if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0:
-                sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[5],
-                                              geometry[14], prim, hit_u[j], hit_v[j], px,
+                sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[4],
+                                              geometry[13], prim, hit_u[j], hit_v[j], px,
                                               py, pz, gx, gy, gz, n0x, n0y, n0z, scale, wx,
                                               wy, wz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy,

@@ -17,18 +17,23 @@ from .motion import I_KIND, I_NVERTS, I_SLICES, I_VERT0, RIGID, adjugate_columns
 
 
 @kernel
-def rebuild(positions, corners, normal, tri_scale, corner_normals, prim, u, v, dx, dy, dz):
+def rebuild(positions, corners, center, corner_normals, prim, u, v, dx, dy, dz):
     """The hit of a ray with direction d on static triangle `prim` at barycentrics (u, v):
-    its corners are rows corners[prim] of positions (engine.surface.SurfaceBuilder).
+    its corners are rows corners[prim] of positions (engine.surface.SurfaceBuilder), its
+    unit normal and offset scale computed here as SurfaceBuilder computes them (the
+    scale relative to the static scene's centre `center`).
     corner_normals is (T, 3, 3) float32, or empty for flat shading everywhere.
     Returns (position, geometric normal facing the ray, shading normal on that side,
     front_facing, offset scale)."""
     w = 1.0 - u - v
     i0, i1, i2 = corners[prim, 0], corners[prim, 1], corners[prim, 2]
-    px = w * positions[i0, 0] + u * positions[i1, 0] + v * positions[i2, 0]
-    py = w * positions[i0, 1] + u * positions[i1, 1] + v * positions[i2, 1]
-    pz = w * positions[i0, 2] + u * positions[i1, 2] + v * positions[i2, 2]
-    gx, gy, gz = normal[prim, 0], normal[prim, 1], normal[prim, 2]
+    p0x, p0y, p0z = positions[i0, 0], positions[i0, 1], positions[i0, 2]
+    p1x, p1y, p1z = positions[i1, 0], positions[i1, 1], positions[i1, 2]
+    p2x, p2y, p2z = positions[i2, 0], positions[i2, 1], positions[i2, 2]
+    px = w * p0x + u * p1x + v * p2x
+    py = w * p0y + u * p1y + v * p2y
+    pz = w * p0z + u * p1z + v * p2z
+    gx, gy, gz = unit_normal(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z)
     front = dot(gx, gy, gz, dx, dy, dz) < 0.0
     sign = 1.0 if front else -1.0
     fx, fy, fz = gx * sign, gy * sign, gz * sign
@@ -49,23 +54,36 @@ def rebuild(positions, corners, normal, tri_scale, corner_normals, prim, u, v, d
             sx, sy, sz = nx, ny, nz
     # the triangle's scale, relative to the static scene's centre (engine.surface), bounds
     # the hit point's
-    return px, py, pz, fx, fy, fz, sx, sy, sz, front, tri_scale[prim]
+    cx, cy, cz = center[0], center[1], center[2]
+    scale = max(abs(p0x - cx), abs(p0y - cy), abs(p0z - cz), abs(p1x - cx), abs(p1y - cy),
+                abs(p1z - cz), abs(p2x - cx), abs(p2y - cy), abs(p2z - cz))
+    return px, py, pz, fx, fy, fz, sx, sy, sz, front, scale
+
+
+@kernel(inline="always")
+def unit_normal(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z):
+    """The unit normal of triangle (p0, p1, p2), (0, 0, 1) when it has no area
+    (engine.surface's, in the same operations)."""
+    gx, gy, gz = cross(p1x - p0x, p1y - p0y, p1z - p0z, p2x - p0x, p2y - p0y, p2z - p0z)
+    ln = math.sqrt(gx * gx + gy * gy + gz * gz)
+    if ln > 0.0:
+        return gx / ln, gy / ln, gz / ln
+    return 0.0, 0.0, 1.0
 
 
 @kernel
 def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
     """`rebuild` for any triangle, static or moving, hit at shutter time `time`.
-    geometry: (positions, corners, normal, tri_scale, material, corner_normals, holdout,
-    corner_uvs, M) in the accelerator's triangle order, M its moving objects
+    geometry: (positions, corners, center, material, corner_normals, holdout, corner_uvs,
+    M) in the accelerator's triangle order, M its moving objects
     (engine.kernels.motion.PackedMotion; triangles from M.prim_start[0] on move). A
     moving triangle is placed as SurfaceBuilder.build places it: a rigid object's
     vertices by its transform at `time`, its corner normals by that transform's
     inverse-transpose; a deforming object's vertices from the time slice of `time`."""
-    positions, corners, normal, tri_scale, corner_normals, M = (
-        geometry[0], geometry[1], geometry[2], geometry[3], geometry[5], geometry[8])
+    positions, corners, center, corner_normals, M = (geometry[0], geometry[1], geometry[2],
+                                                     geometry[4], geometry[7])
     if prim < M.prim_start[0]:
-        return rebuild(positions, corners, normal, tri_scale, corner_normals, prim, u, v,
-                       dx, dy, dz)
+        return rebuild(positions, corners, center, corner_normals, prim, u, v, dx, dy, dz)
     obj = object_of(M, prim)
     info, verts, tris = M.info, M.verts, M.tris
     local = prim - M.prim_start[0]
@@ -87,13 +105,8 @@ def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
                            a22, tx, ty, tz)
     p2x, p2y, p2z = _place(verts, base + i2, rigid, a00, a01, a02, a10, a11, a12, a20, a21,
                            a22, tx, ty, tz)
-    # the placed triangle's unit geometric normal (engine.surface._unit_normals)
-    gx, gy, gz = cross(p1x - p0x, p1y - p0y, p1z - p0z, p2x - p0x, p2y - p0y, p2z - p0z)
-    ln = math.sqrt(gx * gx + gy * gy + gz * gz)
-    if ln > 0.0:
-        gx, gy, gz = gx / ln, gy / ln, gz / ln
-    else:
-        gx, gy, gz = 0.0, 0.0, 1.0
+    # the placed triangle's unit geometric normal
+    gx, gy, gz = unit_normal(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z)
     w = 1.0 - u - v
     px = w * p0x + u * p1x + v * p2x
     py = w * p0y + u * p1y + v * p2y

@@ -42,7 +42,7 @@ def alpha_dim(depth, layer):
 def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz, time, ray, depth, length):
     """Alpha of the hit (a material program's, run for a ray of kind `ray`, the path's
     bounce depth and the hit's distance), its material and its surface point."""
-    tri_material, corner_uvs = geometry[4], geometry[7]
+    tri_material, corner_uvs = geometry[3], geometry[6]
     _, _, alpha_table, _, T, _ = materials
     px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
         geometry, prim, u, v, dx, dy, dz, time)
@@ -152,7 +152,7 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur_t, cur_prim
         prim = cur_prim[i]
         reached = prim < 0 or not cur_t[i] < remaining[i]
         if het_scene and heterogeneous_in(vol, stacks, r):
-            attenuate_tracked(vol, stacks, r, trans, T, geometry[10], geometry[13],
+            attenuate_tracked(vol, stacks, r, trans, T, geometry[9], geometry[12],
                               so[i, 0], so[i, 1], so[i, 2], sd[r, 0], sd[r, 1], sd[r, 2],
                               remaining[i] if reached else cur_t[i],
                               chain(keys[r], layer), hit, regs, het_count)

@@ -110,7 +110,7 @@ def _fill_step(hit, block, geometry, prim, obj, camera, sx, sy, sz):
     """One block of differentials (H_DX or H_DY): the change of each field over the
     surface step s."""
     positions, corners = geometry[0], geometry[1]
-    corner_uvs, objects, colors = geometry[7], geometry[10], geometry[12]
+    corner_uvs, objects, colors = geometry[6], geometry[9], geometry[11]
     hit[block + H_P], hit[block + H_P + 1], hit[block + H_P + 2] = sx, sy, sz
     p0, p1, p2 = positions[corners[prim, 0]], positions[corners[prim, 1]], \
         positions[corners[prim, 2]]

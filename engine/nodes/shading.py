@@ -1,7 +1,7 @@
 """The kernels' side of shader programs: run a hit's material program and read its
 outputs into the Principled parameter row, emission and alpha.
 
-geometry is the compiled path tracer's triangle tuple; its fields 9 to 13 are each
+geometry is the compiled path tracer's triangle tuple; its fields 8 to 12 are each
 triangle's object (int32, empty when no mesh carries ObjectInfo), the object table
 (context.O_* rows), the corner tangents and the corner colours ((T, 3, 4) float32 each,
 empty without), and the packed render camera (engine.kernels.camera_rays.pack_camera;
@@ -30,7 +30,7 @@ def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx
     and run m's program. The caller has written the row's path fields
     (context.path_fields; zeros: a path of no bounces and a ray without footprint); the
     differentials are filled only for a program that reads them (a Bump's)."""
-    tri_object, objects, corner_tangents = geometry[9], geometry[10], geometry[11]
+    tri_object, objects, corner_tangents = geometry[8], geometry[9], geometry[10]
     obj = tri_object[prim] if tri_object.shape[0] > 0 else -1
     tx = ty = tz = ts = 0.0
     if corner_tangents.shape[0] > 0:
@@ -45,14 +45,14 @@ def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx
             tx, ty, tz = tx / ln, ty / ln, tz / ln
         ts = 1.0 if ts > 0.0 else (-1.0 if ts < 0.0 else 0.0)
     cr = cg = cb = ca = 0.0
-    colors = geometry[12]
+    colors = geometry[11]
     if colors.shape[0] > 0:
         b0 = 1.0 - bu - bv
         cr = b0 * colors[prim, 0, 0] + bu * colors[prim, 1, 0] + bv * colors[prim, 2, 0]
         cg = b0 * colors[prim, 0, 1] + bu * colors[prim, 1, 1] + bv * colors[prim, 2, 1]
         cb = b0 * colors[prim, 0, 2] + bu * colors[prim, 1, 2] + bv * colors[prim, 2, 2]
         ca = b0 * colors[prim, 0, 3] + bu * colors[prim, 1, 3] + bv * colors[prim, 2, 3]
-    camera = geometry[13]
+    camera = geometry[12]
     fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, uu, vv, front, ray, depth,
          length, objects, obj, camera, tx, ty, tz, ts, cr, cg, cb, ca)
     if reads_differentials(T, m):
