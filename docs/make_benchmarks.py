@@ -36,7 +36,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [ROOT, os.path.join(ROOT, "tests")]
 from engine.image_error import relmse  # noqa: E402
-from big_scene_benchmarks import big_mesh, many_moving  # noqa: E402
+from big_scene_benchmarks import big_mesh, big_mesh_section, many_moving  # noqa: E402
 from stage_profile import gil_bound, table_lines as stage_table  # noqa: E402
 DOCS = os.path.join(ROOT, "docs")
 SAMPLES = os.path.join(ROOT, "sample_blends")
@@ -275,32 +275,9 @@ def main():
         targets += sec_targets
         done("3")
     if "4" not in skip:
-        r = big_mesh()
-        c, d = r["CYCLES"], r["DRT"]
-        targets.append(("4. 1M triangles: whole process, DRT over Cycles", "<= 1.5x",
-                        f"{d['whole'] / c['whole']:.2f}x (DRT's acceleration structure and "
-                        f"set-up {d['build'] or 0:.1f} s of its {d['render']:.1f} s render "
-                        "call)", bool(d["whole"] / c["whole"] <= 1.5)))
-        targets.append(("4. ... peak memory, DRT over Cycles", "<= 1.2x",
-                        f"{d['maxrss_mb'] / c['maxrss_mb']:.2f}x (the exported arrays: "
-                        f"{d['scene_mb']:.0f} of the {d['maxrss_mb'] - c['maxrss_mb']:.0f} MB "
-                        "more)", bool(d["maxrss_mb"] / c["maxrss_mb"] <= 1.2)))
-        lines += ["## 4. A big mesh", "",
-                  f"Suzanne subdivided to {r['triangles']:,} triangles, 320x240, 1 sample, "
-                  "each engine in a fresh process.", "",
-                  "| | Cycles | DRT |", "|---|---|---|",
-                  f"| file load (s) | {c['load']:.2f} | {d['load']:.2f} |",
-                  f"| render call: sync, build, 1 sample (s) | {c['render']:.2f} | "
-                  f"{d['render']:.2f} |",
-                  f"| DRT: depsgraph to first sample (s) | | {d['first_sample'] or 0:.2f} |",
-                  f"| ... of which export from the depsgraph (s) | | {d['export'] or 0:.2f} |",
-                  f"| ... acceleration structure and render set-up (s) | | "
-                  f"{d['build'] or 0:.2f} |",
-                  f"| ... the first sample (s) | | "
-                  f"{(d['first_sample'] or 0) - (d['export'] or 0) - (d['build'] or 0):.2f} |",
-                  f"| peak resident memory (MB) | {c['maxrss_mb']:.0f} | {d['maxrss_mb']:.0f} |",
-                  f"| DRT: the exported scene's arrays (MB) | | {d['scene_mb']:.0f} |",
-                  ""]
+        sec_lines, sec_targets = big_mesh_section(big_mesh(), os.getloadavg()[0])
+        lines += sec_lines
+        targets += sec_targets
         done("4")
     if "5" not in skip:
         r = many_moving(200 if q else 1000)
