@@ -275,7 +275,8 @@ def main():
         targets += sec_targets
         done("3")
     if "4" not in skip:
-        sec_lines, sec_targets = big_mesh_section(big_mesh(), os.getloadavg()[0])
+        load_now = os.getloadavg()[0]
+        sec_lines, sec_targets = big_mesh_section(big_mesh(), load_now)
         lines += sec_lines
         targets += sec_targets
         done("4")
