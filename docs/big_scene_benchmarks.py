@@ -149,8 +149,8 @@ def big_mesh_section(r: dict, load: float) -> tuple[list, list]:
     lines = ["## 4. A big mesh", "",
              f"Suzanne subdivided to {r['triangles']:,} triangles, 320x240, 1 sample, each "
              f"engine in a fresh process (`docs/big_scene_benchmarks.py`; load average "
-             f"{load:.2f}; {r['repeats']} processes per engine, taking turns, each engine's "
-             "of median whole-process time shown). Seconds from after `import bpy`: the "
+             f"{load:.2f}; {r['repeats']} processes per engine, taking turns; for each "
+             "engine, its run of median whole-process time). Seconds from after `import bpy`: the "
              "file load includes importing and registering DRT; whole process = file load "
              "+ render call.", "",
              "| | Cycles | DRT |", "|---|---|---|",
