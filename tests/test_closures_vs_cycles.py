@@ -15,10 +15,12 @@ a control, DRT rendering it without the feature (as it did before), which must f
     Translucent BSDF replaced by a Diffuse one.
   * refraction: a large Refraction BSDF sphere (IOR 1.45, roughness 0) before a striped
     wall, lit by a white sky (strength 1) alone, Filter Glossy 0 in both engines
-    (with 1, DRT is -2.06 % off, its Glass BSDF +0.26 %: the rough refraction-only lobe
-    differs, not understood yet: at roughness 0.3 DRT is -2.18 % off with Filter Glossy
-    0 and -3.44 % with 1; with 1 and refractive caustics off in both, the smooth sphere
-    is -0.5 %); control: a Glass BSDF (what DRT rendered it as before). Under an area lamp instead, DRT is -2.1 % off Cycles for
+    (with 1, DRT is -2.06 % off, its Glass BSDF +0.26 %: Blender's default distribution
+    for the Refraction BSDF is Beckmann, which DRT renders as GGX (warned), and Filter
+    Glossy widens the smooth sphere into a rough lobe; at roughness 0.3 DRT is -2.18 %
+    off with Filter Glossy 0; with the node set to GGX in both engines -0.03 % at
+    roughness 0.3 and +0.02 % smooth with Filter Glossy 1); control: a Glass BSDF (what
+    DRT rendered it as before). Under an area lamp instead, DRT is -2.1 % off Cycles for
     this sphere and -2.2 % for a Glass BSDF sphere alike (the known lamp-caustics
     difference of docs/comparisons.md, glass_caustics), so the sky isolates the lobe.
 
