@@ -35,7 +35,7 @@ condition; Cycles' own TODO in bsdf_microfacet_eval). Visible-normal sampling ne
 produces those pairs, so only next-event estimation sees them, with their MIS weight:
 a rough glass lit through by a lamp gains light (the rough glass sphere of
 docs/comparisons.md: +0.7% of its image at roughness 0.67). `rough_eval` and `rough_pdf`
-follow Cycles by default (`as_cycles=True`); with `as_cycles=False` they are Walter's
+follow Cycles by default (`as_cycles=True`, or one flag per row); with False they are Walter's
 BTDF and the sampler's own density (what the chi-square tests check), which agree with
 the default on every pair the sampler produces.
 
@@ -106,9 +106,9 @@ def smooth_sample(wo, eta, u, allow_reflect=True, allow_refract=True):
 # --- rough interface -------------------------------------------------------------------
 
 def _refraction_half(wo_c, wi_c, eta_rel, as_cycles=False):
-    """Generalised half vector h ~ wo + eta wi (Walter eq. 16), facing +Z, wo.h, wi.h,
-    |wo + eta wi|^2 and validity: Walter's (wo.h > 0 > wi.h), or with `as_cycles` any
-    h (the cosines then made |wo.h| and -|wi.h|, as Cycles evaluates them)."""
+    """Generalised half vector h ~ wo + eta wi (Walter eq. 16), facing +Z, |wo.h|,
+    -|wi.h|, |wo + eta wi|^2 and validity: Walter's (wo.h > 0 > wi.h), or where
+    `as_cycles` (a bool, or one per row) any h, as Cycles evaluates it."""
     h = wo_c + eta_rel[:, None] * wi_c
     n = np.sqrt((h * h).sum(1))
     ok = n > 1e-12
@@ -117,12 +117,9 @@ def _refraction_half(wo_c, wi_c, eta_rel, as_cycles=False):
     cos_oh = (wo_c * h).sum(1)
     cos_ih = (wi_c * h).sum(1)
     den = (cos_oh + eta_rel * cos_ih) ** 2
-    if as_cycles:
-        cos_oh, cos_ih = np.abs(cos_oh), -np.abs(cos_ih)
-    else:
-        ok &= (cos_oh > 0) & (cos_ih < 0)
+    ok &= np.asarray(as_cycles, bool) | ((cos_oh > 0) & (cos_ih < 0))
     ok &= h[:, 2] > 0
-    return h, cos_oh, cos_ih, den, ok
+    return h, np.abs(cos_oh), -np.abs(cos_ih), den, ok
 
 
 def rough_eval(wo, wi, eta, alpha, as_cycles=True):

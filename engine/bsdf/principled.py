@@ -96,6 +96,11 @@ def _sub(a, rows):
     return a if rows is None else a[rows]
 
 
+def _flag(a, rows):
+    """A flag for all rows (a bool) or one per row (an array), on the rows `rows`."""
+    return a if np.ndim(a) == 0 else a[rows]
+
+
 class PrincipledBSDF:
     """Diffuse, dielectric specular, metal and glass lobes with Blender's weights."""
 
@@ -119,8 +124,9 @@ class PrincipledBSDF:
                  else np.broadcast_to(np.asarray(front_facing, bool), (n,)))
 
         # Refraction also on the pairs the sampler never produces, as Cycles evaluates it
-        # (engine/bsdf/dielectric.py's note); False: Walter's BTDF and the sampler's own
-        # density (the chi-square tests)
+        # (engine/bsdf/dielectric.py's note); False (for all, or per row: an (n,) bool
+        # array): Walter's BTDF and the sampler's own density (the chi-square tests, next-
+        # event estimation towards a uniform world)
         self.as_cycles = True
         self.base = np.maximum(base_color, 0.0)         # Cycles: diffuse is not clamped
         self.base_clamped = np.minimum(self.base, 1.0)  # ... metal F0 and glass tint are
@@ -378,7 +384,8 @@ class PrincipledBSDF:
                     gr = rr if g is None else g[rr]
                     lr = rr if loc is None else loc[rr]
                     f_r, f_t = dielectric.rough_eval(wo[lr], wi[lr], self.eta_glass[gr],
-                                                     self.alpha[gr], self.as_cycles)
+                                                     self.alpha[gr],
+                                                     _flag(self.as_cycles, gr))
                     val = (f_r[:, None] * keep[lr, 1:2]
                            + f_t[:, None] * self.tint_t[gr] * keep[lr, 2:3]) \
                         * self.weight[gr, L_GLASS][:, None]
@@ -415,7 +422,7 @@ class PrincipledBSDF:
                 g = r if idx is None else idx[r]
                 p[r] += q[r, L_GLASS] * dielectric.rough_pdf(
                     wo[r], wi[r], self.eta_glass[g], self.alpha[g], a_g[r], a_t[r],
-                    self.as_cycles)
+                    _flag(self.as_cycles, g))
         return p
 
     def pdf(self, wo, wi, allowed=None):

@@ -215,16 +215,6 @@ class PathIntegrator:
             return np.ones(len(prev_pdf))
         raise ValueError(f"mis_mode must be one of {MIS_MODES}, got {mode!r}")
 
-    @staticmethod
-    def _walter_rows(bsdf, walter, evaluate):
-        """evaluate() with Cycles' refraction pairs, its rows `walter` with Walter's."""
-        out = evaluate()
-        if walter.any():
-            bsdf.as_cycles = False
-            out[walter] = evaluate()[walter]
-            bsdf.as_cycles = True
-        return out
-
     def _nee_weight(self, light_pdf, bsdf_pdf, delta):
         """Weight of a light sample that the BSDF would have sampled with bsdf_pdf."""
         mode = self.mis_mode
@@ -352,8 +342,8 @@ class PathIntegrator:
                 wi_local = to_local(ls.wi, ns)
                 # towards a uniform world (never sampled by Cycles, whose escaping rays
                 # find it) refraction on Walter's pairs only (dielectric.py's note)
-                walter = lights.uniform_world(entry)
-                f = self._walter_rows(bsdf, walter, lambda: bsdf.eval_f(wo, wi_local))
+                bsdf.as_cycles = ~lights.uniform_world(entry)
+                f = bsdf.eval_f(wo, wi_local)
                 # As in Cycles the lobes alone decide, on the shading normals; a shadow
                 # ray leaves a smooth mesh from its curved surface (kernels.terminator).
                 ok = (ls.pdf > 0) & (ls.radiance.max(1) > 0) & (f.max(1) > 0)
@@ -377,13 +367,13 @@ class PathIntegrator:
                     vis = trans.max(1) > 0
                     if vis.any():
                         sv = sel[vis]
-                        bsdf_pdf = self._walter_rows(
-                            bsdf, walter, lambda: bsdf.pdf(wo, wi_local, allowed))[sv]
+                        bsdf_pdf = bsdf.pdf(wo, wi_local, allowed)[sv]
                         w = self._nee_weight(ls.pdf[sv], bsdf_pdf, delta[sv])
                         contrib = (b_live[sv] * f[sv] * np.abs(wi_local[sv, 2:3])
                                    * ls.radiance[sv] * trans[vis] * (w / ls.pdf[sv])[:, None])
                         add(rows[sv], contrib, depth, direct=depth == 0)
 
+            bsdf.as_cycles = True
             # 3. continue by BSDF sampling
             u_lobe = sampler.get_1d(D.bounce_dim(depth, D.BSDF_LOBE), px_l, ix_l)
             u_dir = sampler.get_2d(D.bounce_dim(depth, D.BSDF_DIR), px_l, ix_l)
