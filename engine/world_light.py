@@ -97,6 +97,8 @@ def world_model(world):
     if texture is not None:
         model = EnvironmentMapLightModel(EnvironmentMap(texture, world.strength, world.mapping),
                                          seen_by)
-        model.light_sampling = bool(getattr(world, "light_sampling", True))
-        return model
-    return EnvironmentLightModel(getattr(world, "color", world), seen_by)
+    else:
+        model = EnvironmentLightModel(getattr(world, "color", world), seen_by)
+    # World > Settings > Sampling Method None: not sampled as a light (engine.lights)
+    model.light_sampling = bool(getattr(world, "light_sampling", True))
+    return model

@@ -249,5 +249,8 @@ def test_sampling_method_none_keeps_the_world_from_being_a_light(bpy_drt):
     assert lights.env_index is not None and not lights.uniform_world([lights.env_index])[0]
     assert LightSet([], 10.0, world=unlit).env_index is None
     assert LightSet([], 10.0, world=unlit).world is not None       # still seen by rays
-    uniform = LightSet([], 10.0, world=_export(_world(bpy_drt, "uniform")[0])[0])
+    plain, _ = _world(bpy_drt, "uniform")
+    uniform = LightSet([], 10.0, world=_export(plain)[0])
     assert uniform.env_index is not None and uniform.uniform_world([uniform.env_index])[0]
+    plain.cycles.sampling_method = "NONE"
+    assert LightSet([], 10.0, world=_export(plain)[0]).env_index is None
