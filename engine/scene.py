@@ -42,7 +42,9 @@ class Material:
     single-scattering lobe loses, engine/bsdf/multiscatter.py) or 'BLINN_PHONG' (the
     lecture's normalised Blinn-Phong lobe in the specular and metal lobes, with the
     exponent n = 2 / alpha^2 - 2 that matches GGX's alpha, Walter et al. 2007; glass
-    stays single-scattering GGX).
+    stays single-scattering GGX) or 'BECKMANN' (the Beckmann distribution in the
+    specular, metal and glass lobes, never compensated, as Cycles' Glossy, Glass and
+    Refraction BSDF nodes offer it; compiled path tracer only).
 
     Layers and lobes beyond the base (compiled path tracer only; Cycles' meanings):
       coat_*      Principled's Coat: a GGX dielectric reflection (IOR coat_ior, alpha

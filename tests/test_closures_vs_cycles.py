@@ -13,22 +13,22 @@ a control, DRT rendering it without the feature (as it did before), which must f
   * translucent: a leaf-green plane, Mix(Diffuse, Translucent), lit by an area lamp from
     behind (the camera sees only transmitted light and the dim world); control: the
     Translucent BSDF replaced by a Diffuse one.
-  * refraction: a large Refraction BSDF sphere (IOR 1.45, roughness 0) before a striped
-    wall, lit by a white sky (strength 1) alone, Filter Glossy 0 in both engines
-    (with 1, DRT is -2.06 % off, its Glass BSDF +0.26 %: Blender's default distribution
-    for the Refraction BSDF is Beckmann, which DRT renders as GGX (warned), and Filter
-    Glossy widens the smooth sphere into a rough lobe; at roughness 0.3 DRT is -2.18 %
-    off with Filter Glossy 0; with the node set to GGX in both engines -0.03 % at
-    roughness 0.3 and +0.02 % smooth with Filter Glossy 1); control: a Glass BSDF (what
-    DRT rendered it as before). Under an area lamp instead, DRT is -2.1 % off Cycles for
-    this sphere and -2.2 % for a Glass BSDF sphere alike (the known lamp-caustics
-    difference of docs/comparisons.md, glass_caustics), so the sky isolates the lobe.
+  * refraction: a large smooth Refraction BSDF sphere (IOR 1.45) before a striped wall,
+    lit by a white sky (strength 1) alone, at Blender's defaults: Filter Glossy 1 widens
+    it after blurry bounces into a rough lobe of the node's default distribution,
+    Beckmann (rendered as GGX before: -2.06 %, worst block 7.4 %); control: a Glass BSDF
+    (what DRT rendered it as before that).
+  * beckmann: rough Refraction (roughness 0.3, its default distribution), Glass (0.3)
+    and Glossy (0.4) BSDF spheres with Beckmann in the same room; control: the three
+    with GGX, what DRT rendered Beckmann as before (the Refraction sphere alone was
+    -2.18 % then).
 
 Measured (DRT vs Cycles: mean per channel, worst block; control the same):
   coat         -0.04 %, 0.32 %;  control +1.2 / -2.2 / -2.4 %, 25 %
   sheen        +0.05 %, 0.63 %;  control -2.5 / -2.5 / -2.1 %, 18 %
   translucent  -0.00 %, 0.06 %;  control -80 / -88 / -71 %, 165 %
-  refraction   +0.02 %, 0.46 %;  control +1.5 / +1.5 / +1.7 %, 13 %
+  refraction   -0.00 %, 0.43 %;  control +0.26 / +0.27 / +0.52 %, 13 %
+  beckmann     -0.00 / +0.05 / +0.15 %, 1.22 %;  control -3.7 / -3.6 / -3.2 %, 8.8 %
 """
 from __future__ import annotations
 
@@ -171,33 +171,60 @@ def translucent_scene(bpy, control=False):
     return scene
 
 
-def refraction_scene(bpy, control=False):
+def _striped_room(bpy, sky=1.0):
+    """A grey floor and a striped wall behind where the spheres go, lit by a white sky
+    alone: DRT's lamp caustics through glass differ a little from Cycles'
+    (docs/comparisons.md, glass_caustics), which is not what these scenes are about."""
     scene = _fresh(bpy)
-    # lit by the sky alone: DRT's lamp caustics through glass differ from Cycles' by
-    # about -2 % here, for the Glass BSDF as much as for this one (docs/comparisons.md,
-    # glass_caustics), which is not what this test is about
-    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
-    # Filter Glossy off in both engines (DRT reads it): with Cycles' default 1 DRT is
-    # -2.0 % (blocks -5 %) here while its Glass BSDF matches Cycles' (+0.03 %): the
-    # refraction-only lobe widened after diffuse bounces still differs (left open)
-    scene.cycles.blur_glossy = 0.0
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = sky
     _camera(scene, bpy, (0.0, -4.0, 1.0), (85.0, 0.0, 0.0))
     _plane(scene, bpy, 12.0, mat=grey(bpy))
-    for k in range(6):                     # a striped wall behind the sphere
+    for k in range(6):
         colour = (0.8, 0.7, 0.1, 1.0) if k % 2 else (0.1, 0.2, 0.7, 1.0)
         _plane(scene, bpy, 1.0, location=(-2.5 + k, 2.0, 1.0), rotation_deg=(90.0, 0.0, 0.0),
                mat=_principled(bpy, f"Stripe{k}", **{"Base Color": colour}))
-    mat, nodes, links, out = _material(bpy, "Refraction")
-    node = nodes.new("ShaderNodeBsdfGlass" if control else "ShaderNodeBsdfRefraction")
-    node.inputs["IOR"].default_value = 1.45
-    node.inputs["Roughness"].default_value = 0.0
+    return scene
+
+
+def _bsdf(bpy, name, kind, **inputs):
+    mat, nodes, links, out = _material(bpy, name)
+    node = nodes.new(kind)
+    for key, value in inputs.items():
+        if key == "distribution":
+            node.distribution = value
+        else:
+            node.inputs[key].default_value = value
     links.new(node.outputs[0], out.inputs["Surface"])
+    return mat, node
+
+
+def refraction_scene(bpy, control=False):
+    """A smooth Refraction BSDF sphere at Blender's defaults: Filter Glossy 1 widens it
+    after blurry bounces into a rough lobe of the node's default distribution, Beckmann."""
+    scene = _striped_room(bpy)
+    mat, node = _bsdf(bpy, "Refraction", "ShaderNodeBsdfGlass" if control
+                      else "ShaderNodeBsdfRefraction", IOR=1.45, Roughness=0.0)
+    assert control or node.distribution == "BECKMANN"          # Blender's default
     _sphere(bpy, (0.0, 0.0, 1.0), 0.9, mat)
     return scene
 
 
+def beckmann_scene(bpy, control=False):
+    """Rough Refraction (its default distribution), Glass and Glossy BSDF spheres with
+    Beckmann; control: the three with GGX (what DRT rendered Beckmann as before)."""
+    scene = _striped_room(bpy)
+    dist = "GGX" if control else "BECKMANN"
+    for k, (kind, inputs) in enumerate((
+            ("ShaderNodeBsdfRefraction", dict(IOR=1.45, Roughness=0.3)),
+            ("ShaderNodeBsdfGlass", dict(IOR=1.45, Roughness=0.3)),
+            ("ShaderNodeBsdfGlossy", dict(Roughness=0.4, Color=(0.9, 0.8, 0.6, 1.0))))):
+        mat, node = _bsdf(bpy, f"Beckmann{k}", kind, distribution=dist, **inputs)
+        _sphere(bpy, (-1.3 + 1.3 * k, 0.0, 0.75), 0.6, mat)
+    return scene
+
+
 SCENES = {"coat": coat_scene, "sheen": sheen_scene, "translucent": translucent_scene,
-          "refraction": refraction_scene}
+          "refraction": refraction_scene, "beckmann": beckmann_scene}
 
 
 def render(bpy, name, engine, control=False):

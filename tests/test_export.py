@@ -331,21 +331,49 @@ def test_no_camera_gives_a_clear_error(bpy_drt):
         bpy.ops.render.render()
 
 
-def test_unsupported_shader_node_renders_with_a_warning(bpy_drt):
-    bpy = bpy_drt
-    build_scene(bpy)
-    mat = bpy.data.materials.new("Toony")
+def _plain_gets(bpy, name, kind):
+    """Give the object 'Plain' a new material of one BSDF node of type `kind` (returned)."""
+    mat = bpy.data.materials.new(name)
     if bpy.app.version < (5, 0, 0):
         mat.use_nodes = True
     nodes = mat.node_tree.nodes
     nodes.remove(nodes["Principled BSDF"])
-    toon = nodes.new("ShaderNodeBsdfToon")
-    mat.node_tree.links.new(toon.outputs[0], nodes["Material Output"].inputs["Surface"])
+    node = nodes.new(kind)
+    mat.node_tree.links.new(node.outputs[0], nodes["Material Output"].inputs["Surface"])
     bpy.data.objects["Plain"].data.materials[0] = mat
+    return node
+
+
+def test_unsupported_shader_node_renders_with_a_warning(bpy_drt):
+    bpy = bpy_drt
+    build_scene(bpy)
+    _plain_gets(bpy, "Toony", "ShaderNodeBsdfToon")
     last = _render_drt(bpy)
     assert last["ok"], last["error"]
     assert any("Toony" in w and "Toon" in w for w in last["warnings"]), last["warnings"]
     assert np.isfinite(last["pixels"]).all()
+
+
+def test_reference_integrators_name_what_they_leave_out(bpy_drt):
+    """The distribution and whitted integrators (NumPy reference) do not render coat,
+    sheen, translucency, refraction-only glass or Beckmann: a scene using them says so
+    when one of those integrators is chosen, and the path integrator (which renders
+    them) does not."""
+    bpy = bpy_drt
+    build_scene(bpy)
+    _plain_gets(bpy, "Frosted", "ShaderNodeBsdfRefraction").inputs["Roughness"].default_value = 0.3
+    from drt_addon.export import Reporter, export_scene
+    said = {}
+    for integrator in ("path", "distribution", "whitted"):
+        bpy.context.scene.drt.integrator = integrator
+        reporter = Reporter()
+        export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
+        said[integrator] = [w for w in reporter.warnings if "integrator leaves out" in w]
+    assert said["path"] == []
+    for integrator in ("distribution", "whitted"):
+        assert len(said[integrator]) == 1 and integrator in said[integrator][0]
+        assert "Beckmann" in said[integrator][0] and "Refraction BSDF" in said[integrator][0]
+    bpy.context.scene.drt.integrator = "path"
 
 
 # --------------------------------------------------------------------------- camera

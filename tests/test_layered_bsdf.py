@@ -58,7 +58,7 @@ def wo_at(deg, n):
     return np.tile([np.sin(t), 0.0, np.cos(t)], (n, 1))
 
 
-def sampler_pairs(params, wo, w):
+def sampler_pairs(params, wo, w, front=True):
     """1 where the sampler can produce w from wo, else 0: the kernels evaluate refraction
     as Cycles does, also at pairs whose generalised half vector h ~ wo + eta w (eta the
     IOR on w's side over wo's) is not a microfacet normal that refracts one into the
@@ -67,6 +67,7 @@ def sampler_pairs(params, wo, w):
     if not params.get("transmission"):
         return np.ones(len(w))
     ior = Material(name="m", **params).ior
+    ior = ior if front else 1.0 / ior              # the IOR beyond wo's side (front: 1)
     eta = np.where(wo[:, 2] > 0, ior, 1.0 / ior)
     h = wo + eta[:, None] * w
     h *= np.where(h[:, 2] < 0, -1.0, 1.0)[:, None]
@@ -76,24 +77,29 @@ def sampler_pairs(params, wo, w):
 
 
 def case(name, deg, pdf_name=None):
-    params = MATERIALS[name]
-    pdf_params = MATERIALS[pdf_name or name]
+    return case_of(MATERIALS[name], deg, MATERIALS[pdf_name or name])
+
+
+def case_of(params, deg, pdf_params=None, front=True):
+    """(sample, pdf) of the chi-square test for the material `params` seen from `deg`
+    (front: from outside), the pdf that of `pdf_params` (default: the same)."""
+    pdf_params = pdf_params or params
     tables = kb.kernel_tables()
     allowed = np.ones((1, 3), bool)
 
     def sample(u):
         n = len(u)
         wi, _, _, _, delta, valid = batch.sample_batch(
-            rows_of(params, n), np.ones(n, bool), wo_at(deg, n), u[:, 0],
+            rows_of(params, n), np.full(n, front), wo_at(deg, n), u[:, 0],
             np.ascontiguousarray(u[:, 1:]), np.repeat(allowed, n, 0), tables)
         assert not delta.any()
         return wi, valid
 
     def pdf(w):
         n = len(w)
-        return batch.pdf_batch(rows_of(pdf_params, n), np.ones(n, bool), wo_at(deg, n),
+        return batch.pdf_batch(rows_of(pdf_params, n), np.full(n, front), wo_at(deg, n),
                                np.ascontiguousarray(w), np.repeat(allowed, n, 0), tables
-                               ) * sampler_pairs(pdf_params, wo_at(deg, n), w)
+                               ) * sampler_pairs(pdf_params, wo_at(deg, n), w, front)
     return sample, pdf
 
 

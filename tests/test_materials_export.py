@@ -288,8 +288,8 @@ def test_glossy_and_glass_export_to_the_right_lobes(bpy_drt):
 
 def test_microfacet_distribution_is_exported(bpy_drt):
     """Each node's distribution reaches Material.glossy_model: Multiscatter GGX (Blender's
-    default for Principled, Glossy and Glass) and GGX as they are, Beckmann as GGX
-    (reported); a Mix takes the distribution of its glossiest closure."""
+    default for Principled, Glossy and Glass), GGX and Beckmann (the Refraction BSDF's
+    default) as they are, Ashikhmin-Shirley as GGX (reported); a Mix takes the distribution of its glossiest closure."""
     bpy = bpy_drt
     _reset(bpy)
     for kind in ("ShaderNodeBsdfPrincipled", "ShaderNodeBsdfGlossy", "ShaderNodeBsdfGlass"):
@@ -303,8 +303,18 @@ def test_microfacet_distribution_is_exported(bpy_drt):
         if kind != "ShaderNodeBsdfPrincipled":
             node.distribution = "BECKMANN"
             m, w = _export(mat)
-            assert m.glossy_model == "GGX", kind
-            assert len(w) == 1 and "BECKMANN" in w[0] and "GGX" in w[0]
+            assert m.glossy_model == "BECKMANN" and w == [], kind
+    # the Refraction BSDF's default is Beckmann; Ashikhmin-Shirley is rendered as GGX
+    mat, nt, node = _single(bpy, "ShaderNodeBsdfRefraction")
+    node.inputs["Roughness"].default_value = 0.3
+    assert node.distribution == "BECKMANN"
+    m, w = _export(mat)
+    assert m.glossy_model == "BECKMANN" and m.refraction_only and w == []
+    mat, nt, node = _single(bpy, "ShaderNodeBsdfGlossy")
+    node.distribution = "ASHIKHMIN_SHIRLEY"
+    m, w = _export(mat)
+    assert m.glossy_model == "GGX"
+    assert len(w) == 1 and "ASHIKHMIN_SHIRLEY" in w[0] and "GGX" in w[0]
     # Diffuse + single-scatter Glossy: the glossy side decides, no report
     gloss = ("ShaderNodeBsdfGlossy", {"Color": (1, 1, 1, 1), "Roughness": 0.2})
     mat, nt, mix = _mix(bpy, "DG1", DIFFUSE, gloss, fac=0.25)

@@ -27,7 +27,7 @@ class _Comp:
     spec: float = 0.5
     metal_color: object = None      # None: the base colour (Principled)
     glass_color: object = None      # None: sqrt(base colour) per crossing (Principled)
-    distribution: str = "MULTI_GGX"  # 'MULTI_GGX' or 'GGX' (engine glossy_model)
+    distribution: str = "MULTI_GGX"  # 'MULTI_GGX', 'GGX' or 'BECKMANN' (glossy_model)
     layers: object = None           # a _Layers: coat, sheen, translucency (None: none)
     refraction_only: bool = False   # the glass lobe does not reflect (Refraction BSDF)
 

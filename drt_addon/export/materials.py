@@ -23,15 +23,16 @@ Glossy BSDF
     GGX reflection of its colour with its roughness: DRT's metal lobe with F0 = colour.
     Cycles' Glossy has no Fresnel (reflectance = colour at every angle); Schlick's F0
     lobe reaches white only at grazing angles, so edges are a little brighter here.
-    Multiscatter GGX (the default) and GGX are kept (Cycles' multiscatter Glossy colours
-    its extra bounces by the colour itself, DRT's by Schlick's average of it); Beckmann
-    and Ashikhmin-Shirley are rendered as GGX (reported).
+    Multiscatter GGX (the default), GGX and Beckmann are kept (Cycles' multiscatter
+    Glossy colours its extra bounces by the colour itself, DRT's by Schlick's average of
+    it); Ashikhmin-Shirley is rendered as GGX (reported).
 Glass BSDF
-    DRT's glass lobe with the node's IOR, roughness and distribution (Multiscatter GGX
-    or GGX; Beckmann is rendered as GGX, reported); its colour tints each refraction
+    DRT's glass lobe with the node's IOR, roughness and distribution (Multiscatter GGX,
+    GGX or Beckmann); its colour tints each refraction
     (`Material.glass_color`), as Cycles' Glass does (Cycles also tints the reflection).
 Refraction BSDF
-    Approximated by the glass lobe (which also reflects): reported.
+    The glass lobe's refraction alone, without Fresnel (`Material.refraction_only`), with
+    the node's distribution (Beckmann, its default, or GGX).
 Emission
     Radiance = colour x strength (no 1/pi); alone it is an opaque black emitter, as in
     Cycles (an Emission shader has no BSDF).

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 # The microfacet models of `Material.glossy_model`
-GLOSSY_MODELS = ("GGX", "MULTI_GGX", "BLINN_PHONG")
+GLOSSY_MODELS = ("GGX", "MULTI_GGX", "BLINN_PHONG", "BECKMANN")
 
 
 def flatten_mixes(materials):
@@ -23,6 +23,18 @@ def flatten_mixes(materials):
             children.append((-1, -1))
         i += 1
     return out, np.array(children, np.int64).reshape(-1, 2)
+
+
+def reference_gaps(materials) -> list[str]:
+    """What of these materials (Mix Shader sides included) the NumPy reference
+    integrators (distribution, whitted) do not render, which the compiled path tracer
+    does: an empty list when they render everything."""
+    table = MaterialTable(materials)
+    gaps = [(table.coat_weight > 1e-5, "coat"), (table.sheen_weight > 1e-5, "sheen"),
+            (table.translucent_color.max(1) > 0.0, "translucency"),
+            (table.refraction_only, "the Refraction BSDF (rendered as glass)"),
+            (table.beckmann, "the Beckmann distribution (rendered as GGX)")]
+    return [what for used, what in gaps if used.any()]
 
 
 class MaterialTable:
@@ -59,6 +71,7 @@ class MaterialTable:
                                  f"{', '.join(map(repr, GLOSSY_MODELS))}, not {model!r}")
         self.blinn_phong = np.array([model == "BLINN_PHONG" for model in models], bool)
         self.multiscatter = np.array([model == "MULTI_GGX" for model in models], bool)
+        self.beckmann = np.array([model == "BECKMANN" for model in models], bool)
         # Lobe colours: the metal F0 and the glass tint per crossing, when they are not
         # Principled's own (base colour, sqrt(base colour)).
         metal = [getattr(m, "metal_color", None) for m in materials]

@@ -172,7 +172,7 @@ def _diffuse(node, ctx) -> _Closure:
 def _distribution(node, ctx) -> str:
     """The engine glossy_model of a node's microfacet distribution."""
     d = getattr(node, "distribution", "MULTI_GGX")
-    if d in ("MULTI_GGX", "GGX"):
+    if d in ("MULTI_GGX", "GGX", "BECKMANN"):
         return d
     ctx.issue(f"{node.name!r} uses the {d} distribution; DRT uses GGX")
     return "GGX"
@@ -193,10 +193,9 @@ def _glossy(node, ctx) -> _Closure:
 def _glass(node, ctx, refraction=False) -> _Closure:
     """Glass BSDF, or with `refraction` the Refraction BSDF (its refraction alone)."""
     _normal(node, ctx)
-    smooth = _link(node.inputs["Roughness"]) is None and \
-        float(node.inputs["Roughness"].default_value) == 0.0
-    # a smooth interface has no microfacet distribution to report
-    distribution = "GGX" if refraction and smooth else _distribution(node, ctx)
+    # also for a smooth interface: Filter Glossy widens it into a rough lobe of this
+    # distribution after blurry bounces
+    distribution = _distribution(node, ctx)
     color = _input(node, "Color", ctx, True, WHITE)
     if _is_tex(color):
         ctx.issue(f"the colour of {node.name!r} is textured; DRT tints its refraction "

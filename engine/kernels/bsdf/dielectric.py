@@ -6,13 +6,15 @@ mirrored to the upper side ("canonical") with relative index 1/eta, and the resu
 mirrored back, as in the NumPy module (see there for the sources, the radiance scaling
 1/eta^2 of refraction and the allow flags of the reflect/refract choice). Refraction is
 evaluated as Cycles does, also on pairs the sampler never produces (the NumPy module's
-`as_cycles=True`, its default; see its note), unless `walter` is set.
+`as_cycles=True`, its default; see its note), unless `walter` is set. The rough functions
+take a `beckmann` flag: the Beckmann distribution (beckmann.py) instead of GGX.
 """
 from __future__ import annotations
 
 import math
 
 from ..jit import kernel
+from . import beckmann as bk
 from . import fresnel
 from . import microfacet as mf
 
@@ -106,11 +108,11 @@ def refraction_half(ox, oy, oz, ix, iy, iz, eta_rel):
 @kernel
 def rough_eval(ox, oy, oz, ix, iy, iz, eta, alpha):
     """(f_reflect, f_refract) in 1/sr; one of them is zero for each pair."""
-    return rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, False, False)
+    return rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, False, False, False)
 
 
 @kernel
-def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter):
+def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter, beckmann):
     """`rough_eval`, or with `refract_only` Cycles' Refraction BSDF: no reflection and
     the refraction without its Fresnel factor 1 - F (zero under total internal
     reflection). `walter`: refraction on Walter's pairs only (the NumPy module's
@@ -120,7 +122,7 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter):
     oz = oz * sign
     iz = iz * sign
     if iz > 0.0:
-        base_r, hx, hy, hz = mf.reflection_eval(ox, oy, oz, ix, iy, iz, a)
+        base_r, hx, hy, hz = mf.reflection_eval_of(ox, oy, oz, ix, iy, iz, a, beckmann)
         if base_r == 0.0 or refract_only:
             return 0.0, 0.0
         F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
@@ -134,10 +136,15 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter):
     F_t = fresnel.dielectric(cos_oh, eta_rel)
     if refract_only:
         F_t = 1.0 if F_t >= 1.0 else 0.0
+    den = s * s
+    if beckmann:
+        g2c = bk.G2_over_cos2(ox, oy, oz, ix, iy, iz, a)
+        if not (g2c > 0.0 and den > 0.0):
+            return 0.0, 0.0
+        return 0.0, bk.D(hx, hy, hz, a) * (1.0 - F_t) * (-cos_ih) * cos_oh * g2c / den
     a2 = a * a
     zo, zi = oz, -iz
     g_den = zi * mf.r_len(ox, oy, oz, a2) + zo * mf.r_len(ix, iy, iz, a2)
-    den = s * s
     if not (g_den > 0.0 and den > 0.0):
         return 0.0, 0.0
     val = (2.0 * mf.D(hx, hy, hz, a) * (1.0 - F_t) * (-cos_ih) * cos_oh
@@ -146,14 +153,15 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter):
 
 
 @kernel
-def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, walter):
+def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, walter,
+              beckmann):
     """pdf over wi (1/sr) of `rough_sample` with the same allow flags, also on Cycles'
     pairs unless `walter` (see rough_eval_lobes)."""
     a = mf.clamp_alpha(alpha)
     sign, eta_rel = canonical(oz, eta)
     oz = oz * sign
     iz = iz * sign
-    g1c = mf.G1_over_cos(ox, oy, oz, a)
+    g1c = mf.G1_over_cos_of(ox, oy, oz, a, beckmann)
     if iz > 0.0:
         # reflection: P(reflect | h) D_wo(h) / (4 wo.h)
         hx, hy, hz, ok = mf.half_vector(ox, oy, oz, ix, iy, iz)
@@ -161,7 +169,7 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, 
             return 0.0
         F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
         pr, _ = choice_probs(F_r, allow_reflect, allow_refract)
-        return pr * 0.25 * g1c * mf.D(hx, hy, hz, a)
+        return pr * 0.25 * g1c * mf.D_of(hx, hy, hz, a, beckmann)
     # refraction: P(refract | h) D_wo(h) |dh/dwi|
     hx, hy, hz, cos_oh, cos_ih, ok = refraction_half(ox, oy, oz, ix, iy, iz, eta_rel)
     if not (oz > 0.0 and hz > 0.0) or (walter and not ok):
@@ -174,18 +182,19 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, 
     if not den > 0.0:
         return 0.0
     jac = eta_rel * eta_rel * (-cos_ih) / den
-    return pt * g1c * cos_oh * mf.D(hx, hy, hz, a) * jac
+    return pt * g1c * cos_oh * mf.D_of(hx, hy, hz, a, beckmann) * jac
 
 
 @kernel
-def rough_sample(ox, oy, oz, eta, alpha, u_choice, u0, u1, allow_reflect, allow_refract):
+def rough_sample(ox, oy, oz, eta, alpha, u_choice, u0, u1, allow_reflect, allow_refract,
+                 beckmann):
     """Sample the rough interface: u_choice picks reflection or refraction, (u0, u1) the
     visible normal. Returns (wi_x, wi_y, wi_z, refracted, valid); the weight and pdf of
     the choice are left to the caller (the Principled mixture recomputes both)."""
     a = mf.clamp_alpha(alpha)
     sign, eta_rel = canonical(oz, eta)
     oz = oz * sign
-    hx, hy, hz = mf.sample_visible_normal(ox, oy, oz, a, u0, u1)
+    hx, hy, hz = mf.sample_visible_normal_of(ox, oy, oz, a, u0, u1, beckmann)
     cos_oh = mf.dot(ox, oy, oz, hx, hy, hz)
     F, cos_t, eta_t = fresnel.dielectric_full(max(cos_oh, 0.0), eta_rel)
     pr, pt = choice_probs(F, allow_reflect, allow_refract)
@@ -207,8 +216,8 @@ def rough_sample(ox, oy, oz, eta, alpha, u_choice, u0, u1, allow_reflect, allow_
     else:
         ok = ok and iz > 0.0
     # the pdf of the choice made must be positive
-    g1c = mf.G1_over_cos(ox, oy, oz, a)
-    d = mf.D(hx, hy, hz, a)
+    g1c = mf.G1_over_cos_of(ox, oy, oz, a, beckmann)
+    d = mf.D_of(hx, hy, hz, a, beckmann)
     if refr:
         cos_ih = mf.dot(ix, iy, iz, hx, hy, hz)
         s = cos_oh + eta_t * cos_ih

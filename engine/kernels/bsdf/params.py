@@ -20,7 +20,7 @@ P_METAL_COLOR = 8        # 3 columns: the metal lobe's F0 when P_HAS_METAL_COLOR
 P_HAS_METAL_COLOR = 11   # 0 / 1
 P_GLASS_COLOR = 12       # 3 columns: the refraction tint when P_HAS_GLASS_COLOR is 1
 P_HAS_GLASS_COLOR = 15   # 0 / 1
-P_GLOSSY_MODEL = 16      # GLOSSY_GGX, GLOSSY_BLINN_PHONG or GLOSSY_MULTI_GGX
+P_GLOSSY_MODEL = 16      # GLOSSY_GGX, GLOSSY_BLINN_PHONG, GLOSSY_MULTI_GGX or GLOSSY_BECKMANN
 P_FILTER_ALPHA = 17      # per hit, 0 in the material rows: Filter Glossy's smallest GGX
 #                          alpha for the microfacet lobes (see principled.setup)
 # The lobes beyond Principled's base (layers.py): read only where P_LAYERS is 1
@@ -42,6 +42,7 @@ NPARAM = 36
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
 GLOSSY_MULTI_GGX = 2     # GGX with Cycles' multiple-scattering compensation
+GLOSSY_BECKMANN = 3      # Beckmann (beckmann.py), never compensated, as in Cycles
 
 
 def pack_materials(table) -> np.ndarray:
@@ -59,9 +60,9 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_HAS_METAL_COLOR] = table.has_metal_color
     rows[:, P_GLASS_COLOR:P_GLASS_COLOR + 3] = table.glass_color
     rows[:, P_HAS_GLASS_COLOR] = table.has_glass_color
-    rows[:, P_GLOSSY_MODEL] = np.where(table.blinn_phong, GLOSSY_BLINN_PHONG,
-                                       np.where(table.multiscatter, GLOSSY_MULTI_GGX,
-                                                GLOSSY_GGX))
+    rows[:, P_GLOSSY_MODEL] = np.select(
+        [table.blinn_phong, table.multiscatter, table.beckmann],
+        [GLOSSY_BLINN_PHONG, GLOSSY_MULTI_GGX, GLOSSY_BECKMANN], GLOSSY_GGX)
     rows[:, P_COAT_WEIGHT] = table.coat_weight
     rows[:, P_COAT_ROUGHNESS] = table.coat_roughness
     rows[:, P_COAT_IOR] = table.coat_ior

@@ -30,11 +30,11 @@ from . import microfacet as mf
 from . import multiscatter as ms
 from .albedo import specular_albedo
 from .compensation import compensate
-from .state import (NSTATE, S_ALPHA, S_BLINN, S_DIFFUSE, S_EST, S_ETA_GLASS,  # noqa: F401
+from .state import (NSTATE, S_ALPHA, S_BECKMANN, S_BLINN, S_DIFFUSE, S_EST, S_ETA_GLASS,  # noqa: F401
                     S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH, S_LAYERED, S_METAL_F0, S_MS_E,
                     S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY, S_TINT, S_W_GLASS,
                     S_W_METAL, S_W_SPEC, S_WALTER)
-from .params import (GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
+from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
                      NPARAM, P_BASE,
                      P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
                      P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR, P_LAYERS, P_METAL_COLOR,
@@ -74,6 +74,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     lobe_alpha = mf.clamp_alpha(max(alpha, row[P_FILTER_ALPHA]))
     state[S_ALPHA] = lobe_alpha
     state[S_BLINN] = 1.0 if row[P_GLOSSY_MODEL] == GLOSSY_BLINN_PHONG else 0.0
+    state[S_BECKMANN] = 1.0 if row[P_GLOSSY_MODEL] == GLOSSY_BECKMANN else 0.0
     state[S_EXPONENT] = max(2.0 / (lobe_alpha * lobe_alpha) - 2.0, 0.0)
     base_w = (1.0 - m) * (1.0 - t)
     # specular layer: F0 scaled by 2 * level, IOR recomputed from it
@@ -185,25 +186,28 @@ def selection(state, allow_d, allow_g, allow_t):
 
 @kernel
 def reflection_eval(state, ox, oy, oz, ix, iy, iz):
-    """D G / (4 cos cos) of the reflection lobes (GGX or Blinn-Phong) and h."""
+    """D G / (4 cos cos) of the reflection lobes (GGX, Beckmann or Blinn-Phong) and h."""
     if state[S_BLINN] != 0.0:
         hx, hy, hz, _ = mf.half_vector(ox, oy, oz, ix, iy, iz)
         return blinn_phong.eval_f(ox, oy, oz, ix, iy, iz, state[S_EXPONENT]), hx, hy, hz
-    return mf.reflection_eval(ox, oy, oz, ix, iy, iz, state[S_ALPHA])
+    return mf.reflection_eval_of(ox, oy, oz, ix, iy, iz, state[S_ALPHA],
+                                 state[S_BECKMANN] != 0.0)
 
 
 @kernel
 def reflection_pdf(state, ox, oy, oz, ix, iy, iz):
     if state[S_BLINN] != 0.0:
         return blinn_phong.pdf(ox, oy, oz, ix, iy, iz, state[S_EXPONENT])
-    return mf.reflection_pdf(ox, oy, oz, ix, iy, iz, state[S_ALPHA])
+    return mf.reflection_pdf_of(ox, oy, oz, ix, iy, iz, state[S_ALPHA],
+                                state[S_BECKMANN] != 0.0)
 
 
 @kernel
 def reflection_sample(state, ox, oy, oz, u1, u2):
     if state[S_BLINN] != 0.0:
         return blinn_phong.sample(ox, oy, oz, u1, u2, state[S_EXPONENT])
-    return mf.reflection_sample(ox, oy, oz, state[S_ALPHA], u1, u2)
+    return mf.reflection_sample_of(ox, oy, oz, state[S_ALPHA], u1, u2,
+                                   state[S_BECKMANN] != 0.0)
 
 
 @kernel
@@ -257,7 +261,8 @@ def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
         f_r, f_t = dielectric.rough_eval_lobes(wox, woy, woz, wix, wiy, wiz,
                                                state[S_ETA_GLASS], state[S_ALPHA],
                                                state[S_REFRACT_ONLY] != 0.0,
-                                               state[S_WALTER] != 0.0)
+                                               state[S_WALTER] != 0.0,
+                                               state[S_BECKMANN] != 0.0)
         fr += (f_r + f_t * state[S_TINT]) * w_glass * state[S_MS_GLASS]
         fg += (f_r + f_t * state[S_TINT + 1]) * w_glass * state[S_MS_GLASS + 1]
         fb += (f_r + f_t * state[S_TINT + 2]) * w_glass * state[S_MS_GLASS + 2]
@@ -283,7 +288,8 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
     if q3 > 0.0 and state[S_GLASS_SMOOTH] == 0.0:
         p += q3 * dielectric.rough_pdf(wox, woy, woz, wix, wiy, wiz, state[S_ETA_GLASS],
                                        state[S_ALPHA], allow_g and state[S_REFRACT_ONLY] == 0.0,
-                                       allow_t, state[S_WALTER] != 0.0)
+                                       allow_t, state[S_WALTER] != 0.0,
+                                       state[S_BECKMANN] != 0.0)
     if qc > 0.0 or qs > 0.0 or qt > 0.0:
         p += layers.mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt)
     return p
@@ -366,7 +372,7 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     else:
         wix, wiy, wiz, refr, ok = dielectric.rough_sample(
             wox, woy, woz, state[S_ETA_GLASS], state[S_ALPHA], u_re, u1, u2,
-            allow_g and state[S_REFRACT_ONLY] == 0.0, allow_t)
+            allow_g and state[S_REFRACT_ONLY] == 0.0, allow_t, state[S_BECKMANN] != 0.0)
         kind = TRANSMISSION if refr else GLOSSY
     if not ok:
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False

@@ -22,4 +22,5 @@ S_MS_E = 30          # GGX's E(wo) behind the factors (1: none)
 S_REFRACT_ONLY = 31  # 1: the glass lobe refracts only (Refraction BSDF)
 S_LAYERED = 32       # 1: the lobes of layers.py are in use (their slots follow)
 S_WALTER = layers.NSTATE  # 1: refraction on Walter's pairs only, not Cycles' (dielectric.py)
-NSTATE = layers.NSTATE + 1
+S_BECKMANN = layers.NSTATE + 1  # 1: the microfacet lobes use Beckmann instead of GGX
+NSTATE = layers.NSTATE + 2
