@@ -33,6 +33,9 @@ class Material:
 
     Lobe colours (None = Principled's own rule from `base_color`):
       metal_color  the F0 of the metallic lobe (a Glossy BSDF's colour);
+      metal_fresnel  'SCHLICK' (Principled's metal: Schlick's Fresnel from F0) or
+                   'CONSTANT' (a Glossy BSDF: F0 at every angle, as Cycles' Glossy has no
+                   Fresnel term; compiled path tracer only);
       glass_color  the tint of each refraction through the glass lobe (Principled uses
                    sqrt(base colour); a Glass BSDF node its colour).
 
@@ -77,6 +80,7 @@ class Material:
     emission: tuple = (0.0, 0.0, 0.0)
     alpha: float = 1.0
     metal_color: Optional[tuple] = None
+    metal_fresnel: str = "SCHLICK"
     glass_color: Optional[tuple] = None
     transparent_color: tuple = (1.0, 1.0, 1.0)
     glossy_model: str = "GGX"

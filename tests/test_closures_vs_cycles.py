@@ -1,4 +1,5 @@
-"""Coat, sheen, translucency and the Refraction BSDF against Cycles: four small scenes
+"""Coat, sheen, translucency, the Refraction BSDF, Beckmann and the Glossy BSDF against
+Cycles: six small scenes
 (64 x 48 pixels) built here with bpy at Blender's defaults (bounces, Filter Glossy,
 Principled inputs not named), rendered by Cycles (1024 samples per pixel) and DRT (1024),
 each compared with `compare` of tests/test_multiscatter_vs_cycles.py: image means within
@@ -22,13 +23,18 @@ a control, DRT rendering it without the feature (as it did before), which must f
     and Glossy (0.4) BSDF spheres with Beckmann in the same room; control: the three
     with GGX, what DRT rendered Beckmann as before (the Refraction sphere alone was
     -2.18 % then).
+  * glossy: two dark Glossy BSDF spheres (Multiscatter GGX, roughness 0.2 and 0.5) in
+    the same room: Cycles' Glossy reflects its colour at every angle (no Fresnel term);
+    control: Principled metals of the same colours, Schlick's Fresnel, what DRT
+    rendered a Glossy BSDF as before (brighter towards grazing angles).
 
 Measured (DRT vs Cycles: mean per channel, worst block; control the same):
   coat         -0.04 %, 0.32 %;  control +1.2 / -2.2 / -2.4 %, 25 %
   sheen        +0.05 %, 0.63 %;  control -2.5 / -2.5 / -2.1 %, 18 %
   translucent  -0.00 %, 0.06 %;  control -80 / -88 / -71 %, 165 %
   refraction   -0.00 %, 0.43 %;  control +0.26 / +0.27 / +0.52 %, 13 %
-  beckmann     -0.00 / +0.05 / +0.15 %, 1.22 %;  control -3.7 / -3.6 / -3.2 %, 8.8 %
+  beckmann     -0.05 / -0.04 / -0.03 %, 0.48 %;  control -3.8 / -3.6 / -3.3 %, 9.3 %
+  glossy       -0.00 / +0.00 / +0.00 %, 0.37 %;  control +0.93 / +1.1 / +1.2 %, 6.7 %
 """
 from __future__ import annotations
 
@@ -223,8 +229,26 @@ def beckmann_scene(bpy, control=False):
     return scene
 
 
+def glossy_scene(bpy, control=False):
+    """Two dark Glossy BSDF spheres at Blender's defaults (Multiscatter GGX): Cycles'
+    Glossy has no Fresnel term, its colour is its reflectance at every angle; control:
+    Principled metals of the same colours (Schlick's Fresnel, which whitens towards
+    grazing angles: what DRT rendered a Glossy BSDF as before)."""
+    scene = _striped_room(bpy)
+    for k, (colour, rough) in enumerate((((0.15, 0.1, 0.05, 1.0), 0.2),
+                                          ((0.5, 0.25, 0.08, 1.0), 0.5))):
+        if control:
+            mat = _principled(bpy, f"Glossy{k}", **{"Base Color": colour, "Metallic": 1.0,
+                                                     "Roughness": rough})
+        else:
+            mat, _ = _bsdf(bpy, f"Glossy{k}", "ShaderNodeBsdfGlossy", Color=colour,
+                           Roughness=rough)
+        _sphere(bpy, (-0.7 + 1.4 * k, 0.0, 0.75), 0.65, mat)
+    return scene
+
+
 SCENES = {"coat": coat_scene, "sheen": sheen_scene, "translucent": translucent_scene,
-          "refraction": refraction_scene, "beckmann": beckmann_scene}
+          "refraction": refraction_scene, "beckmann": beckmann_scene, "glossy": glossy_scene}
 
 
 def render(bpy, name, engine, control=False):

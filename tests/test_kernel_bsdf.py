@@ -369,3 +369,35 @@ def test_negative_control_perturbed_roughness(case):
     assert (~close(got, c["ref"].pdf(c["wo"], c["wi"], c["allowed"]))).sum() > 100
     got = batch.eval_f_batch(c["rows"], ~c["front"], c["wo"], c["wi"], c["tables"])
     assert (~close(got, ref)).any(1).sum() > 100
+
+
+def test_glossy_bsdf_reflects_its_colour_at_every_angle():
+    """metal_fresnel 'CONSTANT' (a Glossy BSDF): f = colour x the white lobe's f at
+    every angle, as Cycles' Fresnel-less Glossy; 'SCHLICK' (Principled's metal) whitens
+    towards grazing angles, so the same colour there reflects more."""
+    colour = (0.1, 0.3, 0.6)
+    rng = np.random.default_rng(4)
+    n = 4000
+    cos_o = np.concatenate([rng.random(n - 1), [1e-3]])
+    wo = np.stack([np.sqrt(1 - cos_o ** 2), np.zeros(n), cos_o], -1)
+    wi = rng.normal(size=(n, 3))
+    wi[:, 2] = np.abs(wi[:, 2])
+    wi /= np.linalg.norm(wi, axis=1)[:, None]
+    tables = kb.kernel_tables()
+
+    def f(**params):
+        rows = kb.pack_materials(MaterialTable([Material(metallic=1.0, roughness=0.4,
+                                                         **params)]))[np.zeros(n, int)]
+        return batch.eval_f_batch(rows, np.ones(n, bool), wo, wi, tables)
+    white = f(base_color=(1.0, 1.0, 1.0), metal_fresnel="CONSTANT")
+    const = f(base_color=colour, metal_fresnel="CONSTANT")
+    schlick = f(base_color=colour)
+    assert (white[:, 0] > 0).mean() > 0.5
+    assert np.allclose(const, white * np.array(colour), rtol=1e-12, atol=0.0)
+    assert (schlick >= const * (1 - 1e-12)).all()
+    h = (wo + wi) / np.linalg.norm(wo + wi, axis=1)[:, None]
+    grazing = ((wo * h).sum(1) < 0.3) & (white[:, 0] > 0)       # wo far from the facet
+    assert grazing.sum() > 20
+    assert (schlick[grazing, 0] > 1.5 * const[grazing, 0]).all()
+    with pytest.raises(ValueError, match="metal_fresnel"):
+        MaterialTable([Material(metal_fresnel="F82")])

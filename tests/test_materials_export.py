@@ -297,6 +297,9 @@ def test_microfacet_distribution_is_exported(bpy_drt):
         assert node.distribution == "MULTI_GGX"                  # Blender's default
         m, w = _export(mat)
         assert m.glossy_model == "MULTI_GGX" and w == [], kind
+        # Cycles' Glossy reflects its colour at every angle; Principled's metal is Schlick's
+        assert m.metal_fresnel == ("CONSTANT" if kind == "ShaderNodeBsdfGlossy"
+                                   else "SCHLICK"), kind
         node.distribution = "GGX"
         m, w = _export(mat)
         assert m.glossy_model == "GGX" and w == [], kind

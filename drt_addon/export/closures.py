@@ -26,6 +26,7 @@ class _Comp:
     ior: float = 1.5
     spec: float = 0.5
     metal_color: object = None      # None: the base colour (Principled)
+    metal_fresnel: str = "SCHLICK"  # 'CONSTANT': a Glossy BSDF's (Material.metal_fresnel)
     glass_color: object = None      # None: sqrt(base colour) per crossing (Principled)
     distribution: str = "MULTI_GGX"  # 'MULTI_GGX', 'GGX' or 'BECKMANN' (glossy_model)
     layers: object = None           # a _Layers: coat, sheen, translucency (None: none)
@@ -197,6 +198,7 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
     if p["glass_color"] is not None:
         m.glass_color = tuple(_mean(p["glass_color"]))
     m.refraction_only = bool(p["refraction_only"])
+    m.metal_fresnel = p["metal_fresnel"]
     if p["layers"] is not None:
         for k in LAYER_FIELDS:
             v = getattr(p["layers"], k)
@@ -237,7 +239,8 @@ def _blend(comps, ctx) -> dict:
                     metal_color=None if c.metal_color is None or _same(c.metal_color, c.base)
                     else c.metal_color,
                     glass_color=c.glass_color, distribution=c.distribution,
-                    layers=c.layers, refraction_only=c.refraction_only)
+                    layers=c.layers, refraction_only=c.refraction_only,
+                    metal_fresnel=c.metal_fresnel)
     lw = [(c, comp, *comp.weights()) for c, comp in comps]
     Wm = sum(c * m for c, _, m, _, _ in lw)
     Wg = sum(c * g for c, _, _, g, _ in lw)
@@ -291,10 +294,18 @@ def _blend(comps, ctx) -> dict:
     if len({d for w, d in glossy if w > 0}) > 1:
         ctx.issue(f"closures with different microfacet distributions are mixed; DRT uses "
                   f"{distribution} for all")
+    # the metal lobe's Fresnel: that of the closure with the most metal weight
+    metal_fresnel = max(((c * m, comp.metal_fresnel) for c, comp, m, _, _ in lw),
+                        key=lambda x: x[0])[1]
+    if len({comp.metal_fresnel for c, comp, m, _, _ in lw if c * m > 0}) > 1:
+        ctx.issue(f"a Glossy BSDF and a Principled metal are mixed; DRT gives both the "
+                  f"{'Glossy' if metal_fresnel == 'CONSTANT' else 'Principled'} one's "
+                  f"Fresnel")
     refr = {comp.refraction_only for _, comp, _, g, _ in lw if g > 0}
     if len(refr) > 1:
         ctx.issue("a Refraction BSDF is mixed with a glass; DRT renders both as glass")
     return dict(base=base, metallic=metallic, transmission=float(np.clip(transmission, 0, 1)),
                 roughness=roughness, ior=ior, spec=spec, metal_color=metal_color,
                 glass_color=glass_color, distribution=distribution,
-                layers=_blend_layers(comps, ctx), refraction_only=refr == {True})
+                layers=_blend_layers(comps, ctx), refraction_only=refr == {True},
+                metal_fresnel=metal_fresnel)

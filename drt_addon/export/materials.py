@@ -20,12 +20,11 @@ Principled BSDF
 Diffuse BSDF
     Lambert with its colour (no specular layer). Roughness > 0 (Oren-Nayar) is reported.
 Glossy BSDF
-    GGX reflection of its colour with its roughness: DRT's metal lobe with F0 = colour.
-    Cycles' Glossy has no Fresnel (reflectance = colour at every angle); Schlick's F0
-    lobe reaches white only at grazing angles, so edges are a little brighter here.
-    Multiscatter GGX (the default), GGX and Beckmann are kept (Cycles' multiscatter
-    Glossy colours its extra bounces by the colour itself, DRT's by Schlick's average of
-    it); Ashikhmin-Shirley is rendered as GGX (reported).
+    Microfacet reflection of its colour with its roughness: DRT's metal lobe with
+    reflectance = colour at every angle (`Material.metal_fresnel` 'CONSTANT': Cycles'
+    Glossy has no Fresnel term), its multiple-scattering compensation coloured by the
+    colour itself, as Cycles' is. Multiscatter GGX (the default), GGX and Beckmann are
+    kept; Ashikhmin-Shirley is rendered as GGX (reported).
 Glass BSDF
     DRT's glass lobe with the node's IOR, roughness and distribution (Multiscatter GGX,
     GGX or Beckmann); its colour tints each refraction

@@ -6,6 +6,8 @@ import numpy as np
 
 # The microfacet models of `Material.glossy_model`
 GLOSSY_MODELS = ("GGX", "MULTI_GGX", "BLINN_PHONG", "BECKMANN")
+# The Fresnel term of the metal lobe (`Material.metal_fresnel`)
+METAL_FRESNELS = ("SCHLICK", "CONSTANT")
 
 
 def flatten_mixes(materials):
@@ -33,7 +35,9 @@ def reference_gaps(materials) -> list[str]:
     gaps = [(table.coat_weight > 1e-5, "coat"), (table.sheen_weight > 1e-5, "sheen"),
             (table.translucent_color.max(1) > 0.0, "translucency"),
             (table.refraction_only, "the Refraction BSDF (rendered as glass)"),
-            (table.beckmann, "the Beckmann distribution (rendered as GGX)")]
+            (table.beckmann, "the Beckmann distribution (rendered as GGX)"),
+            (table.metal_constant, "the Glossy BSDF's angle-independent reflectance "
+                                   "(rendered with Schlick's Fresnel)")]
     return [what for used, what in gaps if used.any()]
 
 
@@ -72,6 +76,12 @@ class MaterialTable:
         self.blinn_phong = np.array([model == "BLINN_PHONG" for model in models], bool)
         self.multiscatter = np.array([model == "MULTI_GGX" for model in models], bool)
         self.beckmann = np.array([model == "BECKMANN" for model in models], bool)
+        fresnels = [getattr(m, "metal_fresnel", "SCHLICK") for m in materials]
+        for m, f in zip(materials, fresnels):
+            if f not in METAL_FRESNELS:
+                raise ValueError(f"material {m.name!r}: metal_fresnel must be one of "
+                                 f"{', '.join(map(repr, METAL_FRESNELS))}, not {f!r}")
+        self.metal_constant = np.array([f == "CONSTANT" for f in fresnels], bool)
         # Lobe colours: the metal F0 and the glass tint per crossing, when they are not
         # Principled's own (base colour, sqrt(base colour)).
         metal = [getattr(m, "metal_color", None) for m in materials]

@@ -185,9 +185,10 @@ def _glossy(node, ctx) -> _Closure:
     if s is not None and (s.is_linked or float(s.default_value) != 0.0):
         ctx.issue(f"{node.name!r} is anisotropic; DRT renders it isotropic")
     color = _input(node, "Color", ctx, True, (0.8,) * 3)
+    # Cycles' Glossy has no Fresnel term: its colour at every angle
     return _Closure([(1.0, _Comp(base=color, metallic=1.0,
                                  roughness=_input(node, "Roughness", ctx, False, 0.5),
-                                 distribution=distribution))])
+                                 distribution=distribution, metal_fresnel="CONSTANT"))])
 
 
 def _glass(node, ctx, refraction=False) -> _Closure:

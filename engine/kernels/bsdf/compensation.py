@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from ..jit import kernel
 from . import multiscatter as ms
-from .state import (S_GLASS_SMOOTH, S_METAL_F0, S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC,
+from .state import (S_GLASS_SMOOTH, S_METAL_CONST, S_METAL_F0, S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC,
                     S_REFRACT_ONLY, S_TINT)
 
 
@@ -12,7 +12,8 @@ from .state import (S_GLASS_SMOOTH, S_METAL_F0, S_MS_E, S_MS_GLASS, S_MS_METAL, 
 def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, w_glass,
                tables, state):
     """The multiple-scattering factors at wo (PrincipledBSDF._compensation): 1 unless
-    `multiscatter`; the lobe weights, metal F0 and tint must be in the state already."""
+    `multiscatter`; the lobe weights, metal F0 and Fresnel kind and the tint must be in
+    the state already."""
     state[S_MS_SPEC] = 1.0
     state[S_MS_E] = 1.0
     for c in range(3):
@@ -29,8 +30,10 @@ def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, 
                                                ms.dielectric_fresnel_avg(eta_spec, tables))
         if m > 0.0:
             for c in range(3):
-                state[S_MS_METAL + c] = ms.compensation(
-                    E, E_avg, ms.schlick_fresnel_avg(state[S_METAL_F0 + c]))
+                f0 = state[S_METAL_F0 + c]
+                # a Glossy BSDF's reflectance is its colour at every angle (Cycles' Fss)
+                f_avg = f0 if state[S_METAL_CONST] != 0.0 else ms.schlick_fresnel_avg(f0)
+                state[S_MS_METAL + c] = ms.compensation(E, E_avg, f_avg)
     if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0 and state[S_REFRACT_ONLY] == 0.0:
         eta_rel = 1.0 / eta_glass if woz < 0.0 else eta_glass
         c_o = min(abs(woz), 1.0)

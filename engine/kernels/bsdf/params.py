@@ -37,7 +37,9 @@ P_REFRACT_ONLY = 33      # 0 / 1: the glass lobe refracts only (Refraction BSDF)
 P_SHEEN_LAYERED = 34     # 0 / 1: the sheen dims the lobes below it (Principled's)
 P_BUMP_CORRECTION = 35   # 0 / 1: Cycles' Bump Map Correction for a bent normal
 #                          (engine.nodes.shading.program_normal, bump_shadowing)
-NPARAM = 36
+P_METAL_CONSTANT = 36    # 0 / 1: the metal lobe reflects its F0 at every angle (a
+#                          Glossy BSDF, Cycles' Fresnel-less closure), not Schlick's
+NPARAM = 37
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -75,4 +77,5 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_SHEEN_LAYERED] = table.sheen_layered
     rows[:, P_BUMP_CORRECTION] = table.bump_correction
     rows[:, P_LAYERS] = table.layered
+    rows[:, P_METAL_CONSTANT] = table.metal_constant
     return rows

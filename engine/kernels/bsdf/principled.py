@@ -33,12 +33,12 @@ from .compensation import compensate
 from .state import (NSTATE, S_ALPHA, S_BECKMANN, S_BLINN, S_DIFFUSE, S_EST, S_ETA_GLASS,  # noqa: F401
                     S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH, S_LAYERED, S_METAL_F0, S_MS_E,
                     S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY, S_TINT, S_W_GLASS,
-                    S_W_METAL, S_W_SPEC, S_WALTER)
+                    S_W_METAL, S_W_SPEC, S_WALTER, S_METAL_CONST)
 from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
                      NPARAM, P_BASE,
                      P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
                      P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR, P_LAYERS, P_METAL_COLOR,
-                     P_METALLIC, P_REFRACT_ONLY, P_ROUGHNESS,
+                     P_METAL_CONSTANT, P_METALLIC, P_REFRACT_ONLY, P_ROUGHNESS,
                      P_SPEC_LEVEL, P_TRANSMISSION, pack_materials)
 from .tables import kernel_tables  # noqa: F401  (re-exported)
 from ..warp import INV_PI, cosine_hemisphere
@@ -75,6 +75,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     state[S_ALPHA] = lobe_alpha
     state[S_BLINN] = 1.0 if row[P_GLOSSY_MODEL] == GLOSSY_BLINN_PHONG else 0.0
     state[S_BECKMANN] = 1.0 if row[P_GLOSSY_MODEL] == GLOSSY_BECKMANN else 0.0
+    state[S_METAL_CONST] = row[P_METAL_CONSTANT]
     state[S_EXPONENT] = max(2.0 / (lobe_alpha * lobe_alpha) - 2.0, 0.0)
     base_w = (1.0 - m) * (1.0 - t)
     # specular layer: F0 scaled by 2 * level, IOR recomputed from it
@@ -132,7 +133,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     if m > 0.0:
         F = 0.0
         for c in range(3):
-            F = max(F, fresnel.schlick(state[S_METAL_F0 + c], cos_o) * state[S_MS_METAL + c])
+            F = max(F, metal_fresnel(state, c, cos_o) * state[S_MS_METAL + c])
         est_metal = m * F
     est_gr = 0.0
     est_gt = 0.0
@@ -158,6 +159,16 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
             state[S_DIFFUSE + c] = state[S_DIFFUSE + c] * state[layers.S_BASE_SCALE + c]
         for k in range(5):
             state[S_EST + k] = state[S_EST + k] * smax
+
+
+@kernel
+def metal_fresnel(state, c, cos_oh):
+    """The metal lobe's Fresnel factor in channel c: Schlick's from F0 (Principled), or
+    F0 itself at every angle (a Glossy BSDF: Cycles gives it no Fresnel term, its colour
+    is the closure's weight)."""
+    if state[S_METAL_CONST] != 0.0:
+        return state[S_METAL_F0 + c]
+    return fresnel.schlick(state[S_METAL_F0 + c], cos_oh)
 
 
 @kernel
@@ -253,9 +264,9 @@ def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
             fb += v
         if w_metal > 0.0:
             bw = base * w_metal
-            fr += fresnel.schlick(state[S_METAL_F0], cos_oh) * bw * state[S_MS_METAL]
-            fg += fresnel.schlick(state[S_METAL_F0 + 1], cos_oh) * bw * state[S_MS_METAL + 1]
-            fb += fresnel.schlick(state[S_METAL_F0 + 2], cos_oh) * bw * state[S_MS_METAL + 2]
+            fr += metal_fresnel(state, 0, cos_oh) * bw * state[S_MS_METAL]
+            fg += metal_fresnel(state, 1, cos_oh) * bw * state[S_MS_METAL + 1]
+            fb += metal_fresnel(state, 2, cos_oh) * bw * state[S_MS_METAL + 2]
     w_glass = state[S_W_GLASS]
     if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0 and (see_g if wiz > 0.0 else see_t):
         f_r, f_t = dielectric.rough_eval_lobes(wox, woy, woz, wix, wiy, wiz,

@@ -23,4 +23,5 @@ S_REFRACT_ONLY = 31  # 1: the glass lobe refracts only (Refraction BSDF)
 S_LAYERED = 32       # 1: the lobes of layers.py are in use (their slots follow)
 S_WALTER = layers.NSTATE  # 1: refraction on Walter's pairs only, not Cycles' (dielectric.py)
 S_BECKMANN = layers.NSTATE + 1  # 1: the microfacet lobes use Beckmann instead of GGX
-NSTATE = layers.NSTATE + 2
+S_METAL_CONST = layers.NSTATE + 2  # 1: the metal lobe's Fresnel is its F0 (Glossy BSDF)
+NSTATE = layers.NSTATE + 3
