@@ -27,6 +27,16 @@ def flatten_mixes(materials):
     return out, np.array(children, np.int64).reshape(-1, 2)
 
 
+def _choices(materials, attr, default, allowed) -> list[str]:
+    """Each material's `attr` (default when missing), which must be one of `allowed`."""
+    values = [getattr(m, attr, default) for m in materials]
+    for m, v in zip(materials, values):
+        if v not in allowed:
+            raise ValueError(f"material {m.name!r}: {attr} must be one of "
+                             f"{', '.join(map(repr, allowed))}, not {v!r}")
+    return values
+
+
 def reference_gaps(materials) -> list[str]:
     """What of these materials (Mix Shader sides included) the NumPy reference
     integrators (distribution, whitted) do not render, which the compiled path tracer
@@ -68,19 +78,11 @@ class MaterialTable:
         self.transmission = np.array([m.transmission for m in materials], dtype=np.float64)
         self.specular_ior_level = np.array([m.specular_ior_level for m in materials], np.float64)
         self.alpha = np.array([getattr(m, "alpha", 1.0) for m in materials], dtype=np.float64)
-        models = [getattr(m, "glossy_model", "GGX") for m in materials]
-        for m, model in zip(materials, models):
-            if model not in GLOSSY_MODELS:
-                raise ValueError(f"material {m.name!r}: glossy_model must be one of "
-                                 f"{', '.join(map(repr, GLOSSY_MODELS))}, not {model!r}")
+        models = _choices(materials, "glossy_model", "GGX", GLOSSY_MODELS)
         self.blinn_phong = np.array([model == "BLINN_PHONG" for model in models], bool)
         self.multiscatter = np.array([model == "MULTI_GGX" for model in models], bool)
         self.beckmann = np.array([model == "BECKMANN" for model in models], bool)
-        fresnels = [getattr(m, "metal_fresnel", "SCHLICK") for m in materials]
-        for m, f in zip(materials, fresnels):
-            if f not in METAL_FRESNELS:
-                raise ValueError(f"material {m.name!r}: metal_fresnel must be one of "
-                                 f"{', '.join(map(repr, METAL_FRESNELS))}, not {f!r}")
+        fresnels = _choices(materials, "metal_fresnel", "SCHLICK", METAL_FRESNELS)
         self.metal_constant = np.array([f == "CONSTANT" for f in fresnels], bool)
         # Lobe colours: the metal F0 and the glass tint per crossing, when they are not
         # Principled's own (base colour, sqrt(base colour)).
