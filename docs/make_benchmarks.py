@@ -36,7 +36,8 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [ROOT, os.path.join(ROOT, "tests")]
 from engine.image_error import relmse  # noqa: E402
-from big_scene_benchmarks import big_mesh, big_mesh_section, many_moving  # noqa: E402
+from big_scene_benchmarks import (big_mesh, big_mesh_section, many_moving,  # noqa: E402
+                                  user_env)
 from stage_profile import gil_bound, table_lines as stage_table  # noqa: E402
 DOCS = os.path.join(ROOT, "docs")
 SAMPLES = os.path.join(ROOT, "sample_blends")
@@ -97,7 +98,7 @@ def _cli_render(blend, engine, samples, out, percentage, extra=()):
     t0 = time.perf_counter()
     subprocess.run([sys.executable, "-c", code, "render", blend, "-o", out, "--engine", engine,
                     "--samples", str(samples), "--percentage", str(percentage), *extra],
-                   cwd=ROOT, check=True, capture_output=True, text=True)
+                   cwd=ROOT, check=True, capture_output=True, text=True, env=user_env())
     return time.perf_counter() - t0
 
 
@@ -163,7 +164,10 @@ def equal_error_section(rows, ratios, fixed_costs, pct, ref):
              "a power law fitted to its sample ladder; its seconds as a line in "
              "samples: a fixed cost per process (Python, `bpy` and the add-on, the "
              "file, export, the compiled kernels loaded from their cache, the "
-             "acceleration structure) plus a cost per sample.", "",
+             "acceleration structure) plus a cost per sample. Python's bytecode cache is "
+             "on, as on a user's machine (before 2026-11-26 the benchmark ran with "
+             "PYTHONDONTWRITEBYTECODE set, so each DRT process compiled its sources "
+             "again, about 0.2 s).", "",
              "| scene | Cycles | DRT to the same error | DRT / Cycles | DRT: fixed + "
              "per sample | DRT ladder |", "|---|---|---|---|---|---|", *rows, "",
              "At these sizes DRT's fixed cost per process (median "
