@@ -122,7 +122,18 @@ def supported_nodes(bpy):
                 names.append(kind.bl_rna.name)
         rows.append(f"| {family} | {', '.join(sorted(set(names)))} |")
     return ["| family | nodes |", "|---|---|"] + rows + [
-        "| Groups | node groups (nested), Group Input / Output, Reroute, muted nodes |"]
+        "| Groups | node groups (nested), Group Input / Output, Reroute, muted nodes |",
+        SHADERS_ROW]
+
+
+# the closures (drt_addon/export/nodes/shader.py, export/volumes.py, export/world.py);
+# each is compared with Cycles in tests/test_closures_vs_cycles.py and the *_vs_cycles
+# tests of its feature
+SHADERS_ROW = ("| Shader | Principled BSDF, Diffuse BSDF, Glossy BSDF, Glass BSDF, "
+               "Refraction BSDF (GGX, Multiscatter GGX, Beckmann), Sheen BSDF, "
+               "Translucent BSDF, Emission, Transparent BSDF, Mix Shader, Add Shader; "
+               "Principled Volume, Volume Scatter, Volume Absorption, Volume "
+               "Coefficients; Background |")
 
 
 def program_cost(size=64, spp=16, repeats=3):
