@@ -152,8 +152,10 @@ def main(argv=None):
         "- The glass cube of absorption_glass (a smooth Glass BSDF) differs from Cycles "
         "without its volume too (about -0.6% in the mean, tests/test_volumes_vs_cycles.py "
         "prints it), at the lamp's caustic under it: light through the glass after the "
-        "floor's diffuse bounce, where Filter Glossy widens the smooth glass (as for the "
-        "Refraction BSDF in docs/comparisons.md; not resolved). The test checks the "
+        "floor's diffuse bounce, where Filter Glossy widens the smooth glass into a rough "
+        "Multiscatter GGX lobe (not resolved: Cycles' blur, its flags and its refraction "
+        "pairs were checked against DRT's and agree; the smooth Refraction BSDF's like "
+        "gap was its Beckmann distribution, now rendered). The test checks the "
         "absorption by the ratio of the coloured to the clear glass.",
         "- Next-event estimation from scattering points samples the lamps only (Cycles "
         "adds equiangular sampling): a lamp seen through forward-scattering fog is "
