@@ -37,6 +37,17 @@ LIMITS = {
     "glass IOR 4": dict(transmission=1.0, ior=4.0, roughness=0.0),
     "rough glass IOR 1.0001": dict(transmission=1.0, ior=1.0001, roughness=1e-4),
     "rough glass IOR 4": dict(transmission=1.0, ior=4.0, roughness=1.0),
+    "Beckmann metal roughness 0": dict(metallic=1.0, roughness=0.0, glossy_model="BECKMANN"),
+    "Beckmann metal roughness 1": dict(metallic=1.0, roughness=1.0, glossy_model="BECKMANN"),
+    "Beckmann glass IOR 1.0001": dict(transmission=1.0, ior=1.0001, roughness=1e-4,
+                                      glossy_model="BECKMANN"),
+    "Beckmann glass IOR 4 roughness 1": dict(transmission=1.0, ior=4.0, roughness=1.0,
+                                             glossy_model="BECKMANN"),
+    "Beckmann refraction roughness 1": dict(transmission=1.0, roughness=1.0,
+                                            refraction_only=True, glossy_model="BECKMANN"),
+    "Glossy BSDF (constant Fresnel) roughness 1": dict(metallic=1.0, roughness=1.0,
+                                                       metal_fresnel="CONSTANT",
+                                                       glossy_model="MULTI_GGX"),
     "metallic 0 base 0": dict(metallic=0.0, base_color=(0.0, 0.0, 0.0)),
     "metallic 1 base 0": dict(metallic=1.0, base_color=(0.0, 0.0, 0.0)),
     "metallic 0 base 1": dict(metallic=0.0, base_color=WHITE),
@@ -100,9 +111,12 @@ def _grazing_plane_scene(material, light=None, eye_height=1e-3, size=16):
                                 dict(metallic=1.0, roughness=0.05, glossy_model="MULTI_GGX"),
                                 dict(glossy_model="BLINN_PHONG", metallic=1.0,
                                      roughness=BLINN_1E6),
-                                dict(transmission=1.0, roughness=0.1, ior=1.5)],
+                                dict(transmission=1.0, roughness=0.1, ior=1.5),
+                                dict(metallic=1.0, roughness=0.05, glossy_model="BECKMANN"),
+                                dict(transmission=1.0, roughness=0.1, ior=1.5,
+                                     glossy_model="BECKMANN")],
                          ids=["diffuse", "mirror", "glossy", "multiscatter", "blinn-phong",
-                              "rough glass"])
+                              "rough glass", "beckmann", "beckmann glass"])
 def test_grazing_view_of_a_large_plane_is_finite_and_energy_bounded(kw):
     """Camera rays almost parallel to the plane (grazing glossy lobes): the plane
     reflects the white world only, so no pixel exceeds 1 in expectation."""
