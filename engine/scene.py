@@ -36,6 +36,10 @@ class Material:
       metal_fresnel  'SCHLICK' (Principled's metal: Schlick's Fresnel from F0) or
                    'CONSTANT' (a Glossy BSDF: F0 at every angle, as Cycles' Glossy has no
                    Fresnel term; compiled path tracer only);
+      specular_tint  Principled's Specular Tint on the metal lobe: Cycles' F82-tint
+                   Fresnel (Schlick's, times the tint at about 82 degrees; white: plain
+                   Schlick; compiled path tracer only). Its effect on the dielectric
+                   specular layer and the glass is not modelled;
       glass_color  the tint of each refraction through the glass lobe (Principled uses
                    sqrt(base colour); a Glass BSDF node its colour).
 
@@ -81,6 +85,7 @@ class Material:
     alpha: float = 1.0
     metal_color: Optional[tuple] = None
     metal_fresnel: str = "SCHLICK"
+    specular_tint: tuple = (1.0, 1.0, 1.0)
     glass_color: Optional[tuple] = None
     transparent_color: tuple = (1.0, 1.0, 1.0)
     glossy_model: str = "GGX"

@@ -401,3 +401,37 @@ def test_glossy_bsdf_reflects_its_colour_at_every_angle():
     assert (schlick[grazing, 0] > 1.5 * const[grazing, 0]).all()
     with pytest.raises(ValueError, match="metal_fresnel"):
         MaterialTable([Material(metal_fresnel="F82")])
+
+
+def test_specular_tint_is_cycles_f82_tint_on_metals():
+    """F82-tint (Cycles' Principled metal with a Specular Tint): Schlick's Fresnel times
+    the tint at mu = 1/7, Schlick's at the normal, and its hemispherical average (the
+    multiscatter Fss) F0 + (1 - F0) / 21 - b / 126 by quadrature; a white tint is plain
+    Schlick, bit for bit."""
+    from engine.kernels.bsdf import fresnel as kf
+    for f0, tint in ((0.9, 0.3), (0.5, 1.0), (0.05, 0.0), (1.0, 0.5)):
+        b = kf.f82_tint_b(f0, tint)
+        assert kf.f82_tint(f0, b, 1.0 / 7.0) == pytest.approx(kf.schlick(f0, 1.0 / 7.0) * tint,
+                                                              rel=1e-12, abs=1e-15)
+        assert kf.f82_tint(f0, b, 1.0) == pytest.approx(f0, rel=1e-12)
+        mu = (np.arange(4000) + 0.5) / 4000
+        F = np.array([kf.f82_tint(f0, b, m) for m in mu])
+        assert (F >= 0).all() and (F <= 1).all()
+        unclamped = f0 + (1 - f0) * (1 - mu) ** 5 - b * mu * (1 - mu) ** 6
+        if (unclamped >= 0).all():          # (a tint of 0 dips below 0, clamped there)
+            avg = 2.0 * np.mean(F * mu)
+            assert avg == pytest.approx(f0 + (1 - f0) / 21 - b / 126, abs=1e-6)
+    # through the BSDF: a tinted metal at cos(wo, h) = 1/7 reflects tint x the white one's
+    n = 1
+    t = np.arccos(1.0 / 7.0)
+    wo = np.array([[np.sin(t), 0.0, np.cos(t)]])
+    wi = np.array([[-np.sin(t), 0.0, np.cos(t)]])              # h = the normal
+    tables = kb.kernel_tables()
+
+    def f(tint):
+        mat = Material(metallic=1.0, roughness=0.5, base_color=(0.9, 0.6, 0.3),
+                       specular_tint=tint)
+        rows = kb.pack_materials(MaterialTable([mat]))[np.zeros(n, int)]
+        return batch.eval_f_batch(rows, np.ones(n, bool), wo, wi, tables)[0]
+    assert np.allclose(f((0.2, 0.5, 1.0)), f((1.0, 1.0, 1.0)) * np.array([0.2, 0.5, 1.0]),
+                       rtol=1e-12)

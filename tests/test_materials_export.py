@@ -118,6 +118,16 @@ def test_principled_values(bpy_drt):
     p.inputs["Subsurface Weight"].default_value = 0.5
     m, warnings = _export(mat)
     assert len(warnings) == 1 and "'P'" in warnings[0] and "subsurface" in warnings[0]
+    p.inputs["Subsurface Weight"].default_value = 0.0
+    # Specular Tint: the metal lobe's F82 tint; on the dielectric layer it is reported
+    assert close(m.specular_tint, (1, 1, 1))
+    p.inputs["Specular Tint"].default_value = (1.0, 0.5, 0.25, 1.0)
+    m, warnings = _export(mat)
+    assert close(m.specular_tint, (1.0, 0.5, 0.25))
+    assert len(warnings) == 1 and "specular tint on the dielectric layer" in warnings[0]
+    p.inputs["Metallic"].default_value = 1.0
+    m, warnings = _export(mat)
+    assert close(m.specular_tint, (1.0, 0.5, 0.25)) and warnings == []
 
 
 def test_diffuse_glossy_glass_emission_transparent(bpy_drt):

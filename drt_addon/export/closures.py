@@ -27,6 +27,7 @@ class _Comp:
     spec: float = 0.5
     metal_color: object = None      # None: the base colour (Principled)
     metal_fresnel: str = "SCHLICK"  # 'CONSTANT': a Glossy BSDF's (Material.metal_fresnel)
+    specular_tint: tuple = WHITE    # Principled's, the metal lobe's F82 tint
     glass_color: object = None      # None: sqrt(base colour) per crossing (Principled)
     distribution: str = "MULTI_GGX"  # 'MULTI_GGX', 'GGX' or 'BECKMANN' (glossy_model)
     layers: object = None           # a _Layers: coat, sheen, translucency (None: none)
@@ -199,6 +200,7 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
         m.glass_color = tuple(_mean(p["glass_color"]))
     m.refraction_only = bool(p["refraction_only"])
     m.metal_fresnel = p["metal_fresnel"]
+    m.specular_tint = tuple(p["specular_tint"])
     if p["layers"] is not None:
         for k in LAYER_FIELDS:
             v = getattr(p["layers"], k)
@@ -240,7 +242,7 @@ def _blend(comps, ctx) -> dict:
                     else c.metal_color,
                     glass_color=c.glass_color, distribution=c.distribution,
                     layers=c.layers, refraction_only=c.refraction_only,
-                    metal_fresnel=c.metal_fresnel)
+                    metal_fresnel=c.metal_fresnel, specular_tint=c.specular_tint)
     lw = [(c, comp, *comp.weights()) for c, comp in comps]
     Wm = sum(c * m for c, _, m, _, _ in lw)
     Wg = sum(c * g for c, _, _, g, _ in lw)
@@ -295,8 +297,9 @@ def _blend(comps, ctx) -> dict:
         ctx.issue(f"closures with different microfacet distributions are mixed; DRT uses "
                   f"{distribution} for all")
     # the metal lobe's Fresnel: that of the closure with the most metal weight
-    metal_fresnel = max(((c * m, comp.metal_fresnel) for c, comp, m, _, _ in lw),
-                        key=lambda x: x[0])[1]
+    metal_fresnel, specular_tint = max(
+        ((c * m, (comp.metal_fresnel, comp.specular_tint)) for c, comp, m, _, _ in lw),
+        key=lambda x: x[0])[1]
     if len({comp.metal_fresnel for c, comp, m, _, _ in lw if c * m > 0}) > 1:
         ctx.issue(f"a Glossy BSDF and a Principled metal are mixed; DRT gives both the "
                   f"{'Glossy' if metal_fresnel == 'CONSTANT' else 'Principled'} one's "
@@ -308,4 +311,4 @@ def _blend(comps, ctx) -> dict:
                 roughness=roughness, ior=ior, spec=spec, metal_color=metal_color,
                 glass_color=glass_color, distribution=distribution,
                 layers=_blend_layers(comps, ctx), refraction_only=refr == {True},
-                metal_fresnel=metal_fresnel)
+                metal_fresnel=metal_fresnel, specular_tint=specular_tint)

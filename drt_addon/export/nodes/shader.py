@@ -75,7 +75,16 @@ def _principled(node, ctx) -> _Closure:
             ignored.append(what)
     s = node_input(node, "Specular Tint")
     if s is not None and (s.is_linked or _tinted(s.default_value)):
-        ignored.append("specular tint")
+        # the metal lobe's F82 tint (Cycles' meaning); the dielectric layer's is not
+        # rendered
+        tint = _constant(node, "Specular Tint", ctx, WHITE, color=True)
+        if isinstance(tint, float):               # a pre-4.0 amount of the base colour
+            tint = WHITE
+        comp.specular_tint = tuple(float(x) for x in tuple(tint)[:3])
+        metal = float(_mean(comp.metallic))
+        if metal < 1.0 and _tinted(comp.specular_tint):
+            ignored.append("specular tint on the dielectric layer" if metal > 0.0
+                           else "specular tint (it tints metals only in DRT)")
     s = node_input(node, "Tangent")
     if s is not None and s.is_linked:
         ignored.append("the tangent input")

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from ..jit import kernel
 from . import multiscatter as ms
-from .state import (S_GLASS_SMOOTH, S_METAL_CONST, S_METAL_F0, S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC,
-                    S_REFRACT_ONLY, S_TINT)
+from .state import (S_GLASS_SMOOTH, S_METAL_B, S_METAL_CONST, S_METAL_F0, S_METAL_F82,
+                    S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY, S_TINT)
 
 
 @kernel
@@ -32,7 +32,12 @@ def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, 
             for c in range(3):
                 f0 = state[S_METAL_F0 + c]
                 # a Glossy BSDF's reflectance is its colour at every angle (Cycles' Fss)
-                f_avg = f0 if state[S_METAL_CONST] != 0.0 else ms.schlick_fresnel_avg(f0)
+                if state[S_METAL_CONST] != 0.0:
+                    f_avg = f0
+                elif state[S_METAL_F82] != 0.0:     # Cycles' fresnel_f82_Fss
+                    f_avg = ms.schlick_fresnel_avg(f0) - state[S_METAL_B + c] / 126.0
+                else:
+                    f_avg = ms.schlick_fresnel_avg(f0)
                 state[S_MS_METAL + c] = ms.compensation(E, E_avg, f_avg)
     if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0 and state[S_REFRACT_ONLY] == 0.0:
         eta_rel = 1.0 / eta_glass if woz < 0.0 else eta_glass

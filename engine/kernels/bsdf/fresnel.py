@@ -60,3 +60,21 @@ def ior_from_f0(f0):
     """The IOR >= 1 with normal-incidence reflectance f0 (f0 clamped to [0, 0.9999])."""
     s = math.sqrt(min(max(f0, 0.0), 0.9999))
     return (1.0 + s) / (1.0 - s)
+
+
+@kernel
+def f82_tint_b(f0, tint):
+    """F82-tint's b of one channel: Schlick's value at mu = 1/7 times (1 - tint), over
+    mu (1 - mu)^6 there (Cycles' fresnel_f82tint_B)."""
+    f = 6.0 / 7.0
+    f5 = f * f * f * f * f
+    schlick_82 = f0 + (1.0 - f0) * f5
+    return schlick_82 * (7.0 / (f5 * f)) * (1.0 - tint)
+
+
+@kernel
+def f82_tint(f0, b, cos_theta):
+    """F82-tint Fresnel of one channel: Schlick's minus b mu (1 - mu)^6, in [0, 1]."""
+    s = min(max(1.0 - cos_theta, 0.0), 1.0)
+    s5 = s * s * s * s * s
+    return min(max(f0 + (1.0 - f0) * s5 - b * cos_theta * s5 * s, 0.0), 1.0)

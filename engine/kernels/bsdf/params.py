@@ -39,7 +39,8 @@ P_BUMP_CORRECTION = 35   # 0 / 1: Cycles' Bump Map Correction for a bent normal
 #                          (engine.nodes.shading.program_normal, bump_shadowing)
 P_METAL_CONSTANT = 36    # 0 / 1: the metal lobe reflects its F0 at every angle (a
 #                          Glossy BSDF, Cycles' Fresnel-less closure), not Schlick's
-NPARAM = 37
+P_SPEC_TINT = 37         # 3 columns: Specular Tint, the metal lobe's F82 tint (1: none)
+NPARAM = 40
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -78,4 +79,5 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_BUMP_CORRECTION] = table.bump_correction
     rows[:, P_LAYERS] = table.layered
     rows[:, P_METAL_CONSTANT] = table.metal_constant
+    rows[:, P_SPEC_TINT:P_SPEC_TINT + 3] = table.specular_tint
     return rows

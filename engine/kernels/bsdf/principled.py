@@ -33,12 +33,14 @@ from .compensation import compensate
 from .state import (NSTATE, S_ALPHA, S_BECKMANN, S_BLINN, S_DIFFUSE, S_EST, S_ETA_GLASS,  # noqa: F401
                     S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH, S_LAYERED, S_METAL_F0, S_MS_E,
                     S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY, S_TINT, S_W_GLASS,
-                    S_W_METAL, S_W_SPEC, S_WALTER, S_METAL_CONST)
+                    S_W_METAL, S_W_SPEC, S_WALTER, S_METAL_CONST, S_METAL_F82,
+                    S_METAL_B)
 from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
                      NPARAM, P_BASE,
                      P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
                      P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR, P_LAYERS, P_METAL_COLOR,
                      P_METAL_CONSTANT, P_METALLIC, P_REFRACT_ONLY, P_ROUGHNESS,
+                     P_SPEC_TINT,
                      P_SPEC_LEVEL, P_TRANSMISSION, pack_materials)
 from .tables import kernel_tables  # noqa: F401  (re-exported)
 from ..warp import INV_PI, cosine_hemisphere
@@ -76,6 +78,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     state[S_BLINN] = 1.0 if row[P_GLOSSY_MODEL] == GLOSSY_BLINN_PHONG else 0.0
     state[S_BECKMANN] = 1.0 if row[P_GLOSSY_MODEL] == GLOSSY_BECKMANN else 0.0
     state[S_METAL_CONST] = row[P_METAL_CONSTANT]
+    state[S_METAL_F82] = 0.0
     state[S_EXPONENT] = max(2.0 / (lobe_alpha * lobe_alpha) - 2.0, 0.0)
     base_w = (1.0 - m) * (1.0 - t)
     # specular layer: F0 scaled by 2 * level, IOR recomputed from it
@@ -105,6 +108,8 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
             state[S_TINT + c] = math.sqrt(clamped)
         state[S_DIFFUSE + c] = base * base_w
         diffuse_max = max(diffuse_max, state[S_DIFFUSE + c])
+    if m > 0.0 and state[S_METAL_CONST] == 0.0:
+        f82_setup(row, state)
     w_diff = base_w if diffuse_max > 0.0 else 0.0
     w_spec = base_w if spec_on else 0.0
     w_glass = (1.0 - m) * t
@@ -163,12 +168,31 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
 
 @kernel
 def metal_fresnel(state, c, cos_oh):
-    """The metal lobe's Fresnel factor in channel c: Schlick's from F0 (Principled), or
-    F0 itself at every angle (a Glossy BSDF: Cycles gives it no Fresnel term, its colour
-    is the closure's weight)."""
+    """The metal lobe's Fresnel factor in channel c: Schlick's from F0 (Principled),
+    F82-tint where Specular Tint is not white, or F0 itself at every angle (a Glossy
+    BSDF: Cycles gives it no Fresnel term, its colour is the closure's weight)."""
     if state[S_METAL_CONST] != 0.0:
         return state[S_METAL_F0 + c]
+    if state[S_METAL_F82] != 0.0:
+        return fresnel.f82_tint(state[S_METAL_F0 + c], state[S_METAL_B + c], cos_oh)
     return fresnel.schlick(state[S_METAL_F0 + c], cos_oh)
+
+
+@kernel
+def f82_setup(row, state):
+    """Cycles' F82-tint metal (Kutz et al., "Novel aspects of the Adobe Standard
+    Material"): Schlick's Fresnel minus b mu (1 - mu)^6, with b per channel such that at
+    mu = 1/7 (about 82 degrees) it is Schlick's value times the tint. Nothing to do for
+    a white tint (plain Schlick)."""
+    tinted = False
+    for c in range(3):
+        tinted = tinted or row[P_SPEC_TINT + c] != 1.0
+    if not tinted:
+        return
+    state[S_METAL_F82] = 1.0
+    for c in range(3):
+        state[S_METAL_B + c] = fresnel.f82_tint_b(state[S_METAL_F0 + c],
+                                                  row[P_SPEC_TINT + c])
 
 
 @kernel

@@ -24,4 +24,6 @@ S_LAYERED = 32       # 1: the lobes of layers.py are in use (their slots follow)
 S_WALTER = layers.NSTATE  # 1: refraction on Walter's pairs only, not Cycles' (dielectric.py)
 S_BECKMANN = layers.NSTATE + 1  # 1: the microfacet lobes use Beckmann instead of GGX
 S_METAL_CONST = layers.NSTATE + 2  # 1: the metal lobe's Fresnel is its F0 (Glossy BSDF)
-NSTATE = layers.NSTATE + 3
+S_METAL_F82 = layers.NSTATE + 3    # 1: the metal lobe's Fresnel is F82-tint (Specular Tint)
+S_METAL_B = layers.NSTATE + 4      # 3: F82-tint's b per channel
+NSTATE = layers.NSTATE + 7
