@@ -36,10 +36,11 @@ class Material:
       metal_fresnel  'SCHLICK' (Principled's metal: Schlick's Fresnel from F0) or
                    'CONSTANT' (a Glossy BSDF: F0 at every angle, as Cycles' Glossy has no
                    Fresnel term; compiled path tracer only);
-      specular_tint  Principled's Specular Tint on the metal lobe: Cycles' F82-tint
-                   Fresnel (Schlick's, times the tint at about 82 degrees; white: plain
-                   Schlick; compiled path tracer only). Its effect on the dielectric
-                   specular layer and the glass is not modelled;
+      specular_tint  Principled's Specular Tint (compiled path tracer only): the metal
+                   lobe's F82-tint Fresnel (Schlick's, times the tint at about 82 degrees)
+                   and the specular layer's F0 times the tint (fading to white at grazing
+                   angles), as in Cycles; white: none. Its effect on the glass lobe is
+                   not modelled;
       glass_color  the tint of each refraction through the glass lobe (Principled uses
                    sqrt(base colour); a Glass BSDF node its colour).
 

@@ -1,5 +1,5 @@
 """Coat, sheen, translucency, the Refraction BSDF, Beckmann, the Glossy BSDF and the
-metals' Specular Tint against Cycles: seven small scenes
+Principled Specular Tint against Cycles: seven small scenes
 (64 x 48 pixels) built here with bpy at Blender's defaults (bounces, Filter Glossy,
 Principled inputs not named), rendered by Cycles (1024 samples per pixel) and DRT (1024),
 each compared with `compare` of tests/test_multiscatter_vs_cycles.py: image means within
@@ -27,8 +27,9 @@ a control, DRT rendering it without the feature (as it did before), which must f
     the same room: Cycles' Glossy reflects its colour at every angle (no Fresnel term);
     control: Principled metals of the same colours, Schlick's Fresnel, what DRT
     rendered a Glossy BSDF as before (brighter towards grazing angles).
-  * specular_tint: two Principled metals with a Specular Tint (Cycles' F82-tint
-    Fresnel); control: white tints (plain Schlick, what DRT rendered before).
+  * specular_tint: two Principled metals (Cycles' F82-tint Fresnel) and two
+    dielectrics (the specular layer's tinted F0) with a Specular Tint; control: white
+    tints (what DRT rendered before).
 
 Measured (DRT vs Cycles: mean per channel, worst block; control the same):
   coat         -0.04 %, 0.32 %;  control +1.2 / -2.2 / -2.4 %, 25 %
@@ -37,7 +38,9 @@ Measured (DRT vs Cycles: mean per channel, worst block; control the same):
   refraction   -0.00 %, 0.43 %;  control +0.26 / +0.27 / +0.52 %, 13 %
   beckmann     -0.05 / -0.04 / -0.03 %, 0.48 %;  control -3.8 / -3.6 / -3.3 %, 9.3 %
   glossy       -0.00 / +0.00 / +0.00 %, 0.37 %;  control +0.93 / +1.1 / +1.2 %, 6.7 %
-  specular_tint -0.02 / -0.01 / -0.02 %, 0.26 %;  control +1.3 / +2.2 / +1.3 %, 6.8 %
+  specular_tint -0.02 %, 0.38 %;  control +1.25 / +1.63 / +0.32 %, 4.2 %
+  (the two dielectrics of specular_tint and a third alone: -0.03 %, 0.5 %; control
+  +1.13 / +0.87 / +0.01 %, 4.0 %)
 """
 from __future__ import annotations
 
@@ -251,17 +254,22 @@ def glossy_scene(bpy, control=False):
 
 
 def tint_scene(bpy, control=False):
-    """Two Principled metals with a Specular Tint (Cycles' F82-tint Fresnel: Schlick's
-    times the tint at about 82 degrees, so the tint shows towards the silhouettes);
-    control: the same with a white tint (plain Schlick, what DRT rendered before)."""
+    """Two Principled metals and two dielectrics with a Specular Tint (metals: Cycles'
+    F82-tint Fresnel, Schlick's times the tint at about 82 degrees, so the tint shows
+    towards the silhouettes; dielectrics: the specular layer's F0 times the tint, fading
+    to white at grazing angles); control: the same with white tints (what DRT rendered
+    before)."""
     scene = _striped_room(bpy)
-    for k, (colour, tint, rough) in enumerate((
-            ((0.95, 0.7, 0.3, 1.0), (1.0, 0.3, 0.1, 1.0), 0.25),
-            ((0.9, 0.9, 0.9, 1.0), (0.2, 0.5, 1.0, 1.0), 0.5))):
+    for k, (colour, metal, tint, rough) in enumerate((
+            ((0.95, 0.7, 0.3, 1.0), 1.0, (1.0, 0.3, 0.1, 1.0), 0.25),
+            ((0.9, 0.9, 0.9, 1.0), 1.0, (0.2, 0.5, 1.0, 1.0), 0.5),
+            ((0.05, 0.05, 0.05, 1.0), 0.0, (1.0, 0.2, 0.1, 1.0), 0.2),
+            ((0.3, 0.4, 0.2, 1.0), 0.0, (0.1, 0.6, 2.0, 1.0), 0.4))):
         mat = _principled(bpy, f"Tinted{k}", **{
-            "Base Color": colour, "Metallic": 1.0, "Roughness": rough,
+            "Base Color": colour, "Metallic": metal, "Roughness": rough,
+            "Specular IOR Level": 0.5 if k < 3 else 1.0,
             "Specular Tint": (1.0, 1.0, 1.0, 1.0) if control else tint})
-        _sphere(bpy, (-0.7 + 1.4 * k, 0.0, 0.75), 0.65, mat)
+        _sphere(bpy, (-1.35 + 0.9 * k, 0.0, 0.42), 0.42, mat)
     return scene
 
 

@@ -435,3 +435,34 @@ def test_specular_tint_is_cycles_f82_tint_on_metals():
         return batch.eval_f_batch(rows, np.ones(n, bool), wo, wi, tables)[0]
     assert np.allclose(f((0.2, 0.5, 1.0)), f((1.0, 1.0, 1.0)) * np.array([0.2, 0.5, 1.0]),
                        rtol=1e-12)
+
+
+def test_specular_tint_colours_the_dielectric_layer_as_cycles():
+    """The specular layer with a Specular Tint (kernels/bsdf/specular_tint.py): at the
+    mirror direction of normal incidence its reflectance is F0 x tint; towards grazing
+    it fades to white; a tinted glossy plastic's sampled albedo equals its quadrature,
+    and with a tint <= 1 over a white base the furnace stays <= 1."""
+    from test_layered_bsdf import albedo_both_ways
+    tables = kb.kernel_tables()
+    wo = np.array([[0.0, 0.0, 1.0]])
+
+    def f(tint, wo=wo, wi=wo):
+        mat = Material(base_color=(0.0, 0.0, 0.0), roughness=0.3, specular_tint=tint)
+        rows = kb.pack_materials(MaterialTable([mat]))[np.zeros(1, int)]
+        return batch.eval_f_batch(rows, np.ones(1, bool), wo, wi, tables)[0]
+    tint = np.array([0.5, 1.0, 2.0])
+    assert np.allclose(f(tuple(tint)), f((1.0, 1.0, 1.0)) * tint, rtol=1e-12)
+    t = np.radians(89.0)
+    graze_o = np.array([[np.sin(t), 0.0, np.cos(t)]])
+    graze_i = np.array([[-np.sin(t), 0.0, np.cos(t)]])
+    ratio = f(tuple(tint), graze_o, graze_i) / f((1.0, 1.0, 1.0), graze_o, graze_i)
+    assert np.all(np.abs(ratio - 1.0) <= 0.3 * np.abs(tint - 1.0))   # fading to white
+    for params in (dict(base_color=(1.0, 1.0, 1.0), roughness=0.4,
+                        specular_tint=(0.2, 0.6, 1.0), glossy_model="MULTI_GGX"),
+                   dict(base_color=(0.0, 0.0, 0.0), roughness=0.2, specular_ior_level=1.0,
+                        specular_tint=(1.0, 0.3, 2.0))):
+        for deg in (10.0, 70.0):
+            mc, quad, _ = albedo_both_ways(params, deg)
+            assert np.allclose(mc, quad, rtol=0.01, atol=2e-3), (params, deg, mc, quad)
+            if params["base_color"][0] == 1.0:
+                assert quad.max() <= 1.0 + 0.005

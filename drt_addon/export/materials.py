@@ -14,10 +14,10 @@ Principled BSDF
     Specular IOR Level and Emission Color x Emission Strength as they are. Alpha a: the
     BSDF gets weight a and a Transparent BSDF the rest (so emission is a x emission on
     average), rendered as stochastic transparency. Coat and sheen are the compiled
-    BSDF's layers; Specular Tint is the metal lobe's F82 tint (`Material.specular_tint`,
-    Cycles' F82-tint Fresnel). Subsurface, anisotropy, Specular Tint on the dielectric
-    layer and glass, thin film and diffuse roughness are not modelled: reported when
-    used.
+    BSDF's layers; Specular Tint (`Material.specular_tint`) is the metal lobe's F82
+    tint and the specular layer's F0 tint, as in Cycles. Subsurface, anisotropy,
+    Specular Tint on the glass, thin film and diffuse roughness are not modelled:
+    reported when used.
     The node's distribution is the material's `glossy_model`: 'MULTI_GGX' (Blender's
     default, Cycles' energy-compensated GGX) or 'GGX' (single scattering).
 Diffuse BSDF

@@ -48,8 +48,7 @@ def reference_gaps(materials) -> list[str]:
             (table.beckmann, "the Beckmann distribution (rendered as GGX)"),
             (table.metal_constant, "the Glossy BSDF's angle-independent reflectance "
                                    "(rendered with Schlick's Fresnel)"),
-            ((table.specular_tint < 1.0).any(1) & (table.metallic > 0.0),
-             "the metals' Specular Tint")]
+            ((table.specular_tint != 1.0).any(1), "Specular Tint")]
     return [what for used, what in gaps if used.any()]
 
 
@@ -86,10 +85,11 @@ class MaterialTable:
         self.beckmann = np.array([model == "BECKMANN" for model in models], bool)
         fresnels = _choices(materials, "metal_fresnel", "SCHLICK", METAL_FRESNELS)
         self.metal_constant = np.array([f == "CONSTANT" for f in fresnels], bool)
-        # Cycles clamps the F82 tint to [0, 1]
-        self.specular_tint = np.clip(np.array(
+        # Specular Tint: >= 0 (Cycles clamps the metal's F82 tint to 1, and the tinted
+        # F0 of the specular layer to 1, kernels/bsdf/specular_tint.py)
+        self.specular_tint = np.maximum(np.array(
             [tuple(getattr(m, "specular_tint", (1.0, 1.0, 1.0)))[:3] for m in materials],
-            np.float64).reshape(-1, 3), 0.0, 1.0)
+            np.float64).reshape(-1, 3), 0.0)
         # Lobe colours: the metal F0 and the glass tint per crossing, when they are not
         # Principled's own (base colour, sqrt(base colour)).
         metal = [getattr(m, "metal_color", None) for m in materials]

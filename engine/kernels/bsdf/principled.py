@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 
 from ..jit import kernel
-from . import blinn_phong, dielectric, fresnel, layers
+from . import blinn_phong, dielectric, fresnel, layers, specular_tint
 from . import microfacet as mf
 from . import multiscatter as ms
 from .albedo import specular_albedo
@@ -34,7 +34,7 @@ from .state import (NSTATE, S_ALPHA, S_BECKMANN, S_BLINN, S_DIFFUSE, S_EST, S_ET
                     S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH, S_LAYERED, S_METAL_F0, S_MS_E,
                     S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY, S_TINT, S_W_GLASS,
                     S_W_METAL, S_W_SPEC, S_WALTER, S_METAL_CONST, S_METAL_F82,
-                    S_METAL_B)
+                    S_METAL_B, S_SPEC_TINTED)
 from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
                      NPARAM, P_BASE,
                      P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
@@ -123,12 +123,17 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
                eta_glass, w_spec, m, w_glass, tables, state)
     e_spec = 0.0
     est_spec = 0.0
+    state[S_SPEC_TINTED] = 0.0
     if w_spec > 0.0:
         # the layer's albedo as the diffuse sees it (PrincipledBSDF._layer_albedo)
         e_spec = specular_albedo(cos_o, alpha, eta_spec, tables)
         if state[S_BLINN] == 0.0:
-            e_est = ms.layer_reflectance(cos_o, alpha, eta_spec, tables) * state[S_MS_E]
-            e_spec = max(e_est, e_spec) * state[S_MS_SPEC]
+            if specular_tint.is_tinted(row):
+                e_spec = specular_tint.setup(row, row[P_GLOSSY_MODEL] == GLOSSY_MULTI_GGX,
+                                             cos_o, alpha, eta_spec, e_spec, tables, state)
+            else:
+                e_est = ms.layer_reflectance(cos_o, alpha, eta_spec, tables) * state[S_MS_E]
+                e_spec = max(e_est, e_spec) * state[S_MS_SPEC]
         est_spec = w_spec * e_spec
     est_diff = 0.0
     for c in range(3):
@@ -186,13 +191,13 @@ def f82_setup(row, state):
     a white tint (plain Schlick)."""
     tinted = False
     for c in range(3):
-        tinted = tinted or row[P_SPEC_TINT + c] != 1.0
+        tinted = tinted or min(row[P_SPEC_TINT + c], 1.0) != 1.0
     if not tinted:
         return
     state[S_METAL_F82] = 1.0
-    for c in range(3):
+    for c in range(3):                        # Cycles clamps the F82 tint to 1
         state[S_METAL_B + c] = fresnel.f82_tint_b(state[S_METAL_F0 + c],
-                                                  row[P_SPEC_TINT + c])
+                                                  min(row[P_SPEC_TINT + c], 1.0))
 
 
 @kernel
@@ -280,7 +285,12 @@ def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
     if see_g and (w_spec > 0.0 or w_metal > 0.0):
         base, hx, hy, hz = reflection_eval(state, wox, woy, woz, wix, wiy, wiz)
         cos_oh = min(max(mf.dot(wox, woy, woz, hx, hy, hz), 0.0), 1.0)
-        if w_spec > 0.0:
+        if w_spec > 0.0 and state[S_SPEC_TINTED] != 0.0:
+            bw = base * w_spec
+            fr += specular_tint.reflectance(state, 0, cos_oh, state[S_ETA_SPEC]) * bw
+            fg += specular_tint.reflectance(state, 1, cos_oh, state[S_ETA_SPEC]) * bw
+            fb += specular_tint.reflectance(state, 2, cos_oh, state[S_ETA_SPEC]) * bw
+        elif w_spec > 0.0:
             F = fresnel.dielectric(cos_oh, state[S_ETA_SPEC])
             v = F * (base * w_spec) * state[S_MS_SPEC]
             fr += v

@@ -1,0 +1,76 @@
+"""Principled's Specular Tint on the dielectric specular layer, as Cycles renders it (its
+"generalized Schlick" Fresnel with the real dielectric curve, svm/closure.h and
+closure/bsdf_microfacet.h): the layer's reflectance in channel c is
+
+    F_c(mu) = f0_c + (1 - f0_c) s(mu),   s = (F(mu) - F0) / (1 - F0) in [0, 1],
+
+with F the dielectric Fresnel of the layer's IOR, F0 = F(1) and f0_c = min(F0 tint_c, 1):
+the tint colours the reflection at the normal and fades towards white at grazing
+angles. Everything that depends on the layer's Fresnel follows the same remap, which is
+linear in F: the multiscatter Fss (Cycles: f0 + (1 - f0) s(Fss)), Cycles' estimate of the
+layer's albedo that dims the diffuse below (f0 + (1 - f0) s of its table), and DRT's
+floor on it, the single-scattering albedo (a_c E + b_c A with E the GGX albedo for F = 1,
+A the untinted layer's, b_c = (1 - f0_c) / (1 - F0), a_c = f0_c - b_c F0). The diffuse
+below is dimmed by the largest channel's albedo, as Cycles' closure_layering_weight
+does. A white tint never reaches this module (principled.setup), so untinted materials
+pay nothing (principle 3). The metal lobe's tint is F82-tint (fresnel.py); the glass
+lobe's is not modelled (the exporter warns).
+"""
+from __future__ import annotations
+
+from ..jit import kernel
+from . import fresnel
+from . import multiscatter as ms
+from .params import P_SPEC_TINT
+from .state import S_MS_E, S_SPEC_F0, S_SPEC_MS, S_SPEC_TINTED
+
+
+@kernel
+def is_tinted(row):
+    return (row[P_SPEC_TINT] != 1.0 or row[P_SPEC_TINT + 1] != 1.0
+            or row[P_SPEC_TINT + 2] != 1.0)
+
+
+@kernel
+def remap(F, f0_real):
+    """s = (F - F0) / (1 - F0), clamped to [0, 1] (Cycles' inverse_lerp, saturated)."""
+    den = 1.0 - f0_real
+    if not den > 1e-12:
+        return 1.0
+    return min(max((F - f0_real) / den, 0.0), 1.0)
+
+
+@kernel
+def setup(row, multiscatter, cos_o, alpha, eta_spec, exact, tables, state):
+    """Fill the tinted layer's slots (f0 and multiscatter factor per channel) and return
+    its albedo at wo as the diffuse below sees it. `exact`: the untinted layer's
+    single-scattering albedo (albedo.specular_albedo)."""
+    state[S_SPEC_TINTED] = 1.0
+    f0_real = fresnel.f0_from_ior(eta_spec)
+    estimate = ms.layer_reflectance(cos_o, alpha, eta_spec, tables)
+    s_est = remap(estimate, f0_real)
+    e_white = ms.ggx_albedo(cos_o, alpha, tables)          # the layer with F = 1
+    E_avg = ms.ggx_albedo_avg(alpha, tables) if multiscatter else 1.0
+    s_ss = remap(ms.dielectric_fresnel_avg(eta_spec, tables), f0_real)
+    den = max(1.0 - f0_real, 1e-12)
+    albedo = 0.0
+    for c in range(3):
+        f0 = min(max(f0_real * row[P_SPEC_TINT + c], 0.0), 1.0)
+        state[S_SPEC_F0 + c] = f0
+        factor = 1.0
+        if multiscatter:
+            factor = ms.compensation(state[S_MS_E], E_avg, f0 + (1.0 - f0) * s_ss)
+        state[S_SPEC_MS + c] = factor
+        b = (1.0 - f0) / den
+        floor = (f0 - b * f0_real) * e_white + b * exact
+        cycles = (f0 + (1.0 - f0) * s_est) * state[S_MS_E]
+        albedo = max(albedo, max(cycles, floor) * factor)
+    return albedo
+
+
+@kernel
+def reflectance(state, c, cos_oh, eta_spec):
+    """F_c of the tinted layer times its multiscatter factor, at cos(wo, h) = cos_oh."""
+    s = remap(fresnel.dielectric(cos_oh, eta_spec), fresnel.f0_from_ior(eta_spec))
+    f0 = state[S_SPEC_F0 + c]
+    return (f0 + (1.0 - f0) * s) * state[S_SPEC_MS + c]
