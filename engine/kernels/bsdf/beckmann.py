@@ -156,18 +156,20 @@ def sample_slope_x(cot_t, tan_t, u):
     hi = erf_c
     b = min(max(b, lo), hi)
     x = erfinv(b)
+    tol = 1e-13 * total                                  # on the CDF, relative
     for _ in range(40):
         g = 1.0 + b + k * math.exp(-x * x) - target     # increasing in b
+        if abs(g) <= tol:
+            break
         if g > 0.0:
             hi = b
         else:
             lo = b
         slope = 1.0 - x * tan_t                          # dg/db >= 0
-        step = g / slope if slope > 0.0 else 0.0
-        nb = b - step
-        if not (nb > lo and nb < hi) or step == 0.0:
-            nb = 0.5 * (lo + hi)
-        if abs(nb - b) <= 1e-15 or hi - lo <= 1e-15:
+        nb = b - g / slope if slope > 0.0 else lo - 1.0
+        if not (nb > lo and nb < hi):
+            nb = 0.5 * (lo + hi)                         # Newton left the bracket
+        if abs(nb - b) <= 1e-15 * max(abs(b), 1e-3):
             b = nb
             x = erfinv(b)
             break
