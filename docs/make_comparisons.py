@@ -37,7 +37,7 @@ import comparison_probes as probes  # noqa: E402
 # (scene, resolution percentage): every scene renders at 128 x 128 pixels.
 DOC_SCENES = [("cornell_box", 50)] + [(name, 200) for name in (
     "metals", "glossy_dielectric", "glass", "dof", "instances", "world_light",
-    "ray_visibility", "mirror_caustic", "glass_caustics")]
+    "ray_visibility", "mirror_caustic", "glass_caustics", "node_closures")]
 DRT_SAMPLES = 256
 CYCLES_SAMPLES = 1024
 PANEL = 256          # images are shown at least this wide (nearest-neighbour upscaling)

@@ -702,9 +702,59 @@ def glass_caustics():
     return scene
 
 
+def _node_material(name, kind, **inputs):
+    """A material of one BSDF node of type `kind`, its other inputs and its
+    distribution at Blender's defaults."""
+    mat = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):
+        mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.remove(nt.nodes["Principled BSDF"])
+    node = nt.nodes.new(kind)
+    for key, value in inputs.items():
+        node.inputs[key].default_value = value
+    nt.links.new(node.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+def node_closures():
+    """Shader nodes as artists use them, at their own defaults: a Refraction BSDF
+    (roughness 0.2, its default Beckmann distribution), a Glass BSDF (roughness 0.1,
+    Multiscatter GGX), a dark Glossy BSDF (roughness 0.3: its colour at every angle, no
+    Fresnel), a copper Principled metal and a black plastic with a Specular Tint, and a
+    red Principled plastic with a coat; on a grey floor before a striped wall, lit by a
+    uniform sky alone."""
+    scene = reset()
+    floor = principled("Floor", (0.5, 0.5, 0.5), specular=0.0)
+    quad("Floor", [(-6, -6, 0), (6, -6, 0), (6, 6, 0), (-6, 6, 0)], floor)
+    _stripes("Wall", -4.0, 4.0, 0.0, 4.0, 2.0, STRIPE_COLORS, 12)
+    tinted_metal = principled("TintedCopper", (0.95, 0.64, 0.54), roughness=0.25,
+                              metallic=1.0)
+    tinted_metal.node_tree.nodes["Principled BSDF"].inputs["Specular Tint"].default_value = (
+        1.0, 0.35, 0.2, 1.0)
+    tinted_plastic = principled("TintedPlastic", (0.03, 0.03, 0.03), roughness=0.2)
+    tinted_plastic.node_tree.nodes["Principled BSDF"].inputs["Specular Tint"].default_value = (
+        0.3, 0.6, 1.0, 1.0)
+    coated = principled("Coated", (0.7, 0.08, 0.05), roughness=0.5)
+    coated.node_tree.nodes["Principled BSDF"].inputs["Coat Weight"].default_value = 1.0
+    materials = [
+        _node_material("Refraction", "ShaderNodeBsdfRefraction", IOR=1.45, Roughness=0.2),
+        _node_material("Glass", "ShaderNodeBsdfGlass", IOR=1.45, Roughness=0.1),
+        _node_material("Glossy", "ShaderNodeBsdfGlossy", Color=(0.2, 0.12, 0.05, 1.0),
+                       Roughness=0.3),
+        tinted_metal, tinted_plastic, coated]
+    for k, mat in enumerate(materials):           # two rows, the back one staggered
+        x, y = -0.9 + 0.9 * (k % 3) + 0.45 * (k // 3), 1.0 * (k // 3)
+        uv_sphere(f"Sphere{k}", (x, y, 0.36), 0.36, mat)
+    camera(scene, (0.0, -3.6, 2.4), (math.radians(62.0), 0.0, 0.0), lens=45.0)
+    _comparison_defaults(scene)
+    _set_world(scene, (0.9, 0.9, 0.9), 1.0)
+    return scene
+
+
 COMPARISON_SCENES = {f.__name__: f for f in (
     metals, glossy_dielectric, glass, dof, instances, world_light, ray_visibility,
-    mirror_caustic, glass_caustics)}
+    mirror_caustic, glass_caustics, node_closures)}
 SCENES.update(COMPARISON_SCENES)
 
 
