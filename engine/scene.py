@@ -38,9 +38,9 @@ class Material:
                    Fresnel term; compiled path tracer only);
       specular_tint  Principled's Specular Tint (compiled path tracer only): the metal
                    lobe's F82-tint Fresnel (Schlick's, times the tint at about 82 degrees)
-                   and the specular layer's F0 times the tint (fading to white at grazing
-                   angles), as in Cycles; white: none. Its effect on the glass lobe is
-                   not modelled;
+                   and the specular layer's and glass lobe's F0 times the tint (fading to
+                   white at grazing angles; the glass lets 1 - F through), as in Cycles;
+                   white: none;
       glass_color  the tint of each refraction through the glass lobe (Principled uses
                    sqrt(base colour); a Glass BSDF node its colour).
 

@@ -1,5 +1,5 @@
 """Coat, sheen, translucency, the Refraction BSDF, Beckmann, the Glossy BSDF and the
-Principled Specular Tint against Cycles: seven small scenes
+Principled Specular Tint against Cycles: eight small scenes
 (64 x 48 pixels) built here with bpy at Blender's defaults (bounces, Filter Glossy,
 Principled inputs not named), rendered by Cycles (1024 samples per pixel) and DRT (1024),
 each compared with `compare` of tests/test_multiscatter_vs_cycles.py: image means within
@@ -30,6 +30,8 @@ a control, DRT rendering it without the feature (as it did before), which must f
   * specular_tint: two Principled metals (Cycles' F82-tint Fresnel) and two
     dielectrics (the specular layer's tinted F0) with a Specular Tint; control: white
     tints (what DRT rendered before).
+  * glass_tint: a smooth and a rough Principled glass (IOR 2.2) with strong Specular
+    Tints (the reflection's F0 tinted, 1 - F_c let through); control: white tints.
 
 Measured (DRT vs Cycles: mean per channel, worst block; control the same):
   coat         -0.04 %, 0.32 %;  control +1.2 / -2.2 / -2.4 %, 25 %
@@ -41,6 +43,7 @@ Measured (DRT vs Cycles: mean per channel, worst block; control the same):
   specular_tint -0.02 %, 0.38 %;  control +1.25 / +1.63 / +0.32 %, 4.2 %
   (the two dielectrics of specular_tint and a third alone: -0.03 %, 0.5 %; control
   +1.13 / +0.87 / +0.01 %, 4.0 %)
+  glass_tint   -0.28 / -0.15 / -0.30 %, 1.62 %;  control -0.35 / +0.43 / -0.94 %, 7.9 %
 """
 from __future__ import annotations
 
@@ -273,9 +276,23 @@ def tint_scene(bpy, control=False):
     return scene
 
 
+def glass_tint_scene(bpy, control=False):
+    """Principled glass spheres (smooth and rough) with a Specular Tint: Cycles tints
+    their reflection's F0 and lets the complement through (1 - F_c); control: white
+    tints (what DRT rendered before)."""
+    scene = _striped_room(bpy)
+    for k, (tint, rough) in enumerate((((0.1, 0.5, 4.0, 1.0), 0.0),
+                                        ((4.0, 1.0, 0.1, 1.0), 0.3))):
+        mat = _principled(bpy, f"TintedGlass{k}", **{
+            "Base Color": (1.0, 1.0, 1.0, 1.0), "Transmission Weight": 1.0, "IOR": 2.2,
+            "Roughness": rough, "Specular Tint": (1.0, 1.0, 1.0, 1.0) if control else tint})
+        _sphere(bpy, (-0.7 + 1.4 * k, 0.0, 0.75), 0.65, mat)
+    return scene
+
+
 SCENES = {"coat": coat_scene, "sheen": sheen_scene, "translucent": translucent_scene,
           "refraction": refraction_scene, "beckmann": beckmann_scene, "glossy": glossy_scene,
-          "specular_tint": tint_scene}
+          "specular_tint": tint_scene, "glass_tint": glass_tint_scene}
 
 
 def render(bpy, name, engine, control=False):

@@ -466,3 +466,42 @@ def test_specular_tint_colours_the_dielectric_layer_as_cycles():
             assert np.allclose(mc, quad, rtol=0.01, atol=2e-3), (params, deg, mc, quad)
             if params["base_color"][0] == 1.0:
                 assert quad.max() <= 1.0 + 0.005
+
+
+def test_specular_tint_on_glass_tints_reflection_and_lets_the_rest_through():
+    """Principled glass with a Specular Tint: smooth glass samples carry F_c / F on
+    reflection and (1 - F_c) / (1 - F) on refraction per channel, with F_c = f0_c + (1 -
+    f0_c) (F - F0) / (1 - F0), f0_c = F0 x tint; rough tinted glass's sampled albedo
+    equals its quadrature."""
+    from engine.kernels.bsdf import fresnel as kf
+    from test_layered_bsdf import albedo_both_ways
+    tint = np.array([0.1, 1.0, 3.0])
+    n = 4000
+    rng = np.random.default_rng(8)
+    tables = kb.kernel_tables()
+    t = np.radians(40.0)
+    wo = np.tile([np.sin(t), 0.0, np.cos(t)], (n, 1))
+    u_lobe, u_dir = rng.random(n), rng.random((n, 2))
+
+    def sample(tint):
+        mat = Material(transmission=1.0, roughness=0.0, ior=2.0, base_color=(1.0,) * 3,
+                       specular_tint=tuple(tint))
+        rows = kb.pack_materials(MaterialTable([mat]))[np.zeros(n, int)]
+        return batch.sample_batch(rows, np.ones(n, bool), wo, u_lobe, u_dir,
+                                  np.ones((n, 3), bool), tables)
+    wi_t, w_t, _, _, delta, valid = sample(tint)
+    wi_w, w_w, _, _, _, _ = sample((1.0, 1.0, 1.0))
+    assert delta[valid].all() and np.array_equal(wi_t, wi_w)     # the same choices
+    F = kf.dielectric(np.cos(t), 2.0)
+    F0 = kf.f0_from_ior(2.0)
+    Fc = F0 * tint + (1 - F0 * tint) * (F - F0) / (1 - F0)
+    refl = valid & (wi_t[:, 2] > 0)
+    refr = valid & (wi_t[:, 2] < 0)
+    assert refl.any() and refr.any()
+    assert np.allclose(w_t[refl], w_w[refl] * Fc / F, rtol=1e-12)
+    assert np.allclose(w_t[refr], w_w[refr] * (1 - Fc) / (1 - F), rtol=1e-12)
+    params = dict(transmission=1.0, roughness=0.4, ior=1.6, base_color=(1.0,) * 3,
+                  specular_tint=(0.2, 1.0, 2.5))
+    for deg in (20.0, 70.0):
+        mc, quad, _ = albedo_both_ways(params, deg)
+        assert np.allclose(mc, quad, rtol=0.01, atol=2e-3), (deg, mc, quad)

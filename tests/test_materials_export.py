@@ -119,13 +119,9 @@ def test_principled_values(bpy_drt):
     m, warnings = _export(mat)
     assert len(warnings) == 1 and "'P'" in warnings[0] and "subsurface" in warnings[0]
     p.inputs["Subsurface Weight"].default_value = 0.0
-    # Specular Tint: the metal's F82 tint and the specular layer's; on glass reported
+    # Specular Tint: the metal's F82 tint, the specular layer's and the glass's F0 tint
     assert close(m.specular_tint, (1, 1, 1))
     p.inputs["Specular Tint"].default_value = (1.0, 0.5, 0.25, 1.0)
-    m, warnings = _export(mat)
-    assert close(m.specular_tint, (1.0, 0.5, 0.25))
-    assert len(warnings) == 1 and "specular tint on the transmission" in warnings[0]
-    p.inputs["Transmission Weight"].default_value = 0.0
     m, warnings = _export(mat)
     assert close(m.specular_tint, (1.0, 0.5, 0.25)) and warnings == []
 

@@ -75,15 +75,12 @@ def _principled(node, ctx) -> _Closure:
             ignored.append(what)
     s = node_input(node, "Specular Tint")
     if s is not None and (s.is_linked or _tinted(s.default_value)):
-        # the metal lobe's F82 tint and the specular layer's F0 tint (Cycles' meaning);
-        # the glass lobe's is not rendered
+        # the metal lobe's F82 tint, the specular layer's and the glass's F0 tint
+        # (Cycles' meaning, engine/kernels/bsdf/specular_tint.py)
         tint = _constant(node, "Specular Tint", ctx, WHITE, color=True)
         if isinstance(tint, float):               # a pre-4.0 amount of the base colour
             tint = WHITE
         comp.specular_tint = tuple(float(x) for x in tuple(tint)[:3])
-        if float(_mean(comp.metallic)) < 1.0 and comp.transmission > 0.0 \
-                and _tinted(comp.specular_tint):
-            ignored.append("specular tint on the transmission (glass) lobe")
     s = node_input(node, "Tangent")
     if s is not None and s.is_linked:
         ignored.append("the tangent input")

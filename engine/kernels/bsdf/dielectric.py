@@ -51,7 +51,8 @@ def choice_probs(F, allow_reflect, allow_refract):
 @kernel
 def smooth_sample(ox, oy, oz, eta, u, allow_reflect, allow_refract):
     """Delta reflection or refraction chosen by Fresnel (or forced by the allow flags):
-    (wi_x, wi_y, wi_z, weight, refracted, valid); its pdf is a delta."""
+    (wi_x, wi_y, wi_z, weight, refracted, valid, F); its pdf is a delta, F is the
+    Fresnel reflectance the weight holds (F or 1 - F)."""
     sign, eta_rel = canonical(oz, eta)
     cz = oz * sign
     F, cos_t, eta_t = fresnel.dielectric_full(cz, eta_rel)
@@ -68,7 +69,7 @@ def smooth_sample(ox, oy, oz, eta, u, allow_reflect, allow_refract):
         ok = p > 0.0 and cz > 0.0
         w = F
     w = w / p if ok else 0.0
-    return ix, iy, iz * sign, w, refr, ok
+    return ix, iy, iz * sign, w, refr, ok, F
 
 
 @kernel
@@ -106,9 +107,22 @@ def refraction_half(ox, oy, oz, ix, iy, iz, eta_rel):
 
 
 @kernel
+def cycles_pair(ox, oy, oz, ix, iy, iz, eta_rel, walter):
+    """A refraction pair (canonical directions) as Cycles evaluates it: (h, s = +-|wo +
+    eta wi|, |wo.h|, -|wi.h|, usable), usable for any generalised half vector facing +Z,
+    also where it is not a microfacet normal that refracts one into the other (Walter's
+    condition, required only with `walter`)."""
+    hx, hy, hz, cos_oh, cos_ih, ok = refraction_half(ox, oy, oz, ix, iy, iz, eta_rel)
+    usable = oz > 0.0 and hz > 0.0 and (ok or not walter)
+    s = cos_oh + eta_rel * cos_ih
+    return hx, hy, hz, s, abs(cos_oh), -abs(cos_ih), usable
+
+
+@kernel
 def rough_eval(ox, oy, oz, ix, iy, iz, eta, alpha):
     """(f_reflect, f_refract) in 1/sr; one of them is zero for each pair."""
-    return rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, False, False, False)
+    f_r, f_t, _ = rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, False, False, False)
+    return f_r, f_t
 
 
 @kernel
@@ -116,7 +130,9 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter, b
     """`rough_eval`, or with `refract_only` Cycles' Refraction BSDF: no reflection and
     the refraction without its Fresnel factor 1 - F (zero under total internal
     reflection). `walter`: refraction on Walter's pairs only (the NumPy module's
-    as_cycles=False)."""
+    as_cycles=False). Returns (f_reflect, f_refract, F): F is the Fresnel reflectance
+    at the pair's half vector, which the value holds as F or 1 - F (for a Specular
+    Tint, specular_tint.py)."""
     a = mf.clamp_alpha(alpha)
     sign, eta_rel = canonical(oz, eta)
     oz = oz * sign
@@ -124,15 +140,13 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter, b
     if iz > 0.0:
         base_r, hx, hy, hz = mf.reflection_eval_of(ox, oy, oz, ix, iy, iz, a, beckmann)
         if base_r == 0.0 or refract_only:
-            return 0.0, 0.0
+            return 0.0, 0.0, 0.0
         F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
-        return F_r * base_r, 0.0
-    hx, hy, hz, cos_oh, cos_ih, ok = refraction_half(ox, oy, oz, ix, iy, iz, eta_rel)
-    if not (oz > 0.0 and iz < 0.0 and hz > 0.0) or (walter and not ok):
-        return 0.0, 0.0
-    # Cycles' pairs: any h, |wo.h| and -|wi.h| (ok, Walter's condition, is not required)
-    s = cos_oh + eta_rel * cos_ih      # +-|wo + eta wi|
-    cos_oh, cos_ih = abs(cos_oh), -abs(cos_ih)
+        return F_r * base_r, 0.0, F_r
+    hx, hy, hz, s, cos_oh, cos_ih, usable = cycles_pair(ox, oy, oz, ix, iy, iz, eta_rel,
+                                                        walter)
+    if not (usable and iz < 0.0):
+        return 0.0, 0.0, 0.0
     F_t = fresnel.dielectric(cos_oh, eta_rel)
     if refract_only:
         F_t = 1.0 if F_t >= 1.0 else 0.0
@@ -140,16 +154,16 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter, b
     if beckmann:
         g2c = bk.G2_over_cos2(ox, oy, oz, ix, iy, iz, a)
         if not (g2c > 0.0 and den > 0.0):
-            return 0.0, 0.0
-        return 0.0, bk.D(hx, hy, hz, a) * (1.0 - F_t) * (-cos_ih) * cos_oh * g2c / den
+            return 0.0, 0.0, F_t
+        return 0.0, bk.D(hx, hy, hz, a) * (1.0 - F_t) * (-cos_ih) * cos_oh * g2c / den, F_t
     a2 = a * a
     zo, zi = oz, -iz
     g_den = zi * mf.r_len(ox, oy, oz, a2) + zo * mf.r_len(ix, iy, iz, a2)
     if not (g_den > 0.0 and den > 0.0):
-        return 0.0, 0.0
+        return 0.0, 0.0, F_t
     val = (2.0 * mf.D(hx, hy, hz, a) * (1.0 - F_t) * (-cos_ih) * cos_oh
            / (g_den * den))
-    return 0.0, val
+    return 0.0, val, F_t
 
 
 @kernel
@@ -171,11 +185,10 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, 
         pr, _ = choice_probs(F_r, allow_reflect, allow_refract)
         return pr * 0.25 * g1c * mf.D_of(hx, hy, hz, a, beckmann)
     # refraction: P(refract | h) D_wo(h) |dh/dwi|
-    hx, hy, hz, cos_oh, cos_ih, ok = refraction_half(ox, oy, oz, ix, iy, iz, eta_rel)
-    if not (oz > 0.0 and hz > 0.0) or (walter and not ok):
+    hx, hy, hz, s, cos_oh, cos_ih, usable = cycles_pair(ox, oy, oz, ix, iy, iz, eta_rel,
+                                                        walter)
+    if not usable:
         return 0.0
-    s = cos_oh + eta_rel * cos_ih      # as in rough_eval_lobes: Cycles' pairs
-    cos_oh, cos_ih = abs(cos_oh), -abs(cos_ih)
     F_t = fresnel.dielectric(cos_oh, eta_rel)
     _, pt = choice_probs(F_t, allow_reflect, allow_refract)
     den = s * s

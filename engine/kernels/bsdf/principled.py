@@ -34,7 +34,7 @@ from .state import (NSTATE, S_ALPHA, S_BECKMANN, S_BLINN, S_DIFFUSE, S_EST, S_ET
                     S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH, S_LAYERED, S_METAL_F0, S_MS_E,
                     S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY, S_TINT, S_W_GLASS,
                     S_W_METAL, S_W_SPEC, S_WALTER, S_METAL_CONST, S_METAL_F82,
-                    S_METAL_B, S_SPEC_TINTED)
+                    S_METAL_B, S_SPEC_TINTED, S_GLASS_TINTED)
 from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
                      NPARAM, P_BASE,
                      P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
@@ -116,6 +116,9 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     state[S_W_SPEC] = w_spec
     state[S_W_METAL] = m
     state[S_W_GLASS] = w_glass
+    state[S_GLASS_TINTED] = 0.0
+    if w_glass > 0.0 and state[S_REFRACT_ONLY] == 0.0 and specular_tint.is_tinted(row):
+        specular_tint.glass_setup(row, eta_glass, state)
 
     # albedo-dependent weights at wo (PrincipledBSDF._wo_state)
     cos_o = min(max(woz, 0.0), 1.0)
@@ -303,14 +306,20 @@ def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
             fb += metal_fresnel(state, 2, cos_oh) * bw * state[S_MS_METAL + 2]
     w_glass = state[S_W_GLASS]
     if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0 and (see_g if wiz > 0.0 else see_t):
-        f_r, f_t = dielectric.rough_eval_lobes(wox, woy, woz, wix, wiy, wiz,
+        f_r, f_t, F = dielectric.rough_eval_lobes(wox, woy, woz, wix, wiy, wiz,
                                                state[S_ETA_GLASS], state[S_ALPHA],
                                                state[S_REFRACT_ONLY] != 0.0,
                                                state[S_WALTER] != 0.0,
                                                state[S_BECKMANN] != 0.0)
-        fr += (f_r + f_t * state[S_TINT]) * w_glass * state[S_MS_GLASS]
-        fg += (f_r + f_t * state[S_TINT + 1]) * w_glass * state[S_MS_GLASS + 1]
-        fb += (f_r + f_t * state[S_TINT + 2]) * w_glass * state[S_MS_GLASS + 2]
+        k0 = k1 = k2 = 1.0
+        if state[S_GLASS_TINTED] != 0.0:        # Specular Tint: per channel F_c for F
+            refl = f_r > 0.0
+            k0 = specular_tint.glass_factor(state, 0, F, state[S_ETA_GLASS], refl)
+            k1 = specular_tint.glass_factor(state, 1, F, state[S_ETA_GLASS], refl)
+            k2 = specular_tint.glass_factor(state, 2, F, state[S_ETA_GLASS], refl)
+        fr += (f_r + f_t * state[S_TINT]) * k0 * w_glass * state[S_MS_GLASS]
+        fg += (f_r + f_t * state[S_TINT + 1]) * k1 * w_glass * state[S_MS_GLASS + 1]
+        fb += (f_r + f_t * state[S_TINT + 2]) * k2 * w_glass * state[S_MS_GLASS + 2]
     return fr, fg, fb
 
 
@@ -401,7 +410,7 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
             refr = True
             ok = ok and allow_t
         else:
-            wix, wiy, wiz, ws, refr, ok = dielectric.smooth_sample(
+            wix, wiy, wiz, ws, refr, ok, F = dielectric.smooth_sample(
                 wox, woy, woz, state[S_ETA_GLASS], u_re, allow_g, allow_t)
         kind = TRANSMISSION if refr else GLOSSY
         if not ok:
@@ -410,6 +419,11 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
         wr, wg, wb = w, w, w
         if refr:
             wr, wg, wb = state[S_TINT] * w, state[S_TINT + 1] * w, state[S_TINT + 2] * w
+        if state[S_GLASS_TINTED] != 0.0:        # Specular Tint: per channel F_c for F
+            eta = state[S_ETA_GLASS]
+            wr *= specular_tint.glass_factor(state, 0, F, eta, not refr)
+            wg *= specular_tint.glass_factor(state, 1, F, eta, not refr)
+            wb *= specular_tint.glass_factor(state, 2, F, eta, not refr)
         if state[S_LAYERED] != 0.0:
             s = layers.S_BASE_SCALE
             wr, wg, wb = wr * state[s], wg * state[s + 1], wb * state[s + 2]

@@ -13,8 +13,15 @@ floor on it, the single-scattering albedo (a_c E + b_c A with E the GGX albedo f
 A the untinted layer's, b_c = (1 - f0_c) / (1 - F0), a_c = f0_c - b_c F0). The diffuse
 below is dimmed by the largest channel's albedo, as Cycles' closure_layering_weight
 does. A white tint never reaches this module (principled.setup), so untinted materials
-pay nothing (principle 3). The metal lobe's tint is F82-tint (fresnel.py); the glass
-lobe's is not modelled (the exporter warns).
+pay nothing (principle 3). The metal lobe's tint is F82-tint (fresnel.py).
+
+The glass lobe (Principled's transmission) takes the same F_c, from F0 = F(1) of its
+IOR: its reflection carries F_c where the untinted lobe carries F, its refraction
+1 - F_c where it carries 1 - F (Cycles: reflectance F_c, transmittance (1 - F_c) times
+the refraction tint). `glass_factor` is that ratio per channel at the pair's own F, so
+the dielectric kernels stay as they are; the reflect/refract choice keeps F (an
+importance choice; the weights carry the tint). Its multiscatter compensation stays
+the refraction tint's, as in Cycles.
 """
 from __future__ import annotations
 
@@ -22,7 +29,7 @@ from ..jit import kernel
 from . import fresnel
 from . import multiscatter as ms
 from .params import P_SPEC_TINT
-from .state import S_MS_E, S_SPEC_F0, S_SPEC_MS, S_SPEC_TINTED
+from .state import S_GLASS_F0, S_GLASS_TINTED, S_MS_E, S_SPEC_F0, S_SPEC_MS, S_SPEC_TINTED
 
 
 @kernel
@@ -74,3 +81,23 @@ def reflectance(state, c, cos_oh, eta_spec):
     s = remap(fresnel.dielectric(cos_oh, eta_spec), fresnel.f0_from_ior(eta_spec))
     f0 = state[S_SPEC_F0 + c]
     return (f0 + (1.0 - f0) * s) * state[S_SPEC_MS + c]
+
+
+@kernel
+def glass_setup(row, eta, state):
+    """The glass lobe's tinted F0 per channel (Cycles: F0(ior) x tint, saturated)."""
+    state[S_GLASS_TINTED] = 1.0
+    f0_real = fresnel.f0_from_ior(eta)
+    for c in range(3):
+        state[S_GLASS_F0 + c] = min(max(f0_real * row[P_SPEC_TINT + c], 0.0), 1.0)
+
+
+@kernel
+def glass_factor(state, c, F, eta, reflected):
+    """F_c / F for a reflection, (1 - F_c) / (1 - F) for a refraction, at the pair's
+    Fresnel reflectance F (dielectric.rough_eval_lobes, smooth_sample)."""
+    f0 = state[S_GLASS_F0 + c]
+    Fc = f0 + (1.0 - f0) * remap(F, fresnel.f0_from_ior(eta))
+    if reflected:
+        return Fc / F if F > 0.0 else 0.0
+    return (1.0 - Fc) / (1.0 - F) if F < 1.0 else 0.0

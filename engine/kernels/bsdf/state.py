@@ -29,4 +29,6 @@ S_METAL_B = layers.NSTATE + 4      # 3: F82-tint's b per channel
 S_SPEC_TINTED = layers.NSTATE + 7  # 1: the specular layer has a Specular Tint (specular_tint.py)
 S_SPEC_F0 = layers.NSTATE + 8      # 3: ... its tinted F0 per channel
 S_SPEC_MS = layers.NSTATE + 11     # 3: ... its multiscatter factor per channel
-NSTATE = layers.NSTATE + 14
+S_GLASS_TINTED = layers.NSTATE + 14  # 1: the glass lobe has a Specular Tint (specular_tint.py)
+S_GLASS_F0 = layers.NSTATE + 15      # 3: ... its tinted F0 per channel
+NSTATE = layers.NSTATE + 18
