@@ -5,8 +5,10 @@ Cycles' multiple-scattering compensation of the GGX lobes; the lobe selection by
 estimates with the MIN_SELECTION floor; the `allowed` masks). Same formulas, same order
 of operations, so the values agree with the NumPy class to rounding (to the bit where the
 maths library agrees). Coat, sheen, translucency and the Refraction BSDF's refraction-only
-glass (layers.py; rows with P_LAYERS / P_REFRACT_ONLY) exist in the compiled BSDF only.
-The state's slots: state.py.
+glass (layers.py; rows with P_LAYERS / P_REFRACT_ONLY), the Beckmann distribution
+(beckmann.py), the Glossy BSDF's constant and the Specular Tint's F82-tint metal Fresnel
+(reflection_lobes.py) and the tinted specular layer and glass (specular_tint.py) exist in
+the compiled BSDF only. The state's slots: state.py.
 
 Use, per hit:
     setup(row, front_facing, wox, woy, woz, tables, state)   # fills state[:NSTATE]
@@ -25,23 +27,24 @@ from __future__ import annotations
 import math
 
 from ..jit import kernel
-from . import blinn_phong, dielectric, fresnel, layers, specular_tint
+from . import dielectric, fresnel, layers, specular_tint
 from . import microfacet as mf
 from . import multiscatter as ms
 from .albedo import specular_albedo
 from .compensation import compensate
-from .state import (NSTATE, S_ALPHA, S_BECKMANN, S_BLINN, S_DIFFUSE, S_EST, S_ETA_GLASS,  # noqa: F401
-                    S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH, S_LAYERED, S_METAL_F0, S_MS_E,
-                    S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY, S_TINT, S_W_GLASS,
-                    S_W_METAL, S_W_SPEC, S_WALTER, S_METAL_CONST, S_METAL_F82,
-                    S_METAL_B, S_SPEC_TINTED, S_GLASS_TINTED)
-from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX,  # noqa: F401
-                     NPARAM, P_BASE,
-                     P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
-                     P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR, P_LAYERS, P_METAL_COLOR,
-                     P_METAL_CONSTANT, P_METALLIC, P_REFRACT_ONLY, P_ROUGHNESS,
-                     P_SPEC_TINT,
-                     P_SPEC_LEVEL, P_TRANSMISSION, pack_materials)
+from .reflection_lobes import (f82_setup, metal_fresnel, reflection_eval, reflection_pdf,
+                               reflection_sample)
+from .state import (NSTATE, S_ALPHA, S_BECKMANN, S_BLINN, S_DIFFUSE,  # noqa: F401
+                    S_EST, S_ETA_GLASS, S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH,
+                    S_GLASS_TINTED, S_LAYERED, S_METAL_CONST, S_METAL_F0, S_METAL_F82,
+                    S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY,
+                    S_SPEC_TINTED, S_TINT, S_W_GLASS, S_W_METAL, S_W_SPEC, S_WALTER)
+from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX,  # noqa: F401
+                     GLOSSY_MULTI_GGX, NPARAM, P_BASE, P_GLASS_COLOR, P_GLOSSY_MODEL,
+                     P_HAS_GLASS_COLOR, P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR,
+                     P_LAYERS, P_METAL_COLOR, P_METAL_CONSTANT, P_METALLIC,
+                     P_REFRACT_ONLY, P_ROUGHNESS, P_SPEC_LEVEL, P_TRANSMISSION,
+                     pack_materials)
 from .tables import kernel_tables  # noqa: F401  (re-exported)
 from ..warp import INV_PI, cosine_hemisphere
 
@@ -175,35 +178,6 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
 
 
 @kernel
-def metal_fresnel(state, c, cos_oh):
-    """The metal lobe's Fresnel factor in channel c: Schlick's from F0 (Principled),
-    F82-tint where Specular Tint is not white, or F0 itself at every angle (a Glossy
-    BSDF: Cycles gives it no Fresnel term, its colour is the closure's weight)."""
-    if state[S_METAL_CONST] != 0.0:
-        return state[S_METAL_F0 + c]
-    if state[S_METAL_F82] != 0.0:
-        return fresnel.f82_tint(state[S_METAL_F0 + c], state[S_METAL_B + c], cos_oh)
-    return fresnel.schlick(state[S_METAL_F0 + c], cos_oh)
-
-
-@kernel
-def f82_setup(row, state):
-    """Cycles' F82-tint metal (Kutz et al., "Novel aspects of the Adobe Standard
-    Material"): Schlick's Fresnel minus b mu (1 - mu)^6, with b per channel such that at
-    mu = 1/7 (about 82 degrees) it is Schlick's value times the tint. Nothing to do for
-    a white tint (plain Schlick)."""
-    tinted = False
-    for c in range(3):
-        tinted = tinted or min(row[P_SPEC_TINT + c], 1.0) != 1.0
-    if not tinted:
-        return
-    state[S_METAL_F82] = 1.0
-    for c in range(3):                        # Cycles clamps the F82 tint to 1
-        state[S_METAL_B + c] = fresnel.f82_tint_b(state[S_METAL_F0 + c],
-                                                  min(row[P_SPEC_TINT + c], 1.0))
-
-
-@kernel
 def transmits(state):
     """True where light from behind the surface can contribute (glass, translucency)."""
     return state[S_W_GLASS] > 0.0 or (state[S_LAYERED] != 0.0
@@ -225,32 +199,6 @@ def selection(state, allow_d, allow_g, allow_t):
     if not total > 0.0:
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     return w0 / total, w1 / total, w2 / total, w3 / total, wc / total, ws / total, wt / total
-
-
-@kernel
-def reflection_eval(state, ox, oy, oz, ix, iy, iz):
-    """D G / (4 cos cos) of the reflection lobes (GGX, Beckmann or Blinn-Phong) and h."""
-    if state[S_BLINN] != 0.0:
-        hx, hy, hz, _ = mf.half_vector(ox, oy, oz, ix, iy, iz)
-        return blinn_phong.eval_f(ox, oy, oz, ix, iy, iz, state[S_EXPONENT]), hx, hy, hz
-    return mf.reflection_eval_of(ox, oy, oz, ix, iy, iz, state[S_ALPHA],
-                                 state[S_BECKMANN] != 0.0)
-
-
-@kernel
-def reflection_pdf(state, ox, oy, oz, ix, iy, iz):
-    if state[S_BLINN] != 0.0:
-        return blinn_phong.pdf(ox, oy, oz, ix, iy, iz, state[S_EXPONENT])
-    return mf.reflection_pdf_of(ox, oy, oz, ix, iy, iz, state[S_ALPHA],
-                                state[S_BECKMANN] != 0.0)
-
-
-@kernel
-def reflection_sample(state, ox, oy, oz, u1, u2):
-    if state[S_BLINN] != 0.0:
-        return blinn_phong.sample(ox, oy, oz, u1, u2, state[S_EXPONENT])
-    return mf.reflection_sample_of(ox, oy, oz, state[S_ALPHA], u1, u2,
-                                   state[S_BECKMANN] != 0.0)
 
 
 @kernel
