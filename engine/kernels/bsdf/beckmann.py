@@ -1,7 +1,7 @@
 """The Beckmann microfacet distribution, scalar: D, Smith masking and visible-normal
 sampling, for the nodes that offer it (Glossy, Glass and Refraction BSDF; Blender's
 default for the Refraction BSDF). The GGX twin of each function is in microfacet.py;
-`microfacet.py`'s dispatchers pick one per closure.
+distribution.py picks one of the two per closure.
 
 Formulas (alpha = roughness^2, isotropic, clamped as GGX's; directions in the local
 frame, normal = +Z):
@@ -35,18 +35,13 @@ from __future__ import annotations
 import math
 
 from ..jit import kernel
+from .microfacet import clamp_alpha     # the same clamp as GGX's
 
-ALPHA_MIN = 1e-4            # as microfacet.py (GGX): the same clamp for both
 INV_PI = 1.0 / math.pi
 SQRT_PI = math.sqrt(math.pi)
 INV_SQRT_PI = 1.0 / SQRT_PI
 TWO_PI = 2.0 * math.pi
 ONE_MINUS_EPS = 1.0 - 2.0 ** -53
-
-
-@kernel
-def clamp_alpha(alpha):
-    return min(max(alpha, ALPHA_MIN), 1.0)
 
 
 @kernel

@@ -16,6 +16,7 @@ import math
 from ..jit import kernel
 from . import beckmann as bk
 from . import fresnel
+from . import distribution as dist
 from . import microfacet as mf
 
 # Below this GGX alpha a rough interface is treated as smooth; |eta - 1| below
@@ -138,7 +139,7 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter, b
     oz = oz * sign
     iz = iz * sign
     if iz > 0.0:
-        base_r, hx, hy, hz = mf.reflection_eval_of(ox, oy, oz, ix, iy, iz, a, beckmann)
+        base_r, hx, hy, hz = dist.reflection_eval_of(ox, oy, oz, ix, iy, iz, a, beckmann)
         if base_r == 0.0 or refract_only:
             return 0.0, 0.0, 0.0
         F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
@@ -175,7 +176,7 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, 
     sign, eta_rel = canonical(oz, eta)
     oz = oz * sign
     iz = iz * sign
-    g1c = mf.G1_over_cos_of(ox, oy, oz, a, beckmann)
+    g1c = dist.G1_over_cos_of(ox, oy, oz, a, beckmann)
     if iz > 0.0:
         # reflection: P(reflect | h) D_wo(h) / (4 wo.h)
         hx, hy, hz, ok = mf.half_vector(ox, oy, oz, ix, iy, iz)
@@ -183,7 +184,7 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, 
             return 0.0
         F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
         pr, _ = choice_probs(F_r, allow_reflect, allow_refract)
-        return pr * 0.25 * g1c * mf.D_of(hx, hy, hz, a, beckmann)
+        return pr * 0.25 * g1c * dist.D_of(hx, hy, hz, a, beckmann)
     # refraction: P(refract | h) D_wo(h) |dh/dwi|
     hx, hy, hz, s, cos_oh, cos_ih, usable = cycles_pair(ox, oy, oz, ix, iy, iz, eta_rel,
                                                         walter)
@@ -195,7 +196,7 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, 
     if not den > 0.0:
         return 0.0
     jac = eta_rel * eta_rel * (-cos_ih) / den
-    return pt * g1c * cos_oh * mf.D_of(hx, hy, hz, a, beckmann) * jac
+    return pt * g1c * cos_oh * dist.D_of(hx, hy, hz, a, beckmann) * jac
 
 
 @kernel
@@ -207,7 +208,7 @@ def rough_sample(ox, oy, oz, eta, alpha, u_choice, u0, u1, allow_reflect, allow_
     a = mf.clamp_alpha(alpha)
     sign, eta_rel = canonical(oz, eta)
     oz = oz * sign
-    hx, hy, hz = mf.sample_visible_normal_of(ox, oy, oz, a, u0, u1, beckmann)
+    hx, hy, hz = dist.sample_visible_normal_of(ox, oy, oz, a, u0, u1, beckmann)
     cos_oh = mf.dot(ox, oy, oz, hx, hy, hz)
     F, cos_t, eta_t = fresnel.dielectric_full(max(cos_oh, 0.0), eta_rel)
     pr, pt = choice_probs(F, allow_reflect, allow_refract)
@@ -229,8 +230,8 @@ def rough_sample(ox, oy, oz, eta, alpha, u_choice, u0, u1, allow_reflect, allow_
     else:
         ok = ok and iz > 0.0
     # the pdf of the choice made must be positive
-    g1c = mf.G1_over_cos_of(ox, oy, oz, a, beckmann)
-    d = mf.D_of(hx, hy, hz, a, beckmann)
+    g1c = dist.G1_over_cos_of(ox, oy, oz, a, beckmann)
+    d = dist.D_of(hx, hy, hz, a, beckmann)
     if refr:
         cos_ih = mf.dot(ix, iy, iz, hx, hy, hz)
         s = cos_oh + eta_t * cos_ih

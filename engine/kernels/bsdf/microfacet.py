@@ -1,6 +1,6 @@
 """GGX microfacet distribution, Smith masking, visible-normal sampling and the GGX
-reflection lobe, scalar: the compiled twin of engine/bsdf/microfacet.py. The `..._of`
-functions at the end take a `beckmann` flag and dispatch to GGX or to beckmann.py.
+reflection lobe, scalar: the compiled twin of engine/bsdf/microfacet.py. Its Beckmann
+twin is beckmann.py; distribution.py picks one of the two per closure.
 
 Directions are three floats (x, y, z) in the local frame (normal = +Z), pointing away
 from the surface. Same formulas and operation order as the NumPy module (see there for
@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 
 from ..jit import kernel
-from . import beckmann as bk
 
 ALPHA_MIN = 1e-4
 INV_PI = 1.0 / math.pi
@@ -148,59 +147,3 @@ def reflection_sample(ox, oy, oz, alpha, u0, u1):
              and dot(ox, oy, oz, hx, hy, hz) > 0.0)
     return ix, iy, iz, valid
 
-
-# --- either distribution: GGX, or Beckmann where `beckmann` is set ---------------------
-
-@kernel
-def D_of(hx, hy, hz, alpha, beckmann):
-    if beckmann:
-        return bk.D(hx, hy, hz, alpha)
-    return D(hx, hy, hz, alpha)
-
-
-@kernel
-def G1_over_cos_of(x, y, z, alpha, beckmann):
-    if beckmann:
-        return bk.G1_over_cos(x, y, z, alpha)
-    return G1_over_cos(x, y, z, alpha)
-
-
-@kernel
-def reflection_eval_of(ox, oy, oz, ix, iy, iz, alpha, beckmann):
-    """`reflection_eval` of either distribution."""
-    if not beckmann:
-        return reflection_eval(ox, oy, oz, ix, iy, iz, alpha)
-    hx, hy, hz, ok = half_vector(ox, oy, oz, ix, iy, iz)
-    if not ok:
-        return 0.0, hx, hy, hz
-    return bk.reflection_eval(ox, oy, oz, ix, iy, iz, hx, hy, hz, alpha), hx, hy, hz
-
-
-@kernel
-def reflection_pdf_of(ox, oy, oz, ix, iy, iz, alpha, beckmann):
-    """`reflection_pdf` of either distribution."""
-    if not beckmann:
-        return reflection_pdf(ox, oy, oz, ix, iy, iz, alpha)
-    hx, hy, hz, ok = half_vector(ox, oy, oz, ix, iy, iz)
-    if not (ok and oz > 0.0 and iz > 0.0):
-        return 0.0
-    return bk.reflection_pdf(ox, oy, oz, hx, hy, hz, alpha)
-
-
-@kernel
-def sample_visible_normal_of(ox, oy, oz, alpha, u0, u1, beckmann):
-    if beckmann:
-        return bk.sample_visible_normal(ox, oy, oz, alpha, u0, u1)
-    return sample_visible_normal(ox, oy, oz, alpha, u0, u1)
-
-
-@kernel
-def reflection_sample_of(ox, oy, oz, alpha, u0, u1, beckmann):
-    """`reflection_sample` of either distribution."""
-    if not beckmann:
-        return reflection_sample(ox, oy, oz, alpha, u0, u1)
-    hx, hy, hz = bk.sample_visible_normal(ox, oy, oz, alpha, u0, u1)
-    ix, iy, iz = reflect(ox, oy, oz, hx, hy, hz)
-    valid = (oz > 0.0 and iz > 0.0 and hz > 0.0
-             and dot(ox, oy, oz, hx, hy, hz) > 0.0)
-    return ix, iy, iz, valid

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from ..jit import kernel
 from . import blinn_phong, fresnel
+from . import distribution as dist
 from . import microfacet as mf
 from .params import P_SPEC_TINT
 from .state import (S_ALPHA, S_BECKMANN, S_BLINN, S_EXPONENT, S_METAL_B, S_METAL_CONST,
@@ -48,7 +49,7 @@ def reflection_eval(state, ox, oy, oz, ix, iy, iz):
     if state[S_BLINN] != 0.0:
         hx, hy, hz, _ = mf.half_vector(ox, oy, oz, ix, iy, iz)
         return blinn_phong.eval_f(ox, oy, oz, ix, iy, iz, state[S_EXPONENT]), hx, hy, hz
-    return mf.reflection_eval_of(ox, oy, oz, ix, iy, iz, state[S_ALPHA],
+    return dist.reflection_eval_of(ox, oy, oz, ix, iy, iz, state[S_ALPHA],
                                  state[S_BECKMANN] != 0.0)
 
 
@@ -56,7 +57,7 @@ def reflection_eval(state, ox, oy, oz, ix, iy, iz):
 def reflection_pdf(state, ox, oy, oz, ix, iy, iz):
     if state[S_BLINN] != 0.0:
         return blinn_phong.pdf(ox, oy, oz, ix, iy, iz, state[S_EXPONENT])
-    return mf.reflection_pdf_of(ox, oy, oz, ix, iy, iz, state[S_ALPHA],
+    return dist.reflection_pdf_of(ox, oy, oz, ix, iy, iz, state[S_ALPHA],
                                 state[S_BECKMANN] != 0.0)
 
 
@@ -64,5 +65,5 @@ def reflection_pdf(state, ox, oy, oz, ix, iy, iz):
 def reflection_sample(state, ox, oy, oz, u1, u2):
     if state[S_BLINN] != 0.0:
         return blinn_phong.sample(ox, oy, oz, u1, u2, state[S_EXPONENT])
-    return mf.reflection_sample_of(ox, oy, oz, state[S_ALPHA], u1, u2,
+    return dist.reflection_sample_of(ox, oy, oz, state[S_ALPHA], u1, u2,
                                    state[S_BECKMANN] != 0.0)
