@@ -25,8 +25,8 @@ import os
 import tempfile
 
 import numba
-from numba import njit
-from numba.core import caching
+from numba import njit, types
+from numba.core import caching, event
 
 ENGINE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -100,12 +100,55 @@ if CACHE and EngineCacheLocator not in caching.CacheImpl._locator_classes:
     caching.CacheImpl._locator_classes.insert(0, EngineCacheLocator)
 
 
-def kernel(fn=None, **options):
+def kernel(fn=None, *, allocates=True, **options):
     """@kernel or @kernel(option=...): njit, GIL released, cached when possible.
     Floating-point semantics stay IEEE (no fastmath), so results match the NumPy
-    reference implementations bit for bit where the operations are the same."""
+    reference implementations bit for bit where the operations are the same.
+
+    allocates=False marks a function that kernels call per ray, that creates no array
+    and returns none (scalars, or tuples of them): it is compiled without Numba's
+    reference counting (`_nrt=False`). Its arrays are borrowed from the caller, which
+    holds them for the call. Counted, every array it is given, also each array of a
+    tuple such as the light table, costs an atomic increment on entry and a decrement on
+    return, per call: 26% of a Cornell box render's time before these functions were
+    marked (measured with perf; docs/benchmarks.md, section 1). Numba refuses to compile
+    such a function if it allocates, or returns a new array or a view; `BorrowingCheck`
+    refuses one that returns an argument array. tests/test_kernel_borrowing.py checks
+    both and that renders leak no allocation."""
     opts = dict(nogil=True, cache=CACHE, error_model="numpy")
+    if not allocates:
+        opts["_nrt"] = False
     opts.update(options)
     if fn is None:
         return lambda f: njit(**opts)(f)
     return njit(**opts)(fn)
+
+
+def holds_array(ty) -> bool:
+    """Whether a Numba type is, or is a tuple holding, an array."""
+    if isinstance(ty, types.ArrayCompatible):
+        return True
+    if isinstance(ty, types.BaseTuple):
+        return any(holds_array(t) for t in ty.types)
+    return False
+
+
+class BorrowingCheck(event.Listener):
+    """Refuses, as it compiles, a kernel without reference counting whose result holds
+    an array: its caller would release a reference the kernel never took."""
+
+    def on_start(self, ev):
+        pass
+
+    def on_end(self, ev):
+        dispatcher = (ev.data or {}).get("dispatcher")
+        if dispatcher is None or dispatcher.targetoptions.get("_nrt") is not False:
+            return
+        for sig, cres in list(dispatcher.overloads.items()):
+            if holds_array(cres.signature.return_type):
+                del dispatcher.overloads[sig]
+                raise TypeError(f"{dispatcher.py_func.__qualname__}{sig} returns an array but "
+                                "is marked @kernel(allocates=False)")
+
+
+event.register("numba:compile", BorrowingCheck())

@@ -57,7 +57,7 @@ HET_DIM = 1 << 26          # the tracking's own random numbers (hashed: any coun
 SHADOW = visibility.SHADOW
 
 
-@kernel
+@kernel(allocates=False)
 def has_heterogeneous(vol):
     for m in range(vol.shape[0]):
         if vol[m, V_HET] != 0.0:
@@ -65,7 +65,7 @@ def has_heterogeneous(vol):
     return False
 
 
-@kernel
+@kernel(allocates=False)
 def heterogeneous_in(vol, stacks, p):
     """Whether path (or shadow ray) p's medium has a heterogeneous entry."""
     for k in range(stacks.shape[1]):
@@ -77,7 +77,7 @@ def heterogeneous_in(vol, stacks, p):
     return False
 
 
-@kernel
+@kernel(allocates=False)
 def row_coefficients(vol, m, T, objects, camera, px, py, pz, dx, dy, dz, ray, depth,
                      hit, regs, count):
     """Heterogeneous row m's (sigma_a RGB, sigma_s RGB, emission RGB) at point p, for a
@@ -101,7 +101,7 @@ def row_coefficients(vol, m, T, objects, camera, px, py, pz, dx, dy, dz, ray, de
     return sar, sag, sab, ssr, ssg, ssb, er, eg, eb
 
 
-@kernel
+@kernel(allocates=False)
 def point_medium(vol, stacks, p, T, objects, camera, px, py, pz, dx, dy, dz, ray, depth,
                  hit, regs, count):
     """The medium of p's stack at a point: (sigma_a RGB, sigma_s RGB, g, emission RGB),
@@ -126,7 +126,7 @@ def point_medium(vol, stacks, p, T, objects, camera, px, py, pz, dx, dy, dz, ray
     return sar, sag, sab, ssr, ssg, ssb, gw / gs if gs > 0.0 else 0.0, er, eg, eb
 
 
-@kernel
+@kernel(allocates=False)
 def majorant(vol, stacks, p):
     """The majorant of p's medium: the heterogeneous rows' V_MAJ plus the homogeneous
     rows' largest extinction or emission channel."""
@@ -162,7 +162,7 @@ def shadow_keys(pkey, index, sh_path, depth):
     return out
 
 
-@kernel
+@kernel(allocates=False)
 def tracked_segment(vol, stacks, p, T, objects, camera, ox, oy, oz, dx, dy, dz, t, t_mark,
                     br, bg, bb, ray, depth, key, hit, regs, count):
     """Path p (throughput b) travels distance t (inf: to infinity) from o along d through
@@ -208,7 +208,7 @@ def tracked_segment(vol, stacks, p, T, objects, camera, ox, oy, oz, dx, dy, dz, 
     return False, t, 0.0, 0.0, 0.0, mr, mg, mb, Er, Eg, Eb, 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def tracked_transmittance(vol, stacks, r, T, objects, camera, ox, oy, oz, dx, dy, dz, t,
                           key, hit, regs, count):
     """Ratio tracking: an unbiased estimate of shadow ray r's transmittance (RGB) over
@@ -238,7 +238,7 @@ def tracked_transmittance(vol, stacks, r, T, objects, camera, ox, oy, oz, dx, dy
     return 0.0, 0.0, 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def attenuate_tracked(vol, stacks, r, trans, T, objects, camera, ox, oy, oz, dx, dy, dz,
                       t, key, hit, regs, count):
     tr, tg, tb = tracked_transmittance(vol, stacks, r, T, objects, camera, ox, oy, oz,
@@ -248,7 +248,7 @@ def attenuate_tracked(vol, stacks, r, trans, T, objects, camera, ox, oy, oz, dx,
     trans[r, 2] *= tb
 
 
-@kernel
+@kernel(allocates=False)
 def _sample_row(vol, m, T, objects, camera, lo, hi, n, seed):
     """The largest extinction or emission channel of row m over n^3 jittered points of
     the box [lo, hi]."""

@@ -58,7 +58,7 @@ def clamp_scale(r, g, b, limit):
     return 1.0
 
 
-@kernel
+@kernel(allocates=False)
 def _add(L, p, r, g, b, limit):
     if limit > 0.0 and max(r, g, b) == _INF:
         # an overflowed contribution (parameters near float32's limit, multiplied over

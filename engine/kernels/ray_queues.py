@@ -28,7 +28,7 @@ def towards(sox, soy, soz, px, py, pz, wx, wy, wz, dist, margin, scene_radius):
     return sdx, sdy, sdz, max(far, 0.0)
 
 
-@kernel
+@kernel(allocates=False)
 def push(n, p, b, ox, oy, oz, dx, dy, dz, far, cr, cg, cb, sh_path, sh_org, sh_dir, sh_far,
          sh_contrib, sh_bounce, stacks, sh_stack):
     """Write shadow ray n of path p at its bounce b (contribution c if unoccluded; the
@@ -41,11 +41,12 @@ def push(n, p, b, ox, oy, oz, dx, dy, dz, far, cr, cg, cb, sh_path, sh_org, sh_d
     sh_far[n] = far
     sh_contrib[n, 0], sh_contrib[n, 1], sh_contrib[n, 2] = cr, cg, cb
     if sh_stack.shape[0] > 0:
-        sh_stack[n, :] = stacks[p, :]
+        for i in range(sh_stack.shape[1]):    # element-wise: a slice copy allocates
+            sh_stack[n, i] = stacks[p, i]
     return n + 1
 
 
-@kernel
+@kernel(allocates=False)
 def push_next(n, p, ox, oy, oz, dx, dy, dz, nx_path, nx_org, nx_dir):
     """Write next ray n: path p goes on from o along d. Returns n + 1."""
     nx_path[n] = p

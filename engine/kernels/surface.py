@@ -16,7 +16,7 @@ from .motion import I_KIND, I_NVERTS, I_SLICES, I_VERT0, RIGID, adjugate_columns
     rigid_at
 
 
-@kernel
+@kernel(allocates=False)
 def rebuild(positions, corners, center, corner_normals, prim, u, v, dx, dy, dz):
     """The hit of a ray with direction d on static triangle `prim` at barycentrics (u, v):
     its corners are rows corners[prim] of positions (engine.surface.SurfaceBuilder), its
@@ -71,7 +71,7 @@ def unit_normal(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z):
     return 0.0, 0.0, 1.0
 
 
-@kernel
+@kernel(allocates=False)
 def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
     """`rebuild` for any triangle, static or moving, hit at shutter time `time`.
     geometry: (positions, corners, center, material, corner_normals, holdout, corner_uvs,

@@ -72,7 +72,7 @@ def smooth_lift(positions, corners, c, prim, u, v, px, py, pz, gx, gy, gz):
     return nx * h, ny * h, nz * h
 
 
-@kernel
+@kernel(allocates=False)
 def shadow_origin(positions, corners, corner_normals, cutoff, prim, u, v, px, py, pz, gx,
                   gy, gz, nx, ny, nz, scale, wx, wy, wz):
     """The origin of a shadow ray from hit p (barycentrics (u, v) of triangle prim, whose

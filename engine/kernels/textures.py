@@ -194,7 +194,7 @@ def _blend(tx, ty, a, b, c, d):
     return (1.0 - ty) * ((1.0 - tx) * a + tx * b) + ty * ((1.0 - tx) * c + tx * d)
 
 
-@kernel
+@kernel(allocates=False)
 def texture_rgba(T, tex_id, u, v):
     """`Texture.lookup` of texture `tex_id` at (u, v): scene-linear (r, g, b, a) float64.
     Non-finite coordinates read as 0; an id out of range reads Cycles' missing-image
@@ -256,13 +256,13 @@ def apply_channel(r, g, b, a, channel):
 
 
 # ---------------------------------------------------------------- material parameters
-@kernel
+@kernel(allocates=False)
 def is_textured(T, material, param):
     """Whether parameter `param` (TEX_*) of `material` comes from a texture."""
     return T[INPUTS][material, param, I_TEXTURE] >= 0
 
 
-@kernel
+@kernel(allocates=False)
 def textured_value(T, material, param, u, v):
     """`TextureInput.evaluate` of (material, param) at (u, v): channel x scale + offset.
     Colour parameters (TEX_BASE_COLOR, TEX_EMISSION): (r, g, b); scalar ones: (value, 0,
@@ -278,7 +278,7 @@ def textured_value(T, material, param, u, v):
     return x * so[material, param, 0] + so[material, param, 3], 0.0, 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def apply_to_row(T, material, u, v, row, P_BASE, P_METALLIC, P_ROUGHNESS):
     """Overwrite the textured base colour (row[P_BASE:P_BASE + 3]), metallic and
     roughness of `material` at (u, v) in its float64 parameter row (engine.kernels.bsdf
@@ -295,7 +295,7 @@ def apply_to_row(T, material, u, v, row, P_BASE, P_METALLIC, P_ROUGHNESS):
         row[P_ROUGHNESS] = textured_value(T, material, TEX_ROUGHNESS, u, v)[0]
 
 
-@kernel
+@kernel(allocates=False)
 def emission_at(T, emission_table, material, u, v):
     """`MaterialTable.emission_at` of one hit: (r, g, b); `emission_table` is
     `MaterialTable.emission` (n_mat, 3) (zero where the emission is textured)."""
@@ -305,7 +305,7 @@ def emission_at(T, emission_table, material, u, v):
             emission_table[material, 2])
 
 
-@kernel
+@kernel(allocates=False)
 def alpha_at(T, alpha_table, material, u, v):
     """`MaterialTable.alpha_at` of one hit: coverage clipped to [0, 1] (NaN stays NaN, as
     with np.clip); `alpha_table` is `MaterialTable.alpha` (n_mat,)."""

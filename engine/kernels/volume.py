@@ -80,7 +80,7 @@ def volume_dim(depth, offset):
 
 
 # --------------------------------------------------------------------------- stacks
-@kernel
+@kernel(allocates=False)
 def stack_cross(stacks, p, m, entering):
     """Path p crosses a surface of material row m: entering pushes m, leaving removes
     one entry of m (none: nothing). A full stack ignores a push."""
@@ -99,12 +99,12 @@ def stack_cross(stacks, p, m, entering):
             return
 
 
-@kernel
+@kernel(allocates=False)
 def in_medium(stacks, p):
     return stacks.shape[0] > 0 and stacks[p, 0] >= 0
 
 
-@kernel
+@kernel(allocates=False)
 def medium(vol, stacks, p):
     """The medium at path p's position: (sigma_a RGB, sigma_s RGB, g, emission RGB),
     summed over its stack (g: the scattering-weighted mean)."""
@@ -130,7 +130,7 @@ def medium(vol, stacks, p):
     return sar, sag, sab, ssr, ssg, ssb, g, er, eg, eb
 
 
-@kernel
+@kernel(allocates=False)
 def extinction(vol, stacks, p):
     sar, sag, sab, ssr, ssg, ssb, _, _, _, _ = medium(vol, stacks, p)
     return sar + ssr, sag + ssg, sab + ssb
@@ -154,7 +154,7 @@ def _tr(st, t):
     return math.exp(-st * t) if math.isfinite(t) else 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def segment(vol, stacks, p, br, bg, bb, t, u_channel, u_distance):
     """Path p (throughput b) travels distance t (inf: to infinity) through its medium.
 
@@ -243,7 +243,7 @@ def hg_sample(g, dx, dy, dz, u1, u2):
 
 
 # --------------------------------------------------------------------------- shadows
-@kernel
+@kernel(allocates=False)
 def attenuate(vol, stacks, r, trans, t):
     """Shadow ray r's transmittance through its medium over distance t."""
     if not in_medium(stacks, r):

@@ -59,7 +59,7 @@ def bent_normal(hit, nx, ny, nz, strength, distance, width, dhx, dhy):
     return x / ln, y / ln, z / ln
 
 
-@kernel
+@kernel(allocates=False)
 def execute(ins, regs, hit):
     code, out = ins[0], ins[1]
     if code == BUMP_ENTER:

@@ -206,7 +206,7 @@ def extrapolated(data, start, f, channel):
     return ramp(data, start, f, 1, channel)
 
 
-@kernel
+@kernel(allocates=False)
 def execute(ins, regs, data):
     code, out = ins[0], ins[1]
     if code == COL_MIX:

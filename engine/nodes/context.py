@@ -93,7 +93,7 @@ def object_row(matrix_world, color=(1.0, 1.0, 1.0), random=0.0, pass_index=0,
 IDENTITY_OBJECT = object_row(np.eye(4))
 
 
-@kernel
+@kernel(allocates=False)
 def fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, u, v, front, ray, depth,
          length, objects, obj, camera, tx, ty, tz, ts, cr, cg, cb, ca):
     """Write one hit row's fields of the hit itself (the path's fields and the

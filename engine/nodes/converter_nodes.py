@@ -263,7 +263,7 @@ def hsl_to_rgb(h, s, l):
             _hue_to_rgb(p, q, h - 1.0 / 3.0))
 
 
-@kernel
+@kernel(allocates=False)
 def execute(ins, regs):
     code, out = ins[0], ins[1]
     a = ins[2]

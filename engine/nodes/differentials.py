@@ -105,7 +105,7 @@ def _corner_step(corners, prim, k, b1, b2):
     return (c[1, k] - c[0, k]) * b1 + (c[2, k] - c[0, k]) * b2
 
 
-@kernel
+@kernel(allocates=False)
 def _fill_step(hit, block, geometry, prim, obj, camera, sx, sy, sz):
     """One block of differentials (H_DX or H_DY): the change of each field over the
     surface step s."""
@@ -159,7 +159,7 @@ def orthonormals(nx, ny, nz):
     return ax, ay, az, ny * az - nz * ay, nz * ax - nx * az, nx * ay - ny * ax
 
 
-@kernel
+@kernel(allocates=False)
 def fill_differentials(hit, geometry, prim, obj, camera):
     """The differentials of hit row `hit` (its fields and footprint written) on triangle
     prim of object row obj (-1: none); camera: the packed render camera (empty: none).

@@ -38,7 +38,7 @@ def fresnel_dielectric_cos(cosi, eta):
     return 1.0
 
 
-@kernel
+@kernel(allocates=False)
 def _cos_in(regs, hit, n):
     nx, ny, nz = regs[n], regs[n + 1], regs[n + 2]
     ln = math.sqrt(nx * nx + ny * ny + nz * nz)
@@ -47,7 +47,7 @@ def _cos_in(regs, hit, n):
     return hit[H_I] * nx + hit[H_I + 1] * ny + hit[H_I + 2] * nz
 
 
-@kernel
+@kernel(allocates=False)
 def execute(ins, regs, hit):
     code, out = ins[0], ins[1]
     if code == IN_HIT3:

@@ -11,19 +11,19 @@ from . import bump, color_nodes, converter_nodes, input_nodes, procedural_nodes,
 from .pack import DATA, INIT, NREGS, OPS, PROG, pack_shading
 
 
-@kernel
+@kernel(allocates=False)
 def has_program(T, m):
     prog = T[PROG]
     return 0 <= m < prog.shape[0] and prog[m, 1] > 0
 
 
-@kernel
+@kernel(allocates=False)
 def reads_differentials(T, m):
     """Whether material m's program reads the hit's differentials (context.H_DX, H_DY)."""
     return has_program(T, m) and T[PROG][m, 4] != 0
 
 
-@kernel
+@kernel(allocates=False)
 def run(T, m, hit, regs):
     """Run material m's program on the hit row `hit`; its registers end in regs (at
     least T[NREGS][0] long). No-op for a material without a program."""

@@ -46,7 +46,7 @@ TEX_BRICK_COLOR = 128
 VORONOI_OUTPUTS = ("Distance", "Color", "Position", "W", "Radius")
 
 
-@kernel
+@kernel(allocates=False)
 def texture_point(regs, dims, v, w, scale):
     """The node's point (its first `dims` coordinates used; a 1D point is W) times
     scale."""
@@ -55,7 +55,7 @@ def texture_point(regs, dims, v, w, scale):
     return regs[v] * scale, regs[v + 1] * scale, regs[v + 2] * scale, w * scale
 
 
-@kernel
+@kernel(allocates=False)
 def execute_noise(ins, regs):
     out, v, a, b, c, mode = ins[1], ins[2], ins[3], ins[4], ins[5], ins[6]
     dims = mode % 8
@@ -69,7 +69,7 @@ def execute_noise(ins, regs):
         regs[out] = fac
 
 
-@kernel
+@kernel(allocates=False)
 def execute_voronoi(ins, regs):
     out, v, a, b, c, mode = ins[1], ins[2], ins[3], ins[4], ins[5], ins[6]
     dims = mode % 8
@@ -93,7 +93,7 @@ def execute_voronoi(ins, regs):
         regs[out] = radius
 
 
-@kernel
+@kernel(allocates=False)
 def execute(ins, regs):
     code, out, v = ins[0], ins[1], ins[2]
     if code == TEX_WHITE_NOISE_VALUE or code == TEX_WHITE_NOISE_COLOR:

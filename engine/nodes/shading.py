@@ -23,7 +23,7 @@ OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_
 OUT_VOL_SA, OUT_VOL_SS, OUT_VOL_EM = 7, 8, 9      # engine.kernels.medium_density
 
 
-@kernel
+@kernel(allocates=False)
 def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
                 dx, dy, dz, front, ray, depth, length, hit, regs):
     """Fill the hit row of a hit on triangle prim (material m) at barycentrics (bu, bv)
@@ -60,7 +60,7 @@ def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx
     run(T, m, hit, regs)
 
 
-@kernel
+@kernel(allocates=False)
 def apply_rows(T, m, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS):
     """Write the program's base colour, metallic and roughness into the parameter row."""
     outs = T[OUTS]
@@ -77,7 +77,7 @@ def apply_rows(T, m, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS):
         row[P_ROUGHNESS] = min(max(regs[r], 0.0), 1.0)
 
 
-@kernel
+@kernel(allocates=False)
 def program_emission(T, m, regs, r, g, b):
     """The program's emission, or (r, g, b) when it does not drive it."""
     k = T[OUTS][m, OUT_EMISSION]
@@ -86,7 +86,7 @@ def program_emission(T, m, regs, r, g, b):
     return regs[k], regs[k + 1], regs[k + 2]
 
 
-@kernel
+@kernel(allocates=False)
 def program_alpha(T, m, regs, a):
     """The program's alpha clipped to [0, 1], or a when it does not drive it."""
     k = T[OUTS][m, OUT_ALPHA]
@@ -126,7 +126,7 @@ def valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z):
     return nx_ * ax + nz_ * gx, nx_ * ay + nz_ * gy, nx_ * az + nz_ * gz
 
 
-@kernel
+@kernel(allocates=False)
 def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz, correct):
     """The program's shading normal (a Normal Map's or a Bump's), normalised, twice: as Cycles'
     Principled BSDF uses it for its specular lobes, made a valid specular reflector for
@@ -161,7 +161,7 @@ def normal_rows(T, material, regs, ns, ng, incoming, correct):
     return out
 
 
-@kernel
+@kernel(allocates=False)
 def bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz, soften):
     """The diffuse lobe's f x cos towards world direction l under the raw bent normal r
     (Cycles: Lambert on the node's normal, times bump_shadowing against the surface's
@@ -215,7 +215,7 @@ def bump_shadowing(sx, sy, sz, nx, ny, nz, lx, ly, lz, soften):
     return 2.0 / (1.0 + math.sqrt(1.0 + alpha2 * tan2_i))
 
 
-@kernel
+@kernel(allocates=False)
 def pick_closure(T, m, regs, u):
     """Cycles' Mix Shader sums its two shaders weighted 1 - Fac and Fac; DRT picks one per
     hit with those probabilities (an unbiased estimate of the sum: the picked shader is

@@ -8,7 +8,7 @@ from .state import (S_GLASS_SMOOTH, S_METAL_B, S_METAL_CONST, S_METAL_F0, S_META
                     S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY, S_TINT)
 
 
-@kernel
+@kernel(allocates=False)
 def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, w_glass,
                tables, state):
     """The multiple-scattering factors at wo (PrincipledBSDF._compensation): 1 unless

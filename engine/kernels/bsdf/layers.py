@@ -46,7 +46,7 @@ S_EST_TRANS = 51
 NSTATE = 52
 
 
-@kernel
+@kernel(allocates=False)
 def setup(row, wox, woy, woz, tables, state):
     """Fill the slots above for outgoing wo (local, wo_z > 0)."""
     cos_o = min(max(woz, 0.0), 1.0)
@@ -103,12 +103,12 @@ def setup(row, wox, woy, woz, tables, state):
     state[S_EST_TRANS] = t_max
 
 
-@kernel
+@kernel(allocates=False)
 def base_scale_max(state):
     return max(state[S_BASE_SCALE], max(state[S_BASE_SCALE + 1], state[S_BASE_SCALE + 2]))
 
 
-@kernel
+@kernel(allocates=False)
 def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g):
     """f (1/sr) of the sheen, coat and translucent lobes that a light of the given kinds
     sees (principled.eval_seen adds the scaled base)."""
@@ -133,7 +133,7 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g):
     return fr, fg, fb
 
 
-@kernel
+@kernel(allocates=False)
 def selection(state, allow_d, allow_g, allow_t):
     """Unnormalised selection weights (coat, sheen, translucent) over the allowed kinds."""
     wc = state[S_EST_COAT] if allow_g else 0.0
@@ -142,7 +142,7 @@ def selection(state, allow_d, allow_g, allow_t):
     return wc, ws, wt
 
 
-@kernel
+@kernel(allocates=False)
 def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt):
     """sum q_i pdf_i over the coat, sheen and translucent lobes."""
     p = 0.0
@@ -156,7 +156,7 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt):
     return p
 
 
-@kernel
+@kernel(allocates=False)
 def sample(state, wox, woy, woz, lobe, u1, u2):
     """A direction from lobe 0 (coat), 1 (sheen) or 2 (translucent): (wi, valid)."""
     if lobe == 0:

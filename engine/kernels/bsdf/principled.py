@@ -58,7 +58,7 @@ ONE_MINUS_EPS = 1.0 - 2.0 ** -53
 
 
 
-@kernel
+@kernel(allocates=False)
 def setup(row, front_facing, wox, woy, woz, tables, state):
     """Fill state[:NSTATE] with the lobes' parameters at this hit for outgoing wo."""
     # parameters, clamped as PrincipledBSDF.__init__ does
@@ -177,14 +177,14 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
             state[S_EST + k] = state[S_EST + k] * smax
 
 
-@kernel
+@kernel(allocates=False)
 def transmits(state):
     """True where light from behind the surface can contribute (glass, translucency)."""
     return state[S_W_GLASS] > 0.0 or (state[S_LAYERED] != 0.0
                                       and state[layers.S_EST_TRANS] > 0.0)
 
 
-@kernel
+@kernel(allocates=False)
 def selection(state, allow_d, allow_g, allow_t):
     """Lobe probabilities (diffuse, specular, metal, glass; coat, sheen, translucent of
     layers.py) over the allowed kinds."""
@@ -201,7 +201,7 @@ def selection(state, allow_d, allow_g, allow_t):
     return w0 / total, w1 / total, w2 / total, w3 / total, wc / total, ws / total, wt / total
 
 
-@kernel
+@kernel(allocates=False)
 def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
     """f(wo, wi) in 1/sr of the lobes of the kinds a light is seen by (see_d: diffuse,
     see_g: glossy reflection, see_t: transmission; engine.visibility), delta parts
@@ -225,7 +225,7 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
             fb + gb * state[s + 2] + lb)
 
 
-@kernel
+@kernel(allocates=False)
 def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
     """f (1/sr) of the specular, metal and glass lobes a light of these kinds sees."""
     fr = 0.0
@@ -271,13 +271,13 @@ def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
     return fr, fg, fb
 
 
-@kernel
+@kernel(allocates=False)
 def eval_f(state, wox, woy, woz, wix, wiy, wiz):
     """The whole BSDF f(wo, wi) in 1/sr, every lobe (delta parts excluded)."""
     return eval_seen(state, wox, woy, woz, wix, wiy, wiz, True, True, True)
 
 
-@kernel
+@kernel(allocates=False)
 def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
     """sum_i q_i pdf_i over the lobes, for the selection probabilities q (`selection`)."""
     q0, q1, q2, q3, qc, qs, qt = q
@@ -297,14 +297,14 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
     return p
 
 
-@kernel
+@kernel(allocates=False)
 def pdf(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t):
     """Mixture pdf (1/sr) of `sample` with the same allow flags."""
     q = selection(state, allow_d, allow_g, allow_t)
     return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t)
 
 
-@kernel
+@kernel(allocates=False)
 def pdf_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t,
              see_d, see_g, see_t):
     """The part of `pdf` (same allow flags) due to the lobes of the kinds a light is seen
@@ -320,7 +320,7 @@ def pdf_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t,
                        allow_g, allow_t)
 
 
-@kernel
+@kernel(allocates=False)
 def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     """Choose a lobe with u_lobe, a direction with (u1, u2) (the rest of u_lobe, rescaled,
     picks a glass reflection or refraction). Returns

@@ -14,7 +14,7 @@ from .state import (S_ALPHA, S_BECKMANN, S_BLINN, S_EXPONENT, S_METAL_B, S_METAL
                     S_METAL_F0, S_METAL_F82)
 
 
-@kernel
+@kernel(allocates=False)
 def metal_fresnel(state, c, cos_oh):
     """The metal lobe's Fresnel factor in channel c: Schlick's from F0 (Principled),
     F82-tint where Specular Tint is not white, or F0 itself at every angle (a Glossy
@@ -43,7 +43,7 @@ def f82_setup(row, state):
                                                   min(row[P_SPEC_TINT + c], 1.0))
 
 
-@kernel
+@kernel(allocates=False)
 def reflection_eval(state, ox, oy, oz, ix, iy, iz):
     """D G / (4 cos cos) of the reflection lobes (GGX, Beckmann or Blinn-Phong) and h."""
     if state[S_BLINN] != 0.0:
@@ -53,7 +53,7 @@ def reflection_eval(state, ox, oy, oz, ix, iy, iz):
                                  state[S_BECKMANN] != 0.0)
 
 
-@kernel
+@kernel(allocates=False)
 def reflection_pdf(state, ox, oy, oz, ix, iy, iz):
     if state[S_BLINN] != 0.0:
         return blinn_phong.pdf(ox, oy, oz, ix, iy, iz, state[S_EXPONENT])
@@ -61,7 +61,7 @@ def reflection_pdf(state, ox, oy, oz, ix, iy, iz):
                                 state[S_BECKMANN] != 0.0)
 
 
-@kernel
+@kernel(allocates=False)
 def reflection_sample(state, ox, oy, oz, u1, u2):
     if state[S_BLINN] != 0.0:
         return blinn_phong.sample(ox, oy, oz, u1, u2, state[S_EXPONENT])

@@ -47,7 +47,7 @@ def remap(F, f0_real):
     return min(max((F - f0_real) / den, 0.0), 1.0)
 
 
-@kernel
+@kernel(allocates=False)
 def setup(row, multiscatter, cos_o, alpha, eta_spec, exact, tables, state):
     """Fill the tinted layer's slots (f0 and multiscatter factor per channel) and return
     its albedo at wo as the diffuse below sees it. `exact`: the untinted layer's
@@ -75,7 +75,7 @@ def setup(row, multiscatter, cos_o, alpha, eta_spec, exact, tables, state):
     return albedo
 
 
-@kernel
+@kernel(allocates=False)
 def reflectance(state, c, cos_oh, eta_spec):
     """F_c of the tinted layer times its multiscatter factor, at cos(wo, h) = cos_oh."""
     s = remap(fresnel.dielectric(cos_oh, eta_spec), fresnel.f0_from_ior(eta_spec))
@@ -92,7 +92,7 @@ def glass_setup(row, eta, state):
         state[S_GLASS_F0 + c] = min(max(f0_real * row[P_SPEC_TINT + c], 0.0), 1.0)
 
 
-@kernel
+@kernel(allocates=False)
 def glass_factor(state, c, F, eta, reflected):
     """F_c / F for a reflection, (1 - F_c) / (1 - F) for a refraction, at the pair's
     Fresnel reflectance F (dielectric.rough_eval_lobes, smooth_sample)."""

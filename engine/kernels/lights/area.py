@@ -19,12 +19,12 @@ from ..warp import concentric_disk, safe_unit
 INF = math.inf
 
 
-@kernel
+@kernel(allocates=False)
 def _uses_solid_angle(lamps, k, z, omega):
     return omega >= SOLID_ANGLE_MIN and z > IN_PLANE_REL * (lamps[k, C_LX] + lamps[k, C_LY])
 
 
-@kernel
+@kernel(allocates=False)
 def sample_area(lamps, k, px, py, pz, u0, u1):
     """AreaLightModel.sample for one point: (wix, wiy, wiz, dist, r, g, b, pdf, delta)."""
     use = False
@@ -58,7 +58,7 @@ def sample_area(lamps, k, px, py, pz, u0, u1):
             pdf, False)
 
 
-@kernel
+@kernel(allocates=False)
 def intersect_area(lamps, k, ox, oy, oz, dx, dy, dz):
     """AreaLightModel.intersect for one ray: (t or inf, r, g, b); only the emitting
     side (rays travelling along the light's +Z) hits."""
@@ -86,7 +86,7 @@ def intersect_area(lamps, k, ox, oy, oz, dx, dy, dz):
     return INF, r, g, b
 
 
-@kernel
+@kernel(allocates=False)
 def pdf_area(lamps, k, px, py, pz, wix, wiy, wiz, t):
     """AreaLightModel.pdf: solid-angle pdf of sample(p) producing wi, the light hit at
     distance t (0 when t is not finite or wi grazes the light)."""

@@ -11,7 +11,7 @@ from ..warp import uniform_sphere
 INF = math.inf
 
 
-@kernel
+@kernel(allocates=False)
 def sample_environment(lamps, k, u0, u1):
     """EnvironmentLightModel.sample: (wix, wiy, wiz, inf, r, g, b, pdf, delta = False)."""
     wx, wy, wz = uniform_sphere(u0, u1)
@@ -19,6 +19,6 @@ def sample_environment(lamps, k, u0, u1):
             lamps[k, C_ENV_PDF], False)
 
 
-@kernel
+@kernel(allocates=False)
 def pdf_environment(lamps, k):
     return lamps[k, C_ENV_PDF]

@@ -18,7 +18,7 @@ TWO_PI_SQUARED = 2.0 * math.pi * math.pi
 INF = math.inf
 
 
-@kernel
+@kernel(allocates=False)
 def has_map(L):
     return L[ENV_MAP][M_HAS] != 0.0
 
@@ -47,7 +47,7 @@ def _apply(m, base, x, y, z):
             m[base + 6] * x + m[base + 7] * y + m[base + 8] * z)
 
 
-@kernel
+@kernel(allocates=False)
 def _to_map(L, x, y, z):
     params = L[ENV_MAP]
     if params[M_IDENTITY] != 0.0:
@@ -55,7 +55,7 @@ def _to_map(L, x, y, z):
     return _apply(params, M_MATRIX, x, y, z)
 
 
-@kernel
+@kernel(allocates=False)
 def map_radiance(L, dx, dy, dz):
     """EnvironmentMap.radiance along one direction: (r, g, b)."""
     params = L[ENV_MAP]
@@ -90,13 +90,13 @@ def invert_cdf(cdf, u):
     return i, min(max(off, 0.0), 1.0)
 
 
-@kernel
+@kernel(allocates=False)
 def grid(L):
     """(H, W): the map's rows and columns, as its CDFs hold them."""
     return L[ENV_MARGINAL].shape[0] - 1, L[ENV_CONDITIONAL].shape[1] - 1
 
 
-@kernel
+@kernel(allocates=False)
 def cell_pdf(L, r, c):
     """PiecewiseConstant2D.cell_pdf: density in (u, v) of cell (r, c)."""
     marginal = L[ENV_MARGINAL]
@@ -105,7 +105,7 @@ def cell_pdf(L, r, c):
     return (h * (marginal[r + 1] - marginal[r])) * (w * (cond[r, c + 1] - cond[r, c]))
 
 
-@kernel
+@kernel(allocates=False)
 def sample_map(L, u0, u1):
     """EnvironmentMap.sample: (wx, wy, wz, solid-angle pdf; 0 = none)."""
     h, w = grid(L)
@@ -121,7 +121,7 @@ def sample_map(L, u0, u1):
     return x / n, y / n, z / n, pdf * (params[M_ABS_DET] * n ** 3)
 
 
-@kernel
+@kernel(allocates=False)
 def pdf_map(L, dx, dy, dz):
     """EnvironmentMap.pdf of one unit direction."""
     h, w = grid(L)
@@ -140,7 +140,7 @@ def pdf_map(L, dx, dy, dz):
     return pdf * (params[M_ABS_DET] / n ** 3)
 
 
-@kernel
+@kernel(allocates=False)
 def sample_environment_map(L, u0, u1):
     """EnvironmentMapLightModel.sample: (wix, wiy, wiz, inf, r, g, b, pdf, delta)."""
     wx, wy, wz, pdf = sample_map(L, u0, u1)

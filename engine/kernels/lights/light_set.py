@@ -16,18 +16,18 @@ from .sun import escaped_sun, pdf_sun, sample_sun
 from .triangles import pdf_triangle, sample_triangle, triangle_entry
 
 
-@kernel
+@kernel(allocates=False)
 def n_entries(L):
     """len(LightSet): lamps and emissive triangles."""
     return L[SELECT_PDF].shape[0]
 
 
-@kernel
+@kernel(allocates=False)
 def n_lamps(L):
     return L[LAMPS].shape[0]
 
 
-@kernel
+@kernel(allocates=False)
 def pick(L, u_pick):
     """np.searchsorted(cdf, u_pick, side='right').clip(0, n - 1): the first entry whose
     CDF value exceeds u_pick (-1 for an empty set, as the clip gives)."""
@@ -46,7 +46,7 @@ def pick(L, u_pick):
     return lo
 
 
-@kernel
+@kernel(allocates=False)
 def sample_lamp(lamps, k, px, py, pz, u0, u1):
     """Lamp k's own sample (pick probability not included):
     (wix, wiy, wiz, dist, r, g, b, pdf, delta)."""
@@ -60,7 +60,7 @@ def sample_lamp(lamps, k, px, py, pz, u0, u1):
     return sample_environment(lamps, k, u0, u1)
 
 
-@kernel
+@kernel(allocates=False)
 def sample(L, px, py, pz, u_pick, u1, u2):
     """LightSet.sample for one shading point p: pick an entry with u_pick, sample it with
     (u1, u2). Returns (k, wix, wiy, wiz, dist, r, g, b, pdf, delta, margin): k the entry
@@ -83,7 +83,7 @@ def sample(L, px, py, pz, u_pick, u1, u2):
     return k, wx, wy, wz, dist, r, g, b, pdf * select, False, margin
 
 
-@kernel
+@kernel(allocates=False)
 def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit):
     """LightSet.hit_surfaces for one ray of kind ray_bit (engine.visibility): the nearest
     sphere, disc or area lamp closer than tmax that this kind of ray sees: (t, k, r, g,
@@ -109,7 +109,7 @@ def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit):
     return best_t, best_k, br, bg, bb
 
 
-@kernel
+@kernel(allocates=False)
 def entry_visibility(L, k):
     """The ray kinds that see light entry k (engine.visibility mask): a lamp's own, an
     emissive triangle's object's; every kind for k < 0."""
@@ -121,7 +121,7 @@ def entry_visibility(L, k):
     return int(L[TRI_VISIBILITY][k - lamps.shape[0]])
 
 
-@kernel
+@kernel(allocates=False)
 def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t):
     """LightSet.pdf for one direction: solid-angle pdf, pick probability included, of
     sampling wi from p towards lamp k hit at distance t (0 when k is not a lamp)."""
@@ -142,7 +142,7 @@ def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t):
     return pdf * L[SELECT_PDF][k]
 
 
-@kernel
+@kernel(allocates=False)
 def mesh_pdf(L, prim, px, py, pz, qx, qy, qz):
     """LightSet.mesh_pdf for one hit: solid-angle pdf, pick probability included, of
     next-event estimation from p sampling the point q of global triangle prim (0 when
@@ -153,7 +153,7 @@ def mesh_pdf(L, prim, px, py, pz, qx, qy, qz):
     return pdf_triangle(L, j, px, py, pz, qx, qy, qz) * L[SELECT_PDF][L[LAMPS].shape[0] + j]
 
 
-@kernel
+@kernel(allocates=False)
 def environment_pdf(L, dx, dy, dz):
     """LightSet.environment_pdf for one escaped ray along d: pick probability x the world
     light's solid-angle pdf, 0 when the world is not a light."""
@@ -167,14 +167,14 @@ def environment_pdf(L, dx, dy, dz):
     return pdf_environment(lamps, k) * L[SELECT_PDF][k]
 
 
-@kernel
+@kernel(allocates=False)
 def is_uniform_world(L, k):
     """Whether entry k is the uniform world (LightSet.uniform_world): next-event
     estimation towards it evaluates refraction on Walter's pairs only."""
     return k >= 0 and int(L[ENV][0]) == k and L[LAMPS][k, C_TYPE] == T_ENV
 
 
-@kernel
+@kernel(allocates=False)
 def world_escaped(L, world, ray_bit, dx, dy, dz):
     """What an escaped ray of kind ray_bit (engine.visibility) along d sees of the world,
     and the MIS pdf of that: (r, g, b, environment_pdf(L, d)); the radiance is the
@@ -189,7 +189,7 @@ def world_escaped(L, world, ray_bit, dx, dy, dz):
     return r, g, b, environment_pdf(L, dx, dy, dz)
 
 
-@kernel
+@kernel(allocates=False)
 def environment_radiance(L):
     """The uniform world light's radiance (zeros when the world is not a light or is an
     environment map)."""
@@ -197,13 +197,13 @@ def environment_radiance(L):
     return env[1], env[2], env[3]
 
 
-@kernel
+@kernel(allocates=False)
 def n_suns(L):
     """len(LightSet.suns()): the suns with an angular diameter."""
     return L[SUNS].shape[0]
 
 
-@kernel
+@kernel(allocates=False)
 def sun_escaped(L, j, dx, dy, dz):
     """The j-th non-delta sun seen by an escaped ray d: (r, g, b, pdf) with the radiance
     of sun.escaped(d) and pdf = sun.pdf(None, d, None) x its pick probability."""

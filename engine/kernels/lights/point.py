@@ -19,7 +19,7 @@ from .pack import (C_AXIS, C_COS_HALF, C_INTENSITY, C_IS_SPOT, C_POS, C_RAD, C_R
 INF = math.inf
 
 
-@kernel
+@kernel(allocates=False)
 def spot_factor(lamps, k, dx, dy, dz):
     """PointLightModel._spot for the direction (dx, dy, dz) from the light."""
     if lamps[k, C_IS_SPOT] == 0.0:
@@ -41,7 +41,7 @@ def sphere_one_minus_cos(radius, d2):
     return sin2 / (1.0 + math.sqrt(1.0 - sin2))
 
 
-@kernel
+@kernel(allocates=False)
 def _sample_delta(lamps, k, wx, wy, wz, dist_c, d2):
     ok = d2 > 0.0
     okf = 1.0 if ok else 0.0
@@ -53,7 +53,7 @@ def _sample_delta(lamps, k, wx, wy, wz, dist_c, d2):
     return wx, wy, wz, dist_c, r, g, b, okf, True
 
 
-@kernel
+@kernel(allocates=False)
 def _sample_disc(lamps, k, px, py, pz, u0, u1, ax, ay, az, dist_c):
     radius = lamps[k, C_RADIUS]
     tx, ty, tz, bx, by, bz = orthonormal_basis(ax, ay, az)
@@ -73,7 +73,7 @@ def _sample_disc(lamps, k, px, py, pz, u0, u1, ax, ay, az, dist_c):
             lamps[k, C_RAD + 2] * s, pdf, False)
 
 
-@kernel
+@kernel(allocates=False)
 def sample_point(lamps, k, px, py, pz, u0, u1):
     """PointLightModel.sample for one point:
     (wix, wiy, wiz, dist, r, g, b, pdf, delta), pdf in solid angle (1 for a delta)."""
@@ -114,7 +114,7 @@ def sample_point(lamps, k, px, py, pz, u0, u1):
             lamps[k, C_RAD + 2] * s, pdf, False)
 
 
-@kernel
+@kernel(allocates=False)
 def intersect_point(lamps, k, ox, oy, oz, dx, dy, dz):
     """PointLightModel.intersect for one ray: (t or inf, r, g, b)."""
     if lamps[k, C_TYPE] == T_POINT:
@@ -151,7 +151,7 @@ def intersect_point(lamps, k, ox, oy, oz, dx, dy, dz):
     return INF, r, g, b
 
 
-@kernel
+@kernel(allocates=False)
 def pdf_point(lamps, k, px, py, pz, wix, wiy, wiz, t):
     """PointLightModel.pdf: solid-angle pdf of sampling wi (light hit at distance t)."""
     kind = lamps[k, C_TYPE]

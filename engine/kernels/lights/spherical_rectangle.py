@@ -15,7 +15,7 @@ def _corner_angle(x, y, z, z2, s):
     return math.atan2(z * math.sqrt(x * x + y * y + z2), s * x * y)
 
 
-@kernel
+@kernel(allocates=False)
 def spherical_rectangle(lamps, k, px, py, pz):
     """The rectangle of lamp k seen from p, in its local frame:
     (x0, x1, y0, y1, z_signed, z, k_angle, solid_angle)."""
@@ -50,7 +50,7 @@ def _one_minus_plus(y, dd2):
     return large, small
 
 
-@kernel
+@kernel(allocates=False)
 def sample_spherical_rectangle(lamps, k, x0, x1, y0, y1, zs, z, ka, omega, u0, u1):
     """SphericalRectangle.sample: the offset from p to a point of the rectangle, uniform
     in the solid angle it subtends."""

@@ -12,7 +12,7 @@ from ..warp import TWO_PI, cone_from_one_minus_cos
 INF = math.inf
 
 
-@kernel
+@kernel(allocates=False)
 def sample_sun(lamps, k, u0, u1):
     """SunLightModel.sample: (wix, wiy, wiz, dist = inf, r, g, b, pdf, delta)."""
     if lamps[k, C_TYPE] == T_SUN_DELTA:
@@ -28,7 +28,7 @@ def sample_sun(lamps, k, u0, u1):
             1.0 / (TWO_PI * om), False)
 
 
-@kernel
+@kernel(allocates=False)
 def inside_sun(lamps, k, dx, dy, dz):
     """SunLightModel._inside: d within the sun's disc (1 - cos compared exactly)."""
     ex = dx - lamps[k, C_TO_LIGHT]
@@ -37,7 +37,7 @@ def inside_sun(lamps, k, dx, dy, dz):
     return 0.5 * (ex * ex + ey * ey + ez * ez) <= lamps[k, C_ONE_MINUS]
 
 
-@kernel
+@kernel(allocates=False)
 def pdf_sun(lamps, k, wix, wiy, wiz):
     """SunLightModel.pdf: solid-angle pdf of sampling wi (0 for a delta sun)."""
     if lamps[k, C_TYPE] == T_SUN_DELTA:
@@ -47,7 +47,7 @@ def pdf_sun(lamps, k, wix, wiy, wiz):
     return 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def escaped_sun(lamps, k, dx, dy, dz):
     """SunLightModel.escaped: the radiance an escaping ray d sees (0 off the disc)."""
     if lamps[k, C_TYPE] == T_SUN_DELTA or not inside_sun(lamps, k, dx, dy, dz):

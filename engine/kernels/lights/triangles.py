@@ -18,7 +18,7 @@ def square_to_triangle(u0, u1):
     return u0 - 0.5 * u1, 0.5 * u1
 
 
-@kernel
+@kernel(allocates=False)
 def sample_triangle(L, j, px, py, pz, u0, u1):
     """EmissiveTriangles.sample for triangle entry j (pick probability NOT included):
     (wix, wiy, wiz, dist, r, g, b, pdf, margin)."""
@@ -44,7 +44,7 @@ def sample_triangle(L, j, px, py, pz, u0, u1):
     return wx, wy, wz, dist, rad[j, 0], rad[j, 1], rad[j, 2], pdf, margin
 
 
-@kernel
+@kernel(allocates=False)
 def triangle_entry(L, prim):
     """EmissiveTriangles.entry_of: triangle entry of global triangle id prim, or -1."""
     entry = L[TRI_ENTRY]
@@ -53,7 +53,7 @@ def triangle_entry(L, prim):
     return -1
 
 
-@kernel
+@kernel(allocates=False)
 def pdf_triangle(L, j, px, py, pz, qx, qy, qz):
     """EmissiveTriangles.pdf_area_to_solid_angle: solid-angle pdf at p of the point q
     on triangle entry j, d^3 / (A |n . (q - p)|)."""
