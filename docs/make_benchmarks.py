@@ -39,6 +39,7 @@ from engine.image_error import relmse  # noqa: E402
 from big_scene_benchmarks import (big_mesh, big_mesh_section, many_moving,  # noqa: E402
                                   user_env)
 from stage_profile import gil_bound, table_lines as stage_table  # noqa: E402
+import borrowing_benchmark  # noqa: E402
 DOCS = os.path.join(ROOT, "docs")
 SAMPLES = os.path.join(ROOT, "sample_blends")
 
@@ -73,6 +74,20 @@ def per_core_efficiency(w, h, spp):
                 rate=rays / seconds, bare_rate=rays / bare_seconds,
                 integrator=type(ctx.integrator).__name__,
                 shadow=ctx.accel.rays_traced["OCCLUDED"], paths=stats.paths)
+
+
+def borrowing_lines(b) -> list:
+    """Section 1's paragraph on reference counting (docs/borrowing_benchmark.py)."""
+    return [f"Numba counts references to every array a compiled function is given, also "
+            f"to each array of a tuple (the light table, the geometry), with an atomic "
+            f"increment on entry and a decrement on return, unless the function is "
+            f"compiled without it. The per-ray kernels that allocate nothing borrow their "
+            f"arrays instead (`@kernel(allocates=False)`, engine/kernels/jit.py): the same "
+            f"render ({b['paths']:,} paths, one thread) takes {b['borrowed']:.2f} s so, "
+            f"{b['counted']:.2f} s with every kernel counting (`DRT_BORROWING=0`; "
+            f"{b['counted'] / b['borrowed']:.2f}x; `docs/borrowing_benchmark.py`). perf "
+            f"put the counting at 26% of such a render, about 70 increments per path "
+            f"vertex."]
 
 
 def thread_scaling(w, h, spp, max_threads):
@@ -242,7 +257,8 @@ def main():
                   "(position, normals, UVs), runs the material's node program, samples a "
                   "light and evaluates the BSDF for the light and for the continuation "
                   "direction (MIS), in scalar float64 code, one ray at a time. Embree "
-                  "traces a ray in a fraction of that.", ""]
+                  "traces a ray in a fraction of that.", "",
+                  *borrowing_lines(borrowing_benchmark.main(q)), ""]
         print(lines[-3:], flush=True)
         done("1")
     if "2" not in skip:

@@ -16,6 +16,8 @@ Cache folder, the first writable of:
   3. a per-user cache folder (`drt-numba` in Numba's user cache location).
 When none can be written, kernels compile in memory on every process start instead of
 failing. `DRT_NUMBA_CACHE=0` forces that (a test and debug switch).
+`DRT_BORROWING=0` compiles every kernel with reference counting, to measure what
+borrowing saves (docs/borrowing_benchmark.py); it has its own cache fingerprint.
 """
 from __future__ import annotations
 
@@ -60,8 +62,13 @@ def _cache_root() -> str | None:
     return None
 
 
+BORROWING = os.environ.get("DRT_BORROWING", "1") != "0"
+
+
 def _fingerprint() -> bytes:
     h = hashlib.sha256(numba.__version__.encode())
+    if not BORROWING:
+        h.update(b"reference counting everywhere")
     for path in sorted(glob.glob(os.path.join(ENGINE_DIR, "**", "*.py"), recursive=True)):
         h.update(os.path.relpath(path, ENGINE_DIR).encode())
         with open(path, "rb") as f:
@@ -116,7 +123,7 @@ def kernel(fn=None, *, allocates=True, **options):
     refuses one that returns an argument array. tests/test_kernel_borrowing.py checks
     both and that renders leak no allocation."""
     opts = dict(nogil=True, cache=CACHE, error_model="numpy")
-    if not allocates:
+    if not allocates and BORROWING:
         opts["_nrt"] = False
     opts.update(options)
     if fn is None:

@@ -248,7 +248,7 @@ def attenuate_tracked(vol, stacks, r, trans, T, objects, camera, ox, oy, oz, dx,
     trans[r, 2] *= tb
 
 
-@kernel(allocates=False)
+@kernel
 def _sample_row(vol, m, T, objects, camera, lo, hi, n, seed):
     """The largest extinction or emission channel of row m over n^3 jittered points of
     the box [lo, hi]."""

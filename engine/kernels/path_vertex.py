@@ -274,7 +274,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         at = room and counts[p, 2] < cfg[5] and keep_t
         # 2. next-event estimation: one light entry, one point, one shadow ray
         if n_lights > 0:
-            u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK)
+            # (one light: nothing to pick, and no number drawn for it)
+            u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK) \
+                if n_lights > 1 else 0.0
             u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
             k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
                 lights, px, py, pz, u_pick, u1, u2)
