@@ -85,9 +85,9 @@ def borrowing_lines(b) -> list:
             f"arrays instead (`@kernel(allocates=False)`, engine/kernels/jit.py): the same "
             f"render ({b['paths']:,} paths, one thread) takes {b['borrowed']:.2f} s so, "
             f"{b['counted']:.2f} s with every kernel counting (`DRT_BORROWING=0`; "
-            f"{b['counted'] / b['borrowed']:.2f}x; `docs/borrowing_benchmark.py`). perf "
-            f"put the counting at 26% of such a render, about 70 increments per path "
-            f"vertex."]
+            f"{b['counted'] / b['borrowed']:.2f}x; `docs/borrowing_benchmark.py`): the "
+            f"counting took {1 - b['borrowed'] / b['counted']:.0%} of the counted "
+            f"render."]
 
 
 def thread_scaling(w, h, spp, max_threads):

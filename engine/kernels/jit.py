@@ -117,8 +117,8 @@ def kernel(fn=None, *, allocates=True, **options):
     reference counting (`_nrt=False`). Its arrays are borrowed from the caller, which
     holds them for the call. Counted, every array it is given, also each array of a
     tuple such as the light table, costs an atomic increment on entry and a decrement on
-    return, per call: 26% of a Cornell box render's time before these functions were
-    marked (measured with perf; docs/benchmarks.md, section 1). Numba refuses to compile
+    return, per call: docs/benchmarks.md, section 1, measures what that costs a Cornell
+    box render (docs/borrowing_benchmark.py). Numba refuses to compile
     such a function if it allocates, or returns a new array or a view; `BorrowingCheck`
     refuses one that returns an argument array. tests/test_kernel_borrowing.py checks
     both and that renders leak no allocation."""
@@ -153,7 +153,6 @@ class BorrowingCheck(event.Listener):
             return
         for sig, cres in list(dispatcher.overloads.items()):
             if holds_array(cres.signature.return_type):
-                del dispatcher.overloads[sig]
                 raise TypeError(f"{dispatcher.py_func.__qualname__}{sig} returns an array but "
                                 "is marked @kernel(allocates=False)")
 
