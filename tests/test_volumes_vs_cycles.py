@@ -12,11 +12,15 @@ can fail: the fog left out, no volume bounces against Cycles' four, the Absorpti
 Color left out, the noise fog's density replaced by its average (what DRT rendered
 before it rendered heterogeneous volumes).
 
-Coloured glass: the clear glass cube alone differs from Cycles by about -0.9 % (mean)
-and 6 % (blocks around its caustic and shadow): issue 8's glass gap, measured in
-docs/comparisons.md. The absorption inside is checked by its own effect, the ratio of
-the coloured glass image to the clear glass image, per channel and per block, against
-Cycles' ratio."""
+Coloured glass: both the coloured and the clear glass cube are checked against Cycles
+like the other cases, and the absorption inside by its own effect too: the ratio of the
+coloured glass image to the clear glass image, per channel, and the light it removes, per
+block, against Cycles'. At 4096 samples the removed light's worst block differed from
+Cycles' by 3.9 % until shadow rays towards a light on the far side of a rough (or
+Filter-Glossy-widened) dielectric took the surface's crossing into their volume stack,
+as the refracted path does: they kept the glass's absorption all the way to the lamp.
+Now 0.8 %. (Before Cycles' Russian roulette, 2026-11-26, that gap hid behind another:
+DRT's roulette, interacting with Clamp Indirect, darkened the clear glass by 0.6 %.)"""
 import numpy as np
 import pytest
 
@@ -31,9 +35,8 @@ DRT_SAMPLES = 512
 # against itself at another seed: 2 % at 1024 samples): both engines take more samples there.
 # The noise fog takes fewer: Cycles' null scattering through a procedural texture costs ~10 s
 # per 512 samples here (both engines agree within 1.4 % per block at 512).
-# The coloured and clear glass take 1024 in DRT too: the absorbed light's worst block is
-# noise-limited at 512 (2.2 % to 3.6 % over 4 DRT seeds, with rough refraction as Cycles
-# evaluates it).
+# The coloured and clear glass take 1024 in DRT too: the absorbed light's worst block,
+# the difference of two images, is the noisiest check (1.1 % at 1024, 0.8 % at 4096).
 CASE_SAMPLES = {"tinted": 2048, "multiple": 2048, "noise": 512, "absorption_glass": 1024,
                 "clear_glass": 1024}
 MEAN_TOLERANCE = 0.01
@@ -73,11 +76,11 @@ def test_volume_matches_cycles(bpy_drt, case):
 def test_coloured_glass_absorption_matches_cycles(bpy_drt):
     d_col, c_col = _pair(bpy_drt, "absorption_glass")
     d_clr, c_clr = _pair(bpy_drt, "clear_glass")
+    assert _check("absorption_glass", d_col, c_col)
+    assert _check("clear_glass", d_clr, c_clr)
     ratio_d = d_col.mean(axis=(0, 1)) / d_clr.mean(axis=(0, 1))
     ratio_c = c_col.mean(axis=(0, 1)) / c_clr.mean(axis=(0, 1))
     print("coloured / clear glass, DRT", ratio_d, "Cycles", ratio_c)
-    rel, block = compare(d_clr, c_clr)          # the glass's own difference (volumes.md)
-    print(f"clear glass alone: mean {np.round(100 * rel, 2)} %, worst block {block:.2%}")
     np.testing.assert_allclose(ratio_d, ratio_c, rtol=MEAN_TOLERANCE)
     # what the absorption removes, per block, against Cycles' (blocks of the image)
     lost_d, lost_c = d_clr - d_col, c_clr - c_col

@@ -198,6 +198,7 @@ class CompiledPathIntegrator:
         cone = camera_cones(self.camera, np.ascontiguousarray(dirs, dtype=np.float64))
         ray_bits = np.full(n, visibility.CAMERA, dtype=np.int64)   # each path's ray kind
         min_pdf = np.full(n, np.inf)               # smallest BSDF pdf so far per path
+        cont = np.ones(n)                          # the roulette's verdict for the next vertex
         prev_pdf = np.full(n, np.inf)              # camera rays count as specular: weight 1
         prev_pos = np.ascontiguousarray(origins, dtype=np.float64).copy()
         live = np.arange(n, dtype=np.int64)
@@ -237,7 +238,8 @@ class CompiledPathIntegrator:
                     tm, hits)
                 beta[live] *= factor
             ns, nn = shade(depth, self.cfg, pkey, index, beta, counts, L, coverage,
-                           prev_pdf, prev_pos, ray_bits, min_pdf, path_time, live, o, d, tm,
+                           prev_pdf, prev_pos, ray_bits, min_pdf, cont, path_time, live, o, d,
+                           tm,
                            t, prim, u, v, stopped,
                            self.geometry, self.params, self.emission, self.textures,
                            self.tables, self.lights, self.world, media,

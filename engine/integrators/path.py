@@ -10,7 +10,9 @@ A batch of paths advances one bounce at a time. At each surface vertex:
      proportion to its power, one point on it, one shadow ray, weighted against BSDF
      sampling by the power heuristic;
   3. BSDF sampling over the lobes whose bounce budget (Cycles' diffuse, glossy,
-     transmission and total limits) is not used up; Russian roulette after three bounces.
+     transmission and total limits) is not used up; Cycles' Russian roulette: the ray
+     leaves with a verdict (survival probability q = min(sqrt(max throughput), 1), or
+     ended), applied at the vertex it finds, after the emission found there (step 1).
 Where no lobe may continue, light sampling takes the whole weight (no MIS), so direct
 light stays unbiased with zero bounces.
 
@@ -243,6 +245,7 @@ class PathIntegrator:
         o, d, tm = origins, dirs, tmax
         prev_pdf = np.full(n, np.inf)        # camera rays count as specular: MIS weight 1
         prev_pos = o
+        verdict = np.ones(n)                 # the roulette's, for each path's next vertex
 
         def add(rows, contrib, depth, direct=False):
             # Cycles' clamps: direct light at the first hit (its next-event estimates,
@@ -329,6 +332,13 @@ class PathIntegrator:
                     w = self._hit_weight(prev_pdf[g_live], light_pdf)
                     add(rows[glow], b_live[glow] * em[glow] * w[:, None], depth, direct=depth == 1)
 
+            # the roulette's verdict, after the emission found: 0 ends the path, else
+            # the throughput is divided by the survival probability
+            q = verdict[rows]
+            verdict[rows] = 1.0
+            ended = q == 0.0
+            b_live = b_live / np.where(ended, 1.0, q)[:, None]
+
             bsdf = PrincipledBSDF.from_materials(mats, si.material, si.front_facing, si.uv,
                                                  hits=shader_rows)
             c_live = counts[rows]
@@ -346,7 +356,7 @@ class PathIntegrator:
                 f = bsdf.eval_f(wo, wi_local)
                 # As in Cycles the lobes alone decide, on the shading normals; a shadow
                 # ray leaves a smooth mesh from its curved surface (kernels.terminator).
-                ok = (ls.pdf > 0) & (ls.radiance.max(1) > 0) & (f.max(1) > 0)
+                ok = (ls.pdf > 0) & (ls.radiance.max(1) > 0) & (f.max(1) > 0) & ~ended
                 if ok.any():
                     sel = np.nonzero(ok)[0]
                     org = _shadow_origins(ctx.surfaces, si, sel, ls.wi[sel])
@@ -381,20 +391,21 @@ class PathIntegrator:
             wi_world = to_world(bs.wi, ns)
             # reflection leaves on the geometric normal's side, refraction through it
             side = (wi_world * ng).sum(1)
-            cont = bs.valid & allowed.any(1) & np.where(bs.kind == TRANSMISSION, side < 0, side > 0)
+            cont = (bs.valid & allowed.any(1) & ~ended
+                    & np.where(bs.kind == TRANSMISSION, side < 0, side > 0))
             new_beta = b_live * bs.weight
+            next_verdict = np.ones(len(rows))
             if depth + 1 >= ROULETTE_START:
                 u_rr = sampler.get_1d(D.bounce_dim(depth, D.ROULETTE), px_l, ix_l)
-                q = np.clip(new_beta.max(1), 0.0, 0.95)
-                survive = u_rr < q
-                new_beta = new_beta / np.where(survive, np.maximum(q, 1e-300), 1.0)[:, None]
-                cont &= survive
+                q = np.minimum(np.sqrt(np.maximum(new_beta.max(1), 0.0)), 1.0)
+                next_verdict = np.where(u_rr < q, q, 0.0)
             cont &= new_beta.max(1) > 0
             keep = np.nonzero(cont)[0]
             if keep.size == 0:
                 break
             path = rows[keep]
             beta[path] = new_beta[keep]
+            verdict[path] = next_verdict[keep]
             counts[path, bs.kind[keep]] += 1
             d = wi_world[keep]
             o = offset_origin(si.position[keep], ng[keep], si.scale[keep], d)

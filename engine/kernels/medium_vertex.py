@@ -22,7 +22,7 @@ C_VOLUME_BOUNCES = 14      # cfg entry: Cycles' max volume bounces
 
 @kernel
 def scatter(depth, cfg, pkey, index, p, px, py, pz, dx, dy, dz, br, bg, bb, g, bounce,
-            vbounce, beta, prev_pdf, prev_pos, ray_bits, L, lights, vol, stacks,
+            vbounce, beta, cont, prev_pdf, prev_pos, ray_bits, L, lights, vol, stacks,
             sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns,
             nx_path, nx_org, nx_dir, nn):
     """Path p (throughput b, after the segment's weight) scattered at point x moving
@@ -59,9 +59,7 @@ def scatter(depth, cfg, pkey, index, p, px, py, pz, dx, dy, dz, br, bg, bb, g, b
     wx, wy, wz, pdf = hg_sample(g, dx, dy, dz, u1, u2)
     if bounce[p] + 1 >= ROULETTE_START:
         u_rr = sample_1d(kind, pkey[p], spp, index[p], base + D.ROULETTE)
-        alive, br, bg, bb = roulette(u_rr, br, bg, bb)
-        if not alive:
-            return ns, nn
+        cont[p] = roulette(u_rr, br, bg, bb)     # applied where the next ray arrives
     if not (max(br, bg, bb) > 0.0 and pdf > 0.0):
         return ns, nn
     beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb     # phase / pdf = 1

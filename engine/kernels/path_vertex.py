@@ -27,8 +27,8 @@ from .frame import dot, length, to_local, to_world
 from .jit import kernel
 from .medium_vertex import scatter
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
-                           TRANSMISSION_BIT, _add, _INF, hit_weight, nee_weight, roulette,
-                           uncovered)
+                           TRANSMISSION_BIT, _add, _INF, continues, hit_weight, nee_weight,
+                           roulette, uncovered)
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (V_BOUNDARY, V_HAS, in_medium, medium, passed, segment, stack_cross,
                      volume_dim)
@@ -40,7 +40,7 @@ from ..nodes.context import N_HIT, path_fields
 from ..nodes.differentials import cone_at, cone_moves
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import (apply_rows, bent_diffuse, bump_rejects, pick_closure,
+from ..nodes.shading import (apply_rows, bent_diffuse, bump_rejects, may_emit, pick_closure,
                              program_emission, program_hit, program_normal)
 
 @kernel
@@ -71,7 +71,7 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
 
 @kernel
 def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, ray_bits,
-          min_pdf, path_time, live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
+          min_pdf, cont, path_time, live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
           geometry, params, emission, textures, tables, lights, world, media,
           sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir, path_info):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
@@ -188,10 +188,14 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 w = hit_weight(mode, prev_pdf[p], lpdf)
                 _add(L, p, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w, clamp_hit)
         if scattered:
+            q = continues(cont, p)             # the roulette, after the emission found
+            if q == 0.0:
+                continue
+            br, bg, bb = br / q, bg / q, bb / q
             cone_moves(path_info[1], p, t_end)
             ns_out, nn_out = scatter(depth, cfg, pkey, index, p, ox + dx * t_end,
                                      oy + dy * t_end, oz + dz * t_end, dx, dy, dz, br, bg, bb,
-                                     g_phase, bounce, vbounce, beta, prev_pdf, prev_pos,
+                                     g_phase, bounce, vbounce, beta, cont, prev_pdf, prev_pos,
                                      ray_bits, L, lights, vol, stacks, sh_path, sh_org, sh_dir,
                                      sh_far, sh_contrib, sh_bounce, sh_stack, ns_out, nx_path,
                                      nx_org, nx_dir, nn_out)
@@ -232,6 +236,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             nn_out = ray_queues.push_next(nn_out, p, nox, noy, noz, dx, dy, dz, nx_path,
                                           nx_org, nx_dir)
             continue
+        if cont[p] == 0.0 and not may_emit(textures, emission, m):
+            continue                      # ended by the roulette, and nothing to find here
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         programmed = has_program(textures, m)
         bent, correct = False, True
@@ -260,6 +266,10 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                                px, py, pz)
             w = hit_weight(mode, prev_pdf[p], lpdf)
             _add(L, p, br * er * w, bg * eg * w, bb * eb * w, clamp_hit)
+        q = continues(cont, p)            # the roulette, after the emission found
+        if q == 0.0:
+            continue
+        br, bg, bb = br / q, bg / q, bb / q
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
         row[:] = params[ms]
         if any_textures:
@@ -326,6 +336,11 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                                               br * fr * lr * w, bg * fg * lg * w,
                                               bb * fb * lb * w, sh_path, sh_org, sh_dir,
                                               sh_far, sh_contrib, sh_bounce, stacks, sh_stack)
+                    if (vol.shape[0] > 0 and vol[m, V_HAS] != 0.0
+                            and dot(wx, wy, wz, gx, gy, gz) < 0.0):
+                        # towards a light through the surface: the shadow ray enters or
+                        # leaves the material's volume there, as the refracted path does
+                        stack_cross(sh_stack, ns_out - 1, m, front)
             state[S_WALTER] = 0.0
         # 3. continue by BSDF sampling
         if not (ad or ag or at):
@@ -353,9 +368,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         br, bg, bb = br * wr, bg * wg, bb * wb
         if b + 1 >= ROULETTE_START:
             u_rr = sample_1d(kind, pkey[p], spp, index[p], base + D.ROULETTE)
-            alive, br, bg, bb = roulette(u_rr, br, bg, bb)
-            if not alive:
-                continue
+            cont[p] = roulette(u_rr, br, bg, bb)
         if not max(br, bg, bb) > 0.0 or not (br < _INF and bg < _INF and bb < _INF):
             continue       # nothing left, or overflowed (or NaN): the path ends here
         beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb

@@ -101,12 +101,23 @@ def add_transmitted(L, sh_path, sh_contrib, trans, sh_bounce, clamp_direct, clam
                  clamp_direct if sh_bounce[i] == 0 else clamp_indirect)
 
 
-@kernel
+@kernel(allocates=False)
 def roulette(u, br, bg, bb):
-    """Russian roulette on throughput b: survives with probability min(max(b), 0.95),
-    its throughput divided by it. Returns (survives, b)."""
-    q = min(max(max(br, bg, bb), 0.0), 0.95)
-    if not u < q:
-        return False, br, bg, bb
-    q = max(q, 1e-300)
-    return True, br / q, bg / q, bb / q
+    """Cycles' Russian roulette on throughput b (its path_state_continuation_probability):
+    the path survives with probability q = min(sqrt(max(b)), 1) (the square root roughly
+    follows a view transform, so paths end later than with q = max(b)). Returns q when it
+    survives, 0 when it ends. The decision is taken when the next ray leaves, and applied
+    at the vertex it finds (`continues`): the emission that ray finds is added either way,
+    as in Cycles, which decides after the closest hit, and is not lost to the roulette."""
+    q = min(math.sqrt(max(br, bg, bb, 0.0)), 1.0)
+    return q if u < q else 0.0
+
+
+@kernel(allocates=False)
+def continues(cont, p):
+    """At path p's vertex, after the emission its ray found: the factor its throughput
+    is divided by when it goes on (the survival probability of the roulette that let
+    the ray leave, 1 without one), or 0 when the roulette ended it. Resets the entry."""
+    q = cont[p]
+    cont[p] = 1.0
+    return q

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
+from ..kernels.textures import I_TEXTURE, INPUTS, TEX_EMISSION
 from .context import fill
 from .differentials import fill_differentials
 from .interpreter import reads_differentials, run
@@ -84,6 +85,16 @@ def program_emission(T, m, regs, r, g, b):
     if k < 0:
         return r, g, b
     return regs[k], regs[k + 1], regs[k + 2]
+
+
+@kernel(allocates=False)
+def may_emit(T, emission_table, m):
+    """Whether a hit of material m can find emission: its program drives it, a texture
+    does, or its constant emission is not black."""
+    if T[OUTS][m, OUT_EMISSION] >= 0 or T[INPUTS][m, TEX_EMISSION, I_TEXTURE] >= 0:
+        return True
+    return (emission_table[m, 0] != 0.0 or emission_table[m, 1] != 0.0
+            or emission_table[m, 2] != 0.0)
 
 
 @kernel(allocates=False)
