@@ -129,23 +129,34 @@ def _read_exr(path):
     return px.reshape(h, w, 4)[..., :3].astype(np.float64)
 
 
-def equal_error(blend, percentage, ref_spp, ladder, cycles_spp=64):
+TIMED_RUNS = 3      # processes per timed point of section 3; their median is kept
+
+
+def equal_error(blend, percentage, ref_spp, ladder, cycles_spp=64, runs=TIMED_RUNS):
     """Each engine against its own long render (noise, not bias: the bias between the two
     engines is measured in docs/comparisons.md). Time for DRT to reach the relative MSE
     Cycles reaches at `cycles_spp`, from a power law fitted to the ladder, over Cycles'
-    time for those samples."""
+    time for those samples. Each timed point is the median of `runs` processes, the
+    engines taking turns (a process of 1 to 4 s on a shared machine can meet a burst of
+    other work); its error is that of its image, the same in every run (a fixed
+    seed)."""
     tmp = tempfile.mkdtemp(prefix="drt-bench-")
-    result = {}
-    for engine, spps in (("CYCLES", [cycles_spp]), ("DRT", ladder)):
+    refs = {}
+    for engine in ("CYCLES", "DRT"):
         ref = os.path.join(tmp, f"{engine}_ref.exr")
         _cli_render(blend, engine, ref_spp, ref, percentage)
-        ref_img = _read_exr(ref)
-        rows = []
-        for spp in spps:
+        refs[engine] = _read_exr(ref)
+    points = [("CYCLES", cycles_spp)] + [("DRT", spp) for spp in ladder]
+    secs = {point: [] for point in points}
+    for _ in range(runs):
+        for engine, spp in points:
             out = os.path.join(tmp, f"{engine}_{spp}.exr")
-            secs = _cli_render(blend, engine, spp, out, percentage)
-            rows.append((spp, secs, relmse(_read_exr(out), ref_img)))
-        result[engine] = rows
+            secs[engine, spp].append(_cli_render(blend, engine, spp, out, percentage))
+    result = {"CYCLES": [], "DRT": []}
+    for engine, spp in points:
+        out = os.path.join(tmp, f"{engine}_{spp}.exr")
+        result[engine].append((spp, float(np.median(secs[engine, spp])),
+                               relmse(_read_exr(out), refs[engine])))
     (_, t_c, e_c), = result["CYCLES"]
     spp, secs, err = (np.array(c, dtype=np.float64) for c in zip(*result["DRT"]))
     slope, icpt = np.polyfit(np.log(spp), np.log(err), 1)        # log e = icpt + slope log n
@@ -172,7 +183,8 @@ def equal_error_section(rows, ratios, fixed_costs, pct, ref):
                     bool(max(ratios) <= 1.5)))
     lines = ["## 3. Time to equal error against Cycles", "",
              f"Whole processes (`python -m drt_addon render`, file load and export "
-             f"included), {pct}% resolution, the scenes' own settings. Each engine's "
+             f"included), {pct}% resolution, the scenes' own settings; each time the "
+             f"median of {TIMED_RUNS} processes, the engines taking turns. Each engine's "
              f"error is its relative MSE against its own {ref}-sample render, so this "
              "measures noise per second; the bias between the engines is measured in "
              "[comparisons.md](comparisons.md). DRT's time for Cycles' error comes from "

@@ -88,7 +88,13 @@ class PhaseRecorder:
 
     def _time_cache_loads(self):
         from numba.core import caching
-        original = caching.Cache.load_overload
+
+        from engine.kernels.jit import EngineFunctionCache
+        for cls in (caching.Cache, EngineFunctionCache):   # Numba's, and the engine's
+            self._time_loads_of(cls)
+
+    def _time_loads_of(self, cls):
+        original = cls.__dict__["load_overload"]
         recorder = self
 
         def load_overload(cache, sig, target_context):
@@ -102,7 +108,7 @@ class PhaseRecorder:
                 recorder.loads.append((cache._name.split(" ")[1], seconds, added))
             recorder.kernels_loaded += result is not None
             return result
-        caching.Cache.load_overload = load_overload
+        cls.load_overload = load_overload
 
     def install(self):
         """Wrap the render call's steps (after `drt_addon.register()`)."""

@@ -29,6 +29,7 @@ import tempfile
 import numba
 from numba import njit, types
 from numba.core import caching, event
+from numba.core.runtime import rtsys
 
 ENGINE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -102,6 +103,30 @@ class EngineCacheLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLo
             return None
         return super().from_function(py_func, py_file)
 
+    _ensured: set = set()
+
+    def ensure_cache_path(self):
+        """Numba creates the folder and writes a probe file in it for every kernel (~450
+        per process); once per folder is enough."""
+        if self._cache_path not in EngineCacheLocator._ensured:
+            super().ensure_cache_path()
+            EngineCacheLocator._ensured.add(self._cache_path)
+
+
+class EngineFunctionCache(caching.FunctionCache):
+    """Numba's on-disk cache of one kernel, loading it without first refreshing Numba's
+    typing and lowering registries (Numba's `load_overload` does, to be ready to
+    compile): that imports and installs every registry of Numba (its NumPy, linalg and
+    random implementations, SciPy's BLAS where SciPy is installed), about 0.2 s of every
+    process's first render, and machine code read from the cache needs none of it, only
+    the runtime its allocations call (`rtsys`). A kernel that does compile goes through
+    Numba's pipeline, which refreshes them then."""
+
+    def load_overload(self, sig, target_context):
+        rtsys.initialize(target_context)
+        with self._guard_against_spurious_io_errors():
+            return self._load_overload(sig, target_context)
+
 
 if CACHE and EngineCacheLocator not in caching.CacheImpl._locator_classes:
     caching.CacheImpl._locator_classes.insert(0, EngineCacheLocator)
@@ -122,13 +147,17 @@ def kernel(fn=None, *, allocates=True, **options):
     such a function if it allocates, or returns a new array or a view; `BorrowingCheck`
     refuses one that returns an argument array. tests/test_kernel_borrowing.py checks
     both and that renders leak no allocation."""
-    opts = dict(nogil=True, cache=CACHE, error_model="numpy")
+    opts = dict(nogil=True, error_model="numpy")
     if not allocates and BORROWING:
         opts["_nrt"] = False
     opts.update(options)
-    if fn is None:
-        return lambda f: njit(**opts)(f)
-    return njit(**opts)(fn)
+
+    def compiled(f):
+        dispatcher = njit(**opts)(f)
+        if CACHE:        # Numba's `cache=True`, with the engine's cache class
+            dispatcher._cache = EngineFunctionCache(f)
+        return dispatcher
+    return compiled if fn is None else compiled(fn)
 
 
 def holds_array(ty) -> bool:
