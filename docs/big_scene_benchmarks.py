@@ -70,13 +70,10 @@ def user_env() -> dict:
     return env
 
 
-def big_mesh(engines=("CYCLES", "DRT"), repeats=3):
-    """A subdivided Suzanne with about 1M triangles, rendered at 1 sample by each engine in
-    a fresh process: whole-process seconds and peak resident memory, and for DRT per
-    phase of its render call (docs/render_phases.py)."""
+def save_big_mesh(blend: str) -> int:
+    """Saves the big-mesh scene to `blend`: Suzanne subdivided to about 1M triangles, a
+    camera, a sun, the default world, 320 x 240. Returns its triangle count."""
     import bpy
-    tmp = tempfile.mkdtemp(prefix="drt-bench-")
-    blend = os.path.join(tmp, "big_mesh.blend")
     bpy.ops.wm.read_factory_settings(use_empty=True)
     bpy.ops.mesh.primitive_monkey_add()
     obj = bpy.context.object
@@ -89,6 +86,16 @@ def big_mesh(engines=("CYCLES", "DRT"), repeats=3):
     bpy.ops.object.light_add(type="SUN")
     bpy.context.scene.render.resolution_x, bpy.context.scene.render.resolution_y = 320, 240
     bpy.ops.wm.save_as_mainfile(filepath=blend)
+    return tris
+
+
+def big_mesh(engines=("CYCLES", "DRT"), repeats=3):
+    """A subdivided Suzanne with about 1M triangles, rendered at 1 sample by each engine in
+    a fresh process: whole-process seconds and peak resident memory, and for DRT per
+    phase of its render call (docs/render_phases.py)."""
+    tmp = tempfile.mkdtemp(prefix="drt-bench-")
+    blend = os.path.join(tmp, "big_mesh.blend")
+    tris = save_big_mesh(blend)
     # a DRT process first, untimed: the kernels this scene uses, compiled into the on-disk
     # cache if an engine change left it stale (the timed processes load them from there);
     # then `repeats` processes per engine, taking turns, and per engine the run of median

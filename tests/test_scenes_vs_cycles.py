@@ -27,8 +27,10 @@ single block is held to the same 3% as well (`issue_block`, ISSUE_BLOCK_SCENES).
 with 4 DRT seeds against Cycles (and Cycles against itself with another seed):
 - block MAD: 0.22% to 0.36% on glass, glass_caustics and ray_visibility, 0.30% to 0.81% on
   mirror_caustic (Cycles against itself: 1.19% there, 0.14% to 0.16% elsewhere);
-- means: glass_caustics -0.21% to -0.32% (-1.04% before DRT evaluated rough refraction as
-  Cycles does, engine/bsdf/dielectric.py; blocks at its caustics were 7.3% off), glass
+- means: glass_caustics -0.01% (docs/comparisons.md, 128 x 128, since DRT plays Cycles'
+  Russian roulette: before, its larger boosts met Clamp Indirect more often, -0.21% to
+  -0.32% over 4 seeds; -1.04% before DRT evaluated rough refraction as Cycles does,
+  engine/bsdf/dielectric.py; blocks at its caustics were 7.3% off), glass
   within 0.09%, ray_visibility within 0.18%; metals, glossy_dielectric, dof, instances
   and world_light within 0.1% (earlier measurement, 16 pairs); node_closures (added
   2026-11-26: Refraction BSDF at its Beckmann default, Glass, Glossy, Specular Tint,
