@@ -93,11 +93,14 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     then the bit of the lobe it left by), which decides the lamps it sees; next-event
     estimation evaluates only the lobes the light is seen by and skips the shadow ray
     of a light that casts no shadow. min_pdf: the smallest BSDF pdf along each path so
-    far (Filter Glossy, `prepare_closures`). Writes the shadow rays to sh_* (their
-    contributions before the clamp, which `add_transmitted` applies) and the continuing paths' next
-    rays to nx_*; returns (shadow count, next count). beta, counts, L, alpha, prev_pdf,
-    prev_pos are per-path state, updated in place. path_info: (transparent bounces per
-    path, ray cone per path (n, 2): footprint at the ray's origin and spread, see
+    far (Filter Glossy, `prepare_closures`). cont: each path's Russian roulette verdict
+    for the vertex its ray finds (`path_weights.roulette`: 1 none, q it survived with
+    probability q, 0 it ends there after the emission found). Writes the shadow rays to
+    sh_* (their contributions before the clamp, which `add_transmitted` applies) and the
+    continuing paths' next rays to nx_*; returns (shadow count, next count). beta,
+    counts, L, alpha, prev_pdf, prev_pos are per-path state, updated in place.
+    path_info: (transparent bounces per path, ray cone per path (n, 2): footprint at the
+    ray's origin and spread, see
     engine.nodes.differentials), what shader programs read of the path; the cone moves
     on to the next ray's origin.
 
