@@ -149,14 +149,6 @@ def main(argv=None):
             sections += [f"## {case}", "", text, "", f"![{case}](images/{name})", ""]
     lines += [""] + sections + [
         "## Known differences", "",
-        "- Fixed 2026-11-26: the glass cube of absorption_glass differed from Cycles "
-        "(-0.6 % with its volume, about as much without it). Two causes, each measured "
-        "at 4096 samples: shadow rays towards a lamp on the far side of the glass, "
-        "which Filter Glossy widens into a rough lobe after the floor's diffuse bounce, "
-        "kept the glass's absorption all the way to the lamp (-0.63 % with the volume; "
-        "0.00 % since they cross into or out of it as the refracted path does); and "
-        "DRT's Russian roulette before Cycles' rule, whose larger boosts Clamp Indirect "
-        "cut more often (-0.6 % on the glass without its volume; -0.2 % now).",
         "- Next-event estimation from scattering points samples the lamps only (Cycles "
         "adds equiangular sampling): a lamp seen through forward-scattering fog is "
         "noisier than in Cycles at the same samples.",

@@ -246,9 +246,8 @@ SETTINGS: list[FileSetting] = [
     _ignored("scene.cycles.min_light_bounces", "Sampling > Advanced > Min Light Bounces",
              "DRT plays Cycles' Russian roulette (a path goes on with probability "
              "min(sqrt(max throughput), 1), decided after the emission its next ray "
-             "finds) from the third bounce on, as Min Light Bounces 2 would: from the "
-             "first, as Cycles' default, it was noisier for the time on the Cornell box "
-             f"and glass scenes; {NOISE_ONLY}", 0),
+             "finds) from the third bounce on, as Min Light Bounces 2 would; "
+             f"{NOISE_ONLY}", 0),
     _ignored("scene.cycles.min_transparent_bounces", "Sampling > Advanced > Min "
              "Transparent Bounces", f"DRT does not play Russian roulette on transparent "
              f"bounces; {NOISE_ONLY}", 0),
