@@ -55,6 +55,12 @@ def unit_float(h):
     return np.float64(np.uint64(h) >> _S11) * (1.0 / 9007199254740992.0)
 
 
+# Each Feistel round's key is the permutation's key, mixed once, XORed with its own
+# constant (the round function mixes the result again)
+_R0, _R1 = np.uint64(0x9E3779B97F4A7C15), np.uint64(0x3C6EF372FE94F82A)
+_R2, _R3 = np.uint64(0xDAA66D2C7DDF743F), np.uint64(0x78DDE6E5FD29F054)
+
+
 @kernel
 def permute(i, n, key):
     """A keyed pseudo-random permutation of range(n), evaluated at i.
@@ -62,25 +68,24 @@ def permute(i, n, key):
     Each key selects one permutation. A four-round Feistel network on exactly the b bits
     that hold n - 1 (unbalanced when b is odd: halves of floor(b/2) and ceil(b/2) bits
     that swap places every round, so four rounds restore them; each round is a bijection
-    whatever its round function, here SplitMix64 of the half and a round key), with
+    whatever its round function, here SplitMix64 of the half and the round's key), with
     cycle walking back into [0, n): fewer than two steps per value on average, whatever
-    n is. For n = 2 a key bit decides the swap."""
+    n is. The round keys are one mix of the key, each XORed with its own constant: one
+    mix64 per permutation, four per step of the walk. For n = 2 a key bit decides the
+    swap."""
     n = np.uint64(n)
-    key = np.uint64(key)
     x = np.uint64(i)
     if n <= _ONE:
         return np.uint64(0)
+    h = mix64(key)
     bits = np.uint64(1)
     while (_ONE << bits) < n:
         bits += _ONE
     if bits == _ONE:
-        return x ^ (mix64(key) & _ONE)
+        return x ^ (h & _ONE)
     a = bits >> _ONE              # width of the left half; the right half has bits - a
     b = bits - a
-    r0 = mix64(key)
-    r1 = mix64(key ^ np.uint64(0x9E3779B97F4A7C15))
-    r2 = mix64(key ^ np.uint64(0x3C6EF372FE94F82A))
-    r3 = mix64(key ^ np.uint64(0xDAA66D2C7DDF743F))
+    r0, r1, r2, r3 = h ^ _R0, h ^ _R1, h ^ _R2, h ^ _R3
     ma, mb = (_ONE << a) - _ONE, (_ONE << b) - _ONE
     for _ in range(1024):         # a walk this long has probability < 2**-1024
         left, right = x >> b, x & mb                      # widths (a, b)
