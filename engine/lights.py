@@ -57,6 +57,10 @@ SOLID_ANGLE_MIN = 1e-4
 # ... and when the point is farther from the light's plane than this fraction of the
 # rectangle's edge sum (closer, the spherical rectangle degenerates to 0 or 2 pi).
 IN_PLANE_REL = 1e-7
+# An argument of the spherical rectangle's corner product below 0 but above this is
+# rounding, a solid angle of 0, not 2 pi: farther than IN_PLANE_REL from the plane,
+# 2 pi - omega is still above 1e-6 (SphericalRectangle).
+SOLID_ANGLE_WRAP = -1e-9
 
 
 def _smoothstep01(x):
@@ -278,10 +282,15 @@ class SphericalRectangle:
     corners, here as atan2(|n_i x n_j|, -n_i . n_j) of the edge-plane normals, which
     simplifies to  g = atan2(z |v|, s x y)  at a corner v = (x, y, z) with the sign s
     alternating (+, -, +, -) over (x1, y0), (x1, y1), (x0, y1), (x0, y0): exact even
-    when z -> 0 or omega -> 0 (acos of a dot product would lose half the digits).
+    when z -> 0 or omega -> 0 (acos of a dot product would lose half the digits). The
+    angles are added as arguments of the complex numbers c = s x y + i z |v|: omega is
+    the argument of c0 c1 c2 c3 (one atan2, taken in [0, 2 pi); an argument just below 0
+    is rounding, a solid angle of 0), and the map's starting angle k = 2 pi - g2 - g3
+    enters through its cosine and sine, those of the conjugate of c2 c3.
 
     Sampling u -> (xu, yv) (the paper's eqs. with cancellation-free rewrites):
-      k = 2 pi - g2 - g3,  au = u0 omega + k,
+      k = 2 pi - g2 - g3,  au = u0 omega + k  (cos and sin of au from those of u0 omega
+      and of k),
       N = cos(au) b0 - b1,  D = sin(au),  b0 = -y0 / sqrt(y0^2 + z^2),
       b1 = y1 / sqrt(y1^2 + z^2),  1 - b0^2 = z^2 / (y0^2 + z^2),
       xu = sign(N) z D / sqrt(N^2 - (1 - b0^2) D^2)   [= -cu z0 / sqrt(1 - cu^2) of the
@@ -303,15 +312,24 @@ class SphericalRectangle:
         self.frame = (xh, yh, zh)                   # unit x, y, z axes of the rectangle
         z2 = self.z * self.z
 
-        def g(x, y, s):
-            return np.arctan2(self.z * np.sqrt(x * x + y * y + z2), s * x * y)
+        def c(x, y, s):                             # the corner's angle, as a complex number
+            return s * x * y, self.z * np.sqrt(x * x + y * y + z2)
 
-        g0 = g(self.x1, self.y0, 1.0)
-        g1 = g(self.x1, self.y1, -1.0)
-        g2 = g(self.x0, self.y1, 1.0)
-        g3 = g(self.x0, self.y0, -1.0)
-        self.k = TWO_PI - g2 - g3
-        self.solid_angle = np.maximum(g0 + g1 - self.k, 0.0)
+        def times(a, b):                            # a b, its larger part scaled to 1
+            r, i = a[0] * b[0] - a[1] * b[1], a[0] * b[1] + a[1] * b[0]
+            m = np.maximum(np.abs(r), np.abs(i))
+            ok = m > 0
+            m = np.where(ok, m, 1.0)
+            return np.where(ok, r / m, 1.0), np.where(ok, i / m, 0.0)
+
+        g01 = times(c(self.x1, self.y0, 1.0), c(self.x1, self.y1, -1.0))
+        g23 = times(c(self.x0, self.y1, 1.0), c(self.x0, self.y0, -1.0))
+        sr, si = times(g01, g23)
+        omega = np.arctan2(si, sr)
+        self.solid_angle = np.where(omega >= 0, omega,
+                                    np.where(omega < SOLID_ANGLE_WRAP, omega + TWO_PI, 0.0))
+        norm = np.sqrt(g23[0] ** 2 + g23[1] ** 2)
+        self.cos_k, self.sin_k = g23[0] / norm, -g23[1] / norm
 
     def take(self, mask) -> "SphericalRectangle":
         """The same spherical rectangles for the points p[mask] only."""
@@ -330,9 +348,10 @@ class SphericalRectangle:
         b0 = -y0 / np.where(r00 > 0, r00, 1.0)
         b1 = y1 / np.where(r01 > 0, r01, 1.0)
         b0c2 = z2 / np.where(r00 > 0, r00 * r00, 1.0)      # 1 - b0^2
-        au = u[:, 0] * self.solid_angle + self.k
-        num = np.cos(au) * b0 - b1
-        den = np.sin(au)
+        a = u[:, 0] * self.solid_angle
+        cu, su = np.cos(a), np.sin(a)
+        num = (cu * self.cos_k - su * self.sin_k) * b0 - b1           # cos(au) b0 - b1
+        den = su * self.cos_k + cu * self.sin_k                        # sin(au)
         den2 = num * num - b0c2 * den * den
         ok = den2 > 0
         xu = np.sign(num) * z * den / np.sqrt(np.where(ok, den2, 1.0))

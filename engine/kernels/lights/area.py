@@ -28,13 +28,14 @@ def _uses_solid_angle(lamps, k, z, omega):
 def sample_area(lamps, k, px, py, pz, u0, u1):
     """AreaLightModel.sample for one point: (wix, wiy, wiz, dist, r, g, b, pdf, delta)."""
     use = False
-    x0 = x1 = y0 = y1 = zs = z = ka = omega = 0.0
+    x0 = x1 = y0 = y1 = zs = z = cos_k = sin_k = omega = 0.0
     if lamps[k, C_SR_OK] != 0.0:
-        x0, x1, y0, y1, zs, z, ka, omega = spherical_rectangle(lamps, k, px, py, pz)
+        x0, x1, y0, y1, zs, z, cos_k, sin_k, omega = spherical_rectangle(lamps, k, px, py,
+                                                                          pz)
         use = _uses_solid_angle(lamps, k, z, omega)
     if use:
-        ox, oy, oz = sample_spherical_rectangle(lamps, k, x0, x1, y0, y1, zs, z, ka, omega,
-                                                u0, u1)
+        ox, oy, oz = sample_spherical_rectangle(lamps, k, x0, x1, y0, y1, zs, z, cos_k,
+                                                sin_k, omega, u0, u1)
     else:
         if lamps[k, C_ROUND] != 0.0:
             s0, s1 = concentric_disk(u0, u1)
@@ -95,7 +96,7 @@ def pdf_area(lamps, k, px, py, pz, wix, wiy, wiz, t):
     ok = cos_l > 0.0 and math.isfinite(t)
     out = t * t / (lamps[k, C_AREA] * cos_l) if ok else 0.0
     if ok and lamps[k, C_SR_OK] != 0.0:
-        x0, x1, y0, y1, zs, z, ka, omega = spherical_rectangle(lamps, k, px, py, pz)
+        _, _, _, _, _, z, _, _, omega = spherical_rectangle(lamps, k, px, py, pz)
         if _uses_solid_angle(lamps, k, z, omega):
             out = 1.0 / omega
     return out

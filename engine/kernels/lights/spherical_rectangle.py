@@ -1,24 +1,44 @@
 """The spherical rectangle an area lamp subtends from a point, one point at a time
 (`engine.lights.SphericalRectangle`, Urena, Fajardo, King 2013, in the cancellation-free
-form documented there): its solid angle and the area-preserving sampling map."""
+form documented there): its solid angle and the area-preserving sampling map.
+
+The four corner angles g_i = atan2(z r_i, +-x_i y_i) enter only as their sum (the solid
+angle is g0 + g1 + g2 + g3 - 2 pi) and as g2 + g3 (the map's starting angle, k = 2 pi -
+g2 - g3, through its cosine and sine): so they are added as the arguments of complex
+numbers, multiplied, and one atan2 gives the solid angle, one sincos the sample's angle
+(four atan2, a cos and a sin before 2026-11-26: the results agree to 1e-11 relative).
+"""
 from __future__ import annotations
 
 import math
 
+from ...lights import SOLID_ANGLE_WRAP
 from ..jit import kernel
 from .pack import C_CORNER, C_LX, C_LY, C_XH, C_YH, C_ZH
-from ..warp import TWO_PI, clip, max0, sign
+from ..warp import TWO_PI, clip, sign
 
 
 @kernel
-def _corner_angle(x, y, z, z2, s):
-    return math.atan2(z * math.sqrt(x * x + y * y + z2), s * x * y)
+def _corner(x, y, z, z2, s):
+    """The corner's angle as a complex number (real, imaginary), any length."""
+    return s * x * y, z * math.sqrt(x * x + y * y + z2)
+
+
+@kernel
+def _times(ar, ai, br, bi):
+    """a b, scaled so that its larger part is 1 (the argument is all that counts)."""
+    r, i = ar * br - ai * bi, ar * bi + ai * br
+    m = max(abs(r), abs(i))
+    if m > 0.0:
+        return r / m, i / m
+    return 1.0, 0.0
 
 
 @kernel(allocates=False)
 def spherical_rectangle(lamps, k, px, py, pz):
     """The rectangle of lamp k seen from p, in its local frame:
-    (x0, x1, y0, y1, z_signed, z, k_angle, solid_angle)."""
+    (x0, x1, y0, y1, z_signed, z, cos k, sin k, solid_angle), k the map's starting
+    angle."""
     dx = lamps[k, C_CORNER] - px
     dy = lamps[k, C_CORNER + 1] - py
     dz = lamps[k, C_CORNER + 2] - pz
@@ -29,13 +49,18 @@ def spherical_rectangle(lamps, k, px, py, pz):
     x1 = x0 + lamps[k, C_LX]
     y1 = y0 + lamps[k, C_LY]
     z2 = z * z
-    g0 = _corner_angle(x1, y0, z, z2, 1.0)
-    g1 = _corner_angle(x1, y1, z, z2, -1.0)
-    g2 = _corner_angle(x0, y1, z, z2, 1.0)
-    g3 = _corner_angle(x0, y0, z, z2, -1.0)
-    ka = TWO_PI - g2 - g3
-    omega = max0(g0 + g1 - ka)
-    return x0, x1, y0, y1, zs, z, ka, omega
+    c0r, c0i = _corner(x1, y0, z, z2, 1.0)
+    c1r, c1i = _corner(x1, y1, z, z2, -1.0)
+    c2r, c2i = _corner(x0, y1, z, z2, 1.0)
+    c3r, c3i = _corner(x0, y0, z, z2, -1.0)
+    ar, ai = _times(c0r, c0i, c1r, c1i)                  # g0 + g1
+    br, bi = _times(c2r, c2i, c3r, c3i)                  # g2 + g3
+    sr, si = _times(ar, ai, br, bi)                      # the sum of all four
+    omega = math.atan2(si, sr)                           # omega, modulo 2 pi
+    if omega < 0.0:
+        omega = omega + TWO_PI if omega < SOLID_ANGLE_WRAP else 0.0
+    norm = math.sqrt(br * br + bi * bi)                  # k = 2 pi - (g2 + g3)
+    return x0, x1, y0, y1, zs, z, br / norm, -bi / norm, omega
 
 
 @kernel
@@ -51,7 +76,8 @@ def _one_minus_plus(y, dd2):
 
 
 @kernel(allocates=False)
-def sample_spherical_rectangle(lamps, k, x0, x1, y0, y1, zs, z, ka, omega, u0, u1):
+def sample_spherical_rectangle(lamps, k, x0, x1, y0, y1, zs, z, cos_k, sin_k, omega, u0,
+                               u1):
     """SphericalRectangle.sample: the offset from p to a point of the rectangle, uniform
     in the solid angle it subtends."""
     z2 = z * z
@@ -60,9 +86,9 @@ def sample_spherical_rectangle(lamps, k, x0, x1, y0, y1, zs, z, ka, omega, u0, u
     b0 = -y0 / (r00 if r00 > 0.0 else 1.0)
     b1 = y1 / (r01 if r01 > 0.0 else 1.0)
     b0c2 = z2 / (r00 * r00 if r00 > 0.0 else 1.0)         # 1 - b0^2
-    au = u0 * omega + ka
-    num = math.cos(au) * b0 - b1
-    den = math.sin(au)
+    cu, su = math.cos(u0 * omega), math.sin(u0 * omega)   # the angle k + u0 omega
+    num = (cu * cos_k - su * sin_k) * b0 - b1
+    den = su * cos_k + cu * sin_k
     den2 = num * num - b0c2 * den * den
     if den2 > 0.0:
         xu = sign(num) * z * den / math.sqrt(den2)
