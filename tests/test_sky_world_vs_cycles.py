@@ -7,7 +7,15 @@ controls 256), one render each, cached for the module.
 Scene checks (`test_hdri_world_vs_cycles.within`: image means within 1 % per channel,
 8 x 8 block MAD within 3 % of the mean, largest block within 4 %), at the defaults and
 with a low sun (3 degrees up, rotated 60 degrees). Measured at DRT 512: default means
-within 0.16 %, block MAD 0.26 %, largest block 1.5 %; low sun 0.19 %, 0.21 %, 1.5 %.
+within 0.16 %, block MAD 0.26 %, largest block 1.5 %; low sun, but for its glint, 0.12 %,
+0.21 %, 2.1 %, and its glint -3.0 %. The glint, the block of the sun's reflection in the glossy sphere
+(GLINTS), is noise at these sample counts: over renders
+with other seeds its value's standard deviation is 0.061 for DRT at 512 samples (48
+seeds) and 0.072 for Cycles at 1024 (6 seeds), 2.2 % of the block's value for their
+difference and 7 % of the image mean, against the 4 % the other blocks are held to; the
+seeds' means agree (DRT 4.236 +- 0.009, Cycles 4.245 +- 0.029). It is held to
+GLINT_TOLERANCE = 9 % of its own value (4 standard deviations): a glint that is missing
+or misplaced is off by far more.
 Controls (DRT 256), each of which the checks must reject (measured block MAD 66 %, 71 %,
 31 %):
 - `constant colour`: the Background's own colour set to the sky's mean radiance over
@@ -35,7 +43,7 @@ import numpy as np
 import pytest
 
 from conftest import SAMPLES_DIR, cached_render
-from test_hdri_world_vs_cycles import within
+from test_hdri_world_vs_cycles import BLOCK, within
 
 CYCLES_SAMPLES = 1024
 DRT_SAMPLES = 512
@@ -43,6 +51,7 @@ CONTROL_SAMPLES = 256
 DIRECT_SAMPLES = 64
 PATH = os.path.join(SAMPLES_DIR, "sky_world.blend")
 LOW_ELEVATION, LOW_ROTATION = math.radians(3.0), math.radians(60.0)
+GLINT_TOLERANCE = 0.09
 
 _renders = {}
 
@@ -61,6 +70,9 @@ def _low_sun(scene, rotation=LOW_ROTATION):
 
 
 SCENES = {"default": None, "low sun": _low_sun}
+# (row, column) from the top left of the 8 x 8 block holding the sun's reflection in the
+# glossy sphere (the module's docstring)
+GLINTS = {"low sun": (3, 5)}
 
 
 @pytest.mark.parametrize("name", list(SCENES))
@@ -69,7 +81,23 @@ def test_sky_world_matches_cycles(bpy_drt, name):
     drt = _render(bpy_drt, "DRT", DRT_SAMPLES, SCENES[name], name)
     assert drt.shape == cycles.shape == (64, 64, 3) and np.isfinite(drt).all()
     assert cycles.std() > 0.2 * cycles.mean()
-    assert within(drt, cycles, name)
+    glint = GLINTS.get(name)
+    if glint is None:
+        assert within(drt, cycles, name)
+        return
+    # the glint is held on its own (the module's docstring): the checks see DRT's there
+    d, c = _blocks(drt), _blocks(cycles)
+    mask = np.zeros(d.shape, dtype=bool)
+    mask[glint] = True
+    mask = np.repeat(np.repeat(mask, BLOCK, axis=0), BLOCK, axis=1)[:, :, None]
+    print(f"{name}, glint {d[glint]:.4f} against Cycles' {c[glint]:.4f}")
+    assert within(drt, np.where(mask, drt, cycles), name + " but the glint")
+    assert abs(d[glint] / c[glint] - 1.0) <= GLINT_TOLERANCE
+
+
+def _blocks(img):
+    h, w, _ = img.shape
+    return img.mean(axis=2).reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK).mean(axis=(1, 3))
 
 
 def _constant_colour(scene):
