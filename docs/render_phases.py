@@ -111,16 +111,20 @@ class PhaseRecorder:
         cls.load_overload = load_overload
 
     def install(self):
-        """Wrap the render call's steps (after `drt_addon.register()`)."""
+        """Wrap the render call's steps (after `drt_addon.register()`, at the start of
+        the render call)."""
         from importlib import import_module
 
+        # the tracer loads with the first DRT render of a process (not at registration):
+        # imported here, it is the render call's first phase
         import embreex.mesh_construction as embreex_mesh
-        from drt_addon import render_engine
+        from drt_addon import export, render_engine
         from drt_addon.engine_link import engine
         render = import_module(engine.__name__ + ".render")
         self._time_cache_loads()
+        self.mark("import DRT's tracer (engine, Numba, embreex) and its export")
         keeps = (lambda result: [result])
-        self._wrap(render_engine, "export_scene", "export (depsgraph to scene description)",
+        self._wrap(export, "export_scene", "export (depsgraph to scene description)",
                    held=lambda scene: scene.meshes)
         # Accelerator: its own arrays, then embreex's copy of them into Embree's buffers
         # (engine.accel._embree_scene), then Embree's hierarchy (built by a first query)

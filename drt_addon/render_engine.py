@@ -29,10 +29,11 @@ import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
 from .blender_compat import set_pass_pixels
-from .engine_link import engine
-from .export import BLACK_IMAGE, ExportError, Reporter, export_scene, render_region
 
-aov = import_module(engine.__name__ + ".aov")   # engine.aov, in either package layout
+# The tracer (engine, with NumPy's kernels compiled by Numba, and embreex) and the export
+# are imported by the first DRT render, not when Blender registers the add-on: a Blender
+# that renders with Cycles, or opens no file, pays nothing for DRT (principle 3;
+# tests/test_addon_registration.py).
 
 # What the last render did, for the batch renderer and tests (Blender's operator says
 # FINISHED even when an engine reported an error). "scene" is the exported description,
@@ -146,6 +147,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             self.register_pass(scene, renderlayer, name, channels, chan_id, kind)
 
     def render(self, depsgraph):
+        from .export import ExportError
         last_render.update(ok=False, error=None, warnings=[], stats=None, pixels=None,
                            scene=None, export_stats=None, passes={}, region=None, progress=[],
                            cancelled_in=None, phase=None)
@@ -187,13 +189,16 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         self.update_stats("", message)
 
     def _render(self, depsgraph):
+        t0 = time.perf_counter()
+        from .engine_link import engine           # the first render of a process loads them
+        from .export import BLACK_IMAGE, ExportError, Reporter, export_scene, render_region
+        last_render["import_seconds"] = time.perf_counter() - t0
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
         region = render_region(scene)
         # Material previews: quick, and silent (their scene is Blender's, not the user's).
         reporter = Reporter(None if self.is_preview else self.report)
         self.update_stats("", "DRT: exporting scene")
-        t0 = time.perf_counter()
         last_render["first_sample_seconds"] = None
         export_stats = {}
         description = export_scene(depsgraph, reporter, region=region, stats=export_stats,
@@ -206,7 +211,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             settings.validate()
         except ValueError as e:
             raise ExportError(f"DRT: invalid render settings: {e}") from e
-        export_seconds = time.perf_counter() - t0
+        export_seconds = time.perf_counter() - t0 - last_render["import_seconds"]
         last_render.update(scene=description, export_stats=export_stats, region=region)
         self._check_cancel("export")
         self.update_stats("", "DRT: building acceleration structure")
@@ -279,6 +284,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         images = {}
         if any(n in wanted for n in ("Depth", "Normal", "Denoising Normal", "Denoising Albedo")):
             self.update_stats("", "DRT: depth, normal and albedo passes")
+            from .engine_link import engine
+            aov = import_module(engine.__name__ + ".aov")   # in either package layout
             first = aov.first_hit_passes(ctx)
             images.update({"Depth": first.depth, "Normal": first.normal,
                            "Denoising Albedo": first.albedo,

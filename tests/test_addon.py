@@ -1,6 +1,8 @@
 """The add-on registers, DRT is a render engine Blender can select, and it unregisters
 cleanly."""
 import os
+import subprocess
+import sys
 
 from conftest import ROOT
 
@@ -23,6 +25,44 @@ def test_drt_is_a_registered_render_engine(bpy_drt):
     from drt_addon.render_engine import DRTRenderEngine
     assert DRTRenderEngine.bl_label == "DRT"
     assert DRTRenderEngine.bl_use_shading_nodes_custom is False
+
+
+_LAZY = """
+import sys
+sys.path.insert(0, {root!r})
+import bpy
+import drt_addon
+drt_addon.register()
+loaded = lambda: sorted(m for m in ("engine", "numba", "embreex", "drt_addon.export")
+                        if m in sys.modules)
+print("registered:", loaded())
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+scene.render.engine = "CYCLES"
+scene.render.resolution_x = scene.render.resolution_y = 8
+scene.cycles.samples = 1
+bpy.ops.mesh.primitive_cube_add()
+bpy.ops.object.camera_add(location=(0.0, -6.0, 0.0), rotation=(1.5708, 0.0, 0.0))
+scene.camera = bpy.context.object
+bpy.ops.render.render()
+print("after a Cycles render:", loaded())
+scene.render.engine = "DRT"
+scene.drt.samples = 1
+bpy.ops.render.render()
+print("after a DRT render:", loaded())
+"""
+
+
+def test_registering_drt_loads_no_tracer_until_it_renders():
+    """Principle 3: a Blender with DRT enabled that renders with Cycles pays nothing for
+    DRT's tracer (NumPy kernels compiled by Numba, embreex, the export): they load on the
+    first DRT render."""
+    out = subprocess.run([sys.executable, "-c", _LAZY.format(root=ROOT)], cwd=ROOT,
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    lines = [l for l in out.stdout.splitlines() if l.startswith(("registered", "after"))]
+    assert lines == ["registered: []", "after a Cycles render: []",
+                     "after a DRT render: ['drt_addon.export', 'embreex', 'engine', 'numba']"]
 
 
 def test_unregister_and_register_again(bpy_drt):

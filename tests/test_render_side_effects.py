@@ -106,11 +106,12 @@ def test_a_failed_render_changes_nothing(bpy_drt, blend, monkeypatch):
     """A render that fails after the export (here the acceleration structure raises) is
     reported as one error, and leaves everything as it was."""
     from drt_addon import render_engine
+    from drt_addon.engine_link import engine
     _open(bpy_drt, blend)
     before = snapshot(bpy_drt, blend)
 
     with monkeypatch.context() as m:
-        m.setattr(render_engine.engine, "RenderContext", _broken)
+        m.setattr(engine, "RenderContext", _broken)
         # the engine's error report: in the UI the status bar, here the operator raises
         with pytest.raises(RuntimeError, match="MemoryError: out of memory building"):
             bpy_drt.ops.render.render()
@@ -125,8 +126,9 @@ def test_a_failed_render_in_the_batch_renderer_is_one_line(bpy_drt, blend, monke
                                                           tmp_path, capsys):
     from drt_addon import render_engine
     from drt_addon.batch import EXIT_RENDER, main
+    from drt_addon.engine_link import engine
     before = file_state(blend)
-    monkeypatch.setattr(render_engine.engine, "RenderContext", _broken)
+    monkeypatch.setattr(engine, "RenderContext", _broken)
     code = main(["render", blend, "-o", str(tmp_path / "x.png"), "--no-progress"])
     err = capsys.readouterr().err
     assert code == EXIT_RENDER
