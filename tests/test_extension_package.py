@@ -304,8 +304,8 @@ cls = drt_engine()
 mod = sys.modules.get(cls.__module__) if cls else None
 facts["engine_module"] = cls.__module__ if cls else None
 facts["engine_file"] = getattr(mod, "__file__", None)
-tracer = sys.modules.get(args["pkg"] + ".engine")
-facts["tracer_file"] = getattr(tracer, "__file__", None)
+# the tracer loads with the first DRT render (after it, below)
+facts["tracer_before_render"] = args["pkg"] + ".engine" in sys.modules
 
 bpy.ops.wm.open_mainfile(filepath=args["blend"], load_ui=False)
 scene = bpy.context.scene
@@ -318,6 +318,8 @@ t0 = time.perf_counter()
 bpy.ops.render.render(write_still=False)
 facts["render_seconds"] = time.perf_counter() - t0
 facts["last_render"] = {k: mod.last_render.get(k) for k in ("ok", "error")} if mod else None
+tracer = sys.modules.get(args["pkg"] + ".engine")
+facts["tracer_file"] = getattr(tracer, "__file__", None)
 
 exr = os.path.join(args["tmp"], "render.exr")
 scene.render.image_settings.file_format = "OPEN_EXR"
@@ -497,6 +499,7 @@ def _check_session(facts, user_dir):
     assert facts["enabled"], f"{PKG} is not among the enabled add-ons"
     # The engine and the tracer are the installed copies, never the source checkout.
     assert facts["engine_module"] == PKG + ".drt_addon.render_engine"
+    assert not facts["tracer_before_render"]          # enabling DRT loads no tracer
     for key in ("engine_file", "tracer_file"):
         assert os.path.realpath(facts[key]).startswith(
             os.path.join(ext_dir, "user_default", "drt") + os.sep), (key, facts[key])
