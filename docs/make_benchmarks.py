@@ -8,7 +8,8 @@ anything):
      bounce rays, with sampling, shading and film) over bare Embree's rays per second on
      exactly the same rays, one thread;
   2. cores: the speed-up of N threads over one;
-  3. time to equal error against Cycles, whole processes side by side;
+  3. time to equal error against Cycles, whole processes side by side
+     (docs/equal_error_benchmark.py);
   4. a 1M-triangle mesh: depsgraph to first sample, and peak memory, against Cycles;
   5. 1000 rigidly moving objects: one sample with motion blur over one without;
 and, for the trade of speed against accuracy, 6. what adaptive sampling saves per sample
@@ -26,20 +27,18 @@ import argparse
 import json
 import os
 import platform
-import subprocess
 import sys
 import tempfile
 import time
 
-import numpy as np
-
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [ROOT, os.path.join(ROOT, "tests")]
-from engine.image_error import relmse  # noqa: E402
 from big_scene_benchmarks import (big_mesh, big_mesh_section, many_moving,  # noqa: E402
-                                  save_big_mesh, user_env)
+                                  save_big_mesh)
 from stage_profile import gil_bound, table_lines as stage_table  # noqa: E402
 import borrowing_benchmark  # noqa: E402
+import vertex_costs  # noqa: E402
+from equal_error_benchmark import equal_error, equal_error_section, fmt_row  # noqa: E402
 DOCS = os.path.join(ROOT, "docs")
 SAMPLES = os.path.join(ROOT, "sample_blends")
 
@@ -104,117 +103,7 @@ def thread_scaling(w, h, spp, max_threads):
     return out, profile_render(scene, RenderSettings(samples=spp, threads=1))[2]
 
 
-# ----------------------------------------------------------------------------- 3
-
-def _cli_render(blend, engine, samples, out, percentage, extra=()):
-    """Whole process, as a user runs it: returns wall seconds."""
-    code = ("import sys, runpy; sys.argv = ['drt'] + sys.argv[1:]; "
-            "from drt_addon.batch import main; raise SystemExit(main())")
-    t0 = time.perf_counter()
-    subprocess.run([sys.executable, "-c", code, "render", blend, "-o", out, "--engine", engine,
-                    "--samples", str(samples), "--percentage", str(percentage), *extra],
-                   cwd=ROOT, check=True, capture_output=True, text=True, env=user_env())
-    return time.perf_counter() - t0
-
-
-def _read_exr(path):
-    import bpy
-    img = bpy.data.images.load(path, check_existing=False)
-    try:
-        w, h = img.size
-        px = np.empty(w * h * 4, dtype=np.float32)
-        img.pixels.foreach_get(px)
-    finally:
-        bpy.data.images.remove(img)
-    return px.reshape(h, w, 4)[..., :3].astype(np.float64)
-
-
-TIMED_RUNS = 3      # processes per timed point of section 3; their median is kept
-
-
-def equal_error(blend, percentage, ref_spp, ladder, cycles_spp=64, runs=TIMED_RUNS):
-    """Each engine against its own long render (noise, not bias: the bias between the two
-    engines is measured in docs/comparisons.md). Time for DRT to reach the relative MSE
-    Cycles reaches at `cycles_spp`, from a power law fitted to the ladder, over Cycles'
-    time for those samples. Each timed point is the median of `runs` processes, the
-    engines taking turns (a process of 1 to 4 s on a shared machine can meet a burst of
-    other work); its error is that of its image, the same in every run (a fixed
-    seed)."""
-    tmp = tempfile.mkdtemp(prefix="drt-bench-")
-    refs = {}
-    for engine in ("CYCLES", "DRT"):
-        ref = os.path.join(tmp, f"{engine}_ref.exr")
-        _cli_render(blend, engine, ref_spp, ref, percentage)
-        refs[engine] = _read_exr(ref)
-    points = [("CYCLES", cycles_spp)] + [("DRT", spp) for spp in ladder]
-    secs = {point: [] for point in points}
-    for _ in range(runs):
-        for engine, spp in points:
-            out = os.path.join(tmp, f"{engine}_{spp}.exr")
-            secs[engine, spp].append(_cli_render(blend, engine, spp, out, percentage))
-    result = {"CYCLES": [], "DRT": []}
-    for engine, spp in points:
-        out = os.path.join(tmp, f"{engine}_{spp}.exr")
-        result[engine].append((spp, float(np.median(secs[engine, spp])),
-                               relmse(_read_exr(out), refs[engine])))
-    (_, t_c, e_c), = result["CYCLES"]
-    spp, secs, err = (np.array(c, dtype=np.float64) for c in zip(*result["DRT"]))
-    slope, icpt = np.polyfit(np.log(spp), np.log(err), 1)        # log e = icpt + slope log n
-    need = float(np.exp((np.log(e_c) - icpt) / slope))
-    per, fixed = np.polyfit(spp, secs, 1)                         # seconds = fixed + per n
-    t_d = fixed + per * need
-    return dict(cycles=result["CYCLES"], drt=result["DRT"], slope=slope, fixed=fixed, per=per,
-                drt_spp_needed=need, drt_seconds=t_d, cycles_seconds=t_c, ratio=t_d / t_c)
-
-
 # ----------------------------------------------------------------------------- report
-
-def equal_error_section(rows, ratios, fixed_costs, pct, ref):
-    """(lines, targets) of section 3 from its table rows, DRT/Cycles ratios and (DRT fixed
-    seconds, Cycles seconds) per scene."""
-    targets = []
-    med = float(np.median(ratios))
-    fixed = float(np.median([f for f, _ in fixed_costs]))
-    per_sample = float(np.median([(r * c - f) / c for r, (f, c) in zip(ratios, fixed_costs)]))
-    targets.append(("3. time to Cycles' 64-spp error, median scene", "<= 1.0x",
-                    f"{med:.2f}x (DRT's fixed cost per process {fixed:.1f} s)",
-                    bool(med <= 1.0)))
-    targets.append(("3. ... worst scene", "<= 1.5x", f"{max(ratios):.2f}x",
-                    bool(max(ratios) <= 1.5)))
-    lines = ["## 3. Time to equal error against Cycles", "",
-             f"Whole processes (`python -m drt_addon render`, file load and export "
-             f"included), {pct}% resolution, the scenes' own settings; each time the "
-             f"median of {TIMED_RUNS} processes, the engines taking turns. Each engine's "
-             f"error is its relative MSE against its own {ref}-sample render, so this "
-             "measures noise per second; the bias between the engines is measured in "
-             "[comparisons.md](comparisons.md). DRT's time for Cycles' error comes from "
-             "a power law fitted to its sample ladder; its seconds as a line in "
-             "samples: a fixed cost per process (Python, `bpy` and the add-on, the "
-             "file, export, the compiled kernels loaded from their cache, the "
-             "acceleration structure) plus a cost per sample. Python's bytecode cache is "
-             "on, as on a user's machine (before 2026-11-26 the benchmark ran with "
-             "PYTHONDONTWRITEBYTECODE set, so each DRT process compiled its sources "
-             "again, about 0.2 s).", "",
-             "| scene | Cycles | DRT to the same error | DRT / Cycles | DRT: fixed + "
-             "per sample | DRT ladder |", "|---|---|---|---|---|---|", *rows, "",
-             "At these sizes DRT's fixed cost per process (median "
-             f"{fixed:.1f} s) is most of the gap: Cycles' whole renders take "
-             f"{min(c for _, c in fixed_costs):.1f} to "
-             f"{max(c for _, c in fixed_costs):.1f} s, and DRT's per-sample seconds "
-             "alone, for the same error, are a median "
-             f"{per_sample:.2f}x Cycles' whole time. Over many samples (a long render, "
-             "or many frames in one batch process) only the per-sample cost counts.", ""]
-    return lines, targets
-
-
-def _fmt_equal_error(name, r):
-    c_spp, c_s, c_e = r["cycles"][0]
-    ladder = ", ".join(f"{s} spp {t:.1f} s relMSE {e:.2e}" for s, t, e in r["drt"])
-    return (f"| {name} | {c_s:.1f} s for {c_spp} spp (relMSE {c_e:.2e}) | "
-            f"{r['drt_seconds']:.1f} s ({r['drt_spp_needed']:.0f} spp; slope "
-            f"{r['slope']:.2f}) | **{r['ratio']:.2f}x** | {r['fixed']:.1f} s + "
-            f"{r['per'] * 1e3:.0f} ms | {ladder} |")
-
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -250,9 +139,13 @@ def main():
         total, stages, _ = r["profile"]
         top_stage, top_secs = max(stages.items(), key=lambda kv: kv[1])
         embree = sum(v for k, v in stages.items() if k.startswith("Embree"))
+        vertex_ns = next(v for k, v in stages.items() if k.startswith("shading")) \
+            / (r["rays"] - r["shadow"]) * 1e9
+        ray_ns = r["bare_seconds"] / r["rays"] * 1e9
         targets.append(("1. all-in rays/s over bare Embree, one thread", ">= 0.5",
                         f"{eff:.2f} ({top_stage.split(':')[0]} {top_secs / total:.0%} of the "
-                        f"time, Embree {embree / total:.0%})", eff >= 0.5))
+                        f"time, Embree {embree / total:.0%}: a path vertex's shading "
+                        f"{vertex_ns:.0f} ns, a bare Embree ray {ray_ns:.0f} ns)", eff >= 0.5))
         lines += ["## 1. Per-core efficiency", "",
                   f"Cornell box (tests/engine_scenes.py), {r['paths']:,} paths, one thread, "
                   f"{r['integrator']}.", "",
@@ -265,11 +158,12 @@ def main():
                   "Where the time goes: the same render again with every stage timed "
                   "(`docs/stage_profile.py`).", "",
                   *stage_table(total, stages, r["bare_seconds"]), "",
-                  "The gap is the shading kernel: per path vertex it rebuilds the hit "
-                  "(position, normals, UVs), runs the material's node program, samples a "
-                  "light and evaluates the BSDF for the light and for the continuation "
-                  "direction (MIS), in scalar float64 code, one ray at a time. Embree "
-                  "traces a ray in a fraction of that.", "",
+                  "The gap is the shading kernel: per path vertex it draws four sampler "
+                  "numbers, rebuilds the hit, sets the BSDF up, samples a light, evaluates "
+                  "the BSDF there and samples it for the next ray, in scalar float64 code, "
+                  "one ray at a time. Each piece timed on its own (compiled loops on the "
+                  "scene's own materials, lamp and triangles):", "",
+                  *vertex_costs.lines(vertex_costs.measure(), vertex_ns, ray_ns), "",
                   *borrowing_lines(borrowing_benchmark.main(q)), ""]
         print(lines[-3:], flush=True)
         done("1")
@@ -301,7 +195,7 @@ def main():
         rows, ratios, fixed_costs = [], [], []
         for name, blend in scenes:
             r = equal_error(os.path.join(SAMPLES, blend), pct, ref, ladder)
-            rows.append(_fmt_equal_error(name, r))
+            rows.append(fmt_row(name, r))
             ratios.append(r["ratio"])
             fixed_costs.append((r["fixed"], r["cycles_seconds"]))
             print(rows[-1], flush=True)

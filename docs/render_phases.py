@@ -3,7 +3,7 @@
 `PhaseRecorder.install()` wraps the functions the render call goes through (the export,
 each step of `engine.render.RenderContext`, the render's thread pool) so that each one,
 when it returns, closes a phase: wall time since the last mark, the process's resident
-memory then (/proc/self/statm) and its peak so far (getrusage's maxrss). It also sums
+memory then (/proc/self/statm) and its peak so far (/proc/self/status's VmHWM). It also sums
 the time Numba spends loading compiled kernels from its on-disk cache (the first call of
 each kernel in a fresh process), per phase. Nothing of the tracer is changed: the
 wrappers call the originals.
@@ -24,6 +24,14 @@ def rss_mb() -> float:
 
 
 def peak_mb() -> float:
+    """The process's peak resident memory so far: /proc/self/status's VmHWM, the high-water
+    mark of this program's own memory. (getrusage's maxrss is not: Linux copies it from
+    the parent at fork and keeps it through exec, so a child of a big process reads its
+    parent's size; the benchmark's renders are such children.)"""
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
