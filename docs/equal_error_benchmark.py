@@ -95,11 +95,14 @@ def equal_error_section(rows, ratios, fixed_costs, pct, ref):
              "[comparisons.md](comparisons.md). DRT's time for Cycles' error comes from "
              "a power law fitted to its sample ladder; its seconds as a line in "
              "samples: a fixed cost per process (Python, `bpy` and the add-on, the "
-             "file, export, the compiled kernels loaded from their cache, the "
-             "acceleration structure) plus a cost per sample. Python's bytecode cache is "
-             "on, as on a user's machine (before 2026-11-26 the benchmark ran with "
-             "PYTHONDONTWRITEBYTECODE set, so each DRT process compiled its sources "
-             "again, about 0.2 s).", "",
+             "file, DRT's tracer (Numba, embreex) imported by its first render, export, "
+             "the compiled kernels loaded from their cache, the acceleration structure) "
+             "plus a cost per sample. Python's bytecode cache is on, as on a user's "
+             "machine (before 2026-11-26 the benchmark ran with PYTHONDONTWRITEBYTECODE "
+             "set, so each DRT process compiled its sources again, about 0.2 s). Until "
+             "the same day DRT's add-on imported its tracer when Blender registered it, "
+             "so Cycles' processes paid about 0.2 s for DRT too, and the ratios below "
+             "were lower by that much of Cycles' time.", "",
              "| scene | Cycles | DRT to the same error | DRT / Cycles | DRT: fixed + "
              "per sample | DRT ladder |", "|---|---|---|---|---|---|", *rows, "",
              "At these sizes DRT's fixed cost per process (median "
