@@ -33,7 +33,7 @@ from .blender_compat import set_pass_pixels
 # The tracer (engine, with NumPy's kernels compiled by Numba, and embreex) and the export
 # are imported by the first DRT render, not when Blender registers the add-on: a Blender
 # that renders with Cycles, or opens no file, pays nothing for DRT (principle 3;
-# tests/test_addon_registration.py).
+# tests/test_addon.py).
 
 # What the last render did, for the batch renderer and tests (Blender's operator says
 # FINISHED even when an engine reported an error). "scene" is the exported description,
