@@ -8,14 +8,14 @@ Scene checks (`test_hdri_world_vs_cycles.within`: image means within 1 % per cha
 8 x 8 block MAD within 3 % of the mean, largest block within 4 %), at the defaults and
 with a low sun (3 degrees up, rotated 60 degrees). Measured at DRT 512: default means
 within 0.16 %, block MAD 0.26 %, largest block 1.5 %; low sun, but for its glint,
-0.12 %, 0.21 %, 2.1 %, and its glint -3.0 %. The glint, the block of the sun's reflection in
-the glossy sphere (GLINTS), is noise at these sample counts: over renders with other
-seeds its value's standard deviation is 0.061 for DRT at 512 samples (48 seeds) and
-0.072 for Cycles at 1024 (6 seeds), 2.2 % of the block's value for their difference and
-7 % of the image mean, against the 4 % the other blocks are held to; the seeds' means
-agree (DRT 4.236 +- 0.009, Cycles 4.245 +- 0.029). It is held to GLINT_TOLERANCE = 9 %
-of its own value (4 standard deviations): a glint that is missing or misplaced is off by
-far more.
+0.12 %, 0.21 %, 2.1 %, and its glint -3.0 %. The glint, the block of the sun's
+reflection in the glossy sphere (GLINTS), is noise at these sample counts: over renders
+with other seeds its value's standard deviation is 0.061 for DRT at 512 samples (48
+seeds) and 0.072 for Cycles at 1024 (6 seeds), 2.2 % of the block's value for their
+difference and 7 % of the image mean, against the 4 % the other blocks are held to; the
+seeds' means agree (DRT 4.236 +- 0.009, Cycles 4.245 +- 0.029). It is held to
+GLINT_TOLERANCE = 9 % of its own value (4 standard deviations): a glint that is missing
+or misplaced is off by far more.
 Controls (DRT 256), each of which the checks must reject (measured block MAD 66 %, 71 %,
 31 %):
 - `constant colour`: the Background's own colour set to the sky's mean radiance over
