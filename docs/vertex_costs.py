@@ -38,6 +38,7 @@ from engine.sampling.hashing import pixel_key  # noqa: E402
 CALLS = 1_000_000
 GOLDEN = 0.618033988749895      # additive recurrences: inputs that change every call
 PLASTIC = 0.7548776662466927
+THIRD = 0.5698402909980532       # 1 / plastic number squared
 
 
 @njit
@@ -130,7 +131,7 @@ def _bsdf_use(states, part, n):
             acc += bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, True, True, True, True,
                                  True, True)
         elif part == 3:
-            acc += bsdf.sample(state, wox, woy, woz, (i * 0.5698402909980532) % 1.0,
+            acc += bsdf.sample(state, wox, woy, woz, (i * THIRD) % 1.0,
                                lx * 0.5 + 0.5, ly * 0.5 + 0.5, True, True, True)[6]
         else:
             acc += state[i % bsdf.NSTATE] + wox + woy + woz + lx + ly + lz
@@ -141,7 +142,7 @@ def _bsdf_use(states, part, n):
 def _light(lights, lo, hi, part, n):
     acc = 0.0
     for i in range(n):
-        u, v, w = (i * GOLDEN) % 1.0, (i * PLASTIC) % 1.0, (i * 0.5698402909980532) % 1.0
+        u, v, w = (i * GOLDEN) % 1.0, (i * PLASTIC) % 1.0, (i * THIRD) % 1.0
         px = lo[0] + (hi[0] - lo[0]) * u
         py = lo[1] + (hi[1] - lo[1]) * v
         pz = lo[2] + (hi[2] - lo[2]) * w

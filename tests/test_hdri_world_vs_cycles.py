@@ -54,12 +54,14 @@ def compare(drt, cycles):
     """(relative difference of the means per channel, block MAD over the image mean,
     largest block difference over the image mean)."""
     rel = np.abs(drt.mean(axis=(0, 1)) / cycles.mean(axis=(0, 1)) - 1.0)
-    h, w, _ = cycles.shape
-
-    def blocks(img):
-        return img.mean(axis=2).reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK).mean(axis=(1, 3))
     diff = np.abs(blocks(drt) - blocks(cycles)) / cycles.mean()
     return rel, float(diff.mean()), float(diff.max())
+
+
+def blocks(img):
+    """The means of the image's BLOCK x BLOCK pixel blocks (over the channels too)."""
+    h, w, _ = img.shape
+    return img.mean(axis=2).reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK).mean(axis=(1, 3))
 
 
 def within(drt, cycles, label):

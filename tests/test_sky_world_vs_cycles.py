@@ -43,7 +43,7 @@ import numpy as np
 import pytest
 
 from conftest import SAMPLES_DIR, cached_render
-from test_hdri_world_vs_cycles import BLOCK, within
+from test_hdri_world_vs_cycles import BLOCK, blocks, within
 
 CYCLES_SAMPLES = 1024
 DRT_SAMPLES = 512
@@ -86,18 +86,13 @@ def test_sky_world_matches_cycles(bpy_drt, name):
         assert within(drt, cycles, name)
         return
     # the glint is held on its own (the module's docstring): the checks see DRT's there
-    d, c = _blocks(drt), _blocks(cycles)
+    d, c = blocks(drt), blocks(cycles)
     mask = np.zeros(d.shape, dtype=bool)
     mask[glint] = True
     mask = np.repeat(np.repeat(mask, BLOCK, axis=0), BLOCK, axis=1)[:, :, None]
     print(f"{name}, glint {d[glint]:.4f} against Cycles' {c[glint]:.4f}")
     assert within(drt, np.where(mask, drt, cycles), name + " but the glint")
     assert abs(d[glint] / c[glint] - 1.0) <= GLINT_TOLERANCE
-
-
-def _blocks(img):
-    h, w, _ = img.shape
-    return img.mean(axis=2).reshape(h // BLOCK, BLOCK, w // BLOCK, BLOCK).mean(axis=(1, 3))
 
 
 def _constant_colour(scene):

@@ -100,9 +100,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     continuing paths' next rays to nx_*; returns (shadow count, next count). beta,
     counts, L, alpha, prev_pdf, prev_pos are per-path state, updated in place.
     path_info: (transparent bounces per path, ray cone per path (n, 2): footprint at the
-    ray's origin and spread, see
-    engine.nodes.differentials), what shader programs read of the path; the cone moves
-    on to the next ray's origin.
+    ray's origin and spread, see engine.nodes.differentials), what shader programs read
+    of the path; the cone moves on to the next ray's origin.
 
     media: (bounce, volume bounces, VOL, stacks, shadow stacks, shadow bounces,
     heterogeneous count): each path's bounces so far (depth counts the wavefront's
