@@ -347,14 +347,15 @@ facts["numba_cache_dir"] = getattr(config, "CACHE_DIR", None)
 jit = sys.modules.get(args["pkg"] + ".engine.kernels.jit")
 facts["jit_cache"] = getattr(jit, "CACHE", None)
 kernels = {}
-if "numba" in sys.modules:
-    from numba.core.dispatcher import Dispatcher
+if jit is not None:
+    # the engine's kernels (jit.Kernel); a kernel's Numba dispatcher exists once it was
+    # used (called, or typed by a caller being compiled)
     for name, m in list(sys.modules.items()):
         if name == args["pkg"] + ".engine" or name.startswith(args["pkg"] + ".engine."):
             for v in list(vars(m).values()):
-                if isinstance(v, Dispatcher):
+                if isinstance(v, jit.Kernel):
                     kernels[id(v)] = v
-used = [k for k in kernels.values() if k.signatures]
+used = [k.dispatcher for k in kernels.values() if k.realized and k.signatures]
 facts["kernels"], facts["kernels_used"] = len(kernels), len(used)
 facts["cache_hits"] = sum(sum(k.stats.cache_hits.values()) for k in used)
 facts["cache_misses"] = sum(sum(k.stats.cache_misses.values()) for k in used)

@@ -90,7 +90,13 @@ from numba import njit
 @njit
 def spread(a):
     return np.linalg.norm(a) + np.median(a)
-print(repr(v), hits, loaded, repr(float(spread(np.arange(5.0)))))
+# the engine's kernels, and those whose Numba dispatcher exists (made on first use)
+import engine.integrators.compiled_path
+from engine.kernels.jit import Kernel
+kernels = {id(k): k for name, m in list(sys.modules.items()) if name.startswith('engine')
+           for k in vars(m).values() if isinstance(k, Kernel)}
+made = sum(k.realized for k in kernels.values())
+print(repr(v), hits, loaded, repr(float(spread(np.arange(5.0)))), len(kernels), made)
 """
 
 
@@ -105,8 +111,8 @@ def test_cached_kernels_load_without_numbas_compiler_registries(tmp_path):
         proc = subprocess.run([sys.executable, "-c", LOAD_PROBE], cwd=src, env=env,
                               capture_output=True, text=True, timeout=600)
         assert proc.returncode == 0, proc.stderr
-        v, hits, loaded, spread = proc.stdout.split()
-        return float(v), int(hits), loaded == "True", float(spread)
+        v, hits, loaded, spread, kernels, made = proc.stdout.split()
+        return float(v), int(hits), loaded == "True", float(spread), int(kernels), int(made)
 
     first = run()                      # compiles, and so loads the registries
     second = run()                     # loads from the cache
@@ -114,3 +120,9 @@ def test_cached_kernels_load_without_numbas_compiler_registries(tmp_path):
     assert second[1] == 1 and not second[2]
     assert second[0] == first[0]
     assert first[3] == second[3] == float(np.linalg.norm(np.arange(5.0)) + 2.0)
+    # Dispatchers are made on first use: compiling batch_1d made its callees' too (to
+    # type them); loading it from the cache made batch_1d's alone, of the engine's
+    # hundreds of kernels (the path tracer's included, imported above)
+    kernels, made_compiling, made_loading = second[4], first[5], second[5]
+    assert kernels > 300
+    assert made_loading == 1 < made_compiling

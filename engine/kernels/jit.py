@@ -25,6 +25,7 @@ import glob
 import hashlib
 import os
 import tempfile
+import threading
 
 import numba
 from numba import njit, types
@@ -132,8 +133,68 @@ if CACHE and EngineCacheLocator not in caching.CacheImpl._locator_classes:
     caching.CacheImpl._locator_classes.insert(0, EngineCacheLocator)
 
 
+class Kernel:
+    """A compiled kernel, made on first use: its Numba dispatcher (`njit(...)(py_func)`
+    with the engine's cache) is created when the kernel is first called, compiled or
+    typed, not when its module is imported. The engine defines about 700 kernels; a
+    render loads six of them from the cache, and the rest are never used as dispatchers
+    (the six hold their callees' machine code). Creating them all cost about 0.1 s of
+    every process's first render (each dispatcher inspects its function's signature
+    twice and sets up its cache). Numba sees a Kernel as its dispatcher: `_numba_type_`
+    (typing of a global, a closure variable or an argument), and `targetoptions` and
+    `py_func` (inlining) are the dispatcher's. Calls from Python go through the
+    dispatcher."""
+
+    _lock = threading.Lock()
+
+    def __init__(self, py_func, options: dict):
+        self.py_func = py_func
+        self._options = options
+        self._dispatcher = None
+        self.__name__ = py_func.__name__
+        self.__qualname__ = py_func.__qualname__
+        self.__module__ = py_func.__module__
+        self.__doc__ = py_func.__doc__
+
+    @property
+    def dispatcher(self):
+        """The Numba dispatcher, created once (threads may ask at the same time)."""
+        dispatcher = self._dispatcher
+        if dispatcher is None:
+            with Kernel._lock:
+                if self._dispatcher is None:
+                    made = njit(**self._options)(self.py_func)
+                    if CACHE:        # Numba's `cache=True`, with the engine's cache class
+                        made._cache = EngineFunctionCache(self.py_func)
+                    self._dispatcher = made
+                dispatcher = self._dispatcher
+        return dispatcher
+
+    @property
+    def realized(self) -> bool:
+        """Whether the dispatcher exists (the kernel was called, compiled or typed)."""
+        return self._dispatcher is not None
+
+    @property
+    def _numba_type_(self):
+        return self.dispatcher._numba_type_
+
+    def __call__(self, *args, **kwargs):
+        return self.dispatcher(*args, **kwargs)
+
+    def __getattr__(self, name):
+        # targetoptions, compile, signatures, stats, overloads, ...: the dispatcher's
+        if name in ("py_func", "_options", "_dispatcher"):    # not set yet (a copy)
+            raise AttributeError(name)
+        return getattr(self.dispatcher, name)
+
+    def __repr__(self):
+        return f"<kernel {self.__module__}.{self.__qualname__}>"
+
+
 def kernel(fn=None, *, allocates=True, **options):
-    """@kernel or @kernel(option=...): njit, GIL released, cached when possible.
+    """@kernel or @kernel(option=...): njit, GIL released, cached when possible (a
+    `Kernel`: its dispatcher is made on first use).
     Floating-point semantics stay IEEE (no fastmath), so results match the NumPy
     reference implementations bit for bit where the operations are the same.
 
@@ -153,10 +214,7 @@ def kernel(fn=None, *, allocates=True, **options):
     opts.update(options)
 
     def compiled(f):
-        dispatcher = njit(**opts)(f)
-        if CACHE:        # Numba's `cache=True`, with the engine's cache class
-            dispatcher._cache = EngineFunctionCache(f)
-        return dispatcher
+        return Kernel(f, opts)
     return compiled if fn is None else compiled(fn)
 
 
