@@ -192,14 +192,12 @@ def main():
                   ("depth of field", "dof.blend"), ("motion blur", "motion_cube.blend"),
                   (f"{tris / 1e6:.1f}M-triangle mesh (section 4's)", big)]
         pct, ref, ladder = (25, 256, [4, 16]) if q else (100, 1024, [16, 64, 256])
-        rows, ratios, fixed_costs = [], [], []
+        rows, results = [], []
         for name, blend in scenes:
-            r = equal_error(os.path.join(SAMPLES, blend), pct, ref, ladder)
-            rows.append(fmt_row(name, r))
-            ratios.append(r["ratio"])
-            fixed_costs.append((r["fixed"], r["cycles_seconds"]))
+            results.append(equal_error(os.path.join(SAMPLES, blend), pct, ref, ladder))
+            rows.append(fmt_row(name, results[-1]))
             print(rows[-1], flush=True)
-        sec_lines, sec_targets = equal_error_section(rows, ratios, fixed_costs, pct, ref)
+        sec_lines, sec_targets = equal_error_section(results, rows, pct, ref)
         lines += sec_lines
         targets += sec_targets
         done("3")
