@@ -196,3 +196,50 @@ def test_blades_are_oriented_as_in_cycles():
     near_30 = r[np.abs(ang - 30) < 1].max()
     near_0 = r[np.abs(ang) < 1].max()
     assert near_30 > 0.99 and near_0 < np.cos(np.radians(30)) + 0.01
+
+
+def _interp_by_bisection(x, xp, fp):
+    """NumPy's interpolation rule by a plain search: the last interval with xp[j] <= x."""
+    import bisect
+    if x < xp[0]:
+        return fp[0]
+    if x >= xp[-1]:
+        return fp[-1]
+    j = bisect.bisect_right(xp, x) - 1
+    return (fp[j + 1] - fp[j]) / (xp[j + 1] - xp[j]) * (x - xp[j]) + fp[j]
+
+
+@pytest.mark.parametrize("width", [1.5, 0.7, 4.0])
+def test_guided_filter_lookup_finds_the_same_interval_as_a_full_search(width):
+    """The camera kernel inverts the pixel filter's CDF from a guide table (cutpoints)
+    instead of a binary search over all of it: the same interval, so the same offset to
+    the bit, for u at the guide's cell boundaries, on the CDF's own knots, just below
+    them, at 0 and next to 1, and at random."""
+    from engine.kernels.camera_rays import GUIDE_CELLS, guide_table, interp_guided
+    f = PixelFilter("BLACKMAN_HARRIS", width)
+    cdf, xs = f._cdf, f._xs
+    guide = guide_table(cdf)
+    assert guide.shape == (GUIDE_CELLS + 1,) and np.all(np.diff(guide) >= 0)
+    knots = cdf[::7]
+    u = np.concatenate([np.arange(GUIDE_CELLS) / GUIDE_CELLS, knots, np.nextafter(knots, 0),
+                        [0.0, np.nextafter(1.0, 0)],
+                        np.random.default_rng(6).random(20000)])
+    u = u[(u >= 0) & (u < 1)]
+    xp, fp = cdf.tolist(), xs.tolist()
+    got = np.array([interp_guided(float(v), cdf, xs, guide) for v in u])
+    want = np.array([_interp_by_bisection(float(v), xp, fp) for v in u])
+    assert np.array_equal(got, want)
+    np.testing.assert_allclose(got, np.interp(u, cdf, xs), rtol=0, atol=1e-12)
+
+
+def test_guided_lookup_handles_flat_and_steep_cdfs():
+    """Ties (a flat CDF where the density is zero) and most of the mass in one guide
+    cell: still the interval NumPy picks."""
+    from engine.kernels.camera_rays import guide_table, interp_guided
+    cdf = np.array([0.0, 0.0, 0.0, 1e-9, 2e-9, 0.5, 0.5, 0.5, 0.999999, 1.0, 1.0])
+    xs = np.linspace(-1.0, 1.0, len(cdf))
+    guide = guide_table(cdf, 8)
+    u = np.concatenate([np.linspace(0, 1, 97)[:-1], [1e-9, 5e-10, 0.5, 0.9999995]])
+    got = np.array([interp_guided(float(v), cdf, xs, guide) for v in u])
+    want = np.array([_interp_by_bisection(float(v), cdf.tolist(), xs.tolist()) for v in u])
+    assert np.array_equal(got, want)

@@ -6,7 +6,8 @@ keep the NumPy path); the same formulas as engine/camera.py, engine/pixel_filter
 engine/thin_lens.py, one ray at a time.
 
 `cam` is a float64 vector (see `pack_camera`); the filter is given by its inverse-CDF
-table (xs, cdf), or an empty table for the box filter of radius cam[C_BOX_RADIUS].
+table (xs, cdf) and that table's guide (`guide_table`), or empty tables for the box
+filter of radius cam[C_BOX_RADIUS].
 """
 from __future__ import annotations
 
@@ -25,6 +26,17 @@ from .warp import concentric_disk
 C_ROT = 16          # 9 values, row-major camera-to-world rotation
 C_POS = 25          # 3 values
 N_CAM = 28
+GUIDE_CELLS = 1024  # a power of two: u * GUIDE_CELLS and k / GUIDE_CELLS are exact
+
+
+def guide_table(cdf: np.ndarray, cells: int = GUIDE_CELLS) -> np.ndarray:
+    """Where to start looking in an increasing `cdf` (from 0 to 1) for a u in [0, 1):
+    guide[k] is the last index j with cdf[j] <= k / cells, for k = 0..cells (the cutpoint
+    method: Devroye, Non-Uniform Random Variate Generation, III.2.4). u's interval then
+    lies between guide[k] and guide[k + 1] for k = floor(u * cells): a short search
+    instead of one over the whole table."""
+    u = np.arange(cells + 1, dtype=np.float64) / cells
+    return np.clip(np.searchsorted(cdf, u, side="right") - 1, 0, len(cdf) - 1).astype(np.int64)
 
 
 def pack_camera(model, pixel_filter) -> tuple:
@@ -44,20 +56,27 @@ def pack_camera(model, pixel_filter) -> tuple:
     cam[C_POS:C_POS + 3] = model.position
     if pixel_filter.kind == "BOX":
         cam[C_BOX_RADIUS] = pixel_filter.radius
-        return cam, np.zeros(0), np.zeros(0)
-    return cam, np.ascontiguousarray(pixel_filter._xs), np.ascontiguousarray(pixel_filter._cdf)
+        return cam, np.zeros(0), np.zeros(0), np.zeros(0, np.int64)
+    cdf = np.ascontiguousarray(pixel_filter._cdf)
+    return cam, np.ascontiguousarray(pixel_filter._xs), cdf, guide_table(cdf)
 
 
-@kernel
-def interp(x, xp, fp):
-    """np.interp(x, xp, fp) for one x and increasing xp (ties allowed), NumPy's rule:
-    the last interval with xp[j] <= x, slope times the distance plus fp[j]."""
+@kernel(allocates=False)
+def interp_guided(x, xp, fp, guide):
+    """np.interp(x, xp, fp) for one x, for xp increasing from 0 to 1 (a CDF; ties
+    allowed) and its guide_table: the last interval with xp[j] <= x, slope times the
+    distance plus fp[j] (NumPy's rule), found by a search that starts from the guide's
+    interval of x (a few entries) instead of the whole table (a binary search of the
+    pixel filter's 4097 entries took 130 of a camera ray's 192 ns)."""
     n = xp.shape[0]
     if x < xp[0]:
         return fp[0]
     if x >= xp[n - 1]:
         return fp[n - 1]
-    lo, hi = 0, n - 1                       # xp[lo] <= x < xp[hi]
+    cells = guide.shape[0] - 1
+    k = min(max(int(x * cells), 0), cells - 1)
+    lo = guide[k]                           # xp[lo] <= k / cells <= x
+    hi = min(guide[k + 1] + 1, n - 1)       # xp[hi] > (k + 1) / cells > x, or hi = n - 1
     while hi - lo > 1:
         mid = (lo + hi) >> 1
         if xp[mid] <= x:
@@ -69,10 +88,10 @@ def interp(x, xp, fp):
 
 
 @kernel
-def filter_offset(cam, xs, cdf, u):
+def filter_offset(cam, xs, cdf, guide, u):
     if xs.shape[0] == 0:
         return (u - 0.5) * (2.0 * cam[C_BOX_RADIUS])
-    return interp(u, cdf, xs)
+    return interp_guided(u, cdf, xs, guide)
 
 
 @kernel
@@ -99,14 +118,14 @@ def aperture_point(cam, u0, u1):
 
 
 @kernel
-def generate(cam, xs, cdf, kind, spp, pkey, pixel, index, origins, dirs, tmax):
+def generate(cam, xs, cdf, guide, kind, spp, pkey, pixel, index, origins, dirs, tmax):
     """The camera ray of every (pixel, sample index) of a unit into origins, dirs, tmax."""
     w, h = int(cam[C_W]), int(cam[C_H])
     r = cam[C_ROT:C_ROT + 9]
     for i in range(pixel.shape[0]):
         u0, u1 = sample_2d(kind, pkey[i], spp, index[i], D.PIXEL)
-        fx = pixel[i] % w + 0.5 + filter_offset(cam, xs, cdf, u0)
-        fy = pixel[i] // w + 0.5 + filter_offset(cam, xs, cdf, u1)
+        fx = pixel[i] % w + 0.5 + filter_offset(cam, xs, cdf, guide, u0)
+        fy = pixel[i] // w + 0.5 + filter_offset(cam, xs, cdf, guide, u1)
         px = (fx / w * 2.0 - 1.0) * cam[C_HALF_X] + cam[C_SHIFT_X]
         py = (1.0 - fy / h * 2.0) * cam[C_HALF_Y] + cam[C_SHIFT_Y]
         if cam[C_PERSP] != 0.0:
