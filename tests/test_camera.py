@@ -215,10 +215,11 @@ def test_guided_filter_lookup_finds_the_same_interval_as_a_full_search(width):
     instead of a binary search over all of it: the same interval, so the same offset to
     the bit, for u at the guide's cell boundaries, on the CDF's own knots, just below
     them, at 0 and next to 1, and at random."""
-    from engine.kernels.camera_rays import GUIDE_CELLS, guide_table, interp_guided
+    from engine.kernels.camera_rays import GUIDE_CELLS, interp_guided
+    from engine.kernels.cdf_search import guide_table
     f = PixelFilter("BLACKMAN_HARRIS", width)
     cdf, xs = f._cdf, f._xs
-    guide = guide_table(cdf)
+    guide = guide_table(cdf, GUIDE_CELLS)
     assert guide.shape == (GUIDE_CELLS + 1,) and np.all(np.diff(guide) >= 0)
     knots = cdf[::7]
     u = np.concatenate([np.arange(GUIDE_CELLS) / GUIDE_CELLS, knots, np.nextafter(knots, 0),
@@ -235,7 +236,8 @@ def test_guided_filter_lookup_finds_the_same_interval_as_a_full_search(width):
 def test_guided_lookup_handles_flat_and_steep_cdfs():
     """Ties (a flat CDF where the density is zero) and most of the mass in one guide
     cell: still the interval NumPy picks."""
-    from engine.kernels.camera_rays import guide_table, interp_guided
+    from engine.kernels.camera_rays import interp_guided
+    from engine.kernels.cdf_search import guide_table
     cdf = np.array([0.0, 0.0, 0.0, 1e-9, 2e-9, 0.5, 0.5, 0.5, 0.999999, 1.0, 1.0])
     xs = np.linspace(-1.0, 1.0, len(cdf))
     guide = guide_table(cdf, 8)

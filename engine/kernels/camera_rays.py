@@ -17,6 +17,7 @@ import numpy as np
 
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_2d
+from .cdf_search import guide_table, last_at_most
 from .jit import kernel
 from .warp import concentric_disk
 
@@ -26,22 +27,12 @@ from .warp import concentric_disk
 C_ROT = 16          # 9 values, row-major camera-to-world rotation
 C_POS = 25          # 3 values
 N_CAM = 28
-GUIDE_CELLS = 1024  # a power of two: u * GUIDE_CELLS and k / GUIDE_CELLS are exact
-
-
-def guide_table(cdf: np.ndarray, cells: int = GUIDE_CELLS) -> np.ndarray:
-    """Where to start looking in an increasing `cdf` (from 0 to 1) for a u in [0, 1):
-    guide[k] is the last index j with cdf[j] <= k / cells, for k = 0..cells (the cutpoint
-    method: Devroye, Non-Uniform Random Variate Generation, III.2.4). u's interval then
-    lies between guide[k] and guide[k + 1] for k = floor(u * cells): a short search
-    instead of one over the whole table."""
-    u = np.arange(cells + 1, dtype=np.float64) / cells
-    return np.clip(np.searchsorted(cdf, u, side="right") - 1, 0, len(cdf) - 1).astype(np.int64)
+GUIDE_CELLS = 1024  # the pixel filter's CDF guide (cdf_search)
 
 
 def pack_camera(model, pixel_filter) -> tuple:
-    """(cam vector, filter xs, filter cdf) of an engine.camera.CameraModel and an
-    engine.pixel_filter.PixelFilter."""
+    """(cam vector, filter xs, filter cdf, the cdf's guide) of an
+    engine.camera.CameraModel and an engine.pixel_filter.PixelFilter."""
     c = model.camera
     cam = np.zeros(N_CAM)
     cam[C_W], cam[C_H] = model.width, model.height
@@ -56,33 +47,23 @@ def pack_camera(model, pixel_filter) -> tuple:
     cam[C_POS:C_POS + 3] = model.position
     if pixel_filter.kind == "BOX":
         cam[C_BOX_RADIUS] = pixel_filter.radius
-        return cam, np.zeros(0), np.zeros(0), np.zeros(0, np.int64)
+        return cam, np.zeros(0), np.zeros(0), np.zeros(0, np.int32)
     cdf = np.ascontiguousarray(pixel_filter._cdf)
-    return cam, np.ascontiguousarray(pixel_filter._xs), cdf, guide_table(cdf)
+    return cam, np.ascontiguousarray(pixel_filter._xs), cdf, guide_table(cdf, GUIDE_CELLS)
 
 
 @kernel(allocates=False)
 def interp_guided(x, xp, fp, guide):
     """np.interp(x, xp, fp) for one x, for xp increasing from 0 to 1 (a CDF; ties
-    allowed) and its guide_table: the last interval with xp[j] <= x, slope times the
-    distance plus fp[j] (NumPy's rule), found by a search that starts from the guide's
-    interval of x (a few entries) instead of the whole table (a binary search of the
-    pixel filter's 4097 entries took 130 of a camera ray's 192 ns)."""
+    allowed) and its guide (cdf_search): the last interval with xp[j] <= x, slope times
+    the distance plus fp[j] (NumPy's rule). (A binary search over all of the pixel
+    filter's 4097 entries took 130 of a camera ray's 192 ns.)"""
     n = xp.shape[0]
     if x < xp[0]:
         return fp[0]
     if x >= xp[n - 1]:
         return fp[n - 1]
-    cells = guide.shape[0] - 1
-    k = min(max(int(x * cells), 0), cells - 1)
-    lo = guide[k]                           # xp[lo] <= k / cells <= x
-    hi = min(guide[k + 1] + 1, n - 1)       # xp[hi] > (k + 1) / cells > x, or hi = n - 1
-    while hi - lo > 1:
-        mid = (lo + hi) >> 1
-        if xp[mid] <= x:
-            lo = mid
-        else:
-            hi = mid
+    lo = last_at_most(xp, x, guide)
     slope = (fp[lo + 1] - fp[lo]) / (xp[lo + 1] - xp[lo])
     return slope * (x - xp[lo]) + fp[lo]
 

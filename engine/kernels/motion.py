@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .cdf_search import bisect_last
 from .frame import cross
 from .jit import kernel
 
@@ -91,14 +92,7 @@ def object_of(M, prim):
     n = starts.shape[0] - 1
     if n <= 0 or prim < starts[0] or prim >= starts[n]:
         return -1
-    lo, hi = 0, n                   # starts[lo] <= prim < starts[hi]
-    while hi - lo > 1:
-        mid = (lo + hi) >> 1
-        if starts[mid] <= prim:
-            lo = mid
-        else:
-            hi = mid
-    return lo
+    return bisect_last(starts, prim, 0, n)       # starts[0] <= prim < starts[n]
 
 
 @kernel(inline="always")

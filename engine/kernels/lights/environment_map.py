@@ -7,10 +7,11 @@ from __future__ import annotations
 
 import math
 
+from ..cdf_search import last_at_most
 from ..jit import kernel
 from ..textures import texture_rgba
-from .pack import (ENV_CONDITIONAL, ENV_MAP, ENV_MARGINAL, ENV_PIXELS, ENV_TEXTURE,
-                   M_ABS_DET, M_HAS, M_IDENTITY, M_INVERSE, M_MATRIX, M_STRENGTH)
+from .pack import (ENV_CONDITIONAL, ENV_CONDITIONAL_GUIDE, ENV_MAP, ENV_MARGINAL,
+                   ENV_MARGINAL_GUIDE, ENV_PIXELS, ENV_TEXTURE, M_ABS_DET, M_HAS, M_IDENTITY, M_INVERSE, M_MATRIX, M_STRENGTH)
 
 PI = math.pi
 TWO_PI = 2.0 * math.pi
@@ -66,24 +67,11 @@ def map_radiance(L, dx, dy, dz):
 
 
 @kernel
-def upper_bound(cdf, u):
-    """np.searchsorted(cdf, u, side='right') for one value (1D cdf)."""
-    lo = 0
-    hi = cdf.shape[0]
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if cdf[mid] <= u:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
-
-
-@kernel
-def invert_cdf(cdf, u):
-    """engine.piecewise_2d.invert_cdf for one row: (cell, offset in [0, 1])."""
+def invert_cdf(cdf, u, guide):
+    """engine.piecewise_2d.invert_cdf for one row: (cell, offset in [0, 1]); the search
+    starts from the row's guide (kernels.cdf_search), the same cell as a full search."""
     n = cdf.shape[0] - 1
-    i = min(max(upper_bound(cdf, u) - 1, 0), n - 1)
+    i = min(max(last_at_most(cdf, u, guide), 0), n - 1)
     lo = cdf[i]
     width = cdf[i + 1] - lo
     off = (u - lo) / width if width > 0.0 else 0.0
@@ -109,8 +97,8 @@ def cell_pdf(L, r, c):
 def sample_map(L, u0, u1):
     """EnvironmentMap.sample: (wx, wy, wz, solid-angle pdf; 0 = none)."""
     h, w = grid(L)
-    r, dv = invert_cdf(L[ENV_MARGINAL], u0)
-    c, du = invert_cdf(L[ENV_CONDITIONAL][r], u1)
+    r, dv = invert_cdf(L[ENV_MARGINAL], u0, L[ENV_MARGINAL_GUIDE])
+    c, du = invert_cdf(L[ENV_CONDITIONAL][r], u1, L[ENV_CONDITIONAL_GUIDE][r])
     mx, my, mz, sin_t = uv_to_direction((c + du) / w, (r + dv) / h)
     pdf = cell_pdf(L, r, c) / (TWO_PI_SQUARED * sin_t) if sin_t > 0.0 else 0.0
     params = L[ENV_MAP]

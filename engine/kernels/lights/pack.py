@@ -31,6 +31,8 @@ every scene):
   L[ENV_TEXTURE] int64 (1, 6): its row of `kernels.textures` T[TEXTURES] (offset 0).
   L[ENV_MARGINAL]  float64 (H + 1,), L[ENV_CONDITIONAL] float64 (H, W + 1): the CDFs of
                  its `PiecewiseConstant2D`.
+  L[ENV_MARGINAL_GUIDE] int32 (m + 1,), L[ENV_CONDITIONAL_GUIDE] int32 (H, c + 1): their
+                 guide tables (`kernels.cdf_search`), for the row and column searches.
 """
 from __future__ import annotations
 
@@ -38,6 +40,7 @@ import numpy as np
 
 from ...lights import AreaLightModel, PointLightModel, SunLightModel, TimeSlicedLight
 from ...world_light import EnvironmentLightModel, EnvironmentMapLightModel
+from ..cdf_search import guide_cells, guide_table
 from ..textures import texture_info
 
 # ---------------------------------------------------------------- fields of the tuple L
@@ -60,6 +63,8 @@ ENV_PIXELS = 15
 ENV_TEXTURE = 16
 ENV_MARGINAL = 17
 ENV_CONDITIONAL = 18
+ENV_MARGINAL_GUIDE = 19
+ENV_CONDITIONAL_GUIDE = 20
 
 # ---------------------------------------------------------------- L[ENV_MAP] fields
 M_HAS = 0           # 1: the world is an environment map
@@ -233,7 +238,7 @@ def _pack_map(world) -> tuple:
     params = np.zeros(N_MAP)
     if not isinstance(world, EnvironmentMapLightModel):
         return (params, np.zeros(0, np.float32), np.zeros((0, 6), np.int64), np.zeros(1),
-                np.zeros((0, 1)))
+                np.zeros((0, 1)), np.zeros(2, np.int32), np.zeros((0, 2), np.int32))
     env = world.map
     params[M_HAS] = 1.0
     params[M_IDENTITY] = float(env.identity)
@@ -245,5 +250,8 @@ def _pack_map(world) -> tuple:
     pixels = np.ascontiguousarray(tex.pixels, dtype=np.float32).reshape(-1)
     info = np.array([texture_info(tex, 0)], dtype=np.int64)
     dist = env.distribution
-    return (params, pixels, info, _f64(dist.marginal, (-1,)),
-            _f64(dist.conditional, dist.conditional.shape))
+    marginal = _f64(dist.marginal, (-1,))
+    conditional = _f64(dist.conditional, dist.conditional.shape)
+    return (params, pixels, info, marginal, conditional,
+            guide_table(marginal, guide_cells(len(marginal) - 1)),
+            guide_table(conditional, guide_cells(conditional.shape[1] - 1)))
