@@ -51,3 +51,10 @@ def test_row_guides_of_a_2d_table():
         u = rng.random(500)
         got = [last_at_most(cdf[r], float(x), guides[r]) for x in u]
         np.testing.assert_array_equal(got, np.searchsorted(cdf[r], u, side="right") - 1)
+
+
+def test_an_empty_cdf_has_a_guide_of_zeros():
+    """An empty light set's CDF: the guide exists (the kernels' types never vary) and
+    points nowhere; the light pick returns -1 before using it."""
+    assert guide_table(np.zeros(0), 4).tolist() == [0] * 5
+    assert guide_table(np.zeros((0, 3)), 2).shape == (0, 3)

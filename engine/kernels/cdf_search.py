@@ -26,6 +26,8 @@ def guide_cells(n: int, most: int = 1024) -> int:
 def guide_table(cdf: np.ndarray, cells: int) -> np.ndarray:
     """The guide of each CDF along the last axis: (..., cells + 1) int32."""
     cdf = np.asarray(cdf, dtype=np.float64)
+    if cdf.shape[-1] == 0:                     # an empty set: nothing to find
+        return np.zeros(cdf.shape[:-1] + (cells + 1,), np.int32)
     u = np.arange(cells + 1, dtype=np.float64) / cells
     flat = cdf.reshape(-1, cdf.shape[-1])
     guide = np.empty((flat.shape[0], cells + 1), np.int32)

@@ -4,13 +4,14 @@ it, find lamps hit by rays, and every pdf multiple importance sampling needs. En
 n_lamps is lamp k (row k of L[LAMPS]); entry n_lamps + j is emissive triangle j."""
 from __future__ import annotations
 
+from ..cdf_search import last_at_most
 from ..jit import kernel
 from .area import intersect_area, pdf_area, sample_area
 from .environment import pdf_environment, sample_environment
 from .environment_map import has_map, map_radiance, pdf_map, sample_environment_map
-from .pack import (C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, ENV, LAMPS, SELECT_PDF, SUNS,
-                   TRI_VISIBILITY, T_AREA, T_DISC, T_ENV, T_ENV_MAP, T_POINT, T_SPHERE, T_SUN,
-                   T_SUN_DELTA)
+from .pack import (C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, CDF_GUIDE, ENV, LAMPS, SELECT_PDF,
+                   SUNS, TRI_VISIBILITY, T_AREA, T_DISC, T_ENV, T_ENV_MAP, T_POINT, T_SPHERE,
+                   T_SUN, T_SUN_DELTA)
 from .point import intersect_point, pdf_point, sample_point
 from .sun import escaped_sun, pdf_sun, sample_sun
 from .triangles import pdf_triangle, sample_triangle, triangle_entry
@@ -30,20 +31,13 @@ def n_lamps(L):
 @kernel(allocates=False)
 def pick(L, u_pick):
     """np.searchsorted(cdf, u_pick, side='right').clip(0, n - 1): the first entry whose
-    CDF value exceeds u_pick (-1 for an empty set, as the clip gives)."""
+    CDF value exceeds u_pick (-1 for an empty set, as the clip gives), found from the
+    CDF's guide table (kernels.cdf_search)."""
     cdf = L[CDF]
-    lo = 0
-    hi = cdf.shape[0]
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if u_pick < cdf[mid]:
-            hi = mid
-        else:
-            lo = mid + 1
     n = cdf.shape[0]
-    if lo > n - 1:
-        lo = n - 1
-    return lo
+    if n == 0:
+        return -1
+    return min(last_at_most(cdf, u_pick, L[CDF_GUIDE]) + 1, n - 1)
 
 
 @kernel(allocates=False)

@@ -33,6 +33,7 @@ every scene):
                  its `PiecewiseConstant2D`.
   L[ENV_MARGINAL_GUIDE] int32 (m + 1,), L[ENV_CONDITIONAL_GUIDE] int32 (H, c + 1): their
                  guide tables (`kernels.cdf_search`), for the row and column searches.
+  L[CDF_GUIDE]   int32 (m + 1,): L[CDF]'s guide table, for picking an entry.
 """
 from __future__ import annotations
 
@@ -65,6 +66,7 @@ ENV_MARGINAL = 17
 ENV_CONDITIONAL = 18
 ENV_MARGINAL_GUIDE = 19
 ENV_CONDITIONAL_GUIDE = 20
+CDF_GUIDE = 21
 
 # ---------------------------------------------------------------- L[ENV_MAP] fields
 M_HAS = 0           # 1: the world is an environment map
@@ -230,7 +232,8 @@ def pack_lights(light_set, tri_visibility=None) -> tuple:
         entry = tri[7]
         prims = np.flatnonzero(entry >= 0)
         vis[entry[prims]] = np.asarray(tri_visibility)[prims]
-    return (lamps, select_pdf, cdf, suns) + tri + (env, vis) + _pack_map(light_set.world)
+    return ((lamps, select_pdf, cdf, suns) + tri + (env, vis) + _pack_map(light_set.world)
+            + (guide_table(cdf, guide_cells(len(cdf))),))
 
 
 def _pack_map(world) -> tuple:
