@@ -4,9 +4,10 @@ Non-Uniform Random Variate Generation, III.2.4): for an increasing `cdf` from 0 
 The interval of a u in [0, 1) then lies between guide[k] and guide[k + 1], k = floor(u *
 cells): a binary search over those few entries finds the same interval as one over the
 whole table, so results do not change by a bit, only their cost. The pixel filter's
-inverse CDF (camera_rays) and the environment map's row and column CDFs
-(lights/environment_map) use it; `bisect_last` is the plain bisection under it (also
-motion.object_of's)."""
+inverse CDF (camera_rays), the environment map's row and column CDFs
+(lights/environment_map) and the light pick (lights/light_set) use it; `bisect_last` is
+the plain bisection under it (also motion.object_of's). Guides are built once per scene,
+in NumPy."""
 from __future__ import annotations
 
 import numpy as np

@@ -11,7 +11,8 @@ from ..cdf_search import last_at_most
 from ..jit import kernel
 from ..textures import texture_rgba
 from .pack import (ENV_CONDITIONAL, ENV_CONDITIONAL_GUIDE, ENV_MAP, ENV_MARGINAL,
-                   ENV_MARGINAL_GUIDE, ENV_PIXELS, ENV_TEXTURE, M_ABS_DET, M_HAS, M_IDENTITY, M_INVERSE, M_MATRIX, M_STRENGTH)
+                   ENV_MARGINAL_GUIDE, ENV_PIXELS, ENV_TEXTURE, M_ABS_DET, M_HAS, M_IDENTITY,
+                   M_INVERSE, M_MATRIX, M_STRENGTH)
 
 PI = math.pi
 TWO_PI = 2.0 * math.pi
