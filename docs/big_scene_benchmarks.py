@@ -180,7 +180,7 @@ def big_mesh_section(r: dict, load: float) -> tuple[list, list]:
              f"{d['render']:.2f} |",
              f"| DRT: depsgraph to first sample (s) | | "
              f"{(d['first_sample'] or 0) + imported:.2f} |",
-             f"| ... of which loading DRT's tracer (engine, Numba, embreex) (s) | | "
+             f"| ... of which loading DRT's tracer (engine, Numba, Embree) (s) | | "
              f"{imported:.2f} |",
              f"| ... export from the depsgraph (s) | | {d['export'] or 0:.2f} |",
              f"| ... acceleration structure and render set-up (s) | | {setup:.2f} |",
@@ -216,10 +216,8 @@ def big_mesh_section(r: dict, load: float) -> tuple[list, list]:
               f"MB, loaded from the on-disk cache during the first sample in "
               f"{d['kernel_seconds']:.2f} s, of which the first load ({name}) "
               f"{first_s:.2f} s and {first_mb:.0f} MB: it initialises Numba's code "
-              "generation in the process. The render call's time left over Cycles' is "
-              "mostly Embree's: embreex copies the vertices and triangles into Embree's "
-              f"buffers one element at a time through Python indexing "
-              f"({rows[embree[1][0]][1]:.2f} s; it has no call to share a NumPy buffer), "
-              f"and Embree builds its hierarchy ({rows[embree[2][0]][1]:.2f} s); then the "
-              "kernels' loading.", ""]
+              "generation in the process. Of the accelerator's time, converting the "
+              "vertices once to the float32 buffer Embree shares (no copy by Embree) "
+              f"takes {rows[embree[1][0]][1]:.2f} s and Embree's hierarchy build "
+              f"{rows[embree[2][0]][1]:.2f} s.", ""]
     return lines, targets

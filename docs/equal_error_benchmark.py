@@ -100,7 +100,7 @@ def equal_error_section(results, rows, pct, ref):
              "[comparisons.md](comparisons.md). DRT's time for Cycles' error comes from "
              "a power law fitted to its sample ladder; its seconds as a line in "
              "samples: a fixed cost per process (Python, `bpy` and the add-on, the "
-             "file, DRT's tracer (Numba, embreex) imported by its first render, export, "
+             "file, DRT's tracer (Numba, Embree) imported by its first render, export, "
              "the compiled kernels loaded from their cache, the acceleration structure) "
              "plus a cost per sample. Cycles' seconds are a line too, from its renders "
              "at 1 and 64 samples. *Sampling alone* leaves the fixed costs out: DRT's "

@@ -125,20 +125,22 @@ class PhaseRecorder:
 
         # the tracer loads with the first DRT render of a process (not at registration):
         # imported here, it is the render call's first phase
-        import embreex.mesh_construction as embreex_mesh
         from drt_addon import export, render_engine
         from drt_addon.engine_link import engine
         render = import_module(engine.__name__ + ".render")
+        accel = import_module(engine.__name__ + ".accel")
+        embree_scene = import_module(engine.__name__ + ".embree.scene")
         self._time_cache_loads()
-        self.mark("import DRT's tracer (engine, Numba, embreex) and its export")
+        self.mark("import DRT's tracer (engine, Numba, Embree) and its export")
         keeps = (lambda result: [result])
         self._wrap(export, "export_scene", "export (depsgraph to scene description)",
                    held=lambda scene: scene.meshes)
-        # Accelerator: its own arrays, then embreex's copy of them into Embree's buffers
-        # (engine.accel._embree_scene), then Embree's hierarchy (built by a first query)
-        self._wrap(embreex_mesh, "TriangleMesh", "embreex: vertices and triangles copied "
-                   "into Embree", before="accelerator arrays (engine/accel.py)")
-        self._wrap(render, "Accelerator", "Embree: hierarchy (BVH) build", held=keeps)
+        # Accelerator: its own arrays, then the float32 vertex buffer Embree shares
+        # (engine.embree.scene.padded_float32), then Embree's hierarchy (rtcCommitScene)
+        self._wrap(embree_scene, "padded_float32", "Embree: float32 vertex buffer (shared)",
+                   before="accelerator arrays (engine/accel.py)")
+        self._wrap(accel, "_embree_scene", "Embree: hierarchy (BVH) build")
+        self._wrap(render, "Accelerator", "accelerator finished", held=keeps)
         self._wrap(render, "SurfaceBuilder", "surface arrays (engine/surface.py)", held=keeps)
         self._wrap(render, "MaterialTable", "material table")
         self._wrap(render, "_scene_radius", "scene bounds")

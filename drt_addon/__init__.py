@@ -42,8 +42,6 @@ def register():
     import bpy
 
     _use_extension_numba_cache(bpy)
-    from . import blender_compat
-    blender_compat.import_embreex_isolated()
     from . import properties, render_engine, ui
     properties.register()
     bpy.utils.register_class(render_engine.DRTRenderEngine)

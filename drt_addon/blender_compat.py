@@ -4,11 +4,6 @@ bpy module) never takes them, or by a fact of the running process that is false 
 """
 from __future__ import annotations
 
-import ctypes
-import importlib
-import os
-import sys
-
 import bpy
 
 # Principled BSDF sockets renamed in Blender 4.0: the 4.0+ name -> the name before.
@@ -41,30 +36,6 @@ def prepare_corner_normals(mesh) -> None:
     """Make `mesh.loop_triangles.split_normals` valid (a no-op from Blender 4.1)."""
     if not SPLIT_NORMALS_ON_DEMAND:
         mesh.calc_normals_split()
-
-
-def import_embreex_isolated() -> None:
-    """Import embreex's extension modules with RTLD_DEEPBIND when this process already
-    exports Embree's C API, as a Blender linked against a shared libembree does (Debian's):
-    otherwise embreex's calls bind to Blender's Embree, a different version, and crash.
-    Elsewhere (official Blender builds, the bpy module) Embree's symbols are not global
-    and nothing changes."""
-    deepbind = getattr(os, "RTLD_DEEPBIND", 0)
-    if not deepbind or "embreex" in sys.modules:
-        return
-    try:
-        ctypes.CDLL(None).rtcNewDevice  # noqa: B018  (a lookup: raises if absent)
-    except AttributeError:
-        return
-    flags = sys.getdlopenflags()
-    sys.setdlopenflags(flags | deepbind)
-    try:
-        for module in ("rtcore", "rtcore_scene", "mesh_construction"):  # its C extensions
-            importlib.import_module("embreex." + module)
-    except ImportError:
-        pass  # the engine reports a missing embreex itself
-    finally:
-        sys.setdlopenflags(flags)
 
 
 # Blender 4.2+ takes a render pass's pixels as one flat buffer; 3.4 wants one row per pixel

@@ -1,9 +1,9 @@
-"""Ray queries against the scene's triangles through Intel Embree (`embreex`).
+"""Ray queries against the scene's triangles through Intel Embree's own C API
+(`engine.embree`: scenes on shared NumPy buffers, queries in compiled kernels).
 
-embreex traces one ray at a time inside C with the GIL released, at a fixed tnear of 0
-and time 0, with no instancing. So ray origins are offset by the caller
-(`engine.surface.offset_origin`); batches can be split over threads; and motion is built
-here from plain scenes:
+Batches of rays are traced by one compiled call each (`engine.embree.rays`), at tnear 0:
+ray origins are offset by the caller (`engine.surface.offset_origin`); batches are split
+over threads (every kernel releases the GIL). Motion is built here from plain scenes:
 - static geometry: one shared Embree scene in world space (the only one a scene without
   motion ever builds, so static scenes pay nothing for motion blur);
 - each rigidly moving object: its own Embree scene in object space; every ray is moved
@@ -28,8 +28,8 @@ kernel_triangles=0 as well, every moving object goes through Embree.
 All Embree scenes share one Embree device: one device per scene crashes Embree past
 about a thousand scenes.
 
-Precision: Embree takes float32. Triangles are uploaded once in float32; ray origins and
-directions are rounded per query. The static scene is uploaded relative to `center`, its
+Precision: Embree takes float32. Triangles are converted once to float32 (one NumPy
+operation into the buffer Embree shares); ray origins and directions are rounded per ray. The static scene is uploaded relative to `center`, its
 median vertex, and every ray's origin is moved by the same amount (in
 float64) before rounding: a scene far from the world origin then keeps the float32
 precision it would have at the origin (tests/test_extremes_scale.py: the Cornell box
@@ -46,6 +46,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .embree.rays import intersect_batch, occluded_batch
+from .embree.scene import Scene as EmbreeScene
 from .kernels.motion import pack_motion
 from .kernels.motion_pairs import group_pairs, merge_blocked, merge_hits
 from .kernels.motion_tlas import MotionTLAS, build_tlas
@@ -57,32 +59,16 @@ MISS = -1
 # Moving objects of at most this many triangles are intersected inside the compiled
 # traversal (float64, no Embree call); larger ones by their own Embree scene.
 KERNEL_TRIANGLES = 256
-_BIG = np.float32(1e30)
+_ORIGIN = np.zeros(3)
 _NO_F64, _NO_I64, _NO_BOOL = np.zeros(0), np.zeros(0, np.int64), np.zeros(0, bool)
 _MIN_SPLIT = 4096      # below this many rays, one thread is faster than two
 
 
-_DEVICE = None
-_DEVICE_LOCK = threading.Lock()
-
-
-def _embree_device():
-    """The process's one Embree device (created on first use)."""
-    global _DEVICE
-    with _DEVICE_LOCK:
-        if _DEVICE is None:
-            from embreex import rtcore
-            _DEVICE = rtcore.EmbreeDevice()
-        return _DEVICE
-
-
-def _embree_scene(positions: np.ndarray, triangles: np.ndarray):
-    from embreex import rtcore_scene
-    from embreex.mesh_construction import TriangleMesh as EmbreeMesh
-    scene = rtcore_scene.EmbreeScene(_embree_device())
-    EmbreeMesh(scene, np.ascontiguousarray(positions, dtype=np.float32),
-               np.ascontiguousarray(triangles, dtype=np.int32))
-    return scene
+def _embree_scene(positions: np.ndarray, triangles: np.ndarray, offset=None) -> EmbreeScene:
+    """One committed Embree scene of one triangle mesh (shared buffers, engine.embree)."""
+    scene = EmbreeScene()
+    scene.add_triangles(positions, triangles, offset)
+    return scene.commit()
 
 
 @dataclass
@@ -165,14 +151,10 @@ class Accelerator:
         self.center = np.median(self.positions, axis=0) if len(self.positions) else np.zeros(3)
         self.threads = threads or min(os.cpu_count() or 1, 8)
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
-        self._scene = (_embree_scene(self.positions - self.center, self.triangles)
+        # Embree builds the hierarchy when the scene is committed: here, as part of
+        # building the accelerator (and before a cancel can come), not of the first sample
+        self._scene = (_embree_scene(self.positions, self.triangles, self.center)
                        if len(self.triangles) else None)
-        if self._scene is not None:
-            # Embree builds its hierarchy on a scene's first query: here, so that it is
-            # part of building the accelerator (and a cancel after it), not of the
-            # first sample
-            empty = np.zeros((0, 3), np.float32)
-            self._scene.run(empty, empty, dists=np.zeros(0, np.float32), query="OCCLUDED")
         self.moving: list[MovingObject] = []
         offset = self.static_count
         for m in moving:
@@ -225,38 +207,57 @@ class Accelerator:
             self._pool = None
 
     # -- raw queries -------------------------------------------------------------------
-    def _run(self, scene, origins, dirs, tmax, query, output):
-        """The static scene's queries: origins relative to `center` (see the module
-        docstring)."""
-        with np.errstate(over="ignore"):     # beyond float32 (a clip start of 1e38): a miss
-            o = np.ascontiguousarray(np.asarray(origins, np.float64) - self.center,
-                                     dtype=np.float32)
-        d = np.ascontiguousarray(dirs, dtype=np.float32)
-        dist = np.ascontiguousarray(np.minimum(tmax, _BIG), dtype=np.float32)
+    def _query(self, scene, center, origins, dirs, tmax, time, query):
+        """Embree on float64 rays whose origins are moved by -center before rounding to
+        float32 (engine.embree.rays), split over the pool for large batches. Returns
+        blocked (n,) for OCCLUDED; (prim, t, u, v) for INTERSECT (prim -1, t inf where
+        missed)."""
+        o = np.ascontiguousarray(origins, dtype=np.float64)
+        d = np.ascontiguousarray(dirs, dtype=np.float64)
         n = len(o)
+        far = np.array(np.broadcast_to(tmax, (n,)), dtype=np.float64)
+        tm = _NO_F64 if time is None else np.ascontiguousarray(time, dtype=np.float64)
+        if query == "OCCLUDED":
+            out = (np.zeros(n, bool),)
+
+            def run(a, b):
+                occluded_batch(scene.handle, center, o[a:b], d[a:b], far[a:b],
+                               tm[a:b] if len(tm) else tm, out[0][a:b])
+        else:
+            out = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64),
+                   np.empty(n), np.empty(n), np.empty(n))
+
+            def run(a, b):
+                intersect_batch(scene.handle, center, o[a:b], d[a:b], far[a:b],
+                                tm[a:b] if len(tm) else tm, *(x[a:b] for x in out))
+        if self._pool is None or n < _MIN_SPLIT:
+            run(0, n)
+        else:
+            bounds = np.linspace(0, n, self.threads + 1).astype(int)
+            for f in [self._pool.submit(run, a, b)
+                      for a, b in zip(bounds[:-1], bounds[1:]) if b > a]:
+                f.result()
+        if query == "OCCLUDED":
+            return out[0]
+        _, prim, _, t, u, v = out
+        return prim, t, u, v
+
+    def _run(self, origins, dirs, tmax, query):
+        """The static scene's queries, counted (and recorded for a benchmark's replay)."""
+        n = len(origins)
         with self._count_lock:
             self.rays_traced[query] += n
-            if self.recorder is not None and scene is self._scene:
-                self.recorder.append((query, o, d, dist))
-        return self._run32(scene, o, d, dist, query, output)
+            if self.recorder is not None:
+                self.recorder.append((query, np.array(origins, np.float64),
+                                      np.array(dirs, np.float64),
+                                      np.array(np.broadcast_to(tmax, (n,)), np.float64)))
+        return self._query(self._scene, self.center, origins, dirs, tmax, None, query)
 
-    def _run32(self, scene, o, d, dist, query, output):
-        """Embree on float32 contiguous rays, split over the pool for large batches."""
-        n = len(o)
-        if self._pool is None or n < _MIN_SPLIT:
-            return [scene.run(o, d, dists=dist, query=query, output=output)]
-        bounds = np.linspace(0, n, self.threads + 1).astype(int)
-        futures = [self._pool.submit(scene.run, o[a:b], d[a:b], dist[a:b], query, output)
-                   for a, b in zip(bounds[:-1], bounds[1:]) if b > a]
-        return [f.result() for f in futures]
-
-    def _intersect_scene(self, scene, origins, dirs, tmax):
-        parts = self._run(scene, origins, dirs, tmax, "INTERSECT", 1)
-        prim = np.concatenate([p["primID"] for p in parts]).astype(np.int64)
-        t = np.concatenate([p["tfar"] for p in parts]).astype(np.float64)
-        u = np.concatenate([p["u"] for p in parts]).astype(np.float64)
-        v = np.concatenate([p["v"] for p in parts]).astype(np.float64)
-        return t, prim, u, v
+    def replay(self, batches) -> None:
+        """The recorded static-scene batches through bare Embree (a benchmark's reference:
+        the same queries, without DRT's work around them)."""
+        for query, o, d, far in batches:
+            self._query(self._scene, self.center, o, d, far, None, query)
 
     # -- motion ------------------------------------------------------------------------
     def _trace_moving(self, origins, dirs, time, best, t, prim, u, v, blocked, occlusion):
@@ -292,18 +293,21 @@ class Accelerator:
         parts = []
         for k in np.flatnonzero(unit_start[1:] > unit_start[:-1]):
             a, b = unit_start[k], unit_start[k + 1]
-            parts += self._run32(self._unit_scene[k], o32[a:b], d32[a:b], f32[a:b], query,
-                                 None if occlusion else 1)
+            parts.append(self._query(self._unit_scene[k], _ORIGIN, o32[a:b].astype(np.float64),
+                                     d32[a:b].astype(np.float64), f32[a:b].astype(np.float64),
+                                     None, query))
         with self._count_lock:
             self.rays_traced[query] += count
         if occlusion:
-            merge_blocked(s_ray, np.concatenate(parts).astype(np.int64), blocked)
+            merge_blocked(s_ray, np.where(np.concatenate(parts), 0, MISS).astype(np.int64),
+                          blocked)
         else:
             merge_hits(self.motion, self.tlas, s_ray, s_unit,
-                       np.concatenate([p["primID"] for p in parts]),
-                       np.concatenate([p["tfar"] for p in parts]),
-                       np.concatenate([p["u"] for p in parts]),
-                       np.concatenate([p["v"] for p in parts]), t, prim, u, v, best, hit_unit)
+                       np.concatenate([p[0] for p in parts]).astype(np.int32),
+                       np.concatenate([p[1] for p in parts]).astype(np.float32),
+                       np.concatenate([p[2] for p in parts]).astype(np.float32),
+                       np.concatenate([p[3] for p in parts]).astype(np.float32),
+                       t, prim, u, v, best, hit_unit)
 
     # -- public queries ----------------------------------------------------------------
     def intersect(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
@@ -315,8 +319,7 @@ class Accelerator:
         if n == 0:
             return Hits(t, prim, u, v)
         if self._scene is not None:
-            t, prim, u, v = self._intersect_scene(self._scene, origins, dirs, tmax)
-            t[prim < 0] = np.inf
+            prim, t, u, v = self._run(origins, dirs, tmax, "INTERSECT")
         if self.moving:
             if time is None:
                 raise ValueError("a scene with moving objects needs a time per ray")
@@ -334,8 +337,7 @@ class Accelerator:
         if n == 0:
             return blocked
         if self._scene is not None:
-            blocked = np.concatenate(self._run(self._scene, origins, dirs, tmax,
-                                               "OCCLUDED", None)) != MISS
+            blocked = self._run(origins, dirs, tmax, "OCCLUDED")
         if self.moving:
             if time is None:
                 raise ValueError("a scene with moving objects needs a time per ray")

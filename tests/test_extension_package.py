@@ -337,7 +337,11 @@ facts["std"] = float(rgb.std())
 facts["distinct"] = int(np.unique(rgb).size)
 
 facts["module_files"] = {name: getattr(sys.modules.get(name), "__file__", None)
-                         for name in ("embreex", "numba", "llvmlite")}
+                         for name in ("numba", "llvmlite")}
+# Embree: the library DRT loaded (the embreex wheel's; its Python binding is not used)
+embree = sys.modules.get(args["pkg"] + ".engine.embree.library")
+facts["module_files"]["embreex"] = getattr(getattr(embree, "_LIB", None), "drt_path", None)
+facts["embreex_binding_imported"] = "embreex" in sys.modules
 
 # Numba's view: where the add-on pointed the cache, whether the tracer caches at all, and
 # what each compiled kernel of the tracer did (cache hit: loaded from disk; miss: compiled).
@@ -511,11 +515,13 @@ def _check_session(facts, user_dir):
     assert min(facts["size"]) >= 8
     assert facts["finite"]
     assert facts["max"] > 0.01 and facts["std"] > 1e-3 and facts["distinct"] > 10
-    # embreex, numba and llvmlite from the bundled wheels, which Blender unpacked into
-    # extensions/.local, never from the Python environment running this test.
+    # numba, llvmlite and the Embree library of the embreex wheel from the bundled wheels,
+    # which Blender unpacked into extensions/.local, never from the Python environment
+    # running this test; embreex's own Python binding is never imported.
     site_packages = os.path.realpath(_site_packages(user_dir)) + os.sep
     for name, path in facts["module_files"].items():
         assert path and os.path.realpath(path).startswith(site_packages), (name, path)
+    assert not facts["embreex_binding_imported"]
     # The tracer's kernels were compiled by that numba (a render that used none would
     # not test it).
     assert facts["kernels_used"] > 0
