@@ -4,7 +4,7 @@ Every light model and the LightSet's own rules (pick CDF, strategy choice, pdfs 
 pick probability, margins, deltas, visible_camera) are ported as scalar Numba code; here
 both run on the same inputs and must agree to RTOL = 1e-9 (directions to 1e-12 absolute,
 being unit vectors). The two compute the same operations in the same order, so most
-values agree bit for bit (97 % of the sampled rows of a stress run, all fields).
+values agree to the last bits, but no comparison asks for bit equality.
 
 The one place they may not: NumPy's `@` on a batch of rows is BLAS (gemv, fusing
 multiply-adds), the kernels' dot products are plain sums, so an area lamp's frame
@@ -261,12 +261,22 @@ def close(kernel, numpy, what, rtol=RTOL, atol=0.0):
 REDO_VALUE, REDO_DIRECTION = (1e-6, 0.0), (0.0, 1e-10)
 PLANE = 1e12
 MAX_TIES = 0.005
+# NumPy's transcendental functions are not libm's everywhere: on CPUs with AVX-512 its
+# float64 sin, cos, arccos, exp and log are SVML's, up to 4 ulp from libm's, which the
+# kernels call. Where the row's own conditioning amplifies such ulps (near a lamp's
+# plane, as above), the tolerance is measured, not guessed: NumPy's row again with the
+# shading point nudged by NUDGE (4 ulp, relative), and the kernel may differ from NumPy
+# by CONDITIONING times what that nudge changed (seen on an Intel Xeon: one sampled wi of
+# 593 rows past REDO_DIRECTION).
+NUDGE = 2.0 ** -50
+CONDITIONING = 4.0
 
 
-def agree(what, names, tols, kernel, numpy, numpy_row):
+def agree(what, names, tols, kernel, numpy, numpy_row, numpy_row_nudged=None):
     """The kernel's arrays equal NumPy's batch results to the tolerances, or, for the
     rows where they do not, NumPy's result for that row alone (`numpy_row(i)`) to
-    REDO_* tolerances (exact fields stay exact), or are a rim tie; see above."""
+    REDO_* tolerances (exact fields stay exact), or to the row's measured conditioning
+    (`numpy_row_nudged(i)`, see NUDGE), or are a rim tie; see above."""
     redo = np.zeros(len(kernel[0]), dtype=bool)
     for k, n, (rtol, atol) in zip(kernel, numpy, tols):
         redo |= mismatched(k, n, rtol, atol)
@@ -281,6 +291,12 @@ def agree(what, names, tols, kernel, numpy, numpy_row):
             if not mismatched(k[i:i + 1], o, rtol, atol)[0]:
                 continue
             mine, theirs = np.atleast_1d(k[i]), np.atleast_1d(o[0])
+            if tol != EXACT and numpy_row_nudged is not None:
+                moved = np.atleast_1d(numpy_row_nudged(i)[names.index(name)][0])
+                spread = np.abs(moved - theirs)
+                if np.all(np.isfinite(spread)) and \
+                        np.all(np.abs(mine - theirs) <= CONDITIONING * spread):
+                    continue           # ill-conditioned: within what 4 ulp of p move
             if tol == VALUE and (((mine == 0) != (theirs == 0)).any()
                                  or np.abs(np.concatenate([mine, theirs])).max() > PLANE):
                 ties += 1              # a ray through a lamp's rim or along its plane
@@ -302,7 +318,8 @@ def compare_sample(L, ls, p, up, u):
     s, idx, delta = ls.sample(p, up, u)
     agree("sample", SAMPLE_FIELDS, SAMPLE_TOLS, sample_batch(L, p, up, u),
           fields(s, idx, delta),
-          lambda i: fields(*ls.sample(p[i:i + 1], up[i:i + 1], u[i:i + 1])))
+          lambda i: fields(*ls.sample(p[i:i + 1], up[i:i + 1], u[i:i + 1])),
+          lambda i: fields(*ls.sample(p[i:i + 1] * (1 + NUDGE), up[i:i + 1], u[i:i + 1])))
     return s, idx
 
 
@@ -344,11 +361,12 @@ def compare_hits(L, ls, o, d, tmax):
 
 
 def compare_pdf(L, ls, k, p, wi, t, what="pdf"):
-    def numpy_pdf(rows):
-        return (ls.pdf(k[rows], p[rows], wi[rows], t[rows]),)
+    def numpy_pdf(rows, scale=1.0):
+        return (ls.pdf(k[rows], p[rows] * scale, wi[rows], t[rows]),)
 
     agree(what, ("pdf",), (VALUE,), (lamp_pdf_batch(L, k, p, wi, t),),
-          numpy_pdf(slice(None)), lambda i: numpy_pdf(slice(i, i + 1)))
+          numpy_pdf(slice(None)), lambda i: numpy_pdf(slice(i, i + 1)),
+          lambda i: numpy_pdf(slice(i, i + 1), 1 + NUDGE))
 
 
 # ------------------------------------------------------------------ tests
