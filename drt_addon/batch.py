@@ -6,6 +6,8 @@
                                                            see docs/install.md)
     python -m drt_addon compare A.exr B.exr [-o DIFF.png]  (compare_images.py)
     python -m drt_addon converge SCENE.blend [-o DIR] ...  (converge.py; docs/convergence.md)
+    python -m drt_addon compile [SCENE.blend ...]          (precompile.py: the kernels'
+                                                           cache, before a first render)
 
 One machine renders the frames one after the other through Blender's render pipeline
 (the DRT RenderEngine); `--workers N` or `--cluster ADDRESS` hands them to Dask
@@ -94,8 +96,8 @@ def build_parser() -> argparse.ArgumentParser:
     pk.add_argument("--platform", action="append", dest="platforms", metavar="PLATFORM",
                     help="build only this platform's zip (one of the manifest's platforms, "
                          "e.g. linux-x64; repeatable; default: every platform)")
-    from . import compare_images, converge
-    for command in (compare_images, converge):
+    from . import compare_images, converge, precompile
+    for command in (compare_images, converge, precompile):
         command.add_parser(sub)
     return p
 
@@ -270,6 +272,7 @@ def _render_here(bpy, scene, jobs, overrides, progress) -> list[FrameResult]:
     from . import render_engine
     listener = progress.samples_done
     render_engine.progress_listeners.append(listener)
+    render_engine.compile_listeners.append(progress.compiling)
     try:
         results = []
         for frame, path in jobs:
@@ -278,6 +281,7 @@ def _render_here(bpy, scene, jobs, overrides, progress) -> list[FrameResult]:
         return results
     finally:
         render_engine.progress_listeners.remove(listener)
+        render_engine.compile_listeners.remove(progress.compiling)
 
 
 def run_render(args) -> int:
@@ -332,7 +336,7 @@ def run(argv) -> int:
     args = build_parser().parse_args(argv)
     if args.command == "package":
         return run_package(args)
-    if getattr(args, "run", None) is not None:      # compare, converge
+    if getattr(args, "run", None) is not None:      # compare, converge, compile
         return args.run(args)
     return run_render(args)
 

@@ -32,6 +32,7 @@ class Progress:
         self.frames = tqdm(total=n_frames, desc="frames", unit="frame", file=sys.stderr,
                            position=0, disable=not enabled, dynamic_ncols=True)
         self.samples = None
+        self._label = None
         self.warned = set()                 # warnings said (each once per job)
 
     def say(self, message: str, file=None) -> None:
@@ -43,10 +44,29 @@ class Progress:
         self.samples = self._tqdm(total=total_samples, desc=label, unit=unit,
                                   file=sys.stderr, position=1, leave=False,
                                   disable=not self.enabled, dynamic_ncols=True)
+        self._label = None          # the bar's own label while it says "compiling"
+
+    def compiling(self, done: int, total: int) -> None:
+        """The frame's bar while a first render compiles its kernels: what is compiled,
+        and no sample rate (the first samples' rate is timed from when they start)."""
+        bar = self.samples
+        if bar is None:
+            return
+        from .render_engine import compile_line
+        if self._label is None:
+            self._label = bar.desc
+        bar.set_description_str(f"{self._label}: {compile_line(done, total)}")
 
     def samples_done(self, done: int, total: int | None = None) -> None:
         bar = self.samples
         if bar is None:
+            return
+        if self._label is not None:            # the compile is over: time samples anew
+            bar.set_description_str(self._label)
+            self._label = None
+            bar.reset(total=total or bar.total)
+            bar.initial = bar.n = bar.last_print_n = done    # the rate counts from here
+            bar.refresh()
             return
         if total is not None and total != bar.total:
             bar.total = total

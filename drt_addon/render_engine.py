@@ -30,7 +30,7 @@ from bpy.props import BoolProperty, PointerProperty
 
 from .blender_compat import set_pass_pixels
 
-# The tracer (engine, with NumPy's kernels compiled by Numba, and embreex) and the export
+# The tracer (engine: kernels compiled by Numba, Embree through its C API) and the export
 # are imported by the first DRT render, not when Blender registers the add-on: a Blender
 # that renders with Cycles, or opens no file, pays nothing for DRT (principle 3;
 # tests/test_addon.py).
@@ -44,6 +44,14 @@ last_render = {"ok": None, "error": None, "warnings": [], "stats": None, "pixels
 # Callables told (samples done, samples asked) after every progressive pass (the batch
 # renderer's progress bar).
 progress_listeners: list = []
+# Callables told (kernels compiled, kernels reachable) while a first render compiles.
+compile_listeners: list = []
+
+
+def compile_line(done: int, total: int) -> str:
+    """What a render says while Numba compiles its kernels (once per machine and DRT
+    version: they are cached on disk)."""
+    return f"compiling kernels, one time: {done} of {total}"
 
 
 class RenderCancelled(Exception):
@@ -150,7 +158,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         from .export import ExportError
         last_render.update(ok=False, error=None, warnings=[], stats=None, pixels=None,
                            scene=None, export_stats=None, passes={}, region=None, progress=[],
-                           cancelled_in=None, phase=None)
+                           cancelled_in=None, phase=None, compile_said=None)
         try:
             self._render(depsgraph)
         except RenderCancelled as e:
@@ -239,7 +247,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 for listener in progress_listeners:
                     listener(stats.samples_done, settings.samples)
                 rate = stats.paths_per_second()
-                left = stats.seconds * (1 - fraction) / max(fraction, 1e-9)
+                # the estimate leaves out a first render's one-time kernel compile
+                left = stats.sampling_seconds() * (1 - fraction) / max(fraction, 1e-9)
                 n_pixels = description.width * description.height
                 line = (f"DRT | {stats.status(settings.samples, n_pixels)} | "
                         f"{rate / 1e3:.0f}k paths/s | {left:.0f} s left")
@@ -249,8 +258,19 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                     print(f"Fra:{scene.frame_current} | Time:{_clock(time.perf_counter() - t0)}"
                           f" | {line} | {_threads_label(settings.threads)}", flush=True)
 
+            def compiling(done, total):
+                line = compile_line(done, total)
+                self.update_stats("", f"DRT | {line}")
+                for listener in compile_listeners:
+                    listener(done, total)
+                if bpy.app.background and last_render.get("compile_said") != done:
+                    last_render["compile_said"] = done
+                    print(f"Fra:{scene.frame_current} | Time:{_clock(time.perf_counter() - t0)}"
+                          f" | DRT | {line}", flush=True)
+
             film, stats = engine.render(description, settings, context=ctx, progress=progress,
-                                        cancelled=lambda: self._polled("tracing"))
+                                        cancelled=lambda: self._polled("tracing"),
+                                        compiling=compiling)
             image, alpha = film.mean(), film.mean_alpha()
             set_pass_pixels(combined, _rgba_bottom_up(image, alpha))
             if not stats.cancelled and enabled_passes(view_layer) and \

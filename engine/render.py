@@ -18,6 +18,7 @@ import os
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass
 
 import numpy as np
@@ -30,6 +31,8 @@ from .film import Film
 from .integrators import make_integrator
 from .kernels.camera_rays import generate as generate_camera_rays
 from .kernels.camera_rays import pack_camera
+from .kernels.compile_watch import CompileWatch, reachable
+from .kernels.jit import Kernel
 from .lights import LightSet
 from .mesh_lights import EmissiveTriangles
 from .pixel_filter import PixelFilter
@@ -40,6 +43,9 @@ from .scene import Scene
 from .settings import RenderSettings
 from .surface import SurfaceBuilder
 from .world_light import world_model
+
+
+POLL = 0.25      # seconds between looks at cancel and compile progress while units run
 
 
 @dataclass
@@ -54,9 +60,17 @@ class RenderStats:
     time_limited: bool = False         # stopped by settings.time_limit
     active_pixels: int = -1            # pixels still sampled after the last pass (adaptive)
     pixel_samples: int = 0             # samples taken over all pixels
+    compile_seconds: float = 0.0       # spent compiling kernels (a first render only)
+    kernels_compiled: int = 0          # kernels compiled, of kernels_reachable
+    kernels_reachable: int = 0
+
+    def sampling_seconds(self) -> float:
+        """Seconds spent rendering, the kernels' one-time compile left out."""
+        return max(self.seconds - self.compile_seconds, 0.0)
 
     def paths_per_second(self) -> float:
-        return self.paths / self.seconds if self.seconds > 0 else 0.0
+        seconds = self.sampling_seconds()
+        return self.paths / seconds if seconds > 0 else 0.0
 
     def status(self, samples: int, n_pixels: int) -> str:
         """The stats line: samples, adaptive sampling's share of converged pixels, the
@@ -107,6 +121,19 @@ class RenderContext:
 
     def close(self):
         self.accel.close()
+
+    def entry_kernels(self) -> list:
+        """The compiled kernels this render calls from Python: the camera's, the ray
+        queries', and the integrator's (`compile_watch.reachable` finds their callees)."""
+        import sys
+        from .embree import rays
+        found = [generate_camera_rays, pixel_keys, rays.intersect_batch, rays.occluded_batch]
+        module = sys.modules[type(self.integrator).__module__]
+        found += [v for v in vars(module).values() if isinstance(v, Kernel)]
+        if self.accel.moving:
+            from . import accel
+            found += [v for v in vars(accel).values() if isinstance(v, Kernel)]
+        return found
 
 
 def _scene_radius(scene: Scene, accel: Accelerator) -> float:
@@ -174,11 +201,14 @@ def plan_passes(total: int, first: int = 1, growth: float = 2.0, largest: int = 
 
 def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
            sample_end: int | None = None, progress=None, cancelled=None,
-           context: RenderContext | None = None):
+           context: RenderContext | None = None, compiling=None):
     """Render samples [sample_start, sample_end) (default: all of settings.samples).
 
     progress(film, stats, fraction) is called after every pass; cancelled() is polled
-    between work units. With adaptive sampling (engine.adaptive_sampling) later passes
+    between work units, and every POLL seconds while a unit runs. compiling(done, total)
+    is called while Numba compiles kernels (a first render with an empty cache): `done`
+    of the `total` kernels the render can reach are compiled; a cancel then returns at
+    once and the compile finishes in the background (its kernels are cached). With adaptive sampling (engine.adaptive_sampling) later passes
     take samples only in the pixels that have not converged; with a time limit the render
     stops at the first unit boundary after it. Returns (film, stats)."""
     ctx = context or RenderContext(scene, settings)
@@ -199,6 +229,7 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
         if adaptive else plan_passes(total)
 
     running = [0]
+    abandoned = threading.Event()
 
     def run(pixels, a, b):
         with lock:
@@ -216,6 +247,8 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
         if settings.film_exposure != 1.0:
             rad *= settings.film_exposure      # Film > Exposure, on the way into the film
         with lock:
+            if abandoned.is_set():             # finished after render() returned
+                return 0
             film.add(pix, rad, alpha, index=index)
             stats.paths += len(pix)
             stats.nonfinite_samples += int(bad.sum())
@@ -233,8 +266,11 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
             return False
         return True
 
+    watch = CompileWatch(reachable(ctx.entry_kernels()))
+    stats.kernels_reachable = watch.total
+    pool = ThreadPoolExecutor(threads)
     try:
-        with ThreadPoolExecutor(threads) as pool:
+        with watch:
             for a, b in passes:
                 a, b = a + sample_start, b + sample_start
                 # Pixels per unit: two units per thread, but no unit over chunk_paths
@@ -247,11 +283,21 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
                 futures = [pool.submit(run, active[start:start + per_unit], a, b)
                            for start in range(0, len(active), per_unit)]
                 for f in futures:
-                    if not stop.is_set() and should_stop():
-                        with lock:
-                            stop.set()
-                            stats.units_running_at_cancel = running[0]
-                    f.result()
+                    while True:
+                        if not stop.is_set() and should_stop():
+                            with lock:
+                                stop.set()
+                                stats.units_running_at_cancel = running[0]
+                        if stop.is_set() and watch.compiling:
+                            break       # a compile cannot be interrupted: left running
+                        try:
+                            f.result(timeout=POLL)
+                            break
+                        except FutureTimeout:
+                            if watch.compiling and compiling is not None:
+                                compiling(len(watch.done), watch.total)
+                stats.compile_seconds = watch.seconds
+                stats.kernels_compiled = len(watch.done)
                 stats.seconds = time.perf_counter() - t0
                 if stats.cancelled:
                     break
@@ -268,6 +314,11 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
                 if stop.is_set() or not len(active):
                     break
     finally:
+        # after a cancel during a compile, the unit compiling goes on in the background
+        if stop.is_set():
+            with lock:
+                abandoned.set()
+        pool.shutdown(wait=not stop.is_set(), cancel_futures=True)
         if context is None:
             ctx.close()
     stats.seconds = time.perf_counter() - t0

@@ -31,6 +31,7 @@ from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
 from ..kernels.medium_density import bound_majorants, shadow_keys
 from ..kernels.volume import STACK, V_HET, pack_volumes
 from ..nodes.context import N_OBJ
+from ..nodes.pack import PROG
 from ..nodes.differentials import camera_cones
 from ..sampling.dispatch import pixel_keys
 from .path import MIS_MODES
@@ -115,6 +116,10 @@ class CompiledPathIntegrator:
                             self.geometry[8], self.geometry[9],
                             (surf.positions, surf.corners), self.camera)
         self.het_runs = np.zeros(1, np.int64)
+        # what shade is compiled with (None: without that code; see its docstring)
+        self.features = (self.textures if bool((self.textures[PROG][:, 1] > 0).any()) else None,
+                         self.vol if self.has_volumes else None,
+                         self.vol if self.heterogeneous else None)
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
                             else np.full(STACK, -1, np.int32))
 
@@ -244,7 +249,7 @@ class CompiledPathIntegrator:
                            self.geometry, self.params, self.emission, self.textures,
                            self.tables, self.lights, self.world, media,
                            sh_path, sh_org, sh_dir, sh_far, sh_contrib,
-                           nx_path, nx_org, nx_dir, (used, cone))
+                           nx_path, nx_org, nx_dir, (used, cone), *self.features)
             if ns:
                 sh_time = path_time[sh_path[:ns]] if moving else None
                 clamps = (sh_bounce[:ns], s.clamp_direct, s.clamp_indirect)

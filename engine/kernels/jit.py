@@ -95,6 +95,14 @@ class EngineCacheLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLo
     def get_cache_path(self):
         return self._cache_path
 
+    @classmethod
+    def get_suitable_cache_subpath(cls, py_file):
+        """The source's folder relative to the engine (`kernels_bsdf`), not Numba's hash
+        of its absolute path: a cache built in one place (a source checkout, the
+        extension package's build) loads wherever the engine is installed."""
+        rel = os.path.relpath(os.path.dirname(os.path.abspath(py_file)), ENGINE_DIR)
+        return "engine" if rel == "." else "engine_" + rel.replace(os.sep, "_")
+
     def get_source_stamp(self):
         return FINGERPRINT
 
@@ -164,7 +172,8 @@ class Kernel:
             with Kernel._lock:
                 if self._dispatcher is None:
                     made = njit(**self._options)(self.py_func)
-                    if CACHE:        # Numba's `cache=True`, with the engine's cache class
+                    if CACHE and self._options.get("cache", True):
+                        # Numba's `cache=True`, with the engine's cache class
                         made._cache = EngineFunctionCache(self.py_func)
                     self._dispatcher = made
                 dispatcher = self._dispatcher

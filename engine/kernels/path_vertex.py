@@ -73,7 +73,8 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
 def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, ray_bits,
           min_pdf, cont, path_time, live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
           geometry, params, emission, textures, tables, lights, world, media,
-          sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir, path_info):
+          sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir, path_info,
+          programs, volumes, het):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
 
     cfg: float64 [sampler kind, spp, max_bounces, diffuse, glossy, transmission limits,
@@ -112,7 +113,13 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     through it (`volume.segment`, or `medium_density.tracked_segment` when a medium of
     its stack is heterogeneous): it may scatter there (`medium_vertex.scatter` shades that
     point), emission along it is added, and what it reaches beyond is weighted by its
-    transmittance. A hit on a volume's boundary surface is crossed without a bounce."""
+    transmittance. A hit on a volume's boundary surface is crossed without a bounce.
+
+    programs, volumes, het: what the scene uses, each None when it does not (Numba then
+    compiles this kernel without that code, and never compiles what only it calls: a
+    scene without node programs and volumes compiles about half as much). programs: the
+    shading tables when a material has a shader program; volumes: the volume table
+    when the scene has media; het: the same when one of them is heterogeneous."""
     bounce, vbounce, vol, stacks, sh_stack, sh_bounce, het_count = media
     het_scene = has_heterogeneous(vol)
     vhit = np.zeros(N_HIT)
@@ -148,8 +155,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         str_ = stg = stb = wcr = wcg = wcb = 0.0
         g_phase = 0.0
         mfr = mfg = mfb = 1.0                    # a heterogeneous segment's factor at a lamp
-        if in_medium(stacks, p):
-            if het_scene and heterogeneous_in(vol, stacks, p):
+        if volumes is not None and in_medium(stacks, p):
+            if het is not None and het_scene and heterogeneous_in(vol, stacks, p):
                 # null-scattering tracking (engine.kernels.medium_density); the factor
                 # is also taken at the nearest lamp in front of the geometry
                 t_lamp = _INF
@@ -189,7 +196,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                                    prev_pos[p, 2], dx, dy, dz, t_l)
                 w = hit_weight(mode, prev_pdf[p], lpdf)
                 _add(L, p, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w, clamp_hit)
-        if scattered:
+        if volumes is not None and scattered:
             q = continues(cont, p)             # the roulette, after the emission found
             if q == 0.0:
                 continue
@@ -241,28 +248,28 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         if cont[p] == 0.0 and not may_emit(textures, emission, m):
             continue                      # ended by the roulette, and nothing to find here
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
-        programmed = has_program(textures, m)
+        programmed = programs is not None and has_program(programs, m)
         bent, correct = False, True
         rx, ry, rz = nx, ny, nz
         # the lobe choice's number; a Mix Shader picks its shader with it first
         u_lobe = sample_1d(kind, pkey[p], spp, index[p], base + D.BSDF_LOBE)
         ms = m                                   # the material shaded
         n0x, n0y, n0z = nx, ny, nz               # the surface's own shading normal
-        if programmed:
+        if programs is not None and programmed:
             path_fields(hit_row, counts, path_info[0], p, cone_at(path_info[1], p, t_geom))
-            program_hit(textures, geometry, m, prim, hit_u[j], hit_v[j], uu, vv, px, py, pz,
+            program_hit(programs, geometry, m, prim, hit_u[j], hit_v[j], uu, vv, px, py, pz,
                         gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bits[p], b, t_geom,
                         hit_row, regs)
-            ms, u_lobe = pick_closure(textures, m, regs, u_lobe)
+            ms, u_lobe = pick_closure(programs, m, regs, u_lobe)
             correct = params[ms, P_BUMP_CORRECTION] != 0.0
-            sx, sy, sz, rx, ry, rz = program_normal(textures, ms, regs, nx, ny, nz, gx, gy,
+            sx, sy, sz, rx, ry, rz = program_normal(programs, ms, regs, nx, ny, nz, gx, gy,
                                                     gz, -dx, -dy, -dz, correct)
             bent = sx != nx or sy != ny or sz != nz or rx != nx or ry != ny or rz != nz
             nx, ny, nz = sx, sy, sz
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
         er, eg, eb = emission_at(textures, emission, m, uu, vv)
-        if programmed:
-            er, eg, eb = program_emission(textures, m, regs, er, eg, eb)
+        if programs is not None and programmed:
+            er, eg, eb = program_emission(programs, m, regs, er, eg, eb)
         if er != 0.0 or eg != 0.0 or eb != 0.0:
             lpdf = lt.mesh_pdf(lights, prim, prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2],
                                px, py, pz)
@@ -276,8 +283,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         row[:] = params[ms]
         if any_textures:
             apply_to_row(textures, ms, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
-        if programmed:
-            apply_rows(textures, ms, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS)
+        if programs is not None and programmed:
+            apply_rows(programs, ms, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
         room = b < max_bounces
