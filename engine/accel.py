@@ -29,13 +29,14 @@ All Embree scenes share one Embree device: one device per scene crashes Embree p
 about a thousand scenes.
 
 Precision: Embree takes float32. Triangles are converted once to float32 (one NumPy
-operation into the buffer Embree shares); ray origins and directions are rounded per ray. The static scene is uploaded relative to `center`, its
-median vertex, and every ray's origin is moved by the same amount (in
-float64) before rounding: a scene far from the world origin then keeps the float32
-precision it would have at the origin (tests/test_extremes_scale.py: the Cornell box
-moved by 1e6 renders as at the origin; before, a box 1e5 from the origin lost 14% of its
-pixels to the z-test). Hit points are NOT taken from the float32 distance but
-rebuilt in float64 from the hit's barycentrics (`engine.surface`).
+operation into the buffer Embree shares); ray origins and directions are rounded per
+ray. The static scene is uploaded relative to `center`, its median vertex, and every
+ray's origin is moved by the same amount (in float64) before rounding: a scene far from
+the world origin then keeps the float32 precision it would have at the origin
+(tests/test_extremes_scale.py: the Cornell box moved by 1e6 renders as at the origin;
+before, a box 1e5 from the origin lost 14% of its pixels to the z-test). Hit points are
+NOT taken from the float32 distance but rebuilt in float64 from the hit's barycentrics
+(`engine.surface`).
 """
 from __future__ import annotations
 

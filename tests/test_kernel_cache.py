@@ -126,3 +126,55 @@ def test_cached_kernels_load_without_numbas_compiler_registries(tmp_path):
     kernels, made_compiling, made_loading = second[4], first[5], second[5]
     assert kernels > 300
     assert made_loading == 1 < made_compiling
+
+
+def test_a_cache_built_elsewhere_loads_where_the_engine_is_installed(tmp_path):
+    """The cache's folders are named after the engine's own subfolders, not Numba's hash
+    of their absolute path (engine.kernels.jit.EngineCacheLocator): kernels cached by a
+    copy of the engine in one place load in a copy installed in another, as the extension
+    package's caches must."""
+    cache = tmp_path / "cache"
+    first = _copy_engine(tmp_path / "built-here")
+    second = _copy_engine(tmp_path / "installed-there")
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache))
+
+    def run(src):
+        proc = subprocess.run([sys.executable, "-c", LOAD_PROBE], cwd=src,
+                              env=dict(env, PYTHONPATH=str(src)), capture_output=True,
+                              text=True, timeout=600)
+        assert proc.returncode == 0, proc.stderr
+        return proc.stdout.split()
+
+    built, installed = run(first), run(second)
+    assert int(built[1]) == 0 and int(installed[1]) == 1       # compiled, then loaded
+    assert float(built[0]) == float(installed[0])
+
+
+PURE_PYTHON = """
+import sys, numpy as np
+sys.path.insert(0, {tests!r})
+from engine import render, RenderSettings
+from engine_scenes import cornell_box
+film, stats = render(cornell_box(4, 4), RenderSettings(samples=2, threads=1, seed=5))
+np.save({out!r}, film.mean())
+"""
+
+
+def test_every_kernel_runs_as_plain_python(tmp_path):
+    """NUMBA_DISABLE_JIT=1 runs every kernel as the Python it is written in (Embree's
+    calls through ctypes), for a student to step through: a small render gives the
+    compiled tracer's image (the same paths; float64 arithmetic in the same order, but
+    Python's math functions are not LLVM's)."""
+    from engine import RenderSettings, render
+    from engine_scenes import cornell_box
+    out = tmp_path / "python.npy"
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1", PYTHONPATH=ROOT)
+    code = PURE_PYTHON.format(tests=os.path.join(ROOT, "tests"), out=str(out))
+    proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env,
+                          capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    python = np.load(out)
+    film, _ = render(cornell_box(4, 4), RenderSettings(samples=2, threads=1, seed=5))
+    compiled = film.mean()
+    assert compiled.max() > 0.05                       # lit: the comparison shows something
+    np.testing.assert_allclose(python, compiled, rtol=1e-9, atol=1e-12)

@@ -5,8 +5,8 @@ LLVM to the addresses `engine.embree.library` registers), so a kernel can trace 
 anywhere: a path's bounce, a shadow ray, an ambient-occlusion probe, a random walk.
 
 A query fills one `RTCRayHit` (96 bytes, 16-byte aligned) that the caller provides as
-`RayRecord`: two views of one scratch buffer, float32 fields and uint32 fields (the
-named offsets below, from Embree's rtcore_ray.h). `ray_record()` makes one in Python;
+two views of one scratch buffer, float32 fields and uint32 fields (the named offsets
+below, from Embree's rtcore_ray.h). `ray_record()` makes one in Python;
 `new_ray_record()` inside a kernel. Each thread uses its own.
 
 Precision: Embree takes float32 rays. The caller's float64 origin is moved by `center`
@@ -17,15 +17,21 @@ from __future__ import annotations
 
 import numpy as np
 from numba import types
+from numba.core import config
 
 from ..kernels.jit import kernel
 from . import library
 
-library.register_kernel_symbols()
-
-_sig = types.void(types.uintp, types.uintp, types.uintp)
-rtc_intersect1 = types.ExternalFunction("drt_rtcIntersect1", _sig)
-rtc_occluded1 = types.ExternalFunction("drt_rtcOccluded1", _sig)
+if config.DISABLE_JIT:
+    # kernels run as plain Python (NUMBA_DISABLE_JIT=1, for stepping through them): the
+    # same two calls through ctypes
+    rtc_intersect1 = library.load().rtcIntersect1
+    rtc_occluded1 = library.load().rtcOccluded1
+else:
+    library.register_kernel_symbols()
+    _sig = types.void(types.uintp, types.uintp, types.uintp)
+    rtc_intersect1 = types.ExternalFunction("drt_rtcIntersect1", _sig)
+    rtc_occluded1 = types.ExternalFunction("drt_rtcOccluded1", _sig)
 
 # RTCRayHit, in 4-byte words
 ORG_X, ORG_Y, ORG_Z, TNEAR = 0, 1, 2, 3
