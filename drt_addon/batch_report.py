@@ -50,7 +50,7 @@ class Progress:
         """The frame's bar while a first render compiles its kernels: what is compiled,
         and no sample rate (the first samples' rate is timed from when they start)."""
         bar = self.samples
-        if bar is None:
+        if bar is None or bar.disable:
             return
         from .render_engine import compile_line
         if self._label is None:

@@ -20,6 +20,7 @@ Region).
 from __future__ import annotations
 
 import os
+import sys
 import time
 import traceback
 from importlib import import_module
@@ -262,7 +263,11 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 line = compile_line(done, total)
                 self.update_stats("", f"DRT | {line}")
                 for listener in compile_listeners:
-                    listener(done, total)
+                    try:
+                        listener(done, total)
+                    except Exception as e:      # a progress display never fails a render
+                        print(f"DRT: compile progress listener failed: {e!r}",
+                              file=sys.stderr)
                 if bpy.app.background and last_render.get("compile_said") != done:
                     last_render["compile_said"] = done
                     print(f"Fra:{scene.frame_current} | Time:{_clock(time.perf_counter() - t0)}"

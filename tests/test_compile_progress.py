@@ -143,3 +143,26 @@ def test_shade_is_compiled_without_what_the_scene_lacks():
     last3 = [tuple(type(t) for t in sig[-3:]) for sig in shade.signatures]
     assert (types.NoneType,) * 3 in last3
     assert any(t[0] is types.NoneType and t[1] is not types.NoneType for t in last3)
+
+
+def test_the_batch_renderers_bar_says_compiling_then_counts_samples(capsys):
+    """python -m drt_addon render's frame bar during a first render: 'compiling kernels,
+    one time: N of M' instead of a sample rate, then samples timed from there; with
+    --no-progress nothing is drawn and nothing fails."""
+    from drt_addon.batch_report import Progress
+    quiet = Progress(1, enabled=False)
+    quiet.start_frame("frame 1", 4)
+    quiet.compiling(3, 10)
+    quiet.samples_done(1, 4)
+    quiet.close()
+    shown = Progress(1, enabled=True)
+    shown.start_frame("frame 1", 4)
+    shown.compiling(3, 10)
+    assert shown.samples.desc == "frame 1: compiling kernels, one time: 3 of 10"
+    shown.samples_done(1, 4)
+    assert shown.samples.desc == "frame 1" and shown.samples.n == 1
+    assert shown.samples.initial == 1            # the compile's time is not in the rate
+    shown.samples_done(3, 4)
+    assert shown.samples.n == 3
+    shown.close()
+    assert "compiling kernels, one time: 3 of 10" in capsys.readouterr().err
