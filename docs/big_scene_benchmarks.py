@@ -153,7 +153,8 @@ def big_mesh_section(r: dict, load: float) -> tuple[list, list]:
     c, d = r["CYCLES"], r["DRT"]
     ratio, memory = d["whole"] / c["whole"], d["maxrss_mb"] / c["maxrss_mb"]
     rows = {p[0]: p for p in d["phases"]}
-    embree = [p for p in d["phases"] if "Embree" in p[0] or "accelerator" in p[0]]
+    embree = [p for p in d["phases"] if ("Embree" in p[0] or "accelerator" in p[0])
+              and not p[0].startswith("import")]
     embree_s, embree_mb = sum(p[1] for p in embree), sum(p[3] for p in embree)
     first = d["phases"][-1]
     imported = next((p[1] for p in d["phases"] if p[0].startswith("import DRT's tracer")), 0.0)
