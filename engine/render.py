@@ -208,9 +208,10 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
     between work units, and every POLL seconds while a unit runs. compiling(done, total)
     is called while Numba compiles kernels (a first render with an empty cache): `done`
     of the `total` kernels the render can reach are compiled; a cancel then returns at
-    once and the compile finishes in the background (its kernels are cached). With adaptive sampling (engine.adaptive_sampling) later passes
-    take samples only in the pixels that have not converged; with a time limit the render
-    stops at the first unit boundary after it. Returns (film, stats)."""
+    once and the compile finishes in the background (its kernels are cached). With
+    adaptive sampling (engine.adaptive_sampling) later passes take samples only in the
+    pixels that have not converged; with a time limit the render stops at the first unit
+    boundary after it. Returns (film, stats)."""
     ctx = context or RenderContext(scene, settings)
     sample_end = settings.samples if sample_end is None else sample_end
     if not (0 <= sample_start < sample_end):

@@ -117,7 +117,8 @@ class CompiledPathIntegrator:
                             (surf.positions, surf.corners), self.camera)
         self.het_runs = np.zeros(1, np.int64)
         # what shade is compiled with (None: without that code; see its docstring)
-        self.features = (self.textures if bool((self.textures[PROG][:, 1] > 0).any()) else None,
+        programmed = bool((self.textures[PROG][:, 1] > 0).any())
+        self.features = (self.textures if programmed else None,
                          self.vol if self.has_volumes else None,
                          self.vol if self.heterogeneous else None)
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
