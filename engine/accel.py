@@ -285,29 +285,25 @@ class Accelerator:
         if count == 0:
             return
         s_ray, s_unit = np.empty(count, np.int64), np.empty(count, np.int64)
-        o32, d32 = np.empty((count, 3), np.float32), np.empty((count, 3), np.float32)
-        f32 = np.empty(count, np.float32)
+        # each pair's ray in its unit's space, rounded to float32 by group_pairs as Embree
+        # takes it, and kept in float64 arrays, which the ray kernels read as they are
+        o_unit, d_unit, far_unit = np.empty((count, 3)), np.empty((count, 3)), np.empty(count)
         unit_start = np.empty(len(self._unit_scene) + 1, np.int64)
         group_pairs(self.motion, self.tlas, pr, pu, count, o, d, best, tm,
-                    s_ray, s_unit, o32, d32, f32, unit_start)
+                    s_ray, s_unit, o_unit, d_unit, far_unit, unit_start)
         query = "OCCLUDED" if occlusion else "INTERSECT"
         parts = []
         for k in np.flatnonzero(unit_start[1:] > unit_start[:-1]):
             a, b = unit_start[k], unit_start[k + 1]
-            parts.append(self._query(self._unit_scene[k], _ORIGIN, o32[a:b].astype(np.float64),
-                                     d32[a:b].astype(np.float64), f32[a:b].astype(np.float64),
-                                     None, query))
+            parts.append(self._query(self._unit_scene[k], _ORIGIN, o_unit[a:b], d_unit[a:b],
+                                     far_unit[a:b], None, query))
         with self._count_lock:
             self.rays_traced[query] += count
         if occlusion:
-            merge_blocked(s_ray, np.where(np.concatenate(parts), 0, MISS).astype(np.int64),
-                          blocked)
+            merge_blocked(s_ray, np.where(np.concatenate(parts), 0, MISS), blocked)
         else:
             merge_hits(self.motion, self.tlas, s_ray, s_unit,
-                       np.concatenate([p[0] for p in parts]).astype(np.int32),
-                       np.concatenate([p[1] for p in parts]).astype(np.float32),
-                       np.concatenate([p[2] for p in parts]).astype(np.float32),
-                       np.concatenate([p[3] for p in parts]).astype(np.float32),
+                       *(np.concatenate([p[i] for p in parts]) for i in range(4)),
                        t, prim, u, v, best, hit_unit)
 
     # -- public queries ----------------------------------------------------------------

@@ -70,6 +70,11 @@ def padded_float32(values: np.ndarray, columns: int, offset=None) -> np.ndarray:
     return rows
 
 
+def _xyz_offset(offset):
+    """An (x, y, z) shift as one for (x, y, z, radius) rows (the radius unshifted)."""
+    return None if offset is None else np.append(np.asarray(offset, np.float64), 0.0)
+
+
 def _pointer(a: np.ndarray) -> int:
     return a.ctypes.data
 
@@ -147,11 +152,7 @@ class Scene:
         geom = self._new(kind)
         self._steps(geom, steps)
         for k, pts in enumerate(steps):
-            pts = np.asarray(pts, np.float64)
-            shifted = pts.copy()
-            if offset is not None:
-                shifted[:, :3] -= offset
-            buf = padded_float32(shifted, 4)
+            buf = padded_float32(pts, 4, _xyz_offset(offset))
             self._share(geom, L.BUFFER_VERTEX, k, L.FORMAT_FLOAT4, buf, 16, len(buf))
         self._share(geom, L.BUFFER_INDEX, 0, L.FORMAT_UINT, index, 4, len(index))
         return self._attach(geom, "curves", len(index))
@@ -164,10 +165,7 @@ class Scene:
         geom = self._new(kind)
         self._steps(geom, steps)
         for k, pts in enumerate(steps):
-            pts = np.array(pts, np.float64)
-            if offset is not None:
-                pts[:, :3] -= offset
-            buf = padded_float32(pts, 4)
+            buf = padded_float32(pts, 4, _xyz_offset(offset))
             self._share(geom, L.BUFFER_VERTEX, k, L.FORMAT_FLOAT4, buf, 16, len(buf))
         if kind == L.GEOMETRY_ORIENTED_DISC_POINT:
             if normals is None:

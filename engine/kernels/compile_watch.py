@@ -48,10 +48,10 @@ def reachable(entries) -> set:
         if fn in seen:
             continue
         seen.add(fn)
-        scope = dict(fn.__globals__)
+        scope = fn.__globals__
         if fn.__closure__:
-            scope.update(zip(fn.__code__.co_freevars,
-                             (c.cell_contents for c in fn.__closure__)))
+            scope = {**scope, **dict(zip(fn.__code__.co_freevars,
+                                         (c.cell_contents for c in fn.__closure__)))}
         todo += [o for o in _named(fn.__code__, scope)
                  if isinstance(o, Kernel) and o.py_func not in seen]
     return seen

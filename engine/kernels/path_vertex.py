@@ -117,7 +117,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
 
     programs, volumes, het: what the scene uses, each None when it does not (Numba then
     compiles this kernel without that code, and never compiles what only it calls: a
-    scene without node programs and volumes compiles about half as much). programs: the
+    scene without node programs and volumes compiles in about half the time, benchmarks
+    section 10). programs: the
     shading tables when a material has a shader program; volumes: the volume table
     when the scene has media; het: the same when one of them is heterogeneous."""
     bounce, vbounce, vol, stacks, sh_stack, sh_bounce, het_count = media
