@@ -17,8 +17,9 @@ def group_pairs(M, T, pair_ray, pair_unit, count, origins, dirs, tfar, time,
     """Sorts the first `count` pairs by unit (stable: rays keep their order) into
     s_ray, s_unit and writes each pair's ray as the unit's Embree scene sees it: moved
     into the object's space at the ray's time for a rigid object, as is for a deforming
-    one; float32 origin, direction and far distance (min(tfar, 1e30)), rounded as
-    Accelerator._run rounds rays. unit_start (U + 1,) receives each unit's first pair."""
+    one; origin, direction and far distance (min(tfar, 1e30)) rounded to float32, as
+    Embree takes them (into arrays of any float type). unit_start (U + 1,) receives each
+    unit's first pair."""
     unit_obj, inverses = T.unit_obj, T.translation_inverse
     info, times, trans, quat = M.info, M.step_time, M.step_trans, M.step_quat
     stretch, linear = M.step_stretch, M.step_linear
