@@ -208,8 +208,10 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
     m.alpha = float(alpha)
     m.transparent_color = tuple(t_color)
     if alpha_tex is not None:
-        m.alpha_texture = alpha_tex
-        m.alpha = float(np.clip(alpha_tex.mean(), 0.0, 1.0))
+        # a per-hit Alpha is an output of the material's program (the tracer clips it
+        # to [0, 1] per hit); its plain value is the clipped average
+        _set(m, "alpha", alpha_tex)
+        m.alpha = float(np.clip(m.alpha, 0.0, 1.0))
     return m
 
 
