@@ -2,7 +2,7 @@
 
     python -m drt_addon render SCENE.blend [-o OUT] [--frame F | --frames 1-240 | -a]
                                            [--skip-existing] [overrides] [Dask options]
-    python -m drt_addon package [-o DIR] [--platform P]   (build the extension zips;
+    python -m drt_addon package [-o DIR] [--platform P] [--kernel-tier T]  (extension zips;
                                                            see docs/install.md)
     python -m drt_addon compare A.exr B.exr [-o DIFF.png]  (compare_images.py)
     python -m drt_addon converge SCENE.blend [-o DIR] ...  (converge.py; docs/convergence.md)
@@ -96,6 +96,15 @@ def build_parser() -> argparse.ArgumentParser:
     pk.add_argument("--platform", action="append", dest="platforms", metavar="PLATFORM",
                     help="build only this platform's zip (one of the manifest's platforms, "
                          "e.g. linux-x64; repeatable; default: every platform)")
+    pk.add_argument("--kernel-tier", action="append", dest="kernel_tiers",
+                    choices=("x86-64-v3", "generic"),
+                    help="CPU tier whose compiled kernels this machine's zip ships "
+                         "(repeatable; default: both)")
+    pk.add_argument("--kernel-scene", action="append", dest="kernel_scenes", metavar="NAME",
+                    help="sample scene (sample_blends/NAME.blend) whose render compiles "
+                         "the shipped kernels (repeatable; default: compile's scenes)")
+    pk.add_argument("--no-kernels", action="store_true",
+                    help="ship no compiled kernels (the first render compiles them)")
     from . import compare_images, converge, precompile
     for command in (compare_images, converge, precompile):
         command.add_parser(sub)
@@ -130,7 +139,10 @@ def run_package(args) -> int:
             raise CliError(EXIT_USAGE, f"drt: error: unknown platform {', '.join(unknown)}; "
                                        f"the manifest lists {', '.join(listed)}")
     try:
-        zip_paths = packaging.package(args.output_dir, platforms=args.platforms)
+        zip_paths = packaging.package(
+            args.output_dir, platforms=args.platforms,
+            kernel_tiers=() if args.no_kernels else tuple(args.kernel_tiers or ()) or None,
+            kernel_scenes=tuple(args.kernel_scenes or ()) or None)
     except packaging.PackagingError as e:
         raise CliError(EXIT_RENDER, f"drt: error: package failed: {e}") from None
     except Exception as e:

@@ -38,6 +38,8 @@ import tempfile
 import tomllib
 import zipfile
 
+from . import prebuilt_kernels
+
 REPO_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 MANIFEST = "blender_manifest.toml"
 REQUIREMENTS = "requirements.txt"
@@ -298,6 +300,7 @@ def _stage(root: str, stage: str, manifest: dict, platforms: list[str],
         rel_dir = "" if rel_dir == "." else rel_dir.replace(os.sep, "/") + "/"
         dirnames[:] = [d for d in dirnames
                        if not os.path.islink(os.path.join(dirpath, d))
+                       and rel_dir + d != prebuilt_kernels.FOLDER.replace(os.sep, "/")
                        and os.path.realpath(os.path.join(dirpath, d)) != stage_real
                        and not match.test_path(rel_dir + d + "/")]
         for f in filenames:
@@ -323,10 +326,13 @@ def zip_name(manifest: dict, platform: str) -> str:
 
 
 def package(output_dir: str | None = None, root: str = REPO_ROOT,
-            python: str = sys.executable, platforms: list[str] | None = None) -> list[str]:
+            python: str = sys.executable, platforms: list[str] | None = None,
+            kernel_tiers: tuple | None = None, kernel_scenes: tuple | None = None) -> list[str]:
     """Download the pinned wheels of `platforms` (default: every platform in the manifest),
     build one extension zip per platform into `output_dir`, validate them and return their
-    absolute paths (in the manifest's platform order)."""
+    absolute paths (in the manifest's platform order). The zip of this machine's platform
+    also holds its kernels compiled for `kernel_tiers` (default: prebuilt_kernels' tiers;
+    () for none) by rendering `kernel_scenes` (default: `compile`'s scenes)."""
     output_dir = os.path.abspath(output_dir or DEFAULT_OUTPUT_DIR)
     manifest = read_manifest(root)
     if not (manifest.get("id") and manifest.get("version")):
@@ -349,10 +355,29 @@ def package(output_dir: str | None = None, root: str = REPO_ROOT,
         raise PackagingError(f"cannot create the output folder {output_dir}: {e.strerror}") \
             from None
     zips = [os.path.join(output_dir, zip_name(manifest, p)) for p in chosen]
-    with tempfile.TemporaryDirectory(prefix=".drt-stage-", dir=output_dir) as stage:
-        _stage(root, stage, manifest, chosen, wheels)
-        _blender_ext(tool, python, "build", "--source-dir", stage, "--output-dir", output_dir,
-                     "--split-platforms")
+    host = prebuilt_kernels.host_platform()
+    with_kernels = host if host in chosen and kernel_tiers != () else None
+    # the zip with kernels is built from a stage of its own (the others must not hold them)
+    groups = [g for g in ([with_kernels], [p for p in chosen if p != with_kernels]) if g
+              and g != [None]]
+    with tempfile.TemporaryDirectory(prefix=".drt-stage-", dir=output_dir) as work:
+        kernels = None
+        if with_kernels:
+            kernels = os.path.join(work, "kernels")
+            try:
+                prebuilt_kernels.build(kernels, kernel_tiers,
+                                       kernel_scenes or prebuilt_kernels.precompile.SCENES,
+                                       python, log=_log)
+            except RuntimeError as e:
+                raise PackagingError(str(e)) from None
+        for n, group in enumerate(groups):
+            stage = os.path.join(work, f"stage{n}")
+            group_wheels = [w for w in wheels if any(w in per_platform[p] for p in group)]
+            _stage(root, stage, manifest, group, group_wheels)
+            if group == [with_kernels]:
+                shutil.copytree(kernels, os.path.join(stage, prebuilt_kernels.FOLDER))
+            _blender_ext(tool, python, "build", "--source-dir", stage, "--output-dir",
+                         output_dir, "--split-platforms")
     for zip_path in zips:
         if not os.path.isfile(zip_path):
             raise PackagingError(f"blender_ext build reported success but wrote no {zip_path}")

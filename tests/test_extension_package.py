@@ -2,14 +2,16 @@
 
 `python -m drt_addon package --platform linux-x64` builds and validates this machine's zip
 (one zip per platform; only this one is built, so a run downloads only its wheels); the zip
-holds the add-on, the tracer and the embreex, numba and llvmlite wheels for linux-x64 and
-nothing of the development tree; installed with Blender's own operator into a throwaway user
-extension repository it is enabled as `bl_ext.user_default.drt` and renders the Cornell box
-with the DRT engine, its kernels compiled by the bundled numba and cached in the
-extension's user folder (<user>/extensions/.user/user_default/drt/numba_cache), which a
-second Blender start reads back. Without a writable cache (a truly read-only user folder
-where user namespaces allow a read-only bind mount, else DRT_NUMBA_CACHE=0) it still
-renders.
+holds the add-on, the tracer, its kernels compiled for CPU tiers (engine/kernels/prebuilt)
+and the embreex, numba and llvmlite wheels for linux-x64, and nothing of the development
+tree; installed with Blender's own operator into a throwaway user extension repository it
+is enabled as `bl_ext.user_default.drt` and renders the Cornell box with the DRT engine
+without compiling: the kernels built under the module name `engine` load in the installed
+`bl_ext.user_default.drt.engine`, on this CPU, from the generic tier. The extension's
+user folder (<user>/extensions/.user/user_default/drt/numba_cache) is Numba's cache for
+what the zip does not hold. A truly read-only user folder (a read-only bind mount where
+user namespaces allow one) still renders from the shipped kernels; with DRT_NUMBA_CACHE=0
+it compiles in memory.
 
 Blender runs in subprocesses (`python -I -c ...`, cwd outside the repository): this pytest
 process may hold the source-checkout add-on, and Blender cannot register a second engine
@@ -58,6 +60,11 @@ def _validate(path: str) -> subprocess.CompletedProcess:
 
 
 PLATFORM = "linux-x64"  # this machine's; the only zip the tests build
+# The zip ships the kernels the Cornell box's render reaches, compiled for the generic
+# x86-64 tier alone: the most portable tier, and what a CPU without the x86-64-v3
+# instructions loads (the default build adds x86-64-v3 and more scenes).
+KERNEL_OPTIONS = ("--kernel-tier", "generic", "--kernel-scene", "cornell_box")
+PREBUILT = "engine/kernels/prebuilt/"
 BUNDLED = {"embreex", "numba", "llvmlite"}
 
 
@@ -74,7 +81,7 @@ def built(tmp_path_factory):
     out_dir = tmp_path_factory.mktemp("dist")
     t0 = time.perf_counter()
     proc = subprocess.run([sys.executable, "-m", "drt_addon", "package", "-o", str(out_dir),
-                           "--platform", PLATFORM],
+                           "--platform", PLATFORM, *KERNEL_OPTIONS],
                           cwd=ROOT, capture_output=True, text=True, timeout=900)
     seconds = time.perf_counter() - t0
     assert proc.returncode == 0, f"package failed ({proc.returncode}):\n{proc.stderr}"
@@ -155,6 +162,12 @@ def test_zip_holds_the_addon_tracer_and_wheels_only(built):
     forbidden_tops = {"tests", "docs", "sample_blends", ".venv", ".git", ".ci", "build",
                       "renders", "requirements.txt", "pytest.ini", ".gitignore",
                       ".pytest_cache"}
+    # The compiled kernels: Numba's index and code files, in the engine's cache layout.
+    prebuilt = [n for n in names if n.startswith(PREBUILT) and not n.endswith("/")]
+    assert any(n.endswith(".nbi") for n in prebuilt) and any(n.endswith(".nbc")
+                                                             for n in prebuilt)
+    assert all(n.endswith((".nbi", ".nbc")) for n in prebuilt), prebuilt
+    assert any(n.startswith(PREBUILT + "engine_kernels/") for n in prebuilt)
     for name in names:
         assert name.split("/")[0] not in forbidden_tops, name
         assert "__pycache__" not in name and not name.endswith((".pyc", ".blend", ".zip")), name
@@ -350,6 +363,7 @@ config = sys.modules.get("numba.core.config")
 facts["numba_cache_dir"] = getattr(config, "CACHE_DIR", None)
 jit = sys.modules.get(args["pkg"] + ".engine.kernels.jit")
 facts["jit_cache"] = getattr(jit, "CACHE", None)
+facts["shipped_root"] = getattr(jit, "SHIPPED_ROOT", None)
 kernels = {}
 if jit is not None:
     # the engine's kernels (jit.Kernel); a kernel's Numba dispatcher exists once it was
@@ -536,72 +550,82 @@ def _check_cached_in_extension_folder(facts, user_dir):
         os.path.realpath(p).startswith(cache_dir + os.sep) for p in facts["cache_paths"])
 
 
+def _check_loaded_the_shipped_kernels(facts, user_dir):
+    """Every kernel the render used came from the zip's prebuilt folder: nothing compiled."""
+    shipped = os.path.join(user_dir, "extensions", "user_default", "drt", "engine", "kernels",
+                           "prebuilt")
+    assert os.path.realpath(facts["shipped_root"]) == os.path.realpath(shipped)
+    assert facts["cache_hits"] > 0 and facts["cache_misses"] == 0, (
+        facts["cache_hits"], facts["cache_misses"])
+
+
 def test_install_from_disk_enables_and_renders(first_session, user_dir):
     """Install from Disk in a Blender whose Python has none of the bundled packages: the
-    wheels alone work, and the kernels compile (nothing cached yet) into the extension's
-    user cache folder."""
+    wheels alone work, and the first render compiles nothing: the kernels the zip ships
+    load, though they were built under another package name."""
     facts, cache_after = first_session
     assert facts["env_before"] == {n: None for n in sorted(BUNDLED)}  # the hiding works
     assert not facts["drt_before"]                                      # DRT only once installed
     _check_session(facts, user_dir)
     _check_cached_in_extension_folder(facts, user_dir)
-    assert facts["cache_hits"] == 0 and facts["cache_misses"] > 0
-    # Numba's index (.nbi) and compiled code (.nbc) files, there and only there.
-    assert any(f.endswith(".nbi") for f in cache_after), sorted(cache_after)
-    assert any(f.endswith(".nbc") for f in cache_after), sorted(cache_after)
+    _check_loaded_the_shipped_kernels(facts, user_dir)
+    # nothing was compiled, so nothing was written to the user cache
+    assert cache_after == {}, sorted(cache_after)
+    # Numba's files in the installed extension are the shipped ones only.
     installed = os.path.join(user_dir, "extensions", "user_default", "drt")
-    assert not [os.path.join(d, f) for d, _, fs in os.walk(installed) for f in fs
-                if f.endswith((".nbi", ".nbc"))]
+    found = [os.path.relpath(os.path.join(d, f), installed) for d, _, fs in os.walk(installed)
+             for f in fs if f.endswith((".nbi", ".nbc"))]
+    assert found and all(p.startswith(os.path.join("engine", "kernels", "prebuilt") + os.sep)
+                         for p in found), found
 
 
 def test_after_restart_the_extension_is_enabled_and_prefers_its_wheel(restart_session,
                                                                       user_dir):
     """A second Blender start with the same user folder, nothing hidden: the extension is
     enabled from the saved preferences, Blender's site-packages order picks the bundled
-    embreex and numba over the Python environment's, and the kernels come from the cache
-    the first render wrote."""
+    embreex and numba over the Python environment's, and the kernels load again."""
     facts, _ = restart_session
     assert not facts["drt_before"]
     _check_session(facts, user_dir)
     _check_cached_in_extension_folder(facts, user_dir)
-    assert facts["cache_hits"] > 0
+    _check_loaded_the_shipped_kernels(facts, user_dir)
 
 
-def test_second_render_loads_the_kernels_the_first_one_cached(first_session,
-                                                              restart_session):
+def test_renders_compile_and_write_nothing(first_session, restart_session):
     first, cache_first = first_session
     second, cache_second = restart_session
-    assert second["cache_hits"] > 0
-    assert second["cache_misses"] < first["cache_misses"]
-    # Loading from the cache compiles nothing new: no cache file changed.
-    changed = {f for f in cache_second if cache_first.get(f) != cache_second[f]}
-    assert second["cache_misses"] > 0 or not changed, sorted(changed)
-    print(f"first render (empty cache) {first['render_seconds']:.1f} s, "
-          f"second render (cached) {second['render_seconds']:.1f} s")
+    assert cache_first == cache_second == {}
+    assert first["cache_misses"] == second["cache_misses"] == 0
+    print(f"first render {first['render_seconds']:.1f} s, "
+          f"second render {second['render_seconds']:.1f} s")
 
 
 def test_numba_imported_before_the_addon_still_uses_the_extension_cache(preimported_session,
                                                                         user_dir):
     """numba.core.config reads NUMBA_CACHE_DIR at import; the add-on reloads it when numba
-    was imported first, so the kernels still load from the extension's cache folder."""
+    was imported first, so the cache folder is still the extension's."""
     facts = preimported_session
     assert os.path.realpath(facts["preimported_numba"]).startswith(
         os.path.realpath(_site_packages(user_dir)) + os.sep)
     assert facts["preimported_cache_dir"] == ""  # numba read no cache folder at import
     _check_session(facts, user_dir)
     _check_cached_in_extension_folder(facts, user_dir)
-    assert facts["cache_hits"] > 0
+    _check_loaded_the_shipped_kernels(facts, user_dir)
 
 
 def test_renders_from_a_read_only_user_folder(read_only_session, user_dir):
     """The installed extension, its cache folder and the home folder all read-only (a
     read-only bind mount, which binds root too): jit.py finds no writable cache location,
-    kernels compile in memory, nothing is read or written on disk, and the render works.
-    (DRT_NUMBA_CACHE=0 alone is tested in-process by tests/test_kernel_cache.py.)"""
+    yet the shipped kernels load, and nothing is written. Where such mounts are unavailable,
+    DRT_NUMBA_CACHE=0 instead: every kernel compiles in memory, nothing is read or written
+    on disk. (DRT_NUMBA_CACHE=0 is also tested in-process by tests/test_kernel_cache.py.)"""
     facts, mounted, before, after = read_only_session
-    if mounted:
-        assert facts["cache_dir_writable"] is False  # the mount really is read-only
     _check_session(facts, user_dir)
     assert facts["jit_cache"] is False
-    assert facts["cache_paths"] == [] and facts["cache_hits"] == 0
+    if mounted:
+        assert facts["cache_dir_writable"] is False  # the mount really is read-only
+        _check_loaded_the_shipped_kernels(facts, user_dir)
+    else:
+        assert facts["shipped_root"] is None
+        assert facts["cache_paths"] == [] and facts["cache_hits"] == 0
     assert after == before

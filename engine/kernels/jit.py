@@ -15,7 +15,10 @@ Cache folder, the first writable of:
   2. `engine/kernels/__pycache__/numba` beside the sources;
   3. a per-user cache folder (`drt-numba` in Numba's user cache location).
 When none can be written, kernels compile in memory on every process start instead of
-failing. `DRT_NUMBA_CACHE=0` forces that (a test and debug switch).
+failing. A package's shipped kernels (`engine/kernels/prebuilt`, compiled for CPU tiers by
+`python -m drt_addon package`) are read when that cache has none for this CPU, writable
+or not; files load under any name of the engine package (cache_files.py).
+`DRT_NUMBA_CACHE=0` compiles every kernel in memory (a test and debug switch).
 `DRT_BORROWING=0` compiles every kernel with reference counting, to measure what
 borrowing saves (docs/borrowing_benchmark.py); it has its own cache fingerprint.
 """
@@ -23,6 +26,7 @@ from __future__ import annotations
 
 import glob
 import hashlib
+import inspect
 import os
 import tempfile
 import threading
@@ -31,6 +35,8 @@ import numba
 from numba import njit, types
 from numba.core import caching, event
 from numba.core.runtime import rtsys
+
+from . import cache_files
 
 ENGINE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -80,7 +86,12 @@ def _fingerprint() -> bytes:
 
 CACHE_ROOT = _cache_root()
 CACHE = CACHE_ROOT is not None
-FINGERPRINT = _fingerprint() if CACHE else b""
+# The kernels a package ships, compiled for CPU tiers (cache_files.py), read even where
+# nothing can be written; never with DRT_NUMBA_CACHE=0, which compiles everything.
+SHIPPED_ROOT = (None if os.environ.get("DRT_NUMBA_CACHE", "1") == "0"
+                else cache_files.shipped_root(ENGINE_DIR, CACHE_ROOT))
+LOADS = CACHE or SHIPPED_ROOT is not None
+FINGERPRINT = _fingerprint() if LOADS else b""
 
 
 class EngineCacheLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLocator):
@@ -90,7 +101,8 @@ class EngineCacheLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLo
     def __init__(self, py_func, py_file):
         self._py_file = py_file
         self._lineno = py_func.__code__.co_firstlineno
-        self._cache_path = os.path.join(CACHE_ROOT, self.get_suitable_cache_subpath(py_file))
+        self._cache_path = os.path.join(CACHE_ROOT or SHIPPED_ROOT,
+                                        self.get_suitable_cache_subpath(py_file))
 
     def get_cache_path(self):
         return self._cache_path
@@ -108,7 +120,7 @@ class EngineCacheLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLo
 
     @classmethod
     def from_function(cls, py_func, py_file):
-        if CACHE_ROOT is None or not os.path.abspath(py_file).startswith(ENGINE_DIR + os.sep):
+        if not LOADS or not os.path.abspath(py_file).startswith(ENGINE_DIR + os.sep):
             return None
         return super().from_function(py_func, py_file)
 
@@ -117,6 +129,8 @@ class EngineCacheLocator(caching._SourceFileBackedLocatorMixin, caching._CacheLo
     def ensure_cache_path(self):
         """Numba creates the folder and writes a probe file in it for every kernel (~450
         per process); once per folder is enough."""
+        if not CACHE:          # the shipped kernels only: read, never written
+            return
         if self._cache_path not in EngineCacheLocator._ensured:
             super().ensure_cache_path()
             EngineCacheLocator._ensured.add(self._cache_path)
@@ -131,13 +145,43 @@ class EngineFunctionCache(caching.FunctionCache):
     the runtime its allocations call (`rtsys`). A kernel that does compile goes through
     Numba's pipeline, which refreshes them then."""
 
+    def __init__(self, py_func):
+        super().__init__(py_func)
+        stamp, base = self._impl.locator.get_source_stamp(), self._impl.filename_base
+        # the cache's files read by whatever name this engine package has (none when
+        # nothing can be written: the shipped kernels are then the only ones on disk)
+        self._cache_file = (cache_files.RelocatableCacheFile(self._cache_path, base, stamp)
+                            if CACHE else None)
+        self._shipped = None
+        if SHIPPED_ROOT is not None:
+            sub = EngineCacheLocator.get_suitable_cache_subpath(inspect.getfile(py_func))
+            self._shipped = cache_files.RelocatableCacheFile(
+                os.path.join(SHIPPED_ROOT, sub), base, stamp)
+
     def load_overload(self, sig, target_context):
         rtsys.initialize(target_context)
         with self._guard_against_spurious_io_errors():
             return self._load_overload(sig, target_context)
 
+    def _load_overload(self, sig, target_context):
+        """This CPU's code from the writable cache, else code for a CPU tier this one can
+        run, from the writable cache or the one the package ships (cache_files)."""
+        if not self._enabled:
+            return None
+        key = self._index_key(sig, target_context.codegen())
+        for files, exact in ((self._cache_file, True), (self._shipped, False)):
+            found = files.compatible_key(key, exact) if files is not None else None
+            data = files.load(found) if found is not None else None
+            if data is not None:
+                return self._impl.rebuild(target_context, data)
+        return None
 
-if CACHE and EngineCacheLocator not in caching.CacheImpl._locator_classes:
+    def _save_overload(self, sig, data):
+        if self._cache_file is not None:       # else compiled in memory only
+            super()._save_overload(sig, data)
+
+
+if LOADS and EngineCacheLocator not in caching.CacheImpl._locator_classes:
     caching.CacheImpl._locator_classes.insert(0, EngineCacheLocator)
 
 
@@ -172,7 +216,7 @@ class Kernel:
             with Kernel._lock:
                 if self._dispatcher is None:
                     made = njit(**self._options)(self.py_func)
-                    if CACHE and self._options.get("cache", True):
+                    if LOADS and self._options.get("cache", True):
                         # Numba's `cache=True`, with the engine's cache class
                         made._cache = EngineFunctionCache(self.py_func)
                     self._dispatcher = made
