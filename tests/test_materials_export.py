@@ -448,6 +448,29 @@ def _image_node(nt, img, interpolation="Linear", extension="REPEAT"):
     return node
 
 
+def test_a_material_the_exporter_cannot_read_is_reported_and_the_rest_renders(bpy_drt,
+                                                                                monkeypatch):
+    """Whatever goes wrong while reading one material's nodes (here: a reader that
+    raises, standing in for a set-up the exporter does not know), the render does not
+    fail: that material is its viewport colour, and one warning names it and the error."""
+    from drt_addon.export import materials
+    bpy = bpy_drt
+    _reset(bpy)
+    mat, nt, node = _single(bpy, "ShaderNodeBsdfDiffuse", Color=(0.2, 0.4, 0.6, 1.0))
+    mat.diffuse_color = (0.7, 0.1, 0.1, 1.0)
+
+    def broken(*args, **kwargs):
+        raise AttributeError("'NodeParam' object has no attribute 'texture'")
+    monkeypatch.setattr(materials, "_closure", broken)
+    m, warnings = _export(mat)
+    assert close(m.base_color, (0.7, 0.1, 0.1))
+    assert len(warnings) == 1 and repr(mat.name) in warnings[0]
+    assert "could not read its nodes" in warnings[0] and "AttributeError" in warnings[0]
+    monkeypatch.undo()
+    m, warnings = _export(mat)
+    assert close(m.base_color, (0.2, 0.4, 0.6)) and warnings == []
+
+
 def test_image_texture_export(bpy_drt):
     from engine.textures import srgb_to_linear
     bpy = bpy_drt

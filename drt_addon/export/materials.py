@@ -169,6 +169,21 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
                                glossy_model="MULTI_GGX")
     if not uses_nodes(mat):
         return fallback
+    try:
+        result = _from_nodes(mat, ctx, fallback)
+    except Exception as e:     # a node set-up the exporter does not know: the rest renders
+        ctx.issues = [f"DRT could not read its nodes ({type(e).__name__}: {e}); it renders "
+                      "with its viewport colour"]
+        result = fallback
+    if ctx.issues and reporter is not None:
+        reporter.warn(f"DRT: material {name!r}: " + "; ".join(ctx.issues),
+                      key=(name, "material"))
+    return result
+
+
+def _from_nodes(mat, ctx, fallback) -> "engine.Material":
+    """The material from its node tree (see the module docstring)."""
+    name = mat.name
     for problem in tree_problems(mat.node_tree):
         ctx.issue(problem)
     out = _output_node(mat.node_tree)
@@ -192,7 +207,4 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
         if result.volume is None and _link(out.inputs["Surface"]) is None:
             ctx.issue("no shader reaches its Material Output's Surface; it renders black, "
                       "as in Cycles")
-    if ctx.issues and reporter is not None:
-        reporter.warn(f"DRT: material {name!r}: " + "; ".join(ctx.issues),
-                      key=(name, "material"))
     return result
