@@ -319,6 +319,35 @@ def test_nan_vertex_drops_its_triangles_with_a_warning_naming_the_object(bpy_drt
     assert last["ok"], last["error"]
 
 
+def test_hair_volumes_and_point_clouds_are_named_once_and_the_rest_renders(bpy_drt):
+    """What DRT cannot draw yet is never dropped silently: particle hair on a mesh, a hair
+    Curves object and a Volume object are named in one warning, and the render works."""
+    bpy = bpy_drt
+    build_scene(bpy)
+    from drt_addon.export import Reporter, export_scene
+    reporter = Reporter()
+    export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
+    assert not any("not rendered yet" in w for w in reporter.warnings), reporter.warnings
+    obj = bpy.data.objects["Plain"]
+    mod = obj.modifiers.new("Fur", "PARTICLE_SYSTEM")
+    mod.particle_system.settings.type = "HAIR"
+    mod.particle_system.settings.count = 10
+    smoke = bpy.data.objects.new("Smoke", bpy.data.volumes.new("Smoke"))
+    bpy.context.scene.collection.objects.link(smoke)
+    strands = bpy.data.objects.new("Strands", bpy.data.hair_curves.new("Strands"))
+    bpy.context.scene.collection.objects.link(strands)
+    reporter = Reporter()
+    s = export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
+    said = [w for w in reporter.warnings if "not rendered yet" in w]
+    assert len(said) == 1, reporter.warnings
+    for part in ("particle hair ('Plain (Fur)')", "Volume objects ('Smoke')",
+                 "hair curves ('Strands')"):
+        assert part in said[0], said[0]
+    assert _by_name(s, "Plain")                  # the emitter itself still renders
+    last = _render_drt(bpy)
+    assert last["ok"], last["error"]
+
+
 def test_no_camera_gives_a_clear_error(bpy_drt):
     bpy = bpy_drt
     build_scene(bpy)

@@ -7,6 +7,7 @@ import time
 from ..engine_link import engine
 from .camera import RenderRegion, export_camera, render_region, window_camera
 from .errors import ExportError, Reporter
+from .left_out import LEFT_OUT_TYPES, LeftOut
 from .libraries import missing_library_messages
 from .settings_check import check as check_file_settings
 from .lights import export_light, object_visibility
@@ -106,6 +107,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
 
     cache = MeshCache(reporter)
     meshes, lights = [], []
+    left_out = LeftOut()
     holdouts = 0
     for k, inst in enumerate(depsgraph.object_instances):
         if check_cancel is not None:
@@ -116,6 +118,10 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 continue
             holdout = _is_holdout(inst, obj, view_layer)
             holdouts += holdout
+            if obj.type in LEFT_OUT_TYPES or (not inst.is_instance and obj.type == "MESH"):
+                left_out.note_object(obj)      # hair curves; a mesh's particle hair
+                if obj.type in LEFT_OUT_TYPES:  # (to_mesh fails on hair curves)
+                    continue
             local = cache.local(obj)
             if local is None:
                 continue
@@ -135,12 +141,16 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 else 31)
             if tracker is not None:
                 tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
+        elif obj.type in LEFT_OUT_TYPES and (inst.is_instance or inst.show_self):
+            left_out.note_object(obj)
         elif obj.type == "LIGHT":
             light = export_light(obj, inst.matrix_world.copy(), reporter)
             if light is not None:
                 lights.append(light)
                 if tracker is not None:
                     tracker.note_light(inst, obj, len(lights) - 1)
+    if left_out.message():
+        reporter.warn(left_out.message(), key="left out")
     if not materials:
         materials.append(engine.Material())
     world = export_world(scene.world, reporter)
