@@ -207,9 +207,9 @@ def test_compiled_twin_matches_numpy(interp, mapping, srgb):
     np.testing.assert_allclose(got[:, :3], env.radiance(d), rtol=RTOL, atol=1e-300)
     np.testing.assert_allclose(got[:, 3], ls.environment_pdf(d), rtol=RTOL)
     assert np.all([environment_pdf(L, *x) for x in d[:50]] == got[:50, 3])
-    assert np.all([lamp_pdf(L, k_env, 0.0, 0.0, 0.0, *x, np.inf) for x in d[:50]]
+    assert np.all([lamp_pdf(L, k_env, 0.0, 0.0, 0.0, *x, np.inf, 0.0) for x in d[:50]]
                   == got[:50, 3])
-    one = sample(L, *p[0], up[0], *u[0])
+    one = sample(L, *p[0], up[0], *u[0], 0.0)
     assert one[0] == k[0] and one[8] == pdf[0]
 
 

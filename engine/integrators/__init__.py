@@ -2,29 +2,23 @@
 
 - whitted: mirror-only interreflection, one shadow ray per light (the lecture's baseline)
 - distribution: Cook 1984, distributed glossy and transmission, direct light on diffuse
-- path: Kajiya's path tracing with next-event estimation and MIS; compiled
-  (`compiled_path`) wherever the scene allows, else the NumPy reference (`path`)
+- path: Kajiya's path tracing with next-event estimation and MIS, compiled
+  (`compiled_path`; `path` is its NumPy reference, which the tests compare it with)
 """
 
 
 def make_integrator(name, ctx):
     from .distribution import DistributionIntegrator
-    from .path import PathIntegrator
     from .whitted import WhittedIntegrator
-    table = {"path": PathIntegrator, "distribution": DistributionIntegrator,
-             "whitted": WhittedIntegrator}
     if name == "path":
-        from .compiled_path import CompiledPathIntegrator, unsupported
-        why = unsupported(ctx)
-        if why is None:
-            return CompiledPathIntegrator(ctx)
-        if ctx.scene.has_volumes():
-            raise ValueError(f"the scene has volumes, which the path integrator renders "
-                             f"only where it runs compiled; here it cannot: {why}")
-    elif ctx.scene.has_volumes():
+        from .compiled_path import CompiledPathIntegrator
+        return CompiledPathIntegrator(ctx)
+    table = {"distribution": DistributionIntegrator, "whitted": WhittedIntegrator}
+    if ctx.scene.has_volumes():
         raise ValueError(f"the scene has volumes, which only the 'path' integrator renders "
                          f"(not {name!r})")
     try:
         return table[name](ctx)
     except KeyError:
-        raise ValueError(f"unknown integrator {name!r}; choose one of {sorted(table)}") from None
+        raise ValueError(f"unknown integrator {name!r}; choose one of "
+                         f"{sorted(table) + ['path']}") from None

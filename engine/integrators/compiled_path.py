@@ -8,12 +8,11 @@ queries through transparent layers where needed), one kernel adding what got thr
 Python touches each bounce a handful of times whatever the number of paths, and every
 stage releases the GIL, so work units on threads run in parallel.
 
-It computes the same estimator as `engine.integrators.path.PathIntegrator`, which
-remains the reference implementation (tests compare the two) and serves the scenes this
-one does not handle yet (`unsupported` names the reason): lamps that move during the
-shutter. Motion blur of objects and cameras is handled: each path keeps the shutter
-time of its camera ray for all its rays, the accelerator places moving objects at that
-time, and hits on them are rebuilt there (`kernels.surface.rebuild_at_time`).
+It computes the same estimator as `engine.integrators.path.PathIntegrator` (tests
+compare the two). Motion blur: each path keeps the shutter time of its camera ray for
+all its rays, the accelerator places moving objects at that time, hits on them are
+rebuilt there (`kernels.surface.rebuild_at_time`), and a lamp that moves during the
+shutter is its slice at that time (`kernels.lights.light_set.slice_row`).
 """
 from __future__ import annotations
 
@@ -39,15 +38,6 @@ from .volume_stack import camera_stack
 
 _MODE_IDS = {"mis": MIS, "light": LIGHT_ONLY, "bsdf": BSDF_ONLY}
 VOLUME_BOUNDS_MAX = 256     # volume boundaries one path may cross (Cycles: 1024)
-
-
-def unsupported(ctx) -> str | None:
-    """Why the compiled path tracer cannot render this context yet (None: it can)."""
-    try:
-        klights.pack_lights(ctx.lights)
-    except NotImplementedError as e:
-        return str(e)
-    return None
 
 
 def _or_empty(a, shape, dtype):
@@ -101,7 +91,7 @@ class CompiledPathIntegrator:
         self.skips_shadows = bool(((vis & visibility.SHADOW) == 0).any())
         self.any_transparent = mats.any_transparent
         self.tables = kbsdf.kernel_tables()
-        self.lights = klights.pack_lights(ctx.lights, surf.visibility)
+        self.lights = klights.pack_lights(ctx.lights, surf.visibility, ctx.has_motion)
         self.world = np.ascontiguousarray(ctx.world_radiance, dtype=np.float64)
         # homogeneous volumes (engine.kernels.volume): the table, and the media the
         # camera is inside, where every path starts

@@ -21,13 +21,13 @@ C_VOLUME_BOUNCES = 14      # cfg entry: Cycles' max volume bounces
 
 
 @kernel
-def scatter(depth, cfg, pkey, index, p, px, py, pz, dx, dy, dz, br, bg, bb, g, bounce,
+def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb, g, bounce,
             vbounce, beta, cont, prev_pdf, prev_pos, ray_bits, L, lights, vol, stacks,
             sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns,
             nx_path, nx_org, nx_dir, nn):
-    """Path p (throughput b, after the segment's weight) scattered at point x moving
-    along d, by a Henyey-Greenstein phase function of anisotropy g. Writes at most one
-    shadow ray (returned count ns) and one next ray (nn)."""
+    """Path p (throughput b, after the segment's weight, shutter time `time`) scattered at
+    point x moving along d, by a Henyey-Greenstein phase function of anisotropy g. Writes
+    at most one shadow ray (returned count ns) and one next ray (nn)."""
     kind, spp = int(cfg[0]), int(cfg[1])
     mode = int(cfg[8])
     clamp = cfg[6] if bounce[p] == 0 else cfg[7]
@@ -39,7 +39,7 @@ def scatter(depth, cfg, pkey, index, p, px, py, pz, dx, dy, dz, br, bg, bb, g, b
         u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK)
         u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
         k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
-            lights, px, py, pz, u_pick, u1, u2)
+            lights, px, py, pz, u_pick, u1, u2, time)
         seen = lt.entry_visibility(lights, k)
         if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0:
             ph = hg_phase(g, dx * wx + dy * wy + dz * wz)

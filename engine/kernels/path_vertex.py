@@ -163,7 +163,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 t_lamp = _INF
                 if n_lights > 0:
                     t_lamp = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_geom,
-                                          ray_bits[p])[0]
+                                          ray_bits[p], path_time[p])[0]
                 vmode = 3
                 scattered, t_end, fr, fg, fb, mfr, mfg, mfb, er, eg, eb, g_phase = \
                     tracked_segment(vol, stacks, p, textures, geometry[9], geometry[12],
@@ -182,7 +182,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         # 1a. area and sphere lamps in front of the geometry; the ray goes on behind them
         if n_lights > 0:
             t_l, k_l, lr, lg, lb = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_end,
-                                                ray_bits[p])
+                                                ray_bits[p], path_time[p])
             if k_l >= 0:
                 if vmode == 3:
                     fr, fg, fb = mfr, mfg, mfb
@@ -194,7 +194,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                     t_l = length(ox + dx * t_l - prev_pos[p, 0], oy + dy * t_l - prev_pos[p, 1],
                                  oz + dz * t_l - prev_pos[p, 2])
                 lpdf = lt.lamp_pdf(lights, k_l, prev_pos[p, 0], prev_pos[p, 1],
-                                   prev_pos[p, 2], dx, dy, dz, t_l)
+                                   prev_pos[p, 2], dx, dy, dz, t_l, path_time[p])
                 w = hit_weight(mode, prev_pdf[p], lpdf)
                 _add(L, p, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w, clamp_hit)
         if volumes is not None and scattered:
@@ -203,7 +203,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 continue
             br, bg, bb = br / q, bg / q, bb / q
             cone_moves(path_info[1], p, t_end)
-            ns_out, nn_out = scatter(depth, cfg, pkey, index, p, ox + dx * t_end,
+            ns_out, nn_out = scatter(depth, cfg, pkey, index, p, path_time[p], ox + dx * t_end,
                                      oy + dy * t_end, oz + dz * t_end, dx, dy, dz, br, bg, bb,
                                      g_phase, bounce, vbounce, beta, cont, prev_pdf, prev_pos,
                                      ray_bits, L, lights, vol, stacks, sh_path, sh_org, sh_dir,
@@ -220,7 +220,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             w = hit_weight(mode, prev_pdf[p], epdf)
             er, eg, eb = er * w, eg * w, eb * w
             for s in range(lt.n_suns(lights)):
-                sr, sg, sb, spdf = lt.sun_escaped(lights, s, dx, dy, dz)
+                sr, sg, sb, spdf = lt.sun_escaped(lights, s, dx, dy, dz, path_time[p])
                 w = hit_weight(mode, prev_pdf[p], spdf)
                 er += sr * w
                 eg += sg * w
@@ -299,7 +299,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 if n_lights > 1 else 0.0
             u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
             k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
-                lights, px, py, pz, u_pick, u1, u2)
+                lights, px, py, pz, u_pick, u1, u2, path_time[p])
             lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
             # a uniform world, which Cycles never samples (its escaping rays find it):
             # refraction towards it on Walter's pairs, as those rays see it

@@ -1,6 +1,7 @@
 """Array drivers of the light kernels (compiled loops over rows): what the tests and the
 chi-square harnesses call. Inputs are (n, 3) float64 points / directions, (n,) arrays of
-uniforms, distances and indices; outputs are freshly allocated arrays."""
+uniforms, distances and indices; outputs are freshly allocated arrays. `time`: the rows'
+shutter times (n,) in [0, 1], zeros when not given (only moving lamps read it)."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,8 +10,17 @@ from ..jit import kernel
 from .light_set import hit_lamps, lamp_pdf, mesh_pdf, sample, sun_escaped
 
 
+def _times(time, n):
+    return np.zeros(n) if time is None else np.ascontiguousarray(time, np.float64)
+
+
+def sample_batch(L, p, u_pick, u, time=None):
+    """LightSet.sample over n points (see `_sample_rows`)."""
+    return _sample_rows(L, p, u_pick, u, _times(time, len(p)))
+
+
 @kernel
-def sample_batch(L, p, u_pick, u):
+def _sample_rows(L, p, u_pick, u, time):
     """LightSet.sample over n points: (k (n,) int64, wi (n, 3), dist (n,), radiance
     (n, 3), pdf (n,) with the pick probability, delta (n,) bool, margin (n,))."""
     n = p.shape[0]
@@ -23,7 +33,7 @@ def sample_batch(L, p, u_pick, u):
     margin = np.empty(n)
     for i in range(n):
         k, wx, wy, wz, d, r, g, b, pd, dl, m = sample(L, p[i, 0], p[i, 1], p[i, 2],
-                                                      u_pick[i], u[i, 0], u[i, 1])
+                                                      u_pick[i], u[i, 0], u[i, 1], time[i])
         k_out[i] = k
         wi[i, 0], wi[i, 1], wi[i, 2] = wx, wy, wz
         dist[i] = d
@@ -34,8 +44,13 @@ def sample_batch(L, p, u_pick, u):
     return k_out, wi, dist, rad, pdf, delta, margin
 
 
+def hit_lamps_batch(L, o, d, tmax, time=None):
+    """LightSet.hit_surfaces over n rays (see `_hit_rows`)."""
+    return _hit_rows(L, o, d, tmax, _times(time, len(o)))
+
+
 @kernel
-def hit_lamps_batch(L, o, d, tmax):
+def _hit_rows(L, o, d, tmax, time):
     """LightSet.hit_surfaces over n rays: (t (n,), k (n,) int64, radiance (n, 3))."""
     n = o.shape[0]
     t_out = np.empty(n)
@@ -43,21 +58,26 @@ def hit_lamps_batch(L, o, d, tmax):
     rad = np.empty((n, 3))
     for i in range(n):
         t, k, r, g, b = hit_lamps(L, o[i, 0], o[i, 1], o[i, 2], d[i, 0], d[i, 1], d[i, 2],
-                                  tmax[i], 31)
+                                  tmax[i], 31, time[i])
         t_out[i] = t
         k_out[i] = k
         rad[i, 0], rad[i, 1], rad[i, 2] = r, g, b
     return t_out, k_out, rad
 
 
+def lamp_pdf_batch(L, k, p, wi, t, time=None):
+    """LightSet.pdf over n rows (see `_pdf_rows`)."""
+    return _pdf_rows(L, k, p, wi, t, _times(time, len(p)))
+
+
 @kernel
-def lamp_pdf_batch(L, k, p, wi, t):
+def _pdf_rows(L, k, p, wi, t, time):
     """LightSet.pdf over n rows: (n,) pdfs, pick probability included."""
     n = p.shape[0]
     out = np.empty(n)
     for i in range(n):
         out[i] = lamp_pdf(L, k[i], p[i, 0], p[i, 1], p[i, 2], wi[i, 0], wi[i, 1], wi[i, 2],
-                          t[i])
+                          t[i], time[i])
     return out
 
 
@@ -71,14 +91,19 @@ def mesh_pdf_batch(L, prim, p, q):
     return out
 
 
+def sun_escaped_batch(L, j, d, time=None):
+    """The j-th non-delta sun for n escaped rays (see `_sun_rows`)."""
+    return _sun_rows(L, j, d, _times(time, len(d)))
+
+
 @kernel
-def sun_escaped_batch(L, j, d):
+def _sun_rows(L, j, d, time):
     """The j-th non-delta sun for n escaped rays: (radiance (n, 3), pdf (n,))."""
     n = d.shape[0]
     rad = np.empty((n, 3))
     pdf = np.empty(n)
     for i in range(n):
-        r, g, b, pd = sun_escaped(L, j, d[i, 0], d[i, 1], d[i, 2])
+        r, g, b, pd = sun_escaped(L, j, d[i, 0], d[i, 1], d[i, 2], time[i])
         rad[i, 0], rad[i, 1], rad[i, 2] = r, g, b
         pdf[i] = pd
     return rad, pdf

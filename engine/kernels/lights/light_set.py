@@ -1,7 +1,9 @@
 """The whole light set for one shading point or one ray (`engine.lights.LightSet`):
 pick an entry by its power (the CDF searched as np.searchsorted(side='right')), sample
 it, find lamps hit by rays, and every pdf multiple importance sampling needs. Entry k <
-n_lamps is lamp k (row k of L[LAMPS]); entry n_lamps + j is emissive triangle j."""
+n_lamps is lamp k (row k of L[LAMPS]); entry n_lamps + j is emissive triangle j.
+`time` is the ray's shutter time in [0, 1] (0 when nothing moves): a lamp that moves
+during the shutter is its slice at that time (`lamp_row`)."""
 from __future__ import annotations
 
 from ..cdf_search import last_at_most
@@ -9,9 +11,9 @@ from ..jit import kernel
 from .area import intersect_area, pdf_area, sample_area
 from .environment import pdf_environment, sample_environment
 from .environment_map import has_map, map_radiance, pdf_map, sample_environment_map
-from .pack import (C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, CDF_GUIDE, ENV, LAMPS, SELECT_PDF,
-                   SUNS, TRI_VISIBILITY, T_AREA, T_DISC, T_ENV, T_ENV_MAP, T_POINT, T_SPHERE,
-                   T_SUN, T_SUN_DELTA)
+from .pack import (C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, CDF_GUIDE, ENV, LAMPS, LAMP_SLICES,
+                   SELECT_PDF, SLICE_OF, SUNS, TRI_VISIBILITY, T_AREA, T_DISC, T_ENV,
+                   T_ENV_MAP, T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA)
 from .point import intersect_point, pdf_point, sample_point
 from .sun import escaped_sun, pdf_sun, sample_sun
 from .triangles import pdf_triangle, sample_triangle, triangle_entry
@@ -26,6 +28,17 @@ def n_entries(L):
 @kernel(allocates=False)
 def n_lamps(L):
     return L[LAMPS].shape[0]
+
+
+@kernel(allocates=False)
+def slice_row(L, k, time):
+    """Lamp k's row in L[LAMP_SLICES] at shutter time `time`: its slice min(floor(time
+    K), K - 1) of K; -1 when lamp k does not move (its row is then row k of L[LAMPS])."""
+    count = L[SLICE_OF][k, 1]
+    if count == 0:
+        return -1
+    j = min(max(int(time * count), 0), count - 1)
+    return L[SLICE_OF][k, 0] + j
 
 
 @kernel(allocates=False)
@@ -55,12 +68,13 @@ def sample_lamp(lamps, k, px, py, pz, u0, u1):
 
 
 @kernel(allocates=False)
-def sample(L, px, py, pz, u_pick, u1, u2):
-    """LightSet.sample for one shading point p: pick an entry with u_pick, sample it with
-    (u1, u2). Returns (k, wix, wiy, wiz, dist, r, g, b, pdf, delta, margin): k the entry
-    (-1 for an empty set), dist inf for suns and the world, pdf in solid angle including
-    the pick probability (0 = no sample), delta for points and zero-angle suns, margin
-    the shadow-ray stop before dist for emissive triangles (0 for lamps)."""
+def sample(L, px, py, pz, u_pick, u1, u2, time):
+    """LightSet.sample for one shading point p at shutter time `time`: pick an entry with
+    u_pick, sample it with (u1, u2). Returns (k, wix, wiy, wiz, dist, r, g, b, pdf, delta,
+    margin): k the entry (-1 for an empty set), dist inf for suns and the world, pdf in
+    solid angle including the pick probability (0 = no sample), delta for points and
+    zero-angle suns, margin the shadow-ray stop before dist for emissive triangles (0 for
+    lamps)."""
     k = pick(L, u_pick)
     if k < 0:
         return k, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, 0.0
@@ -70,7 +84,11 @@ def sample(L, px, py, pz, u_pick, u1, u2):
         if lamps[k, C_TYPE] == T_ENV_MAP:
             wx, wy, wz, dist, r, g, b, pdf, delta = sample_environment_map(L, u1, u2)
         else:
-            wx, wy, wz, dist, r, g, b, pdf, delta = sample_lamp(lamps, k, px, py, pz, u1, u2)
+            table, row = lamps, k
+            s = slice_row(L, k, time)
+            if s >= 0:
+                table, row = L[LAMP_SLICES], s
+            wx, wy, wz, dist, r, g, b, pdf, delta = sample_lamp(table, row, px, py, pz, u1, u2)
         return k, wx, wy, wz, dist, r, g, b, pdf * select, delta, 0.0
     wx, wy, wz, dist, r, g, b, pdf, margin = sample_triangle(L, k - lamps.shape[0],
                                                              px, py, pz, u1, u2)
@@ -78,8 +96,9 @@ def sample(L, px, py, pz, u_pick, u1, u2):
 
 
 @kernel(allocates=False)
-def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit):
-    """LightSet.hit_surfaces for one ray of kind ray_bit (engine.visibility): the nearest
+def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit, time):
+    """LightSet.hit_surfaces for one ray of kind ray_bit (engine.visibility) at shutter
+    time `time`: the nearest
     sphere, disc or area lamp closer than tmax that this kind of ray sees: (t, k, r, g,
     b); (tmax, -1, 0, 0, 0) when there is none."""
     lamps = L[LAMPS]
@@ -92,10 +111,14 @@ def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit):
             continue
         if not int(lamps[k, C_VISIBILITY]) & ray_bit:
             continue
+        table, row = lamps, k
+        s = slice_row(L, k, time)
+        if s >= 0:
+            table, row = L[LAMP_SLICES], s
         if kind == T_AREA:
-            t, r, g, b = intersect_area(lamps, k, ox, oy, oz, dx, dy, dz)
+            t, r, g, b = intersect_area(table, row, ox, oy, oz, dx, dy, dz)
         elif kind == T_SPHERE or kind == T_DISC:
-            t, r, g, b = intersect_point(lamps, k, ox, oy, oz, dx, dy, dz)
+            t, r, g, b = intersect_point(table, row, ox, oy, oz, dx, dy, dz)
         else:
             continue                    # not a surface (the world, delta lights)
         if t < best_t:
@@ -116,19 +139,24 @@ def entry_visibility(L, k):
 
 
 @kernel(allocates=False)
-def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t):
-    """LightSet.pdf for one direction: solid-angle pdf, pick probability included, of
-    sampling wi from p towards lamp k hit at distance t (0 when k is not a lamp)."""
+def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t, time):
+    """LightSet.pdf for one direction at shutter time `time`: solid-angle pdf, pick
+    probability included, of sampling wi from p towards lamp k hit at distance t (0 when
+    k is not a lamp)."""
     lamps = L[LAMPS]
     if k < 0 or k >= lamps.shape[0]:
         return 0.0
     kind = lamps[k, C_TYPE]
+    table, row = lamps, k
+    s = slice_row(L, k, time)
+    if s >= 0:
+        table, row = L[LAMP_SLICES], s
     if kind == T_AREA:
-        pdf = pdf_area(lamps, k, px, py, pz, wix, wiy, wiz, t)
+        pdf = pdf_area(table, row, px, py, pz, wix, wiy, wiz, t)
     elif kind == T_POINT or kind == T_SPHERE or kind == T_DISC:
-        pdf = pdf_point(lamps, k, px, py, pz, wix, wiy, wiz, t)
+        pdf = pdf_point(table, row, px, py, pz, wix, wiy, wiz, t)
     elif kind == T_SUN or kind == T_SUN_DELTA:
-        pdf = pdf_sun(lamps, k, wix, wiy, wiz)
+        pdf = pdf_sun(table, row, wix, wiy, wiz)
     elif kind == T_ENV_MAP:
         pdf = pdf_map(L, wix, wiy, wiz)
     else:
@@ -198,10 +226,14 @@ def n_suns(L):
 
 
 @kernel(allocates=False)
-def sun_escaped(L, j, dx, dy, dz):
-    """The j-th non-delta sun seen by an escaped ray d: (r, g, b, pdf) with the radiance
-    of sun.escaped(d) and pdf = sun.pdf(None, d, None) x its pick probability."""
+def sun_escaped(L, j, dx, dy, dz, time):
+    """The j-th non-delta sun seen by an escaped ray d at shutter time `time`: (r, g, b,
+    pdf) with the radiance of sun.escaped(d) and pdf = sun.pdf(None, d, None) x its pick
+    probability."""
     k = L[SUNS][j]
-    lamps = L[LAMPS]
-    r, g, b = escaped_sun(lamps, k, dx, dy, dz)
-    return r, g, b, pdf_sun(lamps, k, dx, dy, dz) * L[SELECT_PDF][k]
+    table, row = L[LAMPS], k
+    s = slice_row(L, k, time)
+    if s >= 0:
+        table, row = L[LAMP_SLICES], s
+    r, g, b = escaped_sun(table, row, dx, dy, dz)
+    return r, g, b, pdf_sun(table, row, dx, dy, dz) * L[SELECT_PDF][k]

@@ -34,6 +34,13 @@ every scene):
   L[ENV_MARGINAL_GUIDE] int32 (m + 1,), L[ENV_CONDITIONAL_GUIDE] int32 (H, c + 1): their
                  guide tables (`kernels.cdf_search`), for the row and column searches.
   L[CDF_GUIDE]   int32 (m + 1,): L[CDF]'s guide table, for picking an entry.
+  Lamps that move during the shutter (`engine.lights.TimeSlicedLight`: the lamp at the
+  middles of K equal slices of the shutter):
+  L[LAMP_SLICES] float64 (n_rows, N_COLUMNS): the rows of every moving lamp's slices.
+  L[SLICE_OF]    int64 (n_lamps, 2): lamp k's first row in L[LAMP_SLICES] and its slice
+                 count K (0 for a lamp that does not move). A moving lamp's own row in
+                 L[LAMPS] is its middle slice (K // 2, as TimeSlicedLight without a time);
+                 a ray at shutter time t in [0, 1] sees slice min(floor(t K), K - 1).
 """
 from __future__ import annotations
 
@@ -67,6 +74,8 @@ ENV_CONDITIONAL = 18
 ENV_MARGINAL_GUIDE = 19
 ENV_CONDITIONAL_GUIDE = 20
 CDF_GUIDE = 21
+LAMP_SLICES = 22
+SLICE_OF = 23
 
 # ---------------------------------------------------------------- L[ENV_MAP] fields
 M_HAS = 0           # 1: the world is an environment map
@@ -134,7 +143,7 @@ def _put(row, col, values):
 
 def _lamp_row(model) -> np.ndarray:
     if isinstance(model, TimeSlicedLight):
-        raise NotImplementedError("moving lamps")
+        return _lamp_row(model.slices[model.k // 2])
     row = np.zeros(N_COLUMNS)
     row[C_VISIBLE] = float(bool(model.visible))
     row[C_VISIBILITY] = float(int(getattr(model, "visibility", 31)))
@@ -192,16 +201,24 @@ def _f64(a, shape):
     return np.array(np.asarray(a, dtype=np.float64).reshape(shape), order="C", copy=True)
 
 
-def pack_lights(light_set, tri_visibility=None) -> tuple:
+def pack_lights(light_set, tri_visibility=None, timed=True) -> tuple:
     """The LightSet as the kernels' tuple L (fields: this module's docstring).
     tri_visibility: the visibility mask of every global triangle (Surfaces.visibility),
     or None when every triangle is seen by every ray.
-    Raises NotImplementedError("moving lamps") when a lamp moves during the shutter
-    (`TimeSlicedLight`): the caller then uses the NumPy LightSet."""
+    A lamp that moves during the shutter (`TimeSlicedLight`) has a row per slice in
+    L[LAMP_SLICES] (see the module docstring); with `timed` False (a render that samples
+    no time: the shutter is closed) it is its middle slice alone, as TimeSlicedLight
+    without a time."""
     models = light_set.models
     lamps = np.zeros((len(models), N_COLUMNS))
+    slice_of = np.zeros((len(models), 2), dtype=np.int64)
+    slice_rows = []
     for k, model in enumerate(models):
         lamps[k] = _lamp_row(model)
+        if isinstance(model, TimeSlicedLight) and timed:
+            slice_of[k] = len(slice_rows), model.k
+            slice_rows += [_lamp_row(m) for m in model.slices]
+    slices = np.array(slice_rows, dtype=np.float64).reshape(-1, N_COLUMNS)
     select_pdf = _f64(light_set.select_pdf, (-1,))
     cdf = _f64(light_set.cdf, (-1,))
     suns = np.array([k for k, _ in light_set.suns()], dtype=np.int64)
@@ -233,7 +250,7 @@ def pack_lights(light_set, tri_visibility=None) -> tuple:
         prims = np.flatnonzero(entry >= 0)
         vis[entry[prims]] = np.asarray(tri_visibility)[prims]
     return ((lamps, select_pdf, cdf, suns) + tri + (env, vis) + _pack_map(light_set.world)
-            + (guide_table(cdf, guide_cells(len(cdf))),))
+            + (guide_table(cdf, guide_cells(len(cdf))), slices, slice_of))
 
 
 def _pack_map(world) -> tuple:
