@@ -142,3 +142,65 @@ def test_soft_falloff_changes_the_image_beyond_the_thresholds(bpy_drt):
     soft = _render(bpy_drt, "light_point_radius", "CYCLES")
     sphere = _render(bpy_drt, "light_point_sphere", "CYCLES")
     assert not within(soft, sphere), compare(soft, sphere)
+
+
+def _light_nodes(strength_node):
+    """Light > Nodes on the lamp: Emission Color orange; Strength 2.5 set on the node, or
+    from a Value node (2.0) times 1.25 through a Math node and a Light Falloff node's
+    Quadratic output (what the public files do to scale a lamp's power)."""
+    def setup(scene):
+        light = scene.objects["Light"].data
+        light.use_nodes = True
+        nt = light.node_tree
+        emission = nt.nodes["Emission"]
+        emission.inputs["Color"].default_value = (1.0, 0.6, 0.3, 1.0)
+        if not strength_node:
+            emission.inputs["Strength"].default_value = 2.5
+            return
+        value = nt.nodes.new("ShaderNodeValue")
+        value.outputs[0].default_value = 2.0
+        math_node = nt.nodes.new("ShaderNodeMath")
+        math_node.operation = "MULTIPLY"
+        math_node.inputs[1].default_value = 1.25
+        falloff = nt.nodes.new("ShaderNodeLightFalloff")
+        falloff.inputs["Smooth"].default_value = 0.0
+        nt.links.new(value.outputs[0], math_node.inputs[0])
+        nt.links.new(math_node.outputs[0], falloff.inputs["Strength"])
+        nt.links.new(falloff.outputs["Quadratic"], emission.inputs["Strength"])
+    return setup
+
+
+@pytest.mark.parametrize("strength_node", [False, True], ids=["constant", "value-math-falloff"])
+def test_light_node_tree_matches_cycles(bpy_drt, strength_node):
+    """A lamp's node tree scales its strength as in Cycles (the lamp's power times the
+    Emission node's colour and strength); the lamp without its nodes fails the same
+    comparison."""
+    setup = _light_nodes(strength_node)
+    tag = f"nodes {strength_node}"
+    cycles = _render(bpy_drt, "light_point", "CYCLES", setup=setup, tag=tag)
+    drt = _render(bpy_drt, "light_point", "DRT", setup=setup, tag=tag)
+    rel, mad = compare(drt, cycles)
+    print(f"light nodes ({tag}): mean difference {100 * rel.max():.3f}%, MAD {100 * mad:.3f}%")
+    assert within(drt, cycles), (rel, mad)
+    plain = _render(bpy_drt, "light_point", "DRT")             # the same lamp, no nodes
+    assert not within(plain, cycles)
+
+
+def test_light_nodes_drt_cannot_read_are_reported(bpy_drt):
+    """A texture in a lamp's node tree is named in a warning; the lamp keeps its own
+    strength and the render works."""
+    bpy = bpy_drt
+    bpy.ops.wm.open_mainfile(filepath=os.path.join(SAMPLES_DIR, "light_point.blend"),
+                             load_ui=False)
+    light = bpy.context.scene.objects["Light"].data
+    light.use_nodes = True
+    nt = light.node_tree
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    nt.links.new(noise.outputs["Fac"], nt.nodes["Emission"].inputs["Strength"])
+    from drt_addon.export import Reporter, export_scene
+    reporter = Reporter()
+    scene = export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
+    assert any("'Light'" in w and repr(noise.name) in w for w in reporter.warnings), \
+        reporter.warnings
+    assert scene.lights[0].strength == pytest.approx(
+        tuple(light.energy * c for c in light.color))

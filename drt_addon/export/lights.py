@@ -1,7 +1,8 @@
 """Blender lights to DRT lights, keeping Blender's units (see engine.lights).
 
 Checked against Cycles 5.0 renders (tests/test_lights_vs_cycles.py), per light type:
-- strength S = colour x blackbody colour (when `use_temperature`) x energy x 2^exposure;
+- strength S = colour x blackbody colour (when `use_temperature`) x energy x 2^exposure,
+  times its node tree's Emission colour x strength (light_nodes.py);
 - `normalize` (on every light type since Blender 4.4): Cycles divides a point or spot
   light's power by the area of its sphere (4 pi r^2, or 4 when r = 0) and a sun's by the
   area of its disc (pi sin^2(angle / 2), or 1 when the angle is 0); with `normalize` off
@@ -17,6 +18,7 @@ import numpy as np
 
 from ..engine_link import engine
 from .errors import Reporter
+from .light_nodes import emission_factor
 from .matrices import to_numpy
 
 
@@ -74,10 +76,12 @@ def export_light(obj, matrix_world, reporter: Reporter):
     m = to_numpy(matrix_world)
     strength = light_strength(light)
     direction = -m[:3, 2] / max(np.linalg.norm(m[:3, 2]), 1e-300)
-    if getattr(light, "use_nodes", False) and light.node_tree is not None:
-        reporter.warn(f"DRT: light {obj.name!r} uses a shader node tree, which DRT ignores; "
-                      "its colour and power are used as set on the light",
-                      key=(obj.name, "nodes"))
+    factor, why = emission_factor(light)          # its node tree (light_nodes.py)
+    if factor is None:
+        reporter.warn(f"DRT: light {obj.name!r}: {why}; its colour and power are used as "
+                      "set on the light", key=(obj.name, "nodes"))
+    else:
+        strength = tuple(c * f for c, f in zip(strength, factor))
     vis = lamp_visibility(obj)
     if light.type in ("POINT", "SPOT"):
         radius = max(float(light.shadow_soft_size), 0.0)
