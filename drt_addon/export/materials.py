@@ -70,6 +70,11 @@ Linked inputs (any node graph, engine/nodes and export/nodes)
     after interpolation like Cycles; float images and Non-Color data are read as they
     are; straight-alpha images have their colour premultiplied when the Alpha output is
     not used (Cycles associates alpha on load).
+Displacement (the Material Output's socket)
+    Rendered as Cycles' Bump Only (Blender's default method): the normal bends as a Bump
+    of the displacement's height would bend it (export/nodes/displacement.py). True
+    displacement (Displacement Only, Displacement and Bump) is rendered the same way and
+    reported.
 
 Anything else falls back to a diffuse surface of the material's viewport colour. Every
 approximation is reported once per material, in one warning naming the material.
@@ -84,6 +89,8 @@ from .closures import _Comp, _reduce, program_outputs
 from .errors import Reporter
 from .images import image_cache
 from .nodes import NodeCompiler
+from .nodes.displacement import displacement_normal
+from .nodes.errors import Unsupported
 from .nodes.links import _all_nodes, _link, _output_node, tree_problems, uses_nodes
 from .nodes.shader import _closure
 from .volumes import export_volume
@@ -145,6 +152,23 @@ def _material(cl, ctx, name) -> "engine.Material":
     return m
 
 
+def _displace(mat, socket, ctx):
+    """The Displacement socket as Cycles' Bump Only (export/nodes/displacement.py): the
+    bent normal becomes the material's shading normal."""
+    try:
+        bent = displacement_normal(mat, socket, ctx)
+    except Unsupported as e:
+        ctx.issue(f"its displacement is not rendered ({e})")
+        return
+    if bent is None:
+        return
+    if ctx.normal is not None:
+        ctx.issue("its displacement is not rendered where a shader has a Normal of its "
+                  "own (DRT uses the shader's)")
+        return
+    ctx.normal = bent
+
+
 def _attach_programs(m, ctx, program):
     """Give m (and the sides of its mixes) the material's program with its own outputs
     (all share the program's instructions and registers; the normal is everyone's)."""
@@ -191,10 +215,10 @@ def _from_nodes(mat, ctx, fallback) -> "engine.Material":
         ctx.issue("it has no Material Output node; using its viewport colour")
         result = fallback
     else:
+        result = _material(_closure(out.inputs["Surface"], ctx), ctx, name)
         disp = out.inputs.get("Displacement")
         if disp is not None and _link(disp) is not None:
-            ctx.issue("its displacement is not rendered")
-        result = _material(_closure(out.inputs["Surface"], ctx), ctx, name)
+            _displace(mat, disp, ctx)
         # a volume inside its meshes (its program outputs, when it varies in space, join
         # the surface's); with no surface shader, the surface is its boundary
         result.volume = export_volume(out.inputs.get("Volume"), ctx)
