@@ -131,3 +131,52 @@ def test_world_ray_visibility_matches_cycles(bpy_drt, ray):
     cycles = _render(bpy_drt, "CYCLES", VISIBILITY_SAMPLES, hide, tag=ray)
     drt = _render(bpy_drt, "DRT", VISIBILITY_SAMPLES, hide, tag=ray)
     assert within(drt, cycles, f"{ray} rays off")
+
+
+def _procedural_sky(scene):
+    """The world's Background Color from nodes instead of the image: a Mix of a horizon
+    orange and a zenith blue by the direction's height (Separate XYZ of Generated through
+    a Map Range), times a Noise texture's Fac, Strength 1.5 (a procedural sky as artists
+    build one). DRT bakes it into a map (export/world_nodes.py)."""
+    nt = scene.world.node_tree
+    bg = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeBackground")
+    coords = nt.nodes.new("ShaderNodeTexCoord")
+    sep = nt.nodes.new("ShaderNodeSeparateXYZ")
+    ramp = nt.nodes.new("ShaderNodeMapRange")
+    ramp.inputs["From Min"].default_value = -0.2
+    mix = nt.nodes.new("ShaderNodeMix")
+    mix.data_type = "RGBA"
+    mix.inputs["A"].default_value = (1.0, 0.45, 0.15, 1.0)
+    mix.inputs["B"].default_value = (0.15, 0.35, 1.0, 1.0)
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = 3.0
+    times = nt.nodes.new("ShaderNodeMix")
+    times.data_type = "RGBA"
+    times.blend_type = "MULTIPLY"
+    times.inputs["Factor"].default_value = 1.0
+    nt.links.new(coords.outputs["Generated"], sep.inputs[0])
+    nt.links.new(sep.outputs["Z"], ramp.inputs["Value"])
+    nt.links.new(ramp.outputs["Result"], mix.inputs["Factor"])
+    nt.links.new(coords.outputs["Generated"], noise.inputs["Vector"])
+    nt.links.new(mix.outputs["Result"], times.inputs["A"])
+    nt.links.new(noise.outputs["Fac"], times.inputs["B"])
+    nt.links.new(times.outputs["Result"], bg.inputs["Color"])
+    bg.inputs["Strength"].default_value = 1.5
+
+
+def test_procedural_world_matches_cycles(bpy_drt):
+    """A world built from nodes (`_procedural_sky`) lights the spheres as in Cycles (the
+    same checks); the Background's own colour in its place (what DRT rendered before)
+    does not."""
+    cycles = _render(bpy_drt, "CYCLES", CONTROL_SAMPLES * 4, _procedural_sky, "sky")
+    drt = _render(bpy_drt, "DRT", CONTROL_SAMPLES * 2, _procedural_sky, "sky")
+    assert within(drt, cycles, "procedural world")
+
+    def plain(scene):
+        _procedural_sky(scene)
+        nt = scene.world.node_tree
+        bg = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeBackground")
+        for link in list(bg.inputs["Color"].links):
+            nt.links.remove(link)
+    assert not within(_render(bpy_drt, "DRT", CONTROL_SAMPLES, plain, "sky plain"), cycles,
+                      "procedural world, its own colour")

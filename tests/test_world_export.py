@@ -135,14 +135,6 @@ def test_unsupported_inputs_warn_and_fall_back(bpy_drt):
     w, warnings = _export(world)
     assert w.texture is None and "MIRROR_BALL" in warnings[0]
     np.testing.assert_allclose(w.color, (0.4, 0.6, 0.8))
-    # a procedural texture on Color, and a linked Strength
-    wave = tree.nodes.new("ShaderNodeTexWave")
-    tree.links.new(wave.outputs["Color"], bg.inputs["Color"])
-    value = tree.nodes.new("ShaderNodeValue")
-    tree.links.new(value.outputs[0], bg.inputs["Strength"])
-    w, warnings = _export(world)
-    assert w.texture is None and len(warnings) == 2
-    assert any("Strength" in t for t in warnings) and any("Wave" in t for t in warnings)
     # an unsupported vector source: the image is kept, the vector ignored
     tree.links.new(env.outputs["Color"], bg.inputs["Color"])
     env.projection = "EQUIRECTANGULAR"
@@ -151,6 +143,34 @@ def test_unsupported_inputs_warn_and_fall_back(bpy_drt):
     w, warnings = _export(world)
     assert w.texture is not None and w.mapping is None
     assert any("Noise" in t for t in warnings)
+
+
+def test_a_node_graph_on_the_background_is_baked_into_a_map(bpy_drt):
+    """A Gradient texture (Linear, of the Generated coordinates: for the world, the ray's
+    direction) on the Background's Color, and a Value node on its Strength: the world is
+    an environment map whose texel along direction d is clamp(d.x, 0, 1) x strength, at
+    World > Settings > Map Resolution across; nothing is reported."""
+    from engine.environment_map import uv_to_direction
+    world, bg = _world(bpy_drt)
+    world.cycles.sample_map_resolution = 64
+    tree = world.node_tree
+    gradient = tree.nodes.new("ShaderNodeTexGradient")
+    coords = tree.nodes.new("ShaderNodeTexCoord")
+    tree.links.new(coords.outputs["Generated"], gradient.inputs["Vector"])
+    tree.links.new(gradient.outputs["Color"], bg.inputs["Color"])
+    value = tree.nodes.new("ShaderNodeValue")
+    value.outputs[0].default_value = 3.0
+    tree.links.new(value.outputs[0], bg.inputs["Strength"])
+    w, warnings = _export(world)
+    assert not warnings and w.texture is not None
+    px = w.texture.pixels
+    h, wd = px.shape[:2]
+    assert (wd, h) == (64, 32)
+    u, v = np.meshgrid((np.arange(wd) + 0.5) / wd, (np.arange(h) + 0.5) / h)
+    d, _ = uv_to_direction(np.stack([u.ravel(), v.ravel()], 1))
+    expected = 3.0 * np.clip(d[:, 0], 0.0, 1.0)
+    for ch in range(3):
+        np.testing.assert_allclose(px[..., ch].ravel(), expected, atol=1e-5)
 
 
 def test_missing_image_is_pink_like_cycles(bpy_drt):

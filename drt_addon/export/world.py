@@ -20,8 +20,9 @@ shader (anything else: a black background, reported):
   singular scale (reported). Any other vector source is reported and ignored.
 - Color from a Sky Texture node: its sky as an environment map and its sun disc as a
   distant light (`world_sky`), through the node's Vector as above.
-- Anything else linked to Color, or a linked Strength: reported; the socket's own value
-  is used.
+- Anything else linked to Color, or a linked Strength: the graph is evaluated along
+  every texel's direction of an equirectangular map, which becomes the environment map
+  (world_nodes.py).
 World > Ray Visibility (`world.cycles_visibility`: camera, diffuse, glossy, transmission,
 shadow) becomes `engine.World.visibility` (whose Shadow bit the engine ignores, as
 Cycles does; see engine.world_light).
@@ -34,6 +35,7 @@ from ..engine_link import engine
 from .errors import Reporter
 from .images import image_cache, image_texture, textures
 from .nodes.links import _link, uses_nodes
+from .world_nodes import bake_background
 from .world_sky import sky_world
 
 BLACK = (0.0, 0.0, 0.0)
@@ -99,25 +101,22 @@ def _export_background(world, reporter: Reporter) -> "engine.World":
                       "using a black background", key=("world", "node"))
         return engine.World(BLACK, visibility=vis)
     color, strength = node.inputs["Color"], node.inputs["Strength"]
-    if strength.is_linked:
-        reporter.warn(f"DRT: world {world.name!r}: the Background's Strength is connected, "
-                      "which DRT does not evaluate; using its own value",
-                      key=("world", "strength"))
     s = float(strength.default_value)
     plain = tuple(c * s for c in color.default_value[:3])
     source = _link(color)
-    if source is None:
+    if source is None and _link(strength) is None:
         return engine.World(plain, visibility=vis)
-    src, socket = source
     ctx = _WorldCtx(world, reporter)
-    world_out = None
-    if src.bl_idname == "ShaderNodeTexEnvironment" and socket.identifier == "Color":
+    src, socket = source if source is not None else (None, None)
+    direct = _link(strength) is None and src is not None and (
+        (src.bl_idname == "ShaderNodeTexEnvironment" and socket.identifier == "Color")
+        or src.bl_idname == "ShaderNodeTexSky")
+    if not direct:           # any other graph: evaluated into a map (world_nodes.py)
+        world_out = bake_background(world, node, vis, ctx)
+    elif src.bl_idname == "ShaderNodeTexEnvironment":
         world_out = _environment(src, s, vis, ctx)
-    elif src.bl_idname == "ShaderNodeTexSky":
-        world_out = sky_world(src, s, vis, _mapping(src, ctx), ctx)
     else:
-        ctx.issue(f"the Background's Color comes from {src.bl_label!r}, which DRT does not "
-                  f"evaluate; using the Background's own colour")
+        world_out = sky_world(src, s, vis, _mapping(src, ctx), ctx)
     ctx.report(reporter)
     return world_out if world_out is not None else engine.World(plain, visibility=vis)
 
