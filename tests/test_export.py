@@ -552,3 +552,20 @@ def test_light_export_warns_about_what_drt_ignores(bpy_drt):
     assert len(s.lights) == 3
     assert any("'Spot'" in w and "elliptical" in w for w in reporter.warnings), reporter.warnings
     assert any("'Area'" in w and "spread" in w for w in reporter.warnings), reporter.warnings
+
+
+def test_an_object_blender_cannot_evaluate_is_left_out_with_a_warning():
+    """obj.to_mesh() raising (Blender: "Object does not have geometry data") leaves that
+    object out, named in a warning, instead of failing the whole render."""
+    from drt_addon.export import Reporter
+    from drt_addon.export.mesh import _evaluate
+
+    class Broken:
+        name = "Broken"
+
+        def to_mesh(self):
+            raise RuntimeError("Error: Object does not have geometry data\n")
+    reporter = Reporter()
+    assert _evaluate(Broken(), reporter=reporter) is None
+    assert reporter.warnings == ["DRT: object 'Broken' is left out: Blender cannot evaluate "
+                                 "its mesh (Error: Object does not have geometry data)"]

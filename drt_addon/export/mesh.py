@@ -224,8 +224,11 @@ def _evaluate(obj, want_uv: Optional[str] = None, reporter=None,
               want_tangents=False, want_colors: Optional[str] = None) -> Optional[LocalMesh]:
     try:
         mesh = obj.to_mesh()
-    except RuntimeError as e:
-        raise ExportError(f"object {obj.name!r}: cannot evaluate its mesh ({e})") from e
+    except RuntimeError as e:     # one object Blender cannot turn into a mesh: the rest renders
+        if reporter is not None:
+            reporter.warn(f"DRT: object {obj.name!r} is left out: Blender cannot evaluate "
+                          f"its mesh ({str(e).strip()})", key=(obj.name, "to_mesh"))
+        return None
     uvs = tangents = colors = None
     try:
         if mesh is None:
