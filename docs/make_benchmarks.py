@@ -118,13 +118,17 @@ def main():
     saved = _load_sections()
     q = args.quick
     cores = os.cpu_count() or 1
-    load = os.getloadavg()[0]
-    machine = (f"{platform.machine()}, {cores} cores, Python {platform.python_version()}; "
-               f"load average {load:.2f} when it started")
+    base = f"{platform.machine()}, {cores} cores, Python {platform.python_version()}"
+    started = {"load": os.getloadavg()[0]}
     lines, targets = [], []
 
     def done(section):
-        """Keep what the section just measured (its lines and targets) and start the next."""
+        """Keep what the section just measured (its lines and targets, the machine and
+        its load average when the section started and ended) and start the next."""
+        end = os.getloadavg()[0]
+        machine = (f"{base}; load average {started['load']:.2f} when it started, "
+                   f"{end:.2f} when it ended")
+        started["load"] = end
         saved[section] = dict(lines=lines[:], targets=targets[:], machine=machine)
         _save_sections(saved)
         lines.clear()
