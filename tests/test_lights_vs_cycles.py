@@ -144,17 +144,22 @@ def test_soft_falloff_changes_the_image_beyond_the_thresholds(bpy_drt):
     assert not within(soft, sphere), compare(soft, sphere)
 
 
-def _light_nodes(strength_node):
-    """Light > Nodes on the lamp: Emission Color orange; Strength 2.5 set on the node, or
-    from a Value node (2.0) times 1.25 through a Math node and a Light Falloff node's
-    Quadratic output (what the public files do to scale a lamp's power)."""
+def _light_nodes(kind):
+    """Light > Nodes on the lamp: Emission Color orange (or a Blackbody node at 3000 K,
+    `kind` "blackbody"); Strength 2.5 set on the node, or from a Value node (2.0) times
+    1.25 through a Math node and a Light Falloff node's Quadratic output (`kind`
+    "value-math-falloff": what the public files do to scale a lamp's power)."""
     def setup(scene):
         light = scene.objects["Light"].data
         light.use_nodes = True
         nt = light.node_tree
         emission = nt.nodes["Emission"]
         emission.inputs["Color"].default_value = (1.0, 0.6, 0.3, 1.0)
-        if not strength_node:
+        if kind == "blackbody":
+            blackbody = nt.nodes.new("ShaderNodeBlackbody")
+            blackbody.inputs["Temperature"].default_value = 3000.0
+            nt.links.new(blackbody.outputs["Color"], emission.inputs["Color"])
+        if kind != "value-math-falloff":
             emission.inputs["Strength"].default_value = 2.5
             return
         value = nt.nodes.new("ShaderNodeValue")
@@ -170,13 +175,13 @@ def _light_nodes(strength_node):
     return setup
 
 
-@pytest.mark.parametrize("strength_node", [False, True], ids=["constant", "value-math-falloff"])
-def test_light_node_tree_matches_cycles(bpy_drt, strength_node):
+@pytest.mark.parametrize("kind", ["constant", "value-math-falloff", "blackbody"])
+def test_light_node_tree_matches_cycles(bpy_drt, kind):
     """A lamp's node tree scales its strength as in Cycles (the lamp's power times the
     Emission node's colour and strength); the lamp without its nodes fails the same
     comparison."""
-    setup = _light_nodes(strength_node)
-    tag = f"nodes {strength_node}"
+    setup = _light_nodes(kind)
+    tag = f"nodes {kind}"
     cycles = _render(bpy_drt, "light_point", "CYCLES", setup=setup, tag=tag)
     drt = _render(bpy_drt, "light_point", "DRT", setup=setup, tag=tag)
     rel, mad = compare(drt, cycles)

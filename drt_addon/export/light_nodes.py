@@ -3,15 +3,18 @@ the active Light Output multiplies the lamp's own strength (colour x power) by i
 and its Strength (1 and white in the tree Blender makes, so that tree changes nothing).
 
 Read: Color and Strength as set on the Emission node, or from constant nodes (Value,
-RGB, Math with constant operands, a Light Falloff node's Quadratic output, which is its
-Strength: Cycles' physical falloff), through reroutes. Nothing reaching the Light Output
-is no light, as in Cycles. What varies over the lamp or with the ray (textures,
-Blackbody, Light Falloff's Linear and Constant outputs, ray-dependent inputs) is not read:
-the exporter then uses the lamp's own strength and says so.
+RGB, Blackbody of a constant temperature, Math with constant operands, a Light Falloff
+node's Quadratic output, which is its Strength: Cycles' physical falloff), through
+reroutes. Nothing reaching the Light Output is no light, as in Cycles. What varies over
+the lamp or with the ray (textures, Light Falloff's Linear and Constant outputs,
+ray-dependent inputs) is not read: the exporter then uses the lamp's own strength and
+says so.
 """
 from __future__ import annotations
 
 import math
+
+from .blackbody import blackbody_rgb
 
 MATH = {"ADD": lambda a, b: a + b, "SUBTRACT": lambda a, b: a - b,
         "MULTIPLY": lambda a, b: a * b,
@@ -60,6 +63,8 @@ def _color(socket) -> tuple:
         return tuple(float(c) for c in socket.default_value[:3])
     if out.node.type == "RGB":
         return tuple(float(c) for c in out.default_value[:3])
+    if out.node.type == "BLACKBODY":
+        return blackbody_rgb(_float(out.node.inputs["Temperature"]))
     raise Unread(out.node.name)
 
 
