@@ -325,6 +325,15 @@ def _rgb_to_bw(nt, p):
     return bw.outputs[0]
 
 
+def _blackbody(nt, p):
+    """Blackbody of a temperature computed by nodes (1250 K x 2, folded at export)."""
+    bb = p.node(nt, "ShaderNodeBlackbody")
+    m = p.node(nt, "ShaderNodeMath", operation="MULTIPLY")
+    m.inputs[0].default_value, m.inputs[1].default_value = 1250.0, 2.0
+    nt.links.new(m.outputs[0], bb.inputs["Temperature"])
+    return bb.outputs[0]
+
+
 def _group(bpy_data, name, build_inner):
     """A shader node group with one float input and one float output."""
     g = bpy_data.node_groups.new(name, "ShaderNodeTree")
@@ -378,7 +387,7 @@ CONVERTER = [(f"math_{o.lower()}", _math(o)) for o in MATH_OPS] + [
     ("clamp_minmax", _clamp("MINMAX")), ("clamp_range", _clamp("RANGE")),
     ("color_rgb", _separate_combine("RGB")), ("color_hsv", _separate_combine("HSV")),
     ("color_hsl", _separate_combine("HSL")), ("rgb_to_bw", _rgb_to_bw),
-    ("nested_groups", _nested_groups)]
+    ("blackbody", _blackbody), ("nested_groups", _nested_groups)]
 
 
 # ---------------------------------------------------------------- vector

@@ -1,11 +1,13 @@
 """Converter nodes to program operations (engine.nodes.converter_nodes): Math, Map
 Range, Clamp, Separate / Combine XYZ and Color (RGB, HSV, HSL; and the legacy RGB and
-HSV nodes), RGB to BW."""
+HSV nodes), RGB to BW, and Blackbody of a temperature that does not vary per hit (a
+constant, export/blackbody.py)."""
 from __future__ import annotations
 
 import importlib
 
 from ...engine_link import engine
+from ..blackbody import blackbody_rgb
 from .errors import Unsupported
 
 CV = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
@@ -78,7 +80,17 @@ def _rgb_to_bw(c, node, out):
     return c.input(node, "Color", "float")         # the link converts by luminance
 
 
+def _blackbody(c, node, out):
+    """Blender's blackbody colour (luminance 1) of a Temperature that does not vary per
+    hit (export/blackbody.py); a varying one is not evaluated."""
+    kelvin = c.fold(c.input(node, "Temperature", "float"))
+    if kelvin is None:
+        raise Unsupported("a Blackbody of a temperature that varies")
+    return c.const(blackbody_rgb(kelvin), "color")
+
+
 TRANSLATORS = {
+    "ShaderNodeBlackbody": _blackbody,
     "ShaderNodeMath": _math,
     "ShaderNodeMapRange": _map_range,
     "ShaderNodeClamp": _clamp,
