@@ -75,7 +75,6 @@ def rough_glass_probe(path):
     bs.render_defaults(scene, size=(32, 32), samples=1024)
     scene.cycles.use_adaptive_sampling = False
     scene.cycles.sample_clamp_indirect = 0.0
-    scene.drt.clamp_indirect = 0.0
     scene.cycles.blur_glossy = 0.0
     bpy.ops.wm.save_as_mainfile(filepath=path)
 

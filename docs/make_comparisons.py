@@ -191,7 +191,7 @@ def known_differences(bpy, tmp, lines):
     probes.rough_glass_probe(probe)
     for label, setup in (("glossy bounces 4 (default)", None),
                          ("glossy bounces 0", probes.scene_setup(
-                             cycles__glossy_bounces=0, drt__glossy_bounces=0))):
+                             cycles__glossy_bounces=0))):
         d, _ = render(bpy, probe, "DRT", 1024, setup=setup)
         c, _ = render(bpy, probe, "CYCLES", 1024, setup=setup)
         rel, mad, block = compare(d, c)
@@ -201,7 +201,7 @@ def known_differences(bpy, tmp, lines):
         print(rows[-1], flush=True)
 
     # 4. World light at the vertex after the last allowed bounce.
-    one = probes.scene_setup(cycles__diffuse_bounces=1, drt__diffuse_bounces=1)
+    one = probes.scene_setup(cycles__diffuse_bounces=1)
     d, _ = render(bpy, blend("world_light"), "DRT", 256, setup=one)
     c, _ = render(bpy, blend("world_light"), "CYCLES", 1024, setup=one)
     rel, mad, block = compare(d, c)

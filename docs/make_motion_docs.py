@@ -37,7 +37,6 @@ def save_png(bpy, path):
 def direct(extra=None):
     def setup(scene):
         scene.cycles.diffuse_bounces = 0
-        scene.drt.diffuse_bounces = 0
         if extra is not None:
             extra(scene)
     return setup

@@ -22,6 +22,23 @@ FILTER_ITEMS = [
 ]
 
 
+# The engine settings DRT reads from the file's Cycles settings (`scene.cycles`, shown in
+# DRT's Light Paths and Film panels): engine name -> (Cycles property, Cycles' default).
+CYCLES_SHARED = {
+    "max_bounces": ("max_bounces", 12), "diffuse_bounces": ("diffuse_bounces", 4),
+    "glossy_bounces": ("glossy_bounces", 4),
+    "transmission_bounces": ("transmission_bounces", 12),
+    "transparent_bounces": ("transparent_max_bounces", 8),
+    "volume_bounces": ("volume_bounces", 0),
+    "clamp_direct": ("sample_clamp_direct", 0.0),
+    "clamp_indirect": ("sample_clamp_indirect", 10.0),
+    "filter_glossy": ("blur_glossy", 1.0),
+    "caustics_reflective": ("caustics_reflective", True),
+    "caustics_refractive": ("caustics_refractive", True),
+    "film_exposure": ("film_exposure", 1.0),
+}
+
+
 class DRTRenderSettings(bpy.types.PropertyGroup):
     samples: IntProperty(name="Samples", description="Samples per pixel",
                          default=64, min=1, max=1 << 24, soft_max=4096)
@@ -45,19 +62,6 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
                       "different seeds give independent images", default=0, min=0)
     sampler: EnumProperty(name="Sampler", items=SAMPLER_ITEMS, default="jittered")
     integrator: EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="path")
-    max_bounces: IntProperty(name="Total", description="Maximum number of bounces",
-                             default=12, min=0, max=1024)
-    diffuse_bounces: IntProperty(name="Diffuse", default=4, min=0, max=1024)
-    glossy_bounces: IntProperty(name="Glossy", default=4, min=0, max=1024)
-    transmission_bounces: IntProperty(name="Transmission", default=12, min=0, max=1024)
-    transparent_bounces: IntProperty(name="Transparent", default=8, min=0, max=1024)
-    volume_bounces: IntProperty(name="Volume", description="Scatterings in volumes a path "
-                                "goes on after (0: direct light in volumes only)",
-                                default=0, min=0, max=1024)
-    clamp_direct: FloatProperty(name="Direct Light", description="Clamp direct light "
-                                "samples to this value (0 disables)", default=0.0, min=0.0)
-    clamp_indirect: FloatProperty(name="Indirect Light", description="Clamp indirect light "
-                                  "samples to this value (0 disables)", default=10.0, min=0.0)
     filter_type: EnumProperty(name="Filter", items=FILTER_ITEMS, default="BLACKMAN_HARRIS")
     filter_width: FloatProperty(name="Width", description="Pixel filter width in pixels",
                                 default=1.5, min=0.01, max=10.0, subtype="PIXEL")
@@ -67,26 +71,20 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
 
     def to_engine_settings(self):
         """The engine's settings: DRT's own, and the file's Cycles settings DRT shares
-        with Cycles (Filter Glossy, caustics, Film > Exposure; Blender's defaults without
-        Cycles). export/file_settings.py lists every setting of the file and what DRT
-        does with it."""
+        with Cycles, in Cycles' own properties (Light Paths: the bounce limits per kind
+        and the clamps, Filter Glossy, the caustics switches; Film > Exposure), Cycles'
+        defaults where the Cycles add-on is off. export/file_settings.py lists every
+        setting of the file and what DRT does with it."""
         from .engine_link import engine
         cycles = getattr(self.id_data, "cycles", None)
+        shared = {key: type(default)(getattr(cycles, name, default))
+                  for key, (name, default) in CYCLES_SHARED.items()}
         return engine.RenderSettings(
-            film_exposure=float(getattr(cycles, "film_exposure", 1.0)),
-            filter_glossy=float(getattr(cycles, "blur_glossy", 1.0)),
-            caustics_reflective=bool(getattr(cycles, "caustics_reflective", True)),
-            caustics_refractive=bool(getattr(cycles, "caustics_refractive", True)),
-            samples=self.samples, seed=self.seed,
+            **shared, samples=self.samples, seed=self.seed,
             adaptive_sampling=self.use_adaptive_sampling,
             adaptive_threshold=self.adaptive_threshold,
-            adaptive_min_samples=self.adaptive_min_samples, time_limit=self.time_limit, sampler=self.sampler,
-            integrator=self.integrator, max_bounces=self.max_bounces,
-            diffuse_bounces=self.diffuse_bounces, glossy_bounces=self.glossy_bounces,
-            transmission_bounces=self.transmission_bounces,
-            transparent_bounces=self.transparent_bounces,
-            volume_bounces=self.volume_bounces, clamp_direct=self.clamp_direct,
-            clamp_indirect=self.clamp_indirect, filter_type=self.filter_type,
+            adaptive_min_samples=self.adaptive_min_samples, time_limit=self.time_limit,
+            sampler=self.sampler, integrator=self.integrator, filter_type=self.filter_type,
             filter_width=self.filter_width, threads=self.engine_threads())
 
     def engine_threads(self) -> int:

@@ -42,16 +42,27 @@ class DRT_PT_light_paths(DRTPanel, bpy.types.Panel):
     bl_label = "Light Paths"
 
     def draw(self, context):
-        s = context.scene.drt
+        """The file's Cycles settings themselves (`scene.cycles`), which DRT renders with:
+        one vocabulary for both engines (properties.CYCLES_SHARED)."""
+        cycles = getattr(context.scene, "cycles", None)
+        if cycles is None:
+            self.layout.label(text="Enable the Cycles add-on to edit these (DRT uses "
+                                   "Cycles' defaults)")
+            return
         col = self.layout.column(align=True)
         col.use_property_split = True
         for name in ("max_bounces", "diffuse_bounces", "glossy_bounces",
-                     "transmission_bounces", "transparent_bounces", "volume_bounces"):
-            col.prop(s, name)
+                     "transmission_bounces", "volume_bounces", "transparent_max_bounces"):
+            col.prop(cycles, name)
         col = self.layout.column(align=True)
         col.use_property_split = True
-        col.prop(s, "clamp_direct")
-        col.prop(s, "clamp_indirect")
+        col.prop(cycles, "sample_clamp_direct")
+        col.prop(cycles, "sample_clamp_indirect")
+        col = self.layout.column(align=True)
+        col.use_property_split = True
+        col.prop(cycles, "blur_glossy")
+        col.prop(cycles, "caustics_reflective")
+        col.prop(cycles, "caustics_refractive")
 
 
 class DRT_PT_film(DRTPanel, bpy.types.Panel):

@@ -155,8 +155,6 @@ def _light_plane_scene(kind, location, target=(0.0, 0.0, 0.0), **props):
     render_defaults(scene, size=(48, 48), samples=256)
     scene.cycles.diffuse_bounces = 0
     scene.cycles.use_adaptive_sampling = False
-    if hasattr(scene, "drt"):
-        scene.drt.diffuse_bounces = 0
     return scene
 
 
@@ -311,8 +309,6 @@ def _motion_stage():
     render_defaults(scene, size=(64, 48), samples=256)
     scene.cycles.diffuse_bounces = 0
     scene.cycles.use_adaptive_sampling = False
-    if hasattr(scene, "drt"):
-        scene.drt.diffuse_bounces = 0
     scene.render.use_motion_blur = True
     scene.render.motion_blur_shutter = MOTION_SHUTTER
     scene.render.motion_blur_position = "CENTER"

@@ -101,6 +101,34 @@ def test_blender_panels_are_shared_with_drt(bpy_drt):
     assert "DRT" not in bpy.types.VIEWLAYER_PT_freestyle.COMPAT_ENGINES
 
 
+def test_light_paths_panel_edits_the_files_cycles_settings(bpy_drt):
+    """DRT's Light Paths panel draws Cycles' own properties, which DRT renders with (one
+    vocabulary): what an artist sets there is what Cycles uses too."""
+    import types
+    from drt_addon import ui
+    scene = bpy_drt.context.scene
+    drawn = []
+
+    class Layout:
+        use_property_split = False
+
+        def column(self, **kw):
+            return self
+
+        def prop(self, data, name, **kw):
+            drawn.append((data, name))
+
+        def label(self, **kw):
+            drawn.append(("label", kw.get("text")))
+    ui.DRT_PT_light_paths.draw(types.SimpleNamespace(layout=Layout()),
+                               types.SimpleNamespace(scene=scene))
+    assert [d for d, _ in drawn] == [scene.cycles] * len(drawn)
+    assert [n for _, n in drawn][:8] == [
+        "max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
+        "volume_bounces", "transparent_max_bounces", "sample_clamp_direct",
+        "sample_clamp_indirect"]
+
+
 def test_manifest_is_a_valid_extension_manifest():
     import tomllib
     with open(os.path.join(ROOT, "blender_manifest.toml"), "rb") as f:

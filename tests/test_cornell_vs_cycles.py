@@ -17,7 +17,6 @@ MEAN_TOLERANCE = 0.10
 
 def _direct_only(scene):
     scene.cycles.diffuse_bounces = 0
-    scene.drt.diffuse_bounces = 0
 
 
 @pytest.fixture(scope="module")

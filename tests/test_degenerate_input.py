@@ -57,7 +57,6 @@ def _build(bpy):
     scene.cycles.samples = scene.drt.samples = SAMPLES
     scene.cycles.use_denoising = scene.cycles.use_adaptive_sampling = False
     scene.cycles.max_bounces = 0
-    scene.drt.max_bounces = 0
     return scene
 
 

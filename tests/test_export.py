@@ -427,7 +427,6 @@ LIGHT_POINT = os.path.join(SAMPLES_DIR, "light_point.blend")
 
 def _direct(scene):
     scene.cycles.diffuse_bounces = 0
-    scene.drt.diffuse_bounces = 0
 
 
 def test_pixel_aspect_matches_cycles(bpy_drt):

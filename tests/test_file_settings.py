@@ -26,7 +26,6 @@ _renders = {}
 def _direct_only(exposure):
     def setup(scene):
         scene.cycles.diffuse_bounces = 0
-        scene.drt.diffuse_bounces = 0
         scene.cycles.film_exposure = exposure
         layer = scene.view_layers[0]
         layer.use_pass_z = True
@@ -225,13 +224,11 @@ def test_fresh_scene_defaults_are_quiet(bpy_drt):
     (lambda s: setattr(s.cycles, "use_animated_seed", True), "same Seed on every frame"),
     (lambda s: setattr(s.cycles, "use_light_tree", False), "Light Tree is off"),
     (lambda s: setattr(s.cycles, "time_limit", 30.0), "Time Limit is 30"),
-    (lambda s: setattr(s.cycles, "volume_bounces", 2), "Volume bounces"),
     (lambda s: setattr(s.cycles, "use_fast_gi", True), "full global illumination"),
     (lambda s: setattr(s.render, "use_freestyle", True), "Freestyle"),
     (lambda s: setattr(s.view_layers[0], "samples", 16), "View Layer > Override > Samples"),
     (lambda s: setattr(s.cycles, "samples", 128), "Max Samples is 128, not used"),
     (lambda s: setattr(s.cycles, "pixel_filter_type", "GAUSSIAN"), "GAUSSIAN"),
-    (lambda s: setattr(s.cycles, "diffuse_bounces", 0), "Diffuse bounces"),
 ])
 def test_a_setting_drt_ignores_warns_once(factory_scene, change, expected):
     _quiet_defaults(factory_scene)
@@ -244,9 +241,24 @@ def test_own_settings_warn_only_when_drt_differs(factory_scene):
     _quiet_defaults(factory_scene)
     factory_scene.cycles.samples = 128
     factory_scene.drt.samples = 128
-    factory_scene.cycles.sample_clamp_indirect = 3.0
-    factory_scene.drt.clamp_indirect = 3.0
     assert _warnings(factory_scene) == []
+
+
+def test_light_paths_and_clamps_are_the_files_own(factory_scene):
+    """The bounce limits per kind and the clamps are the file's Cycles settings, which
+    DRT renders with (as the glass spheres file with Indirect Light clamping off and 8
+    bounces needs): no warning, and the engine gets them."""
+    _quiet_defaults(factory_scene)
+    c = factory_scene.cycles
+    c.max_bounces, c.diffuse_bounces, c.glossy_bounces = 8, 2, 3
+    c.transmission_bounces, c.transparent_max_bounces, c.volume_bounces = 6, 5, 1
+    c.sample_clamp_direct, c.sample_clamp_indirect = 2.0, 0.0
+    assert _warnings(factory_scene) == []
+    s = factory_scene.drt.to_engine_settings()
+    assert (s.max_bounces, s.diffuse_bounces, s.glossy_bounces, s.transmission_bounces,
+            s.transparent_bounces, s.volume_bounces, s.clamp_direct, s.clamp_indirect) \
+        == (8, 2, 3, 6, 5, 1, 2.0, 0.0)
+    assert not hasattr(factory_scene.drt, "max_bounces")      # one vocabulary
 
 
 def test_settings_that_only_matter_with_another_warn_only_then(factory_scene):

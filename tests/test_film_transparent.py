@@ -76,7 +76,7 @@ def test_holdout_matches_cycles(bpy_drt):
         scene.cycles.samples = 256
         scene.cycles.use_denoising = False
         scene.drt.samples = 64
-        scene.cycles.diffuse_bounces = scene.drt.diffuse_bounces = 0
+        scene.cycles.diffuse_bounces = scene.cycles.diffuse_bounces = 0
         bpy.ops.render.render()
         out[engine] = read_render_rgba(bpy, scene)
     a_drt, a_cyc = out["DRT"][:, 3], out["CYCLES"][:, 3]

@@ -51,7 +51,6 @@ _renders = {}
 
 def _direct_only(scene):
     scene.cycles.diffuse_bounces = 0
-    scene.drt.diffuse_bounces = 0
 
 
 def _render(bpy, name, engine, samples=None, setup=None, tag=""):

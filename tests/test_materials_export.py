@@ -568,7 +568,7 @@ def _render(bpy, engine, samples):
     scene.cycles.device = "CPU"
     scene.cycles.diffuse_bounces = 0
     scene.drt.samples = samples
-    scene.drt.diffuse_bounces = 0
+    scene.cycles.diffuse_bounces = 0
     return render_current(bpy, scene)
 
 

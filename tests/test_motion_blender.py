@@ -33,7 +33,6 @@ _renders = {}
 
 def _direct(scene):
     scene.cycles.diffuse_bounces = 0
-    scene.drt.diffuse_bounces = 0
 
 
 def render(bpy, path, engine, tag="", setup=None, samples=None):
@@ -288,7 +287,7 @@ def _render_small(bpy, samples=4):
     scene = bpy.context.scene
     scene.render.engine = "DRT"
     scene.drt.samples = samples
-    scene.drt.diffuse_bounces = 0
+    scene.cycles.diffuse_bounces = 0
     try:
         bpy.ops.render.render()
     except RuntimeError:          # the operator raises when the engine reported an error

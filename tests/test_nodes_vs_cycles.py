@@ -148,7 +148,6 @@ def _tilted_plane(bpy, color, sun_tilt):
     if scene.world.node_tree is not None:
         scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.cycles.max_bounces = 0
-    scene.drt.max_bounces = 0
     return scene
 
 

@@ -66,8 +66,8 @@ def test_extreme_but_legal_settings_render(bpy_drt):
     from drt_addon.render_engine import last_render
     scene = _open(bpy_drt, samples=2)
     scene.drt.filter_width = 0.01
-    scene.drt.clamp_indirect = 0.0
-    scene.drt.max_bounces = 0
+    scene.cycles.sample_clamp_indirect = 0.0
+    scene.cycles.max_bounces = 0
     bpy_drt.ops.render.render()
     assert last_render["ok"]
     assert np.isfinite(last_render["pixels"]).all()

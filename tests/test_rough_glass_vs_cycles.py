@@ -44,7 +44,7 @@ def rough_glass_scene(bpy, roughness, filter_glossy, distribution="MULTI_GGX"):
     scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
     scene.cycles.blur_glossy = filter_glossy
     if filter_glossy == 0.0:
-        scene.cycles.sample_clamp_indirect = scene.drt.clamp_indirect = 0.0
+        scene.cycles.sample_clamp_indirect = scene.cycles.sample_clamp_indirect = 0.0
     _camera(scene, bpy, (0.0, -4.0, 0.0), (90.0, 0.0, 0.0), lens=50.0)
     _area(scene, bpy, (0.0, 3.0, 0.0), (-90.0, 0.0, 0.0), 2.0, 200.0)
     mat, nodes, links, out = _material(bpy, "RoughGlass")

@@ -237,7 +237,7 @@ def _single_scatter(names):
 def _direct_clamped(scene):
     """Direct light clamped at 10 (the lamp seen in the plate from the first surface
     counted as indirect light was this error)."""
-    scene.drt.clamp_direct = 10.0
+    scene.cycles.sample_clamp_direct = 10.0
 
 
 def _no_refractive_caustics(scene):
@@ -302,13 +302,11 @@ LIGHT_PATH_DEFAULTS = ("max_bounces", "diffuse_bounces", "glossy_bounces",
                        "transmission_bounces", "transparent_max_bounces",
                        "sample_clamp_direct", "sample_clamp_indirect", "blur_glossy",
                        "caustics_reflective", "caustics_refractive")
-DRT_DEFAULTS = ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces",
-                "transparent_bounces", "clamp_direct", "clamp_indirect")
 
 
 def test_scene_files_hold_blenders_defaults(bpy_drt):
     """Every comparison scene is as a user makes it: Blender's defaults for the light
-    paths, clamps, Filter Glossy and caustics (Cycles' and DRT's settings) and Multiscatter
+    paths, clamps, Filter Glossy and caustics (Cycles' settings, which DRT reads) and Multiscatter
     GGX on every Principled BSDF; plus what each scene is built to show (cheap: no
     rendering)."""
     bpy = bpy_drt
@@ -317,11 +315,9 @@ def test_scene_files_hold_blenders_defaults(bpy_drt):
         bpy.ops.wm.open_mainfile(filepath=_path(name), load_ui=False)
         scene = bpy.context.scene
         assert (scene.render.resolution_x, scene.render.resolution_y) == SIZE, name
-        c, d = scene.cycles, scene.drt
+        c = scene.cycles                     # DRT renders with these too
         for prop in LIGHT_PATH_DEFAULTS:
             assert getattr(c, prop) == c.bl_rna.properties[prop].default, (name, prop)
-        for prop in DRT_DEFAULTS:
-            assert getattr(d, prop) == d.bl_rna.properties[prop].default, (name, prop)
         assert c.blur_glossy == 1.0 and c.caustics_reflective and c.caustics_refractive
         assert (c.max_bounces, c.diffuse_bounces, c.glossy_bounces, c.transmission_bounces,
                 c.sample_clamp_indirect) == (12, 4, 4, 12, 10.0), name

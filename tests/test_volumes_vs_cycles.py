@@ -99,7 +99,7 @@ def _no_fog(bpy, scene):
 
 
 def _no_volume_bounces(bpy, scene):
-    scene.drt.volume_bounces = 0
+    scene.cycles.volume_bounces = 0
 
 
 def _no_absorption_color(bpy, scene):

@@ -114,7 +114,6 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
         cube(bpy, scene, "Fog", *fog_box, fog)
     elif case == "multiple":
         scene.cycles.volume_bounces = 4
-        scene.drt.volume_bounces = 4
         fog = volume_material(bpy, "Fog", "ShaderNodeVolumeScatter",
                               {"Density": 0.6, "Color": (0.9, 0.9, 0.9, 1.0)})
         cube(bpy, scene, "Fog", *fog_box, fog)
