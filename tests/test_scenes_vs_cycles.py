@@ -366,3 +366,26 @@ def test_caustics_switched_off_in_the_file_match_cycles(bpy_drt):
     assert block <= BLOCK_TOLERANCE
     # and it is a different image from the one with caustics on
     assert not within(_render(bpy_drt, "glass_caustics", "CYCLES"), cycles)
+
+
+def _unclamped_8_bounces(scene):
+    """What the public glass-spheres file sets: Indirect Light clamping off, 8 bounces."""
+    scene.cycles.sample_clamp_indirect = 0.0
+    scene.cycles.max_bounces = 8
+
+
+def test_the_files_clamp_and_bounces_match_cycles(bpy_drt):
+    """The file's Light Paths settings, not defaults of DRT's own: glass_caustics with
+    Indirect Light clamping off and 8 bounces matches Cycles rendering the same file, and
+    DRT with Blender's default clamp of 10 (what DRT rendered before it read the file's
+    clamp) does not."""
+    cycles = _render(bpy_drt, "glass_caustics", "CYCLES", setup=_unclamped_8_bounces,
+                     tag="unclamped")
+    drt = _render(bpy_drt, "glass_caustics", "DRT", setup=_unclamped_8_bounces,
+                  tag="unclamped")
+    rel, mad, block = _report("glass_caustics, unclamped, 8 bounces", drt, cycles)
+    assert (rel <= ISSUE_MEAN_TOLERANCE).all() and mad <= MAD_TOLERANCE
+    assert block <= BLOCK_TOLERANCE
+    clamped = _render(bpy_drt, "glass_caustics", "DRT", samples=CONTROL_SAMPLES,
+                      tag="clamp 10")
+    assert not within(clamped, cycles)
