@@ -358,16 +358,15 @@ def package(output_dir: str | None = None, root: str = REPO_ROOT,
     host = prebuilt_kernels.host_platform()
     with_kernels = host if host in chosen and kernel_tiers != () else None
     # the zip with kernels is built from a stage of its own (the others must not hold them)
-    groups = [g for g in ([with_kernels], [p for p in chosen if p != with_kernels]) if g
-              and g != [None]]
+    others = [p for p in chosen if p != with_kernels]
+    groups = ([[with_kernels]] if with_kernels else []) + ([others] if others else [])
     with tempfile.TemporaryDirectory(prefix=".drt-stage-", dir=output_dir) as work:
         kernels = None
         if with_kernels:
             kernels = os.path.join(work, "kernels")
             try:
-                prebuilt_kernels.build(kernels, kernel_tiers,
-                                       kernel_scenes or prebuilt_kernels.precompile.SCENES,
-                                       python, log=_log)
+                prebuilt_kernels.build(kernels, kernel_tiers, kernel_scenes, python,
+                                       log=_log)
             except RuntimeError as e:
                 raise PackagingError(str(e)) from None
         for n, group in enumerate(groups):

@@ -41,16 +41,18 @@ def host_platform() -> str | None:
     return {"linux": "linux-x64", "win32": "windows-x64"}.get(sys.platform)
 
 
-def build(folder: str, tiers=None, scenes=precompile.SCENES, python: str = sys.executable,
+def build(folder: str, tiers=None, scenes=None, python: str = sys.executable,
           log=None) -> dict:
     """Compile the kernels that rendering `scenes` (sample scene names) reaches, once per
-    tier, into `folder` (it then holds the engine's cache layout: `engine_kernels/...`).
+    tier (default: the shipped tiers; scenes default: `compile`'s), into `folder` (it then
+    holds the engine's cache layout: `engine_kernels/...`).
     Returns {tier: seconds}. Raises RuntimeError with the compile's own message on
     failure."""
     cache_files = _cache_files()
     tiers = tiers or cache_files.SHIPPED_TIERS
     os.makedirs(folder, exist_ok=True)
-    blends = [os.path.join(ROOT, "sample_blends", f"{name}.blend") for name in scenes]
+    blends = [os.path.join(ROOT, "sample_blends", f"{name}.blend")
+              for name in scenes or precompile.SCENES]
     seconds = {}
     for tier in tiers:
         env = {k: v for k, v in os.environ.items()

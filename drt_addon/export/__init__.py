@@ -118,10 +118,11 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 continue
             holdout = _is_holdout(inst, obj, view_layer)
             holdouts += holdout
-            if obj.type in LEFT_OUT_TYPES or (not inst.is_instance and obj.type == "MESH"):
-                left_out.note_object(obj)      # hair curves; a mesh's particle hair
-                if obj.type in LEFT_OUT_TYPES:  # (to_mesh fails on hair curves)
-                    continue
+            if obj.type in LEFT_OUT_TYPES:      # hair curves (to_mesh fails on them)
+                left_out.note_object(obj)
+                continue
+            if not inst.is_instance:
+                left_out.note_hair(obj)           # a mesh's particle hair
             local = cache.local(obj)
             if local is None:
                 continue

@@ -20,11 +20,12 @@ class LeftOut:
             names.append(name)
 
     def note_object(self, obj) -> None:
-        """An object of one of LEFT_OUT_TYPES, and the hair particle systems of a mesh
-        (drawn as strands, Render As Path, with their modifier enabled for renders)."""
-        if obj.type in LEFT_OUT_TYPES:
-            self.note(LEFT_OUT_TYPES[obj.type], obj.name)
-            return
+        """An object of one of LEFT_OUT_TYPES."""
+        self.note(LEFT_OUT_TYPES[obj.type], obj.name)
+
+    def note_hair(self, obj) -> None:
+        """The hair particle systems of a mesh (drawn as strands, Render As Path, with
+        their modifier enabled for renders)."""
         for mod in getattr(obj, "modifiers", ()):
             if mod.type != "PARTICLE_SYSTEM" or not mod.show_render:
                 continue

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 
 from .blackbody import blackbody_rgb
+from .nodes.links import _link
 
 MATH = {"ADD": lambda a, b: a + b, "SUBTRACT": lambda a, b: a - b,
         "MULTIPLY": lambda a, b: a * b,
@@ -28,16 +29,9 @@ class Unread(Exception):
 
 
 def _source(socket):
-    """The output socket feeding `socket` through reroutes, or None when unlinked."""
-    while socket.is_linked:
-        link = socket.links[0]
-        if not link.is_valid or getattr(link, "is_muted", False):
-            return None
-        out = link.from_socket
-        if out.node.type != "REROUTE":
-            return out
-        socket = out.node.inputs[0]
-    return None
+    """The output socket feeding `socket` (through reroutes), or None when unlinked."""
+    found = _link(socket)
+    return None if found is None else found[1]
 
 
 def _float(socket) -> float:

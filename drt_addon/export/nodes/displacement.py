@@ -17,6 +17,7 @@ import importlib
 
 from ...engine_link import engine
 from .input import hit3, normal_input
+from .links import _linked_node
 from .vector import BU, FILTER_WIDTH, VE, _math
 
 C = importlib.import_module(engine.__name__ + ".nodes.context")
@@ -24,15 +25,15 @@ C = importlib.import_module(engine.__name__ + ".nodes.context")
 
 def _height(c, socket):
     """dot(displacement, N) of what is linked to the Displacement socket."""
-    src = socket.links[0].from_node if socket.is_linked else None
+    src = _linked_node(socket)
     if src is not None and src.bl_idname == "ShaderNodeDisplacement":
         h = _math(c, "SUBTRACT", c.input(src, "Height", "float"),
                   c.input(src, "Midlevel", "float"))
         scaled = _math(c, "MULTIPLY", h, c.input(src, "Scale", "float"))
         if not src.inputs["Normal"].is_linked:
             return scaled         # along the shading normal: dot with N is the height
-        d = c.emit(VE.VEC_MATH, "vector", [normal_input(c, src), normal_input(c, src),
-                                           normal_input(c, src), scaled,
+        along = normal_input(c, src)
+        d = c.emit(VE.VEC_MATH, "vector", [along, along, along, scaled,
                                            VE.VECTOR_OPS.index("SCALE")])
     else:
         d = c.socket(socket, "vector")
