@@ -2,7 +2,6 @@
 
 Never imports bpy. The input is an `engine.scene.Scene`, the output an `engine.film.Film`.
 """
-from .bsdf.material_table import reference_gaps
 from .film import Film
 from .render import RenderContext, RenderStats, render
 from .scene import (AreaLight, Camera, Material, ObjectInfo, PointLight, Scene, SunLight,
@@ -14,4 +13,4 @@ from . import sky_texture  # noqa: E402  (Blender's Sky Texture node, for export
 __all__ = ["AreaLight", "Camera", "Film", "Material", "ObjectInfo", "PointLight",
            "RenderContext",
            "RenderSettings", "RenderStats", "Scene", "SunLight", "TriangleMesh", "Volume", "World",
-           "reference_gaps", "render"]
+           "render"]

@@ -125,11 +125,9 @@ class RenderContext:
     def entry_kernels(self) -> list:
         """The compiled kernels this render calls from Python: the camera's, the ray
         queries', and the integrator's (`compile_watch.reachable` finds their callees)."""
-        import sys
         from .embree import rays
         found = [generate_camera_rays, pixel_keys, rays.intersect_batch, rays.occluded_batch]
-        module = sys.modules[type(self.integrator).__module__]
-        found += [v for v in vars(module).values() if isinstance(v, Kernel)]
+        found += self.integrator.entry_kernels()
         if self.accel.moving:
             from . import accel
             found += [v for v in vars(accel).values() if isinstance(v, Kernel)]

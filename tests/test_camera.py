@@ -245,3 +245,32 @@ def test_guided_lookup_handles_flat_and_steep_cdfs():
     got = np.array([interp_guided(float(v), cdf, xs, guide) for v in u])
     want = np.array([_interp_by_bisection(float(v), cdf.tolist(), xs.tolist()) for v in u])
     assert np.array_equal(got, want)
+
+
+@pytest.mark.parametrize("kind,aperture,blades,filt", [
+    ("PERSP", 0.0, 0, "BLACKMAN_HARRIS"), ("PERSP", 0.05, 0, "BLACKMAN_HARRIS"),
+    ("PERSP", 0.05, 6, "BOX"), ("ORTHO", 0.0, 0, "BOX")])
+def test_camera_ray_kernel_matches_the_camera_model(kind, aperture, blades, filt):
+    """The compiled camera rays (engine/kernels/camera_rays.py) against CameraModel with
+    the same sampler numbers and pixel filter."""
+    from engine.render import camera_rays
+    from engine.sampling import dimensions as D
+    from engine import RenderContext, RenderSettings
+    from engine_scenes import cornell_box
+    s = cornell_box(37, 23)
+    c = s.camera
+    c.kind, c.aperture_radius, c.blades, c.focus_distance = kind, aperture, blades, 3.0
+    c.blade_rotation, c.aperture_ratio, c.shift_x, c.shift_y = 0.3, 1.3, 0.1, -0.05
+    ctx = RenderContext(s, RenderSettings(samples=16, filter_type=filt, filter_width=1.7))
+    pixel = np.repeat(np.arange(37 * 23), 16)
+    index = np.tile(np.arange(16), 37 * 23)
+    rays, _ = camera_rays(ctx, pixel, index)
+    u = ctx.sampler.get_2d(D.PIXEL, pixel, index)
+    off = ctx.filter.sample(u)
+    xy = np.stack([pixel % 37 + 0.5 + off[:, 0], pixel // 37 + 0.5 + off[:, 1]], axis=1)
+    lens = ctx.sampler.get_2d(D.LENS, pixel, index) if ctx.camera.has_lens else None
+    ref = ctx.camera.generate(xy, lens)
+    assert np.allclose(rays.origins, ref.origins, rtol=0, atol=1e-12)
+    assert np.allclose(rays.directions, ref.directions, rtol=0, atol=1e-13)
+    assert np.allclose(rays.tmax, ref.tmax, rtol=1e-13)
+    assert not np.allclose(np.roll(rays.origins, 1, 0), ref.origins, atol=1e-6)

@@ -147,15 +147,15 @@ def test_an_integrator_that_cannot_render_the_scene_is_skipped_with_its_reason(
         bpy_drt, tmp_path, capsys):
     code, out, err = drt(capsys, "converge", os.path.join(SAMPLES_DIR, "fog_room.blend"),
                          "-o", str(tmp_path), "--percentage", "25", "--reference", "drt:16",
-                         "--samplers", "random", "--integrators", "path,distribution",
+                         "--samplers", "random", "--integrators", "path,whitted",
                          "--max-samples", "2", "--cache-dir", str(tmp_path / "cache"))
     assert code == 0, err
     with open(tmp_path / "convergence.json") as f:
         result = json.load(f)
     assert [c["label"] for c in result["curves"]] == ["DRT path random"]
-    assert result["skipped"][0]["label"] == "DRT distribution random"
+    assert result["skipped"][0]["label"] == "DRT whitted random"
     assert "volumes" in result["skipped"][0]["reason"]
-    assert "skipped DRT distribution random" in out
+    assert "skipped DRT whitted random" in out
 
 
 def test_clamps_are_measured_as_bias_traded_for_noise(bpy_drt, tmp_path, capsys):

@@ -389,3 +389,28 @@ def test_the_files_clamp_and_bounces_match_cycles(bpy_drt):
     clamped = _render(bpy_drt, "glass_caustics", "DRT", samples=CONTROL_SAMPLES,
                       tag="clamp 10")
     assert not within(clamped, cycles)
+
+
+def _no_diffuse_bounce(scene):
+    scene.cycles.diffuse_bounces = 0
+
+
+def _distribution(scene):
+    scene.drt.integrator = "distribution"
+
+
+def test_distribution_ray_tracing_matches_cycles_without_diffuse_bounces(bpy_drt):
+    """DRT's distribution integrator (Cook 1984: every effect distributed, no diffuse
+    interreflection) is Cycles' path tracing with Light Paths > Diffuse bounces 0: on
+    glossy_dielectric, whose file keeps Cycles' default 4 diffuse bounces, DRT's
+    distribution render matches Cycles' render with 0. Control: the path tracer's render
+    of the same file does not."""
+    cycles = _render(bpy_drt, "glossy_dielectric", "CYCLES", setup=_no_diffuse_bounce,
+                     tag="no diffuse")
+    drt = _render(bpy_drt, "glossy_dielectric", "DRT", setup=_distribution,
+                  tag="distribution")
+    rel, mad, block = _report("glossy_dielectric, distribution vs no diffuse bounce", drt,
+                              cycles)
+    assert (rel <= ISSUE_MEAN_TOLERANCE).all() and mad <= MAD_TOLERANCE
+    assert block <= BLOCK_TOLERANCE
+    assert not within(_render(bpy_drt, "glossy_dielectric", "DRT"), cycles)

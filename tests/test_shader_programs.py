@@ -1,6 +1,6 @@
 """Shader programs in the engine, without Blender: building and folding programs, a
-program driving a material at every hit (checked against the same material's
-parameters set per hit in NumPy), and the cost of programs paid only by scenes that
+program driving a material at every hit (one that gives, per hit, a plain material's
+values renders that material's image), and the cost of programs paid only by scenes that
 have them."""
 from __future__ import annotations
 
@@ -79,14 +79,39 @@ def test_programs_cost_only_the_scenes_that_have_them():
     assert textured.integrator.textures[8][0, 1] > 0
 
 
+def uniform_checker_program(color, roughness):
+    """A program that varies per hit in form but not in value: a Checker of one colour
+    twice, and roughness = fac x 0 + `roughness`."""
+    b = ProgramBuilder()
+    gen = b.emit(I.IN_HIT3, "vector", [C.H_GENERATED], varying=True)
+    c = b.emit(X.TEX_CHECKER_COLOR, "color", [gen, b.constant(color), b.constant(color),
+                                              b.constant(4.0)])
+    fac = b.emit(X.TEX_CHECKER_FAC, "float", [gen, b.constant(4.0)])
+    rough = b.emit(CV.CV_MATH, "float", [fac, b.constant(0.0), b.constant(roughness),
+                                         CV.MATH_OPS.index("MULTIPLY_ADD"), 0])
+    b.output("base_color", c)
+    b.output("roughness", rough)
+    return b.build()
+
+
 def test_program_driven_material_renders_as_its_per_hit_parameters():
-    """The compiled path tracer with the program equals the NumPy reference, which reads
-    the same program through MaterialTable.lookup: the program is evaluated at every
-    hit the same way by both (the checker shows on the floor)."""
-    from test_compiled_path import _assert_same, _both
-    scene = _box(True)
+    """A material whose program gives, at every hit, the values a plain material holds
+    (a Checker of one colour, a roughness computed from it) renders the plain
+    material's image, through the per-hit program path (the program is run: its outputs
+    are varying); the Checker of two colours renders another image."""
+    from engine import render
     settings = RenderSettings(samples=4, max_bounces=3)
-    _assert_same(scene, settings)
-    (with_program, _), (_, _) = _both(scene, settings)
-    (plain, _), _ = _both(_box(False), settings)
-    assert np.abs(with_program - plain).mean() > 0.01 * plain.mean()
+    colour, roughness = (0.6, 0.5, 0.4), 0.3
+    plain = cornell_box(24, 24)
+    plain.materials[0] = dataclasses.replace(plain.materials[0], base_color=colour,
+                                             roughness=roughness)
+    same = cornell_box(24, 24)
+    same.materials[0] = dataclasses.replace(
+        same.materials[0], shader=uniform_checker_program(colour, roughness))
+    ctx = RenderContext(same, settings)
+    assert ctx.integrator.textures[8][0, 1] > 0          # the program runs at each hit
+    ctx.close()
+    a, b = render(plain, settings)[0].mean(), render(same, settings)[0].mean()
+    np.testing.assert_allclose(b, a, rtol=1e-9, atol=1e-12)
+    checker = render(_box(True), settings)[0].mean()
+    assert np.abs(checker - a).mean() > 0.01 * a.mean()

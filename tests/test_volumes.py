@@ -12,7 +12,8 @@ closed forms: no Blender needed.
   phase function's sampling and next-event estimation with their MIS, the volume stack
   across the boundary and shadow rays through the medium.
 - The phase function's sampling against its own pdf (chi-square, tests/chi2.py).
-- The camera's start stack; cost only when used; the NumPy integrators refuse volumes.
+- The camera's start stack; cost only when used; the distribution ray tracer renders volumes,
+  Whitted's refuses them.
 """
 import numpy as np
 import pytest
@@ -143,8 +144,14 @@ def test_scenes_without_volumes_carry_no_volume_state():
         ctx.close()
 
 
-@pytest.mark.parametrize("integrator", ["distribution", "whitted"])
-def test_integrators_without_volumes_refuse_them(integrator):
-    scene = _sphere_scene(Volume(absorption=(1.0,) * 3))
+def test_distribution_renders_volumes_and_whitted_refuses_them():
+    """The distribution ray tracer runs on the path tracer's kernels, media included: an
+    absorbing sphere transmits exp(-sigma_a chord) there too. Whitted's does not model
+    media, and says so."""
+    sigma = 0.7
+    film, _ = render(_sphere_scene(Volume(absorption=(sigma,) * 3)),
+                     RenderSettings(samples=4, integrator="distribution"))
+    np.testing.assert_allclose(_centre(film), np.exp(-sigma * 2 * R), rtol=0.02)
     with pytest.raises(ValueError, match="volumes"):
-        render(scene, RenderSettings(samples=1, integrator=integrator))
+        render(_sphere_scene(Volume(absorption=(1.0,) * 3)),
+               RenderSettings(samples=1, integrator="whitted"))

@@ -158,12 +158,6 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     if scene.world is not None:
         world.volume = world_volume(scene.world, reporter)
     shutter = tracker.finish(meshes, camera, lights) if tracker is not None else None
-    integrator = getattr(getattr(scene, "drt", None), "integrator", "path")
-    if integrator != "path":
-        gaps = engine.reference_gaps(materials)
-        if gaps:
-            reporter.warn(f"DRT: the {integrator} integrator leaves out {', '.join(gaps)}; "
-                          f"the path integrator renders them")
     dark = dark_scene_message(meshes, materials, lights, world)
     if dark:
         reporter.warn(dark, key=BLACK_IMAGE)

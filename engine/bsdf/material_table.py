@@ -37,21 +37,6 @@ def _choices(materials, attr, default, allowed) -> list[str]:
     return values
 
 
-def reference_gaps(materials) -> list[str]:
-    """What of these materials (Mix Shader sides included) the NumPy reference
-    integrators (distribution, whitted) do not render, which the compiled path tracer
-    does: an empty list when they render everything."""
-    table = MaterialTable(materials)
-    gaps = [(table.coat_weight > 1e-5, "coat"), (table.sheen_weight > 1e-5, "sheen"),
-            (table.translucent_color.max(1) > 0.0, "translucency"),
-            (table.refraction_only, "the Refraction BSDF (rendered as glass)"),
-            (table.beckmann, "the Beckmann distribution (rendered as GGX)"),
-            (table.metal_constant, "the Glossy BSDF's angle-independent reflectance "
-                                   "(rendered with Schlick's Fresnel)"),
-            ((table.specular_tint != 1.0).any(1), "Specular Tint")]
-    return [what for used, what in gaps if used.any()]
-
-
 class MaterialTable:
     """Scene materials as arrays, indexed by a hit's material id.
 

@@ -1,24 +1,23 @@
-"""Integrators: each a short loop over the camera, sampler, lights and BSDF interfaces.
+"""Integrators: one wavefront loop (`compiled_path`) of compiled kernels between Embree
+queries, with the vertex kernel and bounce limits of each.
 
-- whitted: mirror-only interreflection, one shadow ray per light (the lecture's baseline)
+- path: Kajiya's path tracing with next-event estimation and MIS (kernels.path_vertex)
 - distribution: Cook 1984, distributed glossy and transmission, direct light on diffuse
-- path: Kajiya's path tracing with next-event estimation and MIS, compiled
-  (`compiled_path`; `path` is its NumPy reference, which the tests compare it with)
+  (the path tracer with no diffuse bounce)
+- whitted: mirror-only interreflection, one shadow ray per lamp (the lecture's baseline,
+  kernels.whitted_vertex)
 """
 
 
 def make_integrator(name, ctx):
+    from .compiled_path import CompiledPathIntegrator
     from .distribution import DistributionIntegrator
     from .whitted import WhittedIntegrator
-    if name == "path":
-        from .compiled_path import CompiledPathIntegrator
-        return CompiledPathIntegrator(ctx)
-    table = {"distribution": DistributionIntegrator, "whitted": WhittedIntegrator}
-    if ctx.scene.has_volumes():
-        raise ValueError(f"the scene has volumes, which only the 'path' integrator renders "
-                         f"(not {name!r})")
-    try:
-        return table[name](ctx)
-    except KeyError:
-        raise ValueError(f"unknown integrator {name!r}; choose one of "
-                         f"{sorted(table) + ['path']}") from None
+    table = {"path": CompiledPathIntegrator, "distribution": DistributionIntegrator,
+             "whitted": WhittedIntegrator}
+    if name not in table:
+        raise ValueError(f"unknown integrator {name!r}; choose one of {sorted(table)}")
+    if name == "whitted" and ctx.scene.has_volumes():
+        raise ValueError("the scene has volumes, which Whitted's ray tracer does not "
+                         "render (choose 'path' or 'distribution')")
+    return table[name](ctx)

@@ -8,8 +8,7 @@ queries through transparent layers where needed), one kernel adding what got thr
 Python touches each bounce a handful of times whatever the number of paths, and every
 stage releases the GIL, so work units on threads run in parallel.
 
-It computes the same estimator as `engine.integrators.path.PathIntegrator` (tests
-compare the two). Motion blur: each path keeps the shutter time of its camera ray for
+The estimator is in `engine.kernels.path_vertex`'s docstring. Motion blur: each path keeps the shutter time of its camera ray for
 all its rays, the accelerator places moving objects at that time, hits on them are
 rebuilt there (`kernels.surface.rebuild_at_time`), and a lamp that moves during the
 shutter is its slice at that time (`kernels.lights.light_set.slice_row`).
@@ -23,6 +22,7 @@ from ..kernels import lights as klights
 from ..kernels.bsdf import principled as kbsdf
 from ..bsdf.material_table import flatten_mixes
 from ..kernels.camera_rays import pack_camera
+from ..kernels.jit import Kernel
 from ..kernels.path_vertex import shade
 from ..kernels.path_weights import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
                                     add_unoccluded)
@@ -33,10 +33,11 @@ from ..nodes.context import N_OBJ
 from ..nodes.pack import PROG
 from ..nodes.differentials import camera_cones
 from ..sampling.dispatch import pixel_keys
-from .path import MIS_MODES
 from .volume_stack import camera_stack
 
 _MODE_IDS = {"mis": MIS, "light": LIGHT_ONLY, "bsdf": BSDF_ONLY}
+MIS_MODES = tuple(_MODE_IDS)
+DIFFUSE_LIMIT = 3           # cfg's diffuse bounce limit (see path_vertex.shade)
 VOLUME_BOUNDS_MAX = 256     # volume boundaries one path may cross (Cycles: 1024)
 
 
@@ -45,6 +46,9 @@ def _or_empty(a, shape, dtype):
 
 
 class CompiledPathIntegrator:
+    """Kajiya's path tracer; subclasses change the vertex kernel (`vertex`, one of
+    path_vertex.shade's signature) or the bounce limits, and keep this wavefront loop."""
+
     def __init__(self, ctx):
         self.ctx = ctx
         s = ctx.settings
@@ -114,6 +118,23 @@ class CompiledPathIntegrator:
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
                             else np.full(STACK, -1, np.int32))
 
+    def entry_kernels(self) -> list:
+        """The compiled kernels this integrator calls from Python (engine.render's
+        compile progress finds their callees)."""
+        mine = [v for v in globals().values() if isinstance(v, Kernel) and v is not shade]
+        return mine + [self.vertex]
+
+    @property
+    def vertex(self):
+        """The kernel that shades one bounce of every live path (a property, not a
+        class attribute: wrapping a kernel at import would make its dispatcher)."""
+        return shade
+
+    @property
+    def shadow_rays_per_path(self) -> int:
+        """The most shadow rays the vertex kernel queues per path and bounce."""
+        return 1
+
     @property
     def mis_mode(self) -> str:
         return self._mode
@@ -128,7 +149,7 @@ class CompiledPathIntegrator:
     def _through_transparent(self, depth, paths, live, used, ray_bits, path_time, time, o,
                              d, tm, hits):
         """Closest hits seen through transparent layers and surfaces the rays do not see
-        (see path.intersect_alpha); time: the rays' shutter times (None when nothing
+        (engine.kernels.transparency); time: the rays' shutter times (None when nothing
         moves). Returns (t, prim, u, v, throughput factor (m, 3), stopped (m,))."""
         m = len(live)
         t_all, prim_all = hits.t.copy(), hits.prim.copy()
@@ -203,7 +224,7 @@ class CompiledPathIntegrator:
         k = n if self.has_volumes else 0
         stacks = np.ascontiguousarray(np.tile(self.start_stack, (k, 1)), np.int32)
         sh_stack = np.full((k, STACK), -1, np.int32)
-        sh_bounce = np.empty(n, np.int64)
+        sh_bounce = np.empty(n * self.shadow_rays_per_path, np.int64)
         media = (bounce, vbounce, self.vol, stacks, sh_stack, sh_bounce, self.het_runs)
         no_keys = np.zeros(0, np.uint64)
         o = np.ascontiguousarray(origins, dtype=np.float64)
@@ -211,9 +232,10 @@ class CompiledPathIntegrator:
         # a writable copy: a read-only view (np.broadcast_to) would be another type to
         # Numba, and load a second copy of the shading kernel (15 MB, 0.1 s per process)
         tm = np.array(np.broadcast_to(tmax, (n,)), dtype=np.float64)
-        sh_path = np.empty(n, np.int64)
-        sh_org, sh_dir = np.empty((n, 3)), np.empty((n, 3))
-        sh_far, sh_contrib = np.empty(n), np.empty((n, 3))
+        ns_max = n * self.shadow_rays_per_path       # the shadow rays one bounce may queue
+        sh_path = np.empty(ns_max, np.int64)
+        sh_org, sh_dir = np.empty((ns_max, 3)), np.empty((ns_max, 3))
+        sh_far, sh_contrib = np.empty(ns_max), np.empty((ns_max, 3))
         nx_path = np.empty(n, np.int64)
         nx_org, nx_dir = np.empty((n, 3)), np.empty((n, 3))
         no_stop = np.zeros(n, bool)
@@ -233,7 +255,7 @@ class CompiledPathIntegrator:
                     depth, (pkey, index), live, used, ray_bits, path_time, ray_time, o, d,
                     tm, hits)
                 beta[live] *= factor
-            ns, nn = shade(depth, self.cfg, pkey, index, beta, counts, L, coverage,
+            ns, nn = self.vertex(depth, self.cfg, pkey, index, beta, counts, L, coverage,
                            prev_pdf, prev_pos, ray_bits, min_pdf, cont, path_time, live, o, d,
                            tm,
                            t, prim, u, v, stopped,

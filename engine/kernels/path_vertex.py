@@ -1,6 +1,26 @@
-"""One vertex of Kajiya's path tracer for every live path of a wavefront: the compiled
-form of the loop body of `engine.integrators.path.PathIntegrator.radiance` (read its
-docstring for the estimator; the steps and names here are the same).
+"""One vertex of Kajiya's path tracer, with next-event estimation and MIS, for every live
+path of a wavefront (the loop: `engine.integrators.compiled_path`).
+
+The estimator, at each surface vertex:
+  1. emission seen by the incoming ray: area and sphere lamps (hit analytically), sun
+     discs (escaped rays) and emissive triangles (hit by the ray cast), each weighted
+     against light sampling by the power heuristic with the pdf light sampling would have
+     had for that direction; camera rays and specular bounces (pdf = inf) see emission
+     with weight 1;
+  2. next-event estimation: one light entry (lamp or emissive triangle) picked in
+     proportion to its power, one point on it, one shadow ray, weighted against BSDF
+     sampling by the power heuristic;
+  3. BSDF sampling over the lobes whose bounce budget (Cycles' diffuse, glossy,
+     transmission and total limits) is not used up; Cycles' Russian roulette: the ray
+     leaves with a verdict (survival probability q = min(sqrt(max throughput), 1), or
+     ended), applied at the vertex it finds, after the emission found there (step 1).
+Where no lobe may continue, light sampling takes the whole weight (no MIS), so direct
+light stays unbiased with zero bounces. The integrator's `mis_mode` (a test and debug
+hook, not a user setting) selects the weights of the two estimators of direct light:
+'mis' (default) the power heuristic; 'light' light sampling only; 'bsdf' BSDF sampling
+only (next-event estimation is kept for delta lights and for directions the BSDF cannot
+sample). All three are unbiased and agree in expectation
+(tests/test_path_estimators.py). Radiance sums are float64.
 
 `shade` runs after the closest-hit query of the bounce. For each live path it adds the
 emission the incoming ray found (lamps hit analytically, the world and sun discs for
@@ -32,16 +52,15 @@ from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (V_BOUNDARY, V_HAS, in_medium, medium, passed, segment, stack_cross,
                      volume_dim)
-from .bsdf.params import P_BASE, P_BUMP_CORRECTION, P_FILTER_ALPHA, P_METALLIC, P_ROUGHNESS
+from .bsdf.params import P_FILTER_ALPHA
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .terminator import shadow_origin
-from .textures import apply_to_row, emission_at
-from ..nodes.context import N_HIT, path_fields
-from ..nodes.differentials import cone_at, cone_moves
+from .surface_hit import material_row, run_program, surface_emission
+from ..nodes.context import N_HIT
+from ..nodes.differentials import cone_moves
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import (apply_rows, bent_diffuse, bump_rejects, may_emit, pick_closure,
-                             program_emission, program_hit, program_normal)
+from ..nodes.shading import bent_diffuse, bump_rejects, may_emit
 
 @kernel
 def prepare_closures(cfg, row, min_pdf, ray_bit):
@@ -125,13 +144,13 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     het_scene = has_heterogeneous(vol)
     vhit = np.zeros(N_HIT)
     tri_material, holdout, corner_uvs = geometry[3], geometry[5], geometry[6]
-    any_textures = textures[1].shape[0] > 0
     film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
     kind, spp = int(cfg[0]), int(cfg[1])
     max_bounces = int(cfg[2])
     clamp_direct, clamp_indirect, mode = cfg[6], cfg[7], int(cfg[8])
     scene_radius = cfg[9]
     n_lights = lt.n_entries(lights)
+    n_lamps = lt.n_lamps(lights)
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
     hit_row = np.zeros(N_HIT)
@@ -179,24 +198,27 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 if scattered:
                     g_phase = medium(vol, stacks, p)[6]
             _add(L, p, er, eg, eb, clamp_hit)
-        # 1a. area and sphere lamps in front of the geometry; the ray goes on behind them
-        if n_lights > 0:
-            t_l, k_l, lr, lg, lb = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_end,
-                                                ray_bits[p], path_time[p])
-            if k_l >= 0:
-                if vmode == 3:
-                    fr, fg, fb = mfr, mfg, mfb
-                else:
-                    fr, fg, fb = passed(vmode, str_, stg, stb, wcr, wcg, wcb, t_l)
-                if vol.shape[0] > 0:
-                    # the ray may start past volume boundaries: the lamp's distance is
-                    # from the path's last vertex
-                    t_l = length(ox + dx * t_l - prev_pos[p, 0], oy + dy * t_l - prev_pos[p, 1],
-                                 oz + dz * t_l - prev_pos[p, 2])
-                lpdf = lt.lamp_pdf(lights, k_l, prev_pos[p, 0], prev_pos[p, 1],
-                                   prev_pos[p, 2], dx, dy, dz, t_l, path_time[p])
-                w = hit_weight(mode, prev_pdf[p], lpdf)
-                _add(L, p, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w, clamp_hit)
+        # 1a. area and sphere lamps in front of the geometry: the ray passes through
+        # lamps (as in Cycles) and finds every one before what it hits
+        for k_l in range(n_lamps):
+            t_l, lr, lg, lb = lt.lamp_hit(lights, k_l, ox, oy, oz, dx, dy, dz, ray_bits[p],
+                                          path_time[p])
+            if not t_l < t_end:
+                continue
+            if vmode == 3:
+                # (the heterogeneous medium's factor is taken at the nearest lamp)
+                fr, fg, fb = mfr, mfg, mfb
+            else:
+                fr, fg, fb = passed(vmode, str_, stg, stb, wcr, wcg, wcb, t_l)
+            if vol.shape[0] > 0:
+                # the ray may start past volume boundaries: the lamp's distance is from
+                # the path's last vertex
+                t_l = length(ox + dx * t_l - prev_pos[p, 0], oy + dy * t_l - prev_pos[p, 1],
+                             oz + dz * t_l - prev_pos[p, 2])
+            lpdf = lt.lamp_pdf(lights, k_l, prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2],
+                               dx, dy, dz, t_l, path_time[p])
+            w = hit_weight(mode, prev_pdf[p], lpdf)
+            _add(L, p, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w, clamp_hit)
         if volumes is not None and scattered:
             q = continues(cont, p)             # the roulette, after the emission found
             if q == 0.0:
@@ -257,20 +279,13 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         ms = m                                   # the material shaded
         n0x, n0y, n0z = nx, ny, nz               # the surface's own shading normal
         if programs is not None and programmed:
-            path_fields(hit_row, counts, path_info[0], p, cone_at(path_info[1], p, t_geom))
-            program_hit(programs, geometry, m, prim, hit_u[j], hit_v[j], uu, vv, px, py, pz,
-                        gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bits[p], b, t_geom,
-                        hit_row, regs)
-            ms, u_lobe = pick_closure(programs, m, regs, u_lobe)
-            correct = params[ms, P_BUMP_CORRECTION] != 0.0
-            sx, sy, sz, rx, ry, rz = program_normal(programs, ms, regs, nx, ny, nz, gx, gy,
-                                                    gz, -dx, -dy, -dz, correct)
-            bent = sx != nx or sy != ny or sz != nz or rx != nx or ry != ny or rz != nz
-            nx, ny, nz = sx, sy, sz
+            ms, u_lobe, nx, ny, nz, rx, ry, rz, bent, correct = run_program(
+                programs, params, geometry, counts, path_info, p, m, prim, hit_u[j],
+                hit_v[j], uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front,
+                ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
-        er, eg, eb = emission_at(textures, emission, m, uu, vv)
-        if programs is not None and programmed:
-            er, eg, eb = program_emission(programs, m, regs, er, eg, eb)
+        er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
+                                      programmed)
         if er != 0.0 or eg != 0.0 or eb != 0.0:
             lpdf = lt.mesh_pdf(lights, prim, prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2],
                                px, py, pz)
@@ -281,11 +296,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             continue
         br, bg, bb = br / q, bg / q, bb / q
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
-        row[:] = params[ms]
-        if any_textures:
-            apply_to_row(textures, ms, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
-        if programs is not None and programmed:
-            apply_rows(programs, ms, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS)
+        material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
         room = b < max_bounces

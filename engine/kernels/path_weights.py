@@ -76,8 +76,11 @@ def _add(L, p, r, g, b, limit):
 
 @kernel
 def uncovered(br, bg, bb):
-    """Alpha of a camera sample whose ray got through with throughput b (see
-    engine.integrators.coverage)."""
+    """Alpha of a camera sample whose ray got through with throughput b. A camera
+    sample's coverage is 1 unless its camera ray, possibly continued through transparent
+    surfaces, escapes to the background with Film > Transparent or reaches a holdout
+    surface (Cycles' holdout: no colour, and a hole in the alpha whatever the film
+    setting); the uncovered part is then what got through: 1 - mean(b)."""
     return 1.0 - min(max((br + bg + bb) / 3.0, 0.0), 1.0)
 
 

@@ -1,7 +1,17 @@
-"""Stochastic transparency (Cycles' transparent closure, Principled Alpha), compiled: the
-per-hit decisions of `engine.integrators.path.intersect_alpha` and
-`shadow_transmittance` (read those for the estimator). The caller loops: closest-hit
-query, one of these kernels, the next query for the rays that go on.
+"""Stochastic transparency (Cycles' transparent closure, Principled Alpha), compiled.
+
+Cycles' Principled Alpha a (and a Transparent BSDF mixed in with weight 1 - a) is a
+transparent closure: a ray hitting such a surface passes through it with probability
+1 - a (a sampler number per path vertex and layer), tinted by the material's transparent
+colour, and the hit it reports is the next surface beyond; otherwise the surface is
+opaque. The expectation is Cycles' a x shading + (1 - a) x what lies behind. Every
+pass-through counts one transparent bounce of the path (Cycles' transparent bounce; not
+a bounce of Max Bounces); a ray that would pass through more than Transparent bounces
+surfaces ends there (Cycles terminates such a path). Shadow rays carry the product of
+(1 - alpha) x the transparent colour of the surfaces they cross (Cycles' transparent
+shadows), over at most that many surfaces (more block). The caller loops: closest-hit
+query, one of these kernels (`alpha_pass`, `shadow_pass`), the next query for the rays
+that go on.
 
 `materials` is the tuple (material of each triangle, maybe_transparent per material,
 alpha per material, transparent colour per material (M, 3), textures T, visibility of

@@ -6,6 +6,8 @@ n_lamps is lamp k (row k of L[LAMPS]); entry n_lamps + j is emissive triangle j.
 during the shutter is its slice at that time (`lamp_row`)."""
 from __future__ import annotations
 
+import math
+
 from ..cdf_search import last_at_most
 from ..jit import kernel
 from .area import intersect_area, pdf_area, sample_area
@@ -17,6 +19,8 @@ from .pack import (C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, CDF_GUIDE, ENV, LAMPS, 
 from .point import intersect_point, pdf_point, sample_point
 from .sun import escaped_sun, pdf_sun, sample_sun
 from .triangles import pdf_triangle, sample_triangle, triangle_entry
+
+_INF = math.inf
 
 
 @kernel(allocates=False)
@@ -39,6 +43,16 @@ def slice_row(L, k, time):
         return -1
     j = min(max(int(time * count), 0), count - 1)
     return L[SLICE_OF][k, 0] + j
+
+
+@kernel(allocates=False)
+def lamp_row(L, k, time):
+    """(sliced, row): where lamp k is at shutter time `time`, row `row` of
+    L[LAMP_SLICES] if sliced (it moves during the shutter), else of L[LAMPS]."""
+    s = slice_row(L, k, time)
+    if s >= 0:
+        return True, s
+    return False, k
 
 
 @kernel(allocates=False)
@@ -68,6 +82,17 @@ def sample_lamp(lamps, k, px, py, pz, u0, u1):
 
 
 @kernel(allocates=False)
+def sample_lamp_at(L, k, px, py, pz, u1, u2, time):
+    """Lamp k (k < n_lamps) sampled with (u1, u2) at shutter time `time`, its pick
+    probability not included: (wix, wiy, wiz, dist, r, g, b, pdf, delta)."""
+    if L[LAMPS][k, C_TYPE] == T_ENV_MAP:
+        return sample_environment_map(L, u1, u2)
+    sliced, row = lamp_row(L, k, time)
+    table = L[LAMP_SLICES] if sliced else L[LAMPS]
+    return sample_lamp(table, row, px, py, pz, u1, u2)
+
+
+@kernel(allocates=False)
 def sample(L, px, py, pz, u_pick, u1, u2, time):
     """LightSet.sample for one shading point p at shutter time `time`: pick an entry with
     u_pick, sample it with (u1, u2). Returns (k, wix, wiy, wiz, dist, r, g, b, pdf, delta,
@@ -81,14 +106,8 @@ def sample(L, px, py, pz, u_pick, u1, u2, time):
     select = L[SELECT_PDF][k]
     lamps = L[LAMPS]
     if k < lamps.shape[0]:
-        if lamps[k, C_TYPE] == T_ENV_MAP:
-            wx, wy, wz, dist, r, g, b, pdf, delta = sample_environment_map(L, u1, u2)
-        else:
-            table, row = lamps, k
-            s = slice_row(L, k, time)
-            if s >= 0:
-                table, row = L[LAMP_SLICES], s
-            wx, wy, wz, dist, r, g, b, pdf, delta = sample_lamp(table, row, px, py, pz, u1, u2)
+        wx, wy, wz, dist, r, g, b, pdf, delta = sample_lamp_at(L, k, px, py, pz, u1, u2,
+                                                               time)
         return k, wx, wy, wz, dist, r, g, b, pdf * select, delta, 0.0
     wx, wy, wz, dist, r, g, b, pdf, margin = sample_triangle(L, k - lamps.shape[0],
                                                              px, py, pz, u1, u2)
@@ -96,31 +115,33 @@ def sample(L, px, py, pz, u_pick, u1, u2, time):
 
 
 @kernel(allocates=False)
-def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit, time):
-    """LightSet.hit_surfaces for one ray of kind ray_bit (engine.visibility) at shutter
-    time `time`: the nearest
-    sphere, disc or area lamp closer than tmax that this kind of ray sees: (t, k, r, g,
-    b); (tmax, -1, 0, 0, 0) when there is none."""
+def lamp_hit(L, k, ox, oy, oz, dx, dy, dz, ray_bit, time):
+    """Where a ray of kind ray_bit (engine.visibility) at shutter time `time` meets lamp
+    k's surface (sphere, disc or area lamps, visible to that kind of ray): (t, r, g, b);
+    t = inf where it does not."""
     lamps = L[LAMPS]
+    kind = lamps[k, C_TYPE]
+    if lamps[k, C_VISIBLE] == 0.0 or not int(lamps[k, C_VISIBILITY]) & ray_bit:
+        return _INF, 0.0, 0.0, 0.0
+    sliced, row = lamp_row(L, k, time)
+    table = L[LAMP_SLICES] if sliced else L[LAMPS]
+    if kind == T_AREA:
+        return intersect_area(table, row, ox, oy, oz, dx, dy, dz)
+    if kind == T_SPHERE or kind == T_DISC:
+        return intersect_point(table, row, ox, oy, oz, dx, dy, dz)
+    return _INF, 0.0, 0.0, 0.0          # not a surface (the world, suns, delta lights)
+
+
+@kernel(allocates=False)
+def hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit, time):
+    """The nearest lamp surface (`lamp_hit`) closer than tmax: (t, k, r, g, b); (tmax,
+    -1, 0, 0, 0) when there is none. A ray passes through lamps, as in Cycles, and sees
+    every lamp in front of what it hits (the shading kernels loop over `lamp_hit`)."""
     best_t = tmax
     best_k = -1
     br, bg, bb = 0.0, 0.0, 0.0
-    for k in range(lamps.shape[0]):
-        kind = lamps[k, C_TYPE]
-        if lamps[k, C_VISIBLE] == 0.0 or kind == T_SUN or kind == T_SUN_DELTA:
-            continue
-        if not int(lamps[k, C_VISIBILITY]) & ray_bit:
-            continue
-        table, row = lamps, k
-        s = slice_row(L, k, time)
-        if s >= 0:
-            table, row = L[LAMP_SLICES], s
-        if kind == T_AREA:
-            t, r, g, b = intersect_area(table, row, ox, oy, oz, dx, dy, dz)
-        elif kind == T_SPHERE or kind == T_DISC:
-            t, r, g, b = intersect_point(table, row, ox, oy, oz, dx, dy, dz)
-        else:
-            continue                    # not a surface (the world, delta lights)
+    for k in range(L[LAMPS].shape[0]):
+        t, r, g, b = lamp_hit(L, k, ox, oy, oz, dx, dy, dz, ray_bit, time)
         if t < best_t:
             best_t, best_k, br, bg, bb = t, k, r, g, b
     return best_t, best_k, br, bg, bb
@@ -147,10 +168,8 @@ def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t, time):
     if k < 0 or k >= lamps.shape[0]:
         return 0.0
     kind = lamps[k, C_TYPE]
-    table, row = lamps, k
-    s = slice_row(L, k, time)
-    if s >= 0:
-        table, row = L[LAMP_SLICES], s
+    sliced, row = lamp_row(L, k, time)
+    table = L[LAMP_SLICES] if sliced else L[LAMPS]
     if kind == T_AREA:
         pdf = pdf_area(table, row, px, py, pz, wix, wiy, wiz, t)
     elif kind == T_POINT or kind == T_SPHERE or kind == T_DISC:
@@ -231,9 +250,7 @@ def sun_escaped(L, j, dx, dy, dz, time):
     pdf) with the radiance of sun.escaped(d) and pdf = sun.pdf(None, d, None) x its pick
     probability."""
     k = L[SUNS][j]
-    table, row = L[LAMPS], k
-    s = slice_row(L, k, time)
-    if s >= 0:
-        table, row = L[LAMP_SLICES], s
+    sliced, row = lamp_row(L, k, time)
+    table = L[LAMP_SLICES] if sliced else L[LAMPS]
     r, g, b = escaped_sun(table, row, dx, dy, dz)
     return r, g, b, pdf_sun(table, row, dx, dy, dz) * L[SELECT_PDF][k]

@@ -1,0 +1,55 @@
+"""What the vertex kernels (path_vertex.shade, whitted_vertex.shade_whitted) do at a
+surface before they shade it: run the material's shader program (its outputs, the closure
+a Mix Shader picks, the normal it bends), read the emission, and fill the hit's material
+row. `programs` is None in a scene without shader programs (engine.nodes.shading), and
+Numba then compiles these without that code."""
+from __future__ import annotations
+
+from .bsdf.params import P_BASE, P_BUMP_CORRECTION, P_METALLIC, P_ROUGHNESS
+from .jit import kernel
+from .textures import apply_to_row, emission_at
+from ..nodes.context import path_fields
+from ..nodes.differentials import cone_at
+from ..nodes.shading import (apply_rows, pick_closure, program_emission, program_hit,
+                             program_normal)
+
+
+@kernel
+def run_program(programs, params, geometry, counts, path_info, p, m, prim, hu, hv, uu, vv,
+                px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bit, b, t_geom,
+                hit_row, regs, u_lobe):
+    """Run material m's program at the hit of path p (what its Light Path and geometry
+    nodes read: the path's counts, its ray cone at t_geom, the hit), leaving its outputs
+    in regs. Returns (the material shaded (a Mix Shader's pick with u_lobe), u_lobe
+    rescaled, the shading normal s, the raw bent normal r, bent: s or r differ from n,
+    correct: the material's Bump Map Correction)."""
+    path_fields(hit_row, counts, path_info[0], p, cone_at(path_info[1], p, t_geom))
+    program_hit(programs, geometry, m, prim, hu, hv, uu, vv, px, py, pz, gx, gy, gz, nx, ny,
+                nz, dx, dy, dz, front, ray_bit, b, t_geom, hit_row, regs)
+    ms, u_lobe = pick_closure(programs, m, regs, u_lobe)
+    correct = params[ms, P_BUMP_CORRECTION] != 0.0
+    sx, sy, sz, rx, ry, rz = program_normal(programs, ms, regs, nx, ny, nz, gx, gy, gz, -dx,
+                                            -dy, -dz, correct)
+    bent = sx != nx or sy != ny or sz != nz or rx != nx or ry != ny or rz != nz
+    return ms, u_lobe, sx, sy, sz, rx, ry, rz, bent, correct
+
+
+@kernel
+def surface_emission(programs, textures, emission, m, uu, vv, regs, programmed):
+    """Material m's emitted radiance at the hit: its (textured) emission, or what its
+    program (run by `run_program` when `programmed`) says."""
+    er, eg, eb = emission_at(textures, emission, m, uu, vv)
+    if programs is not None and programmed:
+        er, eg, eb = program_emission(programs, m, regs, er, eg, eb)
+    return er, eg, eb
+
+
+@kernel
+def material_row(params, textures, programs, ms, uu, vv, regs, programmed, row):
+    """Fill `row` with material ms's parameters at the hit: its plain row, its textures
+    at (uu, vv), its program's outputs."""
+    row[:] = params[ms]
+    if textures[1].shape[0] > 0:
+        apply_to_row(textures, ms, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
+    if programs is not None and programmed:
+        apply_rows(programs, ms, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS)

@@ -1,0 +1,215 @@
+"""One vertex of Whitted's ray tracer (1980) for every live path of a wavefront: the
+lecture's baseline, on the same BSDFs, lights, shader programs and motion as the path
+tracer (`path_vertex.shade`, whose arguments this kernel takes, so that one wavefront
+loop runs both: `engine.integrators.compiled_path`).
+
+At each hit:
+- the emission the ray found, unweighted (lamps hit in front of the surface, the world
+  and sun discs for escaped rays, emissive surfaces);
+- direct light from every lamp through ONE shadow ray to a fixed point of it (the
+  sample at (1/2, 1/2): an area lamp's centre, the direction of a sphere lamp's or a
+  sun's centre), so shadows are hard. The world and emissive surfaces light nothing
+  directly; they are seen along the rays. The light is weighted by the lobes that are
+  not followed (diffuse, sheen, translucency: `bsdf.eval_seen` with diffuse rays only);
+- one continuing ray, a perfect mirror reflection or a perfect refraction: the
+  material's specular, metal, coat and glass lobes with their roughness set to zero
+  (GGX at alpha = 1e-4 for reflection, the exact smooth interface for glass), chosen by
+  their weights, so a rough metal is a mirror here, as in Whitted's model. Where a hit
+  both reflects and refracts, one of the two rays of Whitted's tree is followed, with
+  probability proportional to its weight and the weight divided by that probability: the
+  same expectation as the tree, one ray per path.
+
+Only the pixel (and the shutter time, the lens) is sampled; the lobe choice above takes
+one number per bounce. Every path ends at the file's Max Bounces (no Russian roulette).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..bsdf.lobes import TRANSMISSION
+from ..sampling import dimensions as D
+from ..sampling.dispatch import sample_1d
+from . import lights as lt
+from . import ray_queues
+from .bsdf import principled as bsdf
+from .bsdf.params import P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_ROUGHNESS, P_TRANSLUCENT
+from .frame import dot, to_local, to_world
+from .jit import kernel
+from .lights.light_set import sample_lamp_at
+from .lights.pack import C_TYPE, LAMPS, T_ENV, T_ENV_MAP
+from .path_weights import DIFFUSE_BIT, SHADOW_BIT, _add, uncovered
+from .surface import hit_uv, offset_origin, rebuild_at_time
+from .surface_hit import material_row, run_program, surface_emission
+from ..nodes.context import N_HIT
+from ..nodes.differentials import cone_moves
+from ..nodes.interpreter import has_program
+from ..nodes.pack import NREGS
+from ..nodes.shading import bent_diffuse
+
+CENTRE = 0.5           # the fixed point of every lamp: its sample at (1/2, 1/2)
+
+
+@kernel
+def lamp_rays(lights):
+    """Shadow rays per shading point: one per lamp that is not the world."""
+    count = 0
+    lamps = lights[LAMPS]
+    for k in range(lights[LAMPS].shape[0]):
+        kind = lamps[k, C_TYPE]
+        if kind != T_ENV and kind != T_ENV_MAP:
+            count += 1
+    return count
+
+
+@kernel
+def mirror_row(row):
+    """The material row of the lobes Whitted follows: roughness zero (the coat's too),
+    no translucency (a diffuse lobe), no Filter Glossy."""
+    row[P_ROUGHNESS] = 0.0
+    row[P_COAT_ROUGHNESS] = 0.0
+    row[P_FILTER_ALPHA] = 0.0
+    for c in range(3):
+        row[P_TRANSLUCENT + c] = 0.0
+
+
+@kernel
+def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
+                  ray_bits, min_pdf, cont, path_time, live, ro, rd, rt, hit_t, hit_prim,
+                  hit_u, hit_v, stopped, geometry, params, emission, textures, tables,
+                  lights, world, media, sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path,
+                  nx_org, nx_dir, path_info, programs, volumes, het):
+    """Whitted's bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
+    The arguments are `path_vertex.shade`'s (read its docstring); this kernel reads no
+    roulette verdict, MIS state or volume (min_pdf, cont, prev_pdf, prev_pos, volumes and
+    het are unused), and queues up to `lamp_rays(lights)` shadow rays per path, so sh_*
+    must hold that many times the live paths. Returns (shadow count, next count)."""
+    bounce, sh_bounce, stacks, sh_stack = media[0], media[5], media[3], media[4]
+    tri_material, holdout, corner_uvs = geometry[3], geometry[5], geometry[6]
+    film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
+    kind, spp = int(cfg[0]), int(cfg[1])
+    max_bounces = int(cfg[2])
+    clamp_direct, clamp_indirect = cfg[6], cfg[7]
+    scene_radius = cfg[9]
+    lamps = lights[LAMPS]
+    state = np.empty(bsdf.NSTATE)
+    row = np.empty(params.shape[1])
+    hit_row = np.zeros(N_HIT)
+    regs = np.zeros(max(textures[NREGS][0], 1))
+    ns_out, nn_out = 0, 0
+    base = D.FIRST_BOUNCE + depth * D.PER_BOUNCE
+    for j in range(live.shape[0]):
+        p = live[j]
+        ox, oy, oz = ro[j, 0], ro[j, 1], ro[j, 2]
+        dx, dy, dz = rd[j, 0], rd[j, 1], rd[j, 2]
+        br, bg, bb = beta[p, 0], beta[p, 1], beta[p, 2]
+        hit = hit_prim[j] >= 0
+        t_geom = hit_t[j] if hit else rt[j]
+        b = bounce[p]
+        clamp_hit = 0.0 if b == 0 else (clamp_direct if b == 1 else clamp_indirect)
+        # 1. emission found: every lamp in front of the geometry (rays pass through lamps)
+        for k in range(lamps.shape[0]):
+            t_l, lr, lg, lb = lt.lamp_hit(lights, k, ox, oy, oz, dx, dy, dz, ray_bits[p],
+                                          path_time[p])
+            if t_l < t_geom:
+                _add(L, p, br * lr, bg * lg, bb * lb, clamp_hit)
+        if not hit:
+            if b == 0 and film_transparent:
+                alpha[p] = uncovered(br, bg, bb)
+                continue
+            er, eg, eb, _ = lt.world_escaped(lights, world, ray_bits[p], dx, dy, dz)
+            for s in range(lt.n_suns(lights)):
+                sr, sg, sb, _ = lt.sun_escaped(lights, s, dx, dy, dz, path_time[p])
+                er, eg, eb = er + sr, eg + sg, eb + sb
+            _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)
+            continue
+        if stopped[j]:
+            continue                      # past the transparent bounce limit
+        prim = hit_prim[j]
+        if b == 0 and holdout.shape[0] > 0 and holdout[prim]:
+            if alpha.shape[0] > 0:        # Cycles' holdout: a hole, for camera rays only
+                alpha[p] = uncovered(br, bg, bb)
+            continue
+        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
+            geometry, prim, hit_u[j], hit_v[j], dx, dy, dz, path_time[p])
+        m = tri_material[prim]
+        uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
+        programmed = programs is not None and has_program(programs, m)
+        bent, correct = False, True
+        rx, ry, rz = nx, ny, nz
+        u_lobe = sample_1d(kind, pkey[p], spp, index[p], base + D.BSDF_LOBE)
+        ms = m
+        n0x, n0y, n0z = nx, ny, nz
+        if programs is not None and programmed:
+            ms, u_lobe, nx, ny, nz, rx, ry, rz, bent, correct = run_program(
+                programs, params, geometry, counts, path_info, p, m, prim, hit_u[j],
+                hit_v[j], uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front,
+                ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
+        er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
+                                      programmed)
+        _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)
+        wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
+        material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)
+        # 2. direct light: one shadow ray to each lamp's fixed point, on the lobes that
+        # are not followed (diffuse, sheen, translucency)
+        bsdf.setup(row, front, wox, woy, woz, tables, state)
+        clamp = clamp_direct if b == 0 else clamp_indirect
+        for k in range(lamps.shape[0]):
+            if lamps[k, C_TYPE] == T_ENV or lamps[k, C_TYPE] == T_ENV_MAP:
+                continue
+            seen = lt.entry_visibility(lights, k)
+            if not seen & DIFFUSE_BIT:
+                continue
+            wx, wy, wz, dist, lr, lg, lb, lpdf, delta = sample_lamp_at(
+                lights, k, px, py, pz, CENTRE, CENTRE, path_time[p])
+            if not (lpdf > 0.0 and max(lr, lg, lb) > 0.0):
+                continue
+            if bent:
+                fr, fg, fb = bent_diffuse(state, wox, woy, woz, n0x, n0y, n0z, rx, ry, rz,
+                                          wx, wy, wz, correct)
+            else:
+                lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
+                fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, True, False,
+                                            False)
+                c = abs(lz)
+                fr, fg, fb = fr * c, fg * c, fb * c
+            if not max(fr, fg, fb) > 0.0:
+                continue
+            w = 1.0 / lpdf
+            cr, cg, cb = br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w
+            if not seen & SHADOW_BIT:            # a lamp casting no shadow
+                _add(L, p, cr, cg, cb, clamp)
+                continue
+            sox, soy, soz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
+            sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy, wz,
+                                                     dist, 0.0, scene_radius)
+            ns_out = ray_queues.push(ns_out, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr,
+                                      cg, cb, sh_path, sh_org, sh_dir, sh_far, sh_contrib,
+                                      sh_bounce, stacks, sh_stack)
+        # 3. one ray of Whitted's tree: mirror reflection or refraction
+        if b >= max_bounces:
+            continue
+        mirror_row(row)
+        bsdf.setup(row, front, wox, woy, woz, tables, state)
+        ad, ag, at = False, counts[p, 1] < cfg[4], counts[p, 2] < cfg[5]
+        if not (ag or at):
+            continue
+        ix, iy, iz, wr, wg, wb, spdf, skind, sdelta, valid = bsdf.sample(
+            state, wox, woy, woz, u_lobe, 0.5, 0.5, ad, ag, at)
+        if not valid:
+            continue
+        wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
+        side = dot(wx, wy, wz, gx, gy, gz)
+        if (side >= 0.0) if skind == TRANSMISSION else (side <= 0.0):
+            continue       # reflection leaves on the geometric normal's side, refraction through
+        br, bg, bb = br * wr, bg * wg, bb * wb
+        if not max(br, bg, bb) > 0.0 or not (br < np.inf and bg < np.inf and bb < np.inf):
+            continue
+        beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
+        counts[p, skind] += 1
+        bounce[p] = b + 1
+        ray_bits[p] = DIFFUSE_BIT << skind
+        nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
+        cone_moves(path_info[1], p, t_geom)
+        nn_out = ray_queues.push_next(nn_out, p, nox, noy, noz, wx, wy, wz, nx_path, nx_org,
+                                      nx_dir)
+    return ns_out, nn_out
