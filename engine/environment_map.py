@@ -27,7 +27,8 @@ the cell, so no cell where the looked-up radiance is non-zero gets pdf 0. A samp
 and the world direction is d = M^-1 d' / |M^-1 d'|, whose pdf carries the Jacobian of
 d -> M d / |M d|:  d(omega') / d(omega) = |det M| / |M d|^3.
 
-The compiled twin is `engine.kernels.lights.environment_map`.
+The radiance, the sampling and the pdf are computed by
+`engine.kernels.lights.environment_map` (from the arrays pack.py puts in the light set).
 """
 from __future__ import annotations
 
@@ -36,7 +37,6 @@ import numpy as np
 from .piecewise_2d import PiecewiseConstant2D
 from .textures import LUMINANCE, Texture, srgb_to_linear
 
-TWO_PI_SQUARED = 2.0 * np.pi * np.pi
 # |det M| below this (relative to the largest entry cubed) is taken as singular
 SINGULAR = 1e-12
 
@@ -77,7 +77,8 @@ def importance(texture: Texture, strength) -> np.ndarray:
 
 
 class EnvironmentMap:
-    """The image-based world: radiance along any direction, and direction sampling."""
+    """The image-based world's parameters: its texture, strength and mapping, and the
+    importance distribution the kernels sample directions from."""
 
     def __init__(self, texture: Texture, strength=(1.0, 1.0, 1.0), mapping=None):
         self.texture = texture
@@ -96,36 +97,3 @@ class EnvironmentMap:
         self.distribution = PiecewiseConstant2D(f)
         # mean luminance over the sphere: sum f x (2 pi / W) / (4 pi)
         self.mean_luminance = float(f.sum() / (2.0 * f.shape[1]))
-
-    def _to_map(self, d):
-        return d if self.identity else d @ self.matrix.T
-
-    def radiance(self, d):
-        """Radiance (n, 3) arriving from directions d (n, 3) (escaped rays)."""
-        uv = direction_to_uv(self._to_map(np.asarray(d, np.float64)))
-        return self.texture.lookup(uv)[:, :3] * self.strength
-
-    def sample(self, u):
-        """u (n, 2) -> (unit world directions (n, 3), solid-angle pdf (n,); 0 = none)."""
-        uv, pdf_uv = self.distribution.sample(u)
-        dm, sin_t = uv_to_direction(uv)
-        ok = sin_t > 0
-        pdf = np.where(ok, pdf_uv / (TWO_PI_SQUARED * np.where(ok, sin_t, 1.0)), 0.0)
-        if self.identity:
-            return dm, pdf
-        w = dm @ self.inverse.T
-        n = np.linalg.norm(w, axis=1)
-        return w / n[:, None], pdf * (self.abs_det * n ** 3)
-
-    def pdf(self, d):
-        """Solid-angle pdf (n,) with which `sample` produces the unit directions d."""
-        dm = self._to_map(np.asarray(d, np.float64))
-        n = np.linalg.norm(dm, axis=1)
-        sin_t = np.hypot(dm[:, 0], dm[:, 1]) / n
-        uv = direction_to_uv(dm)
-        ok = sin_t > 0
-        pdf = np.where(ok, self.distribution.pdf(uv) / (TWO_PI_SQUARED
-                                                        * np.where(ok, sin_t, 1.0)), 0.0)
-        if self.identity:
-            return pdf
-        return pdf * (self.abs_det / n ** 3)

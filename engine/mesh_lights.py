@@ -14,8 +14,8 @@ probability proportional to its estimated power  P_j = luminance(L_j) x pi x A_j
 power one side emits: a point in front of a two-sided triangle only ever receives one
 side's light, so this is the same estimate an equally bright one-sided area lamp gets.
 
-Sampling a point on triangle (v0, v1, v2) from u in [0,1)^2 uses Heitz's low-distortion
-map (E. Heitz, "A Low-Distortion Map Between Triangle and Square", 2019):
+Sampling (engine/kernels/lights/triangles.py) a point on triangle (v0, v1, v2) from u in
+[0,1)^2 uses Heitz's low-distortion map (E. Heitz, "A Low-Distortion Map Between Triangle and Square", 2019):
     if u1 > u0: s = u0 / 2, t = u1 - s    else: t = u1 / 2, s = u0 - t
     q = v0 + s (v1 - v0) + t (v2 - v0)
 which is piecewise linear with constant Jacobian, hence uniform in area (pdf 1/A), and
@@ -36,7 +36,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .lights import LightSample, luminance
+from .luminance import luminance
 from .surface import RELATIVE_OFFSET, triangle_scale
 
 
@@ -97,42 +97,3 @@ class EmissiveTriangles:
         prim = np.asarray(prim, dtype=np.int64)
         ok = (prim >= 0) & (prim < len(self.entry))
         return np.where(ok, self.entry[np.where(ok, prim, 0)], -1)
-
-    @staticmethod
-    def square_to_triangle(u):
-        """Heitz's map: weights (s, t) of the edges v1 - v0 and v2 - v0, uniform in area."""
-        u0, u1 = u[:, 0], u[:, 1]
-        upper = u1 > u0
-        b1 = np.where(upper, 0.5 * u0, u0 - 0.5 * u1)
-        b2 = np.where(upper, u1 - 0.5 * u0, 0.5 * u1)
-        return b1, b2
-
-    def sample(self, p, tri, u) -> LightSample:
-        """A uniform point on triangle entries `tri` (one per shading point), as a
-        direction from p with its solid-angle pdf (pick probability NOT included)."""
-        b1, b2 = self.square_to_triangle(u)
-        q = self.v0[tri] + b1[:, None] * self.e1[tri] + b2[:, None] * self.e2[tri]
-        to = q - p
-        dist = np.linalg.norm(to, axis=1)
-        ok_d = dist > 0
-        wi = np.where(ok_d[:, None], to / np.where(ok_d, dist, 1.0)[:, None], (0.0, 0.0, 1.0))
-        cos_l = np.abs((wi * self.normal[tri]).sum(1))
-        ok = ok_d & (cos_l > 0)
-        pdf = np.where(ok, dist * dist / (self.area[tri] * np.where(ok, cos_l, 1.0)), 0.0)
-        rad = np.where(ok[:, None], self.radiance[tri], 0.0)
-        # Shadow rays stop before the plane offset from the triangle by the same relative
-        # amount as ray origins (engine.surface), measured along the ray: Embree rounds
-        # the triangle and the ray to float32, so the light must not occlude itself.
-        scale = self.tri_scale[tri]          # bounds q's coordinates (relative to the centre)
-        margin = np.where(ok, RELATIVE_OFFSET * scale / np.where(ok, cos_l, 1.0), 0.0)
-        return LightSample(wi, dist, rad, pdf, False, margin)
-
-    def pdf_area_to_solid_angle(self, tri, p, q):
-        """Solid-angle pdf of sample(p, tri, .) producing the point q on triangle tri."""
-        to = q - p
-        d2 = (to * to).sum(1)
-        cos_abs_d = np.abs((to * self.normal[tri]).sum(1))     # |cos| x distance
-        ok = (cos_abs_d > 0) & (d2 > 0)
-        # d^2 / (A |cos|) = d^3 / (A |n . (q - p)|)
-        return np.where(ok, d2 * np.sqrt(d2) / (self.area[tri] * np.where(ok, cos_abs_d, 1.0)),
-                        0.0)

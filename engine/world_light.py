@@ -1,14 +1,14 @@
-"""The world as a light: what escaped rays see and how next-event estimation samples it.
+"""The world as a light: the parameters of what escaped rays see and of how next-event
+estimation samples it (engine/kernels/lights/environment.py, environment_map.py).
 
 Two models, one per kind of `engine.scene.World`:
 - `EnvironmentLightModel`, a uniform background (colour x strength), as Cycles samples
   it: uniform directions over the sphere, pdf 1 / (4 pi);
 - `EnvironmentMapLightModel`, an equirectangular image (`engine.environment_map`),
   directions importance-sampled from the image's luminance.
-Both are lights of the `engine.lights.LightSet` with the same interface as the lamps
-(sample, pdf, power) plus `escaped(d)`, the radiance along escaping rays. They are never
-hit as surfaces (BSDF rays find them by escaping), weighted by MIS against the BSDF rays
-that escape (`LightSet.environment_pdf`).
+Both are entries of the `engine.lights.LightSet` with a power, as the lamps. They are never
+hit as surfaces (BSDF rays find them by escaping), and weighted by MIS against the BSDF
+rays that escape.
 
 Ray visibility (Blender's World > Ray Visibility, `World.visibility`): `seen_by` is the
 world's mask (engine.visibility); escaped rays of a kind it lacks see black (camera rays
@@ -23,8 +23,7 @@ import numpy as np
 
 from . import visibility as vis
 from .environment_map import EnvironmentMap
-from .light_sample import INF, LightSample, luminance
-from .warp import uniform_sphere
+from .luminance import luminance
 
 
 class _World:
@@ -53,18 +52,6 @@ class EnvironmentLightModel(_World):
         # irradiance pi L on a scene of cross-section pi R^2 (as for the sun)
         return luminance(self.radiance) * np.pi * np.pi * scene_radius ** 2
 
-    def escaped(self, d, time=None):
-        return np.broadcast_to(self.radiance, (len(d), 3)).copy()
-
-    def sample(self, p, u, time=None):
-        n = len(p)
-        wi = uniform_sphere(u)
-        rad = np.broadcast_to(self.radiance, (n, 3)).copy()
-        return LightSample(wi, np.full(n, INF), rad, np.full(n, self.pdf_value), False)
-
-    def pdf(self, p, wi, t, time=None):
-        return np.full(len(wi), self.pdf_value)
-
 
 class EnvironmentMapLightModel(_World):
     """An environment map as a light (see engine.environment_map)."""
@@ -75,18 +62,6 @@ class EnvironmentMapLightModel(_World):
 
     def power(self, scene_radius):
         return self.map.mean_luminance * np.pi * np.pi * scene_radius ** 2
-
-    def escaped(self, d, time=None):
-        return self.map.radiance(d)
-
-    def sample(self, p, u, time=None):
-        n = len(p)
-        wi, pdf = self.map.sample(u)
-        rad = np.where((pdf > 0)[:, None], self.map.radiance(wi), 0.0)
-        return LightSample(wi, np.full(n, INF), rad, pdf, False)
-
-    def pdf(self, p, wi, t, time=None):
-        return self.map.pdf(wi)
 
 
 def world_model(world):

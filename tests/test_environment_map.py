@@ -1,8 +1,9 @@
-"""The environment map (engine.environment_map) and its sampling distribution
-(engine.piecewise_2d): the equirectangular convention, the distribution against its
-function, the map's direction sampler against its own pdf (chi-square, tests/chi2.py),
-the pdf's integral over the sphere, and the compiled twin (engine.kernels.lights
-.environment_map through the packed light set) against the NumPy code.
+"""The environment map (engine.environment_map, its distribution engine.piecewise_2d,
+sampled by the kernels of engine.kernels.lights.environment_map through the packed light
+set): the equirectangular convention, the map's direction sampler against its own pdf
+(chi-square, tests/chi2.py; black texels are never sampled), the pdf's integral over the
+sphere, the radiance of a texel against the image, and what an escaped ray sees against
+what a light sample carries.
 
 Chi-square in the map's own coordinates: a sampled world direction d is taken to the
 map's frame (M d / |M d|, computed here, not by the model) and to its equirectangular
@@ -12,7 +13,7 @@ is then exactly the texel grid, so every cell integral is of a smooth function (
 pdf is piecewise constant per texel in (u, v)). The chart density is
     pdf(d) x d(omega_world)/d(omega_map) x 2 pi^2 sin(theta) / (4 pi),
 with d(omega_world)/d(omega_map) = |M d|^3 / |det M| written out here again, so the
-test checks the model's pdf, Jacobian included, against its sampler.
+test checks the kernel's pdf, Jacobian included, against its sampler.
 """
 from __future__ import annotations
 
@@ -24,18 +25,15 @@ from numba import typeof
 
 from chi2 import chi2_test, directions, spherical
 from engine.environment_map import EnvironmentMap, direction_to_uv, uv_to_direction
-from engine.kernels.lights import (environment_pdf, lamp_pdf, pack_lights, sample,
-                                   world_escaped)
-from engine.kernels.lights.batch import sample_batch
+from engine.kernels.lights import environment_pdf, lamp_pdf, pack_lights, world_escaped
+from engine.kernels.lights.batch import sample_batch, world_escaped_batch
 from engine.lights import LightSet
-from engine.piecewise_2d import PiecewiseConstant2D
 from engine.scene import PointLight, World
 from engine.textures import Texture
 from engine.world_light import world_model
 
 N_CHI2 = 1_000_000
 N_TESTS = 4            # chi-square tests in this module (Sidak correction)
-RTOL = 1e-9
 
 
 def rotation_z(angle):
@@ -70,6 +68,30 @@ def environment(interp="Linear", mapping="identity", srgb=False, **kw):
     return EnvironmentMap(tex, (0.5, 1.0, 2.0), MAPPINGS[mapping])
 
 
+def world_of(env):
+    return World(texture=env.texture, strength=tuple(env.strength), mapping=env.matrix)
+
+
+def packed_world(env, lamps=()):
+    """The kernels' light set of this map as the world (and lamps): (L, LightSet)."""
+    ls = LightSet(list(lamps), 3.0, world=world_model(world_of(env)))
+    return pack_lights(ls), ls
+
+
+def map_sample(L, u, up=None):
+    """Directions (n, 3) sampled from the world light with u (n, 2), and their pdfs."""
+    n = len(u)
+    up = np.full(n, 0.5) if up is None else up
+    k, wi, dist, rad, pdf, delta, _ = sample_batch(L, np.zeros((n, 3)), up,
+                                                   np.ascontiguousarray(u, np.float64))
+    return wi, pdf, rad, k
+
+
+def map_pdf(L, d):
+    """The world light's solid-angle pdf along unit directions d (n, 3)."""
+    return world_escaped_batch(L, np.zeros(3), np.ascontiguousarray(d, np.float64))[1]
+
+
 def unit_rows(rng, n):
     d = rng.normal(size=(n, 3))
     return d / np.linalg.norm(d, axis=1, keepdims=True)
@@ -94,35 +116,13 @@ def test_equirectangular_convention_and_inverse():
     np.testing.assert_allclose(sin_t, np.hypot(w[:, 0], w[:, 1]), atol=1e-14)
 
 
-# ------------------------------------------------------------------ distribution
-
-def test_piecewise_constant_2d_samples_its_function():
-    rng = np.random.default_rng(2)
-    f = rng.random((6, 10)) ** 3
-    f[2] = 0.0
-    f[:, 4] = 0.0
-    dist = PiecewiseConstant2D(f)
-    uv, pdf = dist.sample(rng.random((400_000, 2)))
-    r, c = dist.cell_of(uv)
-    counts = np.bincount(r * 10 + c, minlength=60).reshape(6, 10)
-    expected = f / f.sum() * len(uv)
-    assert counts[f == 0].sum() == 0                     # black cells never sampled
-    nz = f > 0
-    chi2 = ((counts[nz] - expected[nz]) ** 2 / expected[nz]).sum()
-    assert chi2 < nz.sum() + 6 * np.sqrt(2 * nz.sum())   # ~ mean + 6 sigma of chi2(k)
-    np.testing.assert_allclose(pdf, f[r, c] / f.mean(), rtol=1e-12)
-    np.testing.assert_allclose(dist.pdf(uv), pdf, rtol=0)
-    # the pdf integrates to one over [0, 1]^2, and a black function is sampled uniformly
-    assert dist.cell_pdf(*np.divmod(np.arange(60), 10)).mean() == pytest.approx(1.0)
-    black = PiecewiseConstant2D(np.zeros((3, 4)))
-    uv0, pdf0 = black.sample(rng.random((10, 2)))
-    assert np.isfinite(uv0).all() and np.all(pdf0 == 1.0)
-
+# ------------------------------------------------------------------ sampling
 
 @pytest.mark.parametrize("interp,mapping", [("Linear", "identity"), ("Closest", "identity"),
                                             ("Linear", "rotation"), ("Linear", "scale")])
 def test_map_directions_follow_the_pdf(interp, mapping):
     env = environment(interp, mapping)
+    L, _ = packed_world(env)
     m = env.matrix
     inv = np.linalg.inv(m)
     det = abs(np.linalg.det(m))
@@ -134,7 +134,7 @@ def test_map_directions_follow_the_pdf(interp, mapping):
         return directions(2.0 * uv[:, 1] - 1.0, np.pi * (2.0 * np.mod(uv[:, 0], 1.0) - 1.0))
 
     def sample(u):
-        d, pdf = env.sample(u[:, 1:3])
+        d, pdf, _, _ = map_sample(L, u[:, 1:3])
         return to_chart(d), pdf > 0
 
     def pdf(wc):
@@ -144,7 +144,7 @@ def test_map_directions_follow_the_pdf(interp, mapping):
         d = dm @ inv.T
         d /= np.linalg.norm(d, axis=1, keepdims=True)
         jac = np.linalg.norm(d @ m.T, axis=1) ** 3 / det
-        return env.pdf(d) * jac * 2.0 * np.pi ** 2 * sin_t / (4.0 * np.pi)
+        return map_pdf(L, d) * jac * 2.0 * np.pi ** 2 * sin_t / (4.0 * np.pi)
 
     res = chi2_test(sample, pdf, N_CHI2, seed=zlib.crc32(f"{interp}{mapping}".encode()) % 1000,
                     n_tests=N_TESTS, rows=h, cols=w, adaptive=False)
@@ -168,8 +168,9 @@ def test_pdf_integrates_to_one_over_the_sphere(mapping):
     angle measure independently of the sampler); a pdf without the mapping's Jacobian
     misses by far more."""
     env = environment("Linear", mapping)
+    L, _ = packed_world(env)
     d = _sphere_grid(2000, np.random.default_rng(4))
-    pdf = env.pdf(d)
+    pdf = map_pdf(L, d)
     integral = pdf.mean() * 4.0 * np.pi
     print(mapping, "integral", integral)
     assert abs(integral - 1.0) < 1e-3
@@ -178,39 +179,47 @@ def test_pdf_integrates_to_one_over_the_sphere(mapping):
         assert abs((pdf / jac).mean() * 4.0 * np.pi - 1.0) > 0.05
 
 
-# ------------------------------------------------------------------ compiled twin
+# ------------------------------------------------------------------ radiance
+
+@pytest.mark.parametrize("mapping", ["identity", "rotation", "scale"])
+def test_an_escaped_ray_sees_the_texel_it_points_at(mapping):
+    """With Closest interpolation, the direction through a texel's centre (the map's
+    frame taken back to the world by the inverse mapping, computed here) sees that
+    texel x the strength."""
+    env = environment("Closest", mapping)
+    L, _ = packed_world(env)
+    h, w = env.texture.height, env.texture.width
+    rows, cols = np.meshgrid(np.arange(h), np.arange(w), indexing="ij")
+    uv = np.stack([(cols.ravel() + 0.5) / w, (rows.ravel() + 0.5) / h], axis=1)
+    dm, _ = uv_to_direction(uv)
+    d = dm @ np.linalg.inv(env.matrix).T
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    rad, _ = world_escaped_batch(L, np.zeros(3), d)
+    texels = random_map()[rows.ravel(), cols.ravel()] * env.strength
+    np.testing.assert_allclose(rad, texels, rtol=1e-6)
+
 
 @pytest.mark.parametrize("interp,mapping,srgb", [("Linear", "identity", False),
                                                  ("Closest", "rotation", False),
                                                  ("Linear", "scale", True)])
-def test_compiled_twin_matches_numpy(interp, mapping, srgb):
+def test_light_samples_carry_what_escaped_rays_see(interp, mapping, srgb):
+    """Beside a lamp, the world light's samples carry the radiance and the pdf that an
+    escaped ray along the same direction finds (what MIS weighs it against), and the
+    lamp pdf of the world entry is that pdf too."""
     env = environment(interp, mapping, srgb)
-    world = World(texture=env.texture, strength=tuple(env.strength), mapping=env.matrix)
-    ls = LightSet([PointLight((0, 0, 2), (50.0, 50.0, 50.0))], 3.0, world=world_model(world))
-    L = pack_lights(ls)
+    L, ls = packed_world(env, [PointLight((0, 0, 2), (50.0, 50.0, 50.0))])
     k_env = ls.env_index
     rng = np.random.default_rng(3)
     n = 4000
-    p = rng.normal(size=(n, 3))
-    up, u = rng.random(n), rng.random((n, 2))
-    k, wi, dist, rad, pdf, delta, _ = sample_batch(L, p, up, u)
-    s, idx, dl = ls.sample(p, up, u)
-    assert np.array_equal(k, idx) and (k == k_env).sum() > n // 4
+    d, pdf, rad, k = map_sample(L, rng.random((n, 2)), rng.random(n))
     env_rows = k == k_env
-    np.testing.assert_allclose(wi[env_rows], s.wi[env_rows], rtol=0, atol=1e-12)
-    np.testing.assert_allclose(pdf, s.pdf, rtol=RTOL)
-    np.testing.assert_allclose(rad, s.radiance, rtol=RTOL, atol=1e-300)
-    assert np.all(np.isinf(dist[env_rows])) and not delta[env_rows].any()
-    # escaped rays: radiance and MIS pdf along any direction, and the lamp pdf
-    d = np.concatenate([unit_rows(rng, 2000), s.wi[env_rows][:500]])
-    got = np.array([world_escaped(L, np.zeros(3), 2, *x) for x in d])
-    np.testing.assert_allclose(got[:, :3], env.radiance(d), rtol=RTOL, atol=1e-300)
-    np.testing.assert_allclose(got[:, 3], ls.environment_pdf(d), rtol=RTOL)
-    assert np.all([environment_pdf(L, *x) for x in d[:50]] == got[:50, 3])
-    assert np.all([lamp_pdf(L, k_env, 0.0, 0.0, 0.0, *x, np.inf, 0.0) for x in d[:50]]
-                  == got[:50, 3])
-    one = sample(L, *p[0], up[0], *u[0], 0.0)
-    assert one[0] == k[0] and one[8] == pdf[0]
+    assert env_rows.sum() > n // 4
+    seen, pdf_seen = world_escaped_batch(L, np.zeros(3), np.ascontiguousarray(d[env_rows]))
+    np.testing.assert_allclose(rad[env_rows], seen, rtol=1e-12, atol=1e-300)
+    np.testing.assert_allclose(pdf[env_rows], pdf_seen, rtol=1e-12)
+    for x in d[env_rows][:50]:
+        assert environment_pdf(L, *x) == world_escaped(L, np.zeros(3), 2, *x)[3]
+        assert lamp_pdf(L, k_env, 0.0, 0.0, 0.0, *x, np.inf, 0.0) == environment_pdf(L, *x)
 
 
 def test_world_hidden_from_camera_rays_is_black_for_them():

@@ -20,10 +20,13 @@ import numpy as np
 import pytest
 
 from engine import Camera, Material, RenderContext, RenderSettings, Scene, World, render
-from engine.environment_map import EnvironmentMap
+from engine.kernels.lights import pack_lights
+from engine.kernels.lights.batch import world_escaped_batch
 from engine.integrators.compiled_path import CompiledPathIntegrator
+from engine.lights import LightSet
 from engine.piecewise_2d import PiecewiseConstant2D
 from engine.textures import Texture
+from engine.world_light import world_model
 from engine_scenes import look_at, quad, uv_sphere
 
 RHO = 0.5
@@ -48,13 +51,14 @@ def sky_world(**kw):
 def hemisphere_irradiance(world, n=1500, seed=0):
     """E on an up-facing surface: the integral of L cos over the upper hemisphere, on a
     jittered n x 4n grid in (cos theta, phi) (cells of equal solid angle)."""
-    env = EnvironmentMap(world.texture, world.strength, world.mapping)
+    L = pack_lights(LightSet([], 1.0, world=world_model(world)))
     rng = np.random.default_rng(seed)
     c = (np.arange(n)[:, None] + rng.random((n, 4 * n))) / n
     p = (np.arange(4 * n)[None, :] + rng.random((n, 4 * n))) / (4 * n) * 2.0 * np.pi
     s = np.sqrt(1.0 - c * c)
     d = np.stack([s * np.cos(p), s * np.sin(p), c], -1).reshape(-1, 3)
-    return (env.radiance(d) * c.reshape(-1, 1)).mean(0) * 2.0 * np.pi
+    radiance = world_escaped_batch(L, np.zeros(3), np.ascontiguousarray(d))[0]
+    return (radiance * c.reshape(-1, 1)).mean(0) * 2.0 * np.pi
 
 
 def plane_scene(world, material=None, size=8):

@@ -1,9 +1,11 @@
-"""Each light's sampler against its own pdf, and next-event estimation against closed forms.
+"""Each light's sampler against its own pdf, and next-event estimation against closed forms,
+on the compiled light kernels (engine.kernels.lights, through their array drivers in
+batch.py) that render.
 
 1. Chi-square goodness of fit (tests/chi2.py, Mitsuba style, Sidak-corrected 1 % level over
-   all the tests of this module): the directions sample(p, u) returns must follow
-   pdf(p, wi) -- the pdf found the way multiple importance sampling finds it, through
-   intersect() (a direction that misses the light has pdf 0).
+   all the tests of this module): the directions `sample` returns must follow the pdf
+   found the way multiple importance sampling finds it, through `hit_lamps` and
+   `lamp_pdf` (a direction that misses the light has pdf 0).
    A light's support is a small, sharp-edged patch of the sphere, and Gauss-Legendre cell
    integrals of a discontinuous integrand are inaccurate; so each test bins its directions
    in a *chart*: a smooth bijection from the light's own parameter square (a, b) in
@@ -25,11 +27,15 @@
 from __future__ import annotations
 
 import zlib
+from typing import NamedTuple
 
 import numpy as np
 import pytest
 
 from chi2 import chi2_test, directions, spherical
+from engine.kernels.lights import pack_lights
+from engine.kernels.lights.batch import (hit_lamps_batch, lamp_pdf_batch, mesh_pdf_batch,
+                                         sample_batch, sun_escaped_batch)
 from engine.lights import (SOLID_ANGLE_MIN, AreaLightModel, LightSet, PointLightModel,
                            SunLightModel)
 from engine.mesh_lights import EmissiveTriangles
@@ -161,23 +167,54 @@ def area_light(shape, sx, sy=None, center=(0, 0, 1), matrix=None, strength=10.0)
     return AreaLight(m, (strength,) * 3, shape, sx, sy if sy is not None else sx)
 
 
-def model_pdf_via_intersect(model, p):
-    """pdf(p, wi) as MIS finds it: intersect first, pdf where it hits, 0 elsewhere."""
+def packed(*lights, mesh=None, radius=1.0):
+    """The kernels' light tuple of these scene lights (and emissive triangles)."""
+    return pack_lights(LightSet(list(lights), radius, mesh_lights=mesh), None, False)
+
+
+class Samples(NamedTuple):
+    entry: np.ndarray
+    wi: np.ndarray
+    dist: np.ndarray
+    radiance: np.ndarray
+    pdf: np.ndarray
+    delta: np.ndarray
+    margin: np.ndarray
+
+
+def kernel_sample(L, P, u, u_pick=None):
+    """light_set.sample at the points P (n, 3) with numbers u (n, 2) (and u_pick (n,),
+    one half when there is one light to pick)."""
+    n = len(P)
+    u_pick = np.full(n, 0.5) if u_pick is None else u_pick
+    return Samples(*sample_batch(L, np.ascontiguousarray(P, np.float64),
+                                 np.ascontiguousarray(u_pick, np.float64),
+                                 np.ascontiguousarray(u, np.float64)))
+
+
+def kernel_pdf_via_hit(L, P, wi):
+    """The pdf of directions wi from P as MIS finds it: the lamp hit first, its pdf
+    there, 0 where no lamp is hit. Returns (pdf, t, radiance)."""
+    P = np.ascontiguousarray(P, np.float64)
+    wi = np.ascontiguousarray(wi, np.float64)
+    t, k, rad = hit_lamps_batch(L, P, wi, np.full(len(wi), np.inf))
+    hit = k >= 0
+    out = np.zeros(len(wi))
+    if hit.any():
+        out[hit] = lamp_pdf_batch(L, k[hit], P[hit], wi[hit], t[hit])
+    return out, t, rad
+
+
+def model_pdf_via_intersect(L, p):
+    """pdf(p, wi) as MIS finds it (`kernel_pdf_via_hit`) for the chi-square harness."""
     def pdf(wi, d=None):
-        P = np.broadcast_to(p, wi.shape).copy()
-        t, _ = model.intersect(P, wi)
-        hit = np.isfinite(t)
-        out = np.zeros(len(wi))
-        if hit.any():
-            out[hit] = model.pdf(P[hit], wi[hit], t[hit])
-        return out
+        return kernel_pdf_via_hit(L, np.broadcast_to(p, wi.shape), wi)[0]
     return pdf
 
 
-def model_sampler(model, p):
+def model_sampler(L, p):
     def sample(u2):
-        P = np.broadcast_to(p, (len(u2), 3)).copy()
-        s = model.sample(P, u2)
+        s = kernel_sample(L, np.broadcast_to(p, (len(u2), 3)), u2)
         return s.wi, s.pdf > 0
     return sample
 
@@ -197,9 +234,16 @@ def grazing_point(center, normal, tangent, dist, degrees):
                                                - np.cos(th) * np.asarray(normal, float))
 
 
-def _solid_angle_used(model, p):
-    sr, use = model._spherical(np.asarray(p, float)[None])
-    return bool(use[0])
+def _solid_angle_used(L, p):
+    """Whether the area lamp of L is sampled uniformly in solid angle from p: then every
+    sample has the same pdf, 1 / the solid angle (by area, the pdf varies with the
+    point)."""
+    n = 64
+    u = np.random.default_rng(0).random((n, 2))
+    pdf = kernel_sample(L, np.tile(np.asarray(p, float), (n, 1)), u).pdf
+    pdf = pdf[pdf > 0]
+    assert pdf.size > n // 2
+    return bool(np.ptp(pdf) <= 1e-9 * pdf.max())
 
 
 RECT_CASES = [
@@ -215,12 +259,13 @@ RECT_CASES = [
 @pytest.mark.parametrize("case", RECT_CASES, ids=[c[0] for c in RECT_CASES])
 def test_rectangle_samples_follow_pdf(case):
     name, kw, p, spherical_expected = case
-    model = AreaLightModel(area_light(**kw))
+    light = area_light(**kw)
+    model, L = AreaLightModel(light), packed(light)
     if p == "graze":
         p = grazing_point(model.center, model.normal, [1, 0, 0], 2.0, 85.0)
     p = np.asarray(p, float)
-    assert _solid_angle_used(model, p) == spherical_expected
-    res = chart_chi2(model_sampler(model, p), model_pdf_via_intersect(model, p),
+    assert _solid_angle_used(L, p) == spherical_expected
+    res = chart_chi2(model_sampler(L, p), model_pdf_via_intersect(L, p),
                      rect_chart(model, p), seed=_seed(name))
     print(name, res)
     assert res.passed, str(res)
@@ -230,10 +275,12 @@ def test_rectangle_samples_follow_pdf(case):
 def test_sheared_parallelogram_light_uses_area_sampling_and_passes():
     m = np.eye(4)
     m[:3, 1] = (0.5, 1.0, 0.0)                         # sheared: edges not perpendicular
-    model = AreaLightModel(area_light("RECTANGLE", 1.0, 0.8, matrix=m))
+    light = area_light("RECTANGLE", 1.0, 0.8, matrix=m)
+    model, L = AreaLightModel(light), packed(light)
     assert not model.solid_angle_ok
     p = np.array([0.2, 0.1, 0.3])
-    res = chart_chi2(model_sampler(model, p), model_pdf_via_intersect(model, p),
+    assert not _solid_angle_used(L, p)
+    res = chart_chi2(model_sampler(L, p), model_pdf_via_intersect(L, p),
                      rect_chart(model, p), seed=11)
     print(res)
     assert res.passed, str(res)
@@ -250,11 +297,12 @@ DISK_CASES = [
 @pytest.mark.parametrize("case", DISK_CASES, ids=[c[0] for c in DISK_CASES])
 def test_disk_and_ellipse_samples_follow_pdf(case):
     name, kw, p = case
-    model = AreaLightModel(area_light(**kw))
+    light = area_light(**kw)
+    model, L = AreaLightModel(light), packed(light)
     if p == "graze":
         p = grazing_point(model.center, model.normal, [0.6, 0.8, 0], 1.5, 85.0)
     p = np.asarray(p, float)
-    res = chart_chi2(model_sampler(model, p), model_pdf_via_intersect(model, p),
+    res = chart_chi2(model_sampler(L, p), model_pdf_via_intersect(L, p),
                      disk_chart(model, p), seed=_seed(name))
     print(name, res)
     assert res.passed, str(res)
@@ -270,25 +318,28 @@ SPHERE_CASES = [
 @pytest.mark.parametrize("case", SPHERE_CASES, ids=[c[0] for c in SPHERE_CASES])
 def test_sphere_light_outside_samples_follow_pdf(case):
     name, kw, p = case
-    model = PointLightModel(PointLight((0.0, 0.0, 0.5), (5.0, 5.0, 5.0), **kw))
+    light = PointLight((0.0, 0.0, 0.5), (5.0, 5.0, 5.0), **kw)
+    model, L = PointLightModel(light), packed(light)
     p = np.asarray(p, float)
     to = model.position - p
     d2 = to @ to
-    chart = ConeChart(to, model._cone(np.array([d2]))[0])
-    res = chart_chi2(model_sampler(model, p), model_pdf_via_intersect(model, p), chart,
+    # the cone the sphere subtends: 1 - cos = 1 - sqrt(1 - r^2 / d^2)
+    one_minus = model.radius ** 2 / d2 / (1.0 + np.sqrt(1.0 - model.radius ** 2 / d2))
+    chart = ConeChart(to, one_minus)
+    res = chart_chi2(model_sampler(L, p), model_pdf_via_intersect(L, p), chart,
                      seed=_seed(name))
     print(name, res)
     assert res.passed, str(res)
 
 
 def test_sphere_light_inside_samples_follow_pdf():
-    model = PointLightModel(PointLight((0.0, 0.0, 0.5), (5.0, 5.0, 5.0), radius=1.0))
+    L = packed(PointLight((0.0, 0.0, 0.5), (5.0, 5.0, 5.0), radius=1.0))
     p = np.array([0.3, -0.2, 0.9])
 
     def sample(u):
-        return model_sampler(model, p)(u[:, 1:3])
+        return model_sampler(L, p)(u[:, 1:3])
 
-    res = chi2_test(sample, model_pdf_via_intersect(model, p), N_CHI2, seed=5,
+    res = chi2_test(sample, model_pdf_via_intersect(L, p), N_CHI2, seed=5,
                     n_tests=N_TESTS)
     print(res)
     assert res.passed, str(res)
@@ -297,14 +348,14 @@ def test_sphere_light_inside_samples_follow_pdf():
 def test_soft_falloff_disc_samples_follow_pdf():
     light = PointLight((0.0, 0.0, 0.5), (5.0, 5.0, 5.0), radius=0.4)
     light.soft_falloff = True                        # attribute may postdate this test
-    model = PointLightModel(light)
+    model, L = PointLightModel(light), packed(light)
     assert model.disc
     p = np.array([0.2, 0.1, -0.3])
     axis = (model.position - p) / np.linalg.norm(model.position - p)
     from engine.warp import orthonormal_basis
     t, b = orthonormal_basis(axis[None])
     chart = PlanarChart(p, model.position, model.radius * t[0], model.radius * b[0], "disk")
-    res = chart_chi2(model_sampler(model, p), model_pdf_via_intersect(model, p), chart, seed=8)
+    res = chart_chi2(model_sampler(L, p), model_pdf_via_intersect(L, p), chart, seed=8)
     print(res)
     assert res.passed, str(res)
 
@@ -315,13 +366,14 @@ SUN_CASES = [("sun-10deg", 10.0), ("sun-180deg", 180.0)]
 @pytest.mark.parametrize("case", SUN_CASES, ids=[c[0] for c in SUN_CASES])
 def test_sun_cone_samples_follow_pdf(case):
     name, degrees = case
-    model = SunLightModel(SunLight((0.3, -0.2, -1.0), (3.0, 3.0, 3.0), np.radians(degrees)))
+    light = SunLight((0.3, -0.2, -1.0), (3.0, 3.0, 3.0), np.radians(degrees))
+    model, L = SunLightModel(light), packed(light)
     p = np.zeros(3)
 
-    def pdf(wi, d=None):
-        return model.pdf(None, wi, None)                 # escaped rays: no intersect
+    def pdf(wi, d=None):                                 # escaped rays find the sun
+        return sun_escaped_batch(L, 0, np.ascontiguousarray(wi, np.float64))[1]
 
-    res = chart_chi2(model_sampler(model, p), pdf, ConeChart(model.to_light, model.one_minus),
+    res = chart_chi2(model_sampler(L, p), pdf, ConeChart(model.to_light, model.one_minus),
                      seed=_seed(name))
     print(name, res)
     assert res.passed, str(res)
@@ -405,20 +457,21 @@ def _mesh_point(p):
 
 def _mesh_case(p, light_set):
     chart = TriangleChart(p, light_set.mesh)
+    L = pack_lights(light_set, None, False)
 
     def sample(u2):
-        P = np.broadcast_to(p, (len(u2), 3)).copy()
+        P = np.broadcast_to(p, (len(u2), 3))
         # the pick number is independent of the point's numbers
         u_pick = np.random.default_rng(len(u2)).random(len(u2))
-        ls, _, _ = light_set.sample(P, u_pick, u2)
+        ls = kernel_sample(L, P, u2, u_pick)
         return ls.wi, ls.pdf > 0
 
     def pdf(wi, d=None):
         tri, _, t = chart.hit(wi)
-        P = np.broadcast_to(p, wi.shape)
+        P = np.ascontiguousarray(np.broadcast_to(p, wi.shape))
         prim = np.where(tri >= 0, light_set.mesh.prim[np.maximum(tri, 0)], -1)
         q = P + wi * np.where(np.isfinite(t), t, 0.0)[:, None]
-        return light_set.mesh_pdf(prim, P, q)
+        return mesh_pdf_batch(L, prim.astype(np.int64), P, np.ascontiguousarray(q))
 
     return chart, sample, pdf
 
@@ -446,14 +499,15 @@ def test_number_of_chi2_tests_matches_the_sidak_correction():
 
 def test_negative_control_area_pdf_for_solid_angle_samples_fails():
     """Solid-angle samples of a near rectangle checked against the area-sampling pdf."""
-    model = AreaLightModel(area_light("SQUARE", 1.0))
+    light = area_light("SQUARE", 1.0)
+    model, L = AreaLightModel(light), packed(light)
     p = np.array([0.1, 0.0, 0.4])
-    assert _solid_angle_used(model, p)
+    assert _solid_angle_used(L, p)
 
     def wrong_pdf(wi, d):
         return d * d / (model.area * np.abs(wi @ model.normal))
 
-    res = chart_chi2(model_sampler(model, p), wrong_pdf, rect_chart(model, p), seed=3)
+    res = chart_chi2(model_sampler(L, p), wrong_pdf, rect_chart(model, p), seed=3)
     print(res)
     assert not res.passed
     assert abs(res.pdf_integral - 1.0) < 1e-4     # right normalisation, wrong shape
@@ -514,8 +568,8 @@ def rect_on_axis(L, a, b, h):
                     + B / np.sqrt(1 + B * B) * np.arctan(A / np.sqrt(1 + B * B)))
 
 
-def _model_sampler(model):
-    return lambda P, u, rng: model.sample(P, u)
+def _lamp_sampler(L):
+    return lambda P, u, rng: kernel_sample(L, P, u)
 
 
 def test_closed_forms_agree_with_each_other():
@@ -556,7 +610,8 @@ def _area_closed_form(model, p, n_r):
 @pytest.mark.parametrize("case", NEE_CASES, ids=[c[0] for c in NEE_CASES])
 def test_area_light_irradiance_by_nee(case):
     name, make, p, n_r = case
-    model = AreaLightModel(make())
+    light = make()
+    model, L = AreaLightModel(light), packed(light)
     if isinstance(p, str):
         p = grazing_point(model.center, model.normal, [1, 0, 0], 2.0, 85.0)
         n_r = model.center - p                        # facing the light's centre
@@ -566,7 +621,7 @@ def test_area_light_irradiance_by_nee(case):
         assert expected == pytest.approx(rect_on_axis(model.radiance[0], 0.5, 0.5, 1.0), rel=1e-12)
     if name == "disk-axis":
         assert expected == pytest.approx(np.pi * model.radiance[0] * 0.36 / (0.81 + 0.36), rel=1e-7)
-    est, se = nee_irradiance(_model_sampler(model), p, n_r, seed=_seed(name))
+    est, se = nee_irradiance(_lamp_sampler(L), p, n_r, seed=_seed(name))
     err = est / expected - 1
     print(f"{name}: E={est:.6g} expected={expected:.6g} err={100 * err:+.3f}% "
           f"(se {100 * se / expected:.3f}%)")
@@ -574,29 +629,31 @@ def test_area_light_irradiance_by_nee(case):
 
 
 def test_sphere_light_irradiance_by_nee():
-    model = PointLightModel(PointLight((0.0, 0.0, 1.0), (20.0, 20.0, 20.0), radius=0.3))
+    light = PointLight((0.0, 0.0, 1.0), (20.0, 20.0, 20.0), radius=0.3)
+    model, L = PointLightModel(light), packed(light)
     p = np.array([0.4, 0.0, 0.0])
     to = model.position - p
     d = np.linalg.norm(to)
     n_r = np.array([0.0, 0.0, 1.0])
     expected = np.pi * model.sphere_radiance[0] * (0.3 / d) ** 2 * (to @ n_r) / d
-    est, se = nee_irradiance(_model_sampler(model), p, n_r, seed=1)
+    est, se = nee_irradiance(_lamp_sampler(L), p, n_r, seed=1)
     print(f"sphere: E={est:.6g} expected={expected:.6g} err={100 * (est / expected - 1):+.3f}% "
           f"(se {100 * se / expected:.3f}%)")
     assert abs(est / expected - 1) < 0.005
 
 
 def test_sun_irradiance_by_nee():
-    model = SunLightModel(SunLight((0.3, -0.2, -1.0), (3.0, 3.0, 3.0), np.radians(20.0)))
+    light = SunLight((0.3, -0.2, -1.0), (3.0, 3.0, 3.0), np.radians(20.0))
+    model = SunLightModel(light)
     n_r = np.array([0.0, 0.0, 1.0])
     expected = 3.0 * (model.to_light @ n_r)
-    est, se = nee_irradiance(_model_sampler(model), np.zeros(3), n_r, seed=2)
+    est, se = nee_irradiance(_lamp_sampler(packed(light)), np.zeros(3), n_r, seed=2)
     print(f"sun: E={est:.6g} expected={expected:.6g} err={100 * (est / expected - 1):+.3f}%")
     assert abs(est / expected - 1) < 0.005
 
 
 def test_emissive_triangles_and_mixed_light_set_irradiance_by_nee():
-    """All lights at once through LightSet.sample: selection pdf x light pdf."""
+    """All lights at once through the light set's sample: selection pdf x light pdf."""
     mesh = emissive_mesh()
     lamps = [area_light("SQUARE", 0.5, center=(0.0, 0.0, 2.0)),
              PointLight((0.5, 0.5, 1.5), (8.0, 8.0, 8.0), radius=0.1),
@@ -614,9 +671,10 @@ def test_emissive_triangles_and_mixed_light_set_irradiance_by_nee():
     expected += np.pi * sph.sphere_radiance[0] * (0.1 / d) ** 2 * (to @ n_r) / d
     expected += 1.0
 
+    L = pack_lights(ls, None, False)
+
     def sample(P, u, rng):
-        s, _, _ = ls.sample(P, rng.random(len(P)), u)
-        return s
+        return kernel_sample(L, P, u, rng.random(len(P)))
 
     est, se = nee_irradiance(sample, p, n_r, seed=9)
     print(f"mixed: E={est:.6g} expected={expected:.6g} err={100 * (est / expected - 1):+.3f}% "
@@ -626,17 +684,14 @@ def test_emissive_triangles_and_mixed_light_set_irradiance_by_nee():
 
 # ------------------------------------------------------------------------ robustness
 
-def _finite_sample(model, P, u):
-    s = model.sample(P, u)
+def _finite_sample(L, P, u):
+    s = kernel_sample(L, P, u)
     assert np.all(np.isfinite(s.wi)) and np.all(np.isfinite(s.radiance))
     assert np.all(np.isfinite(s.pdf)) and np.all(s.pdf >= 0)
     assert not np.any(np.isnan(s.dist))
-    t, r = model.intersect(P, s.wi)
+    pdf, t, r = kernel_pdf_via_hit(L, P, s.wi)
     assert not np.any(np.isnan(t)) and np.all(np.isfinite(r))
-    hit = np.isfinite(t)
-    if hit.any():
-        pdf = model.pdf(P[hit], s.wi[hit], t[hit])
-        assert np.all(np.isfinite(pdf)) and np.all(pdf >= 0)
+    assert np.all(np.isfinite(pdf)) and np.all(pdf >= 0)
     return s
 
 
@@ -653,11 +708,12 @@ def _probe_points(center, normal, size):
 @pytest.mark.parametrize("size", [1e-6, 1.0, 1e4])
 @pytest.mark.parametrize("shape", ["SQUARE", "RECTANGLE", "DISK", "ELLIPSE"])
 def test_area_lights_stay_finite_at_degenerate_points(shape, size):
-    model = AreaLightModel(area_light(shape, size, 0.5 * size, center=(1.0, 2.0, 3.0)))
+    light = area_light(shape, size, 0.5 * size, center=(1.0, 2.0, 3.0))
+    model, L = AreaLightModel(light), packed(light)
     P = _probe_points(model.center, model.normal, size)
     rng = np.random.default_rng(0)
     for u in (rng.random((len(P), 2)), np.zeros((len(P), 2)), np.full((len(P), 2), 1 - 1e-16)):
-        _finite_sample(model, P, u)
+        _finite_sample(L, P, u)
 
 
 @pytest.mark.parametrize("light", [
@@ -675,47 +731,47 @@ def test_point_and_spot_lights_stay_finite_including_at_the_light(light):
     P = np.array([[0, 0, 0], [0, 0, -1e-300], [0, 0, -1], [1e4, 0, 0], [0, 0, 1e-8],
                   [0, 0, -2e4]], float)
     rng = np.random.default_rng(0)
-    s = _finite_sample(model, P, rng.random((len(P), 2)))
+    s = _finite_sample(packed(light), P, rng.random((len(P), 2)))
     assert np.all(s.radiance[0] == 0) or not model.delta   # exactly at a point light: nothing
 
 
 def test_point_light_disc_mode_stays_finite():
     light = PointLight((0, 0, 0), (1, 1, 1), radius=0.5)
     light.soft_falloff = True
-    model = PointLightModel(light)
+    assert PointLightModel(light).disc
     P = np.array([[0, 0, 0], [0, 0, 1e-300], [0, 0.2, 0], [3, 0, 0]], float)
-    _finite_sample(model, P, np.random.default_rng(0).random((len(P), 2)))
+    _finite_sample(packed(light), P, np.random.default_rng(0).random((len(P), 2)))
 
 
 @pytest.mark.parametrize("degrees", [0.0, 1e-9, 1e-4, 0.5, 90.0, 180.0, 360.0])
 def test_sun_stays_finite_for_any_angle(degrees):
-    model = SunLightModel(SunLight((0.0, 0.0, -1.0), (2.0, 2.0, 2.0), np.radians(degrees)))
+    light = SunLight((0.0, 0.0, -1.0), (2.0, 2.0, 2.0), np.radians(degrees))
+    model, L = SunLightModel(light), packed(light)
     P = np.zeros((4, 3))
-    s = model.sample(P, np.random.default_rng(0).random((4, 2)))
+    s = kernel_sample(L, P, np.random.default_rng(0).random((4, 2)))
     assert np.all(np.isfinite(s.wi)) and np.all(np.isfinite(s.radiance))
     assert np.all(np.isfinite(s.pdf)) and np.all(s.pdf > 0)
     if not model.delta:
         # the estimate of irradiance at normal incidence is the strength, whatever the angle
-        est, _ = nee_irradiance(_model_sampler(model), np.zeros(3), UP, n=200_000, seed=3)
+        est, _ = nee_irradiance(_lamp_sampler(L), np.zeros(3), UP, n=200_000, seed=3)
         assert est == pytest.approx(2.0, rel=0.01)
 
 
 def test_emissive_triangles_stay_finite_on_and_in_the_plane():
     mesh = emissive_mesh()
-    ls = LightSet([], 1.0, mesh_lights=mesh)
+    L = packed(mesh=mesh)
     P = np.array([[-0.5, -0.9, 1.0], [0.0, 0.0, 1.0], [5.0, 5.0, 1.0], [0.1, 0, 1 + 1e-300],
                   mesh.v0[0], mesh.v0[0] + 0.5 * mesh.e1[0]])
     rng = np.random.default_rng(1)
     for _ in range(20):
-        s, idx, _ = ls.sample(P, rng.random(len(P)), rng.random((len(P), 2)))
+        s = kernel_sample(L, P, rng.random((len(P), 2)), rng.random(len(P)))
         assert np.all(np.isfinite(s.wi)) and np.all(np.isfinite(s.pdf))
         assert np.all(np.isfinite(s.radiance)) and np.all(np.isfinite(s.margin))
     tiny = EmissiveTriangles([[0, 0, 0]], [[1e-7, 0, 0]], [[0, 1e-7, 0]], [[1, 1, 1]], [0], 1)
     huge = EmissiveTriangles([[0, 0, 0]], [[1e4, 0, 0]], [[0, 1e4, 0]], [[1, 1, 1]], [0], 1)
     for m in (tiny, huge):
-        ls = LightSet([], 1.0, mesh_lights=m)
-        s, _, _ = ls.sample(np.array([[0.0, 0.0, 1.0], [0, 0, 0]]), np.array([0.5, 0.5]),
-                            np.array([[0.3, 0.4], [0.5, 0.5]]))
+        s = kernel_sample(packed(mesh=m), np.array([[0.0, 0.0, 1.0], [0, 0, 0]]),
+                          np.array([[0.3, 0.4], [0.5, 0.5]]), np.array([0.5, 0.5]))
         assert np.all(np.isfinite(s.pdf)) and np.all(np.isfinite(s.radiance))
 
 
@@ -729,10 +785,10 @@ def test_degenerate_and_dark_triangles_are_not_lights():
 
 
 def test_solid_angle_threshold_is_where_the_docstring_says():
-    model = AreaLightModel(area_light("SQUARE", 1.0))
+    L = packed(area_light("SQUARE", 1.0))
     near = np.array([0.0, 0.0, 0.0])
     far = np.array([0.0, 0.0, 1.0 - 1.0 / np.sqrt(SOLID_ANGLE_MIN) * 1.5])
-    assert _solid_angle_used(model, near)
-    assert not _solid_angle_used(model, far)
+    assert _solid_angle_used(L, near)
+    assert not _solid_angle_used(L, far)
     in_plane = np.array([0.1, 0.1, 1.0 - 1e-9])
-    assert not _solid_angle_used(model, in_plane)
+    assert not _solid_angle_used(L, in_plane)

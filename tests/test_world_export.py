@@ -258,6 +258,7 @@ def test_sampling_method_none_keeps_the_world_from_being_a_light(bpy_drt):
     not (escaping rays alone find it, as in Cycles). A uniform world is sampled too (for
     less noise; Cycles relies on escaping rays alone there), marked so that next-event
     estimation evaluates refraction towards it as those rays see it."""
+    from engine.kernels.lights import is_uniform_world, pack_lights
     from engine.lights import LightSet
     world, bg = _world(bpy_drt, "sampled")
     _environment(bpy_drt, world, bg, _image(bpy_drt, "hdr_sampled"))
@@ -266,11 +267,13 @@ def test_sampling_method_none_keeps_the_world_from_being_a_light(bpy_drt):
     unlit = _export(world)[0]
     assert lit.light_sampling and not unlit.light_sampling
     lights = LightSet([], 10.0, world=lit)
-    assert lights.env_index is not None and not lights.uniform_world([lights.env_index])[0]
+    assert lights.env_index is not None
+    assert not is_uniform_world(pack_lights(lights), lights.env_index)
     assert LightSet([], 10.0, world=unlit).env_index is None
     assert LightSet([], 10.0, world=unlit).world is not None       # still seen by rays
     plain, _ = _world(bpy_drt, "uniform")
     uniform = LightSet([], 10.0, world=_export(plain)[0])
-    assert uniform.env_index is not None and uniform.uniform_world([uniform.env_index])[0]
+    assert uniform.env_index is not None
+    assert is_uniform_world(pack_lights(uniform), uniform.env_index)
     plain.cycles.sampling_method = "NONE"
     assert LightSet([], 10.0, world=_export(plain)[0]).env_index is None

@@ -2,7 +2,7 @@
 small NumPy-semantics helpers the kernels share (clip, sign, safe_unit).
 
 Each function computes the same floating-point operations, in the same order, as its
-vectorised original in `engine.warp` / `engine.lights`, so the compiled samplers give
+vectorised original in `engine.warp`, so the compiled samplers give
 the NumPy reference's values (bit for bit where both use the same libm).
 """
 from __future__ import annotations
@@ -54,7 +54,7 @@ def sign(x):
 
 @kernel
 def safe_unit(x, y, z):
-    """engine.lights._safe_unit: (unit vector, length), (0, 0, 1) for a zero vector."""
+    """(unit vector, length), (0, 0, 1) for a zero vector."""
     n = math.sqrt(x * x + y * y + z * z)
     if n > 0.0:
         return x / n, y / n, z / n, n
@@ -97,7 +97,7 @@ def uniform_sphere(u0, u1):
 
 @kernel
 def cone_from_one_minus_cos(u0, u1, one_minus_cos_max):
-    """engine.lights.cone_from_one_minus_cos: a uniform direction in the cone about +Z
+    """A uniform direction in the cone about +Z
     with 1 - cos(theta_max) given; also returns 1 - cos(theta) of the direction."""
     omz = u0 * one_minus_cos_max
     sin_t = math.sqrt(max0(omz * (2.0 - omz)))

@@ -1,5 +1,33 @@
-"""Light sampling as compiled scalar kernels: a faithful port of `engine.lights`
-(LightSet and every light model) and `engine.mesh_lights` (emissive triangles).
+"""Light sampling as compiled scalar kernels, for the lamps of `engine.lights` (their
+parameters, packed by pack.py) and the emissive triangles of `engine.mesh_lights`.
+
+Every light has sample (one direction per shading point from u in [0,1)^2, through a
+continuous map of u, so stratification survives; pdf in solid angle), an intersection
+(what a BSDF-sampled ray sees) and pdf (the solid-angle pdf with which sampling produces
+a direction: a deterministic function of the point and the direction, so whatever
+strategy the sampler chose for the point, the pdf chooses the same, and the power
+heuristic weights of multiple importance sampling sum to one;
+tests/test_kernel_lights.py checks that every sample is found again with its pdf).
+
+Strategies (all pdfs in solid angle, omega = solid angle subtended, A = area):
+- sphere light outside the sphere: the uniform cone it subtends, pdf 1 / (2 pi (1 - cos
+  theta_max)) with sin^2 theta_max = r^2 / d^2 (1 - cos computed without cancellation so
+  a 1e-6 m light 1e4 m away keeps its precision); inside: uniform sphere, 1 / (4 pi).
+- sun disc: uniform cone, 1 / (2 pi (1 - cos(a/2))), 1 - cos(x) = 2 sin^2(x/2).
+- rectangle and square area lights: uniform in the spherical rectangle they subtend,
+  pdf 1 / omega (Urena, Fajardo, King 2013, "An Area-Preserving Parametrization for
+  Spherical Rectangles", EGSR), rewritten here in a cancellation-free form (see
+  spherical_rectangle.py). Fallback to uniform area sampling, pdf d^2 / (A |cos theta_l|),
+  when (area.py):
+    omega < SOLID_ANGLE_MIN           (far or edge-on light: area sampling is then as good
+                                       and the spherical inversion loses digits),
+    |z| < IN_PLANE_REL x (edge sum)   (p almost in the light's plane: omega -> 0 or 2 pi),
+    the edges are not perpendicular   (a sheared transform makes a parallelogram).
+- disk and ellipse area lights: uniform area sampling (Shirley-Chiu concentric map), as
+  Cycles does for ellipses.
+- point light with soft_falloff and r > 0: uniform area sampling of the facing disc.
+
+Use:
 
     L = pack_lights(light_set)                 # once per scene (NumPy arrays)
     k, wix, wiy, wiz, dist, r, g, b, pdf, delta, margin = sample(L, px, py, pz, u_pick, u1,
@@ -13,7 +41,7 @@
     n_suns(L);  sun_escaped(L, j, dx, dy, dz, time) -> (r, g, b, pdf)
     n_entries(L);  entry_visibility(L, k)
 
-Every pdf is in solid angle with the pick probability included, as LightSet's. `time` is
+Every pdf is in solid angle with the pick probability (LightSet.select_pdf) included. `time` is
 the ray's shutter time in [0, 1]: a lamp that moves during the shutter is its slice at
 that time (pack.py, TimeSlicedLight). Array drivers for tests: `batch`.
 """

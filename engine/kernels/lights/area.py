@@ -1,6 +1,6 @@
 """Area lamps, SQUARE / RECTANGLE / DISK / ELLIPSE (`engine.lights.AreaLightModel`).
 
-Strategy, a function of the shading point only (AreaLightModel._spherical): uniform in
+Strategy, a function of the shading point only (`_uses_solid_angle`): uniform in
 the spherical rectangle when the edges are perpendicular (C_SR_OK), the solid angle is
 at least SOLID_ANGLE_MIN and the point is farther than IN_PLANE_REL x (lx + ly) from the
 light's plane; uniform by area otherwise (concentric disk map for the round shapes).
@@ -26,7 +26,7 @@ def _uses_solid_angle(lamps, k, z, omega):
 
 @kernel(allocates=False)
 def sample_area(lamps, k, px, py, pz, u0, u1):
-    """AreaLightModel.sample for one point: (wix, wiy, wiz, dist, r, g, b, pdf, delta)."""
+    """A sample of area lamp k from one point: (wix, wiy, wiz, dist, r, g, b, pdf, delta)."""
     use = False
     x0 = x1 = y0 = y1 = zs = z = cos_k = sin_k = omega = 0.0
     if lamps[k, C_SR_OK] != 0.0:
@@ -61,7 +61,7 @@ def sample_area(lamps, k, px, py, pz, u0, u1):
 
 @kernel(allocates=False)
 def intersect_area(lamps, k, ox, oy, oz, dx, dy, dz):
-    """AreaLightModel.intersect for one ray: (t or inf, r, g, b); only the emitting
+    """Where one ray meets area lamp k: (t or inf, r, g, b); only the emitting
     side (rays travelling along the light's +Z) hits."""
     nx, ny, nz = lamps[k, C_NORMAL], lamps[k, C_NORMAL + 1], lamps[k, C_NORMAL + 2]
     cx, cy, cz = lamps[k, C_CENTER], lamps[k, C_CENTER + 1], lamps[k, C_CENTER + 2]
@@ -89,7 +89,7 @@ def intersect_area(lamps, k, ox, oy, oz, dx, dy, dz):
 
 @kernel(allocates=False)
 def pdf_area(lamps, k, px, py, pz, wix, wiy, wiz, t):
-    """AreaLightModel.pdf: solid-angle pdf of sample(p) producing wi, the light hit at
+    """The solid-angle pdf of sample_area(p) producing wi, the light hit at
     distance t (0 when t is not finite or wi grazes the light)."""
     cos_l = abs(wix * lamps[k, C_NORMAL] + wiy * lamps[k, C_NORMAL + 1]
                 + wiz * lamps[k, C_NORMAL + 2])

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..jit import kernel
-from .light_set import hit_lamps, lamp_pdf, mesh_pdf, sample, sun_escaped
+from .light_set import hit_lamps, lamp_pdf, mesh_pdf, sample, sun_escaped, world_escaped
 
 
 def _times(time, n):
@@ -15,13 +15,13 @@ def _times(time, n):
 
 
 def sample_batch(L, p, u_pick, u, time=None):
-    """LightSet.sample over n points (see `_sample_rows`)."""
+    """`light_set.sample` over n points (see `_sample_rows`)."""
     return _sample_rows(L, p, u_pick, u, _times(time, len(p)))
 
 
 @kernel
 def _sample_rows(L, p, u_pick, u, time):
-    """LightSet.sample over n points: (k (n,) int64, wi (n, 3), dist (n,), radiance
+    """`light_set.sample` over n points: (k (n,) int64, wi (n, 3), dist (n,), radiance
     (n, 3), pdf (n,) with the pick probability, delta (n,) bool, margin (n,))."""
     n = p.shape[0]
     k_out = np.empty(n, dtype=np.int64)
@@ -45,13 +45,13 @@ def _sample_rows(L, p, u_pick, u, time):
 
 
 def hit_lamps_batch(L, o, d, tmax, time=None):
-    """LightSet.hit_surfaces over n rays (see `_hit_rows`)."""
+    """`light_set.hit_lamps` over n rays (see `_hit_rows`)."""
     return _hit_rows(L, o, d, tmax, _times(time, len(o)))
 
 
 @kernel
 def _hit_rows(L, o, d, tmax, time):
-    """LightSet.hit_surfaces over n rays: (t (n,), k (n,) int64, radiance (n, 3))."""
+    """`light_set.hit_lamps` over n rays: (t (n,), k (n,) int64, radiance (n, 3))."""
     n = o.shape[0]
     t_out = np.empty(n)
     k_out = np.empty(n, dtype=np.int64)
@@ -66,13 +66,13 @@ def _hit_rows(L, o, d, tmax, time):
 
 
 def lamp_pdf_batch(L, k, p, wi, t, time=None):
-    """LightSet.pdf over n rows (see `_pdf_rows`)."""
+    """`light_set.lamp_pdf` over n rows (see `_pdf_rows`)."""
     return _pdf_rows(L, k, p, wi, t, _times(time, len(p)))
 
 
 @kernel
 def _pdf_rows(L, k, p, wi, t, time):
-    """LightSet.pdf over n rows: (n,) pdfs, pick probability included."""
+    """`light_set.lamp_pdf` over n rows: (n,) pdfs, pick probability included."""
     n = p.shape[0]
     out = np.empty(n)
     for i in range(n):
@@ -83,7 +83,7 @@ def _pdf_rows(L, k, p, wi, t, time):
 
 @kernel
 def mesh_pdf_batch(L, prim, p, q):
-    """LightSet.mesh_pdf over n rows: (n,) pdfs, pick probability included."""
+    """`light_set.mesh_pdf` over n rows: (n,) pdfs, pick probability included."""
     n = p.shape[0]
     out = np.empty(n)
     for i in range(n):
@@ -104,6 +104,20 @@ def _sun_rows(L, j, d, time):
     pdf = np.empty(n)
     for i in range(n):
         r, g, b, pd = sun_escaped(L, j, d[i, 0], d[i, 1], d[i, 2], time[i])
+        rad[i, 0], rad[i, 1], rad[i, 2] = r, g, b
+        pdf[i] = pd
+    return rad, pdf
+
+
+@kernel
+def world_escaped_batch(L, world, d):
+    """What n escaped diffuse rays along d see of the world: (radiance (n, 3), the MIS
+    pdf of the world light along d (n,))."""
+    n = d.shape[0]
+    rad = np.empty((n, 3))
+    pdf = np.empty(n)
+    for i in range(n):
+        r, g, b, pd = world_escaped(L, world, 2, d[i, 0], d[i, 1], d[i, 2])
         rad[i, 0], rad[i, 1], rad[i, 2] = r, g, b
         pdf[i] = pd
     return rad, pdf

@@ -13,7 +13,7 @@ INF = math.inf
 
 @kernel(allocates=False)
 def sample_environment(lamps, k, u0, u1):
-    """EnvironmentLightModel.sample: (wix, wiy, wiz, inf, r, g, b, pdf, delta = False)."""
+    """A uniform direction over the sphere: (wix, wiy, wiz, inf, r, g, b, pdf, delta = False)."""
     wx, wy, wz = uniform_sphere(u0, u1)
     return (wx, wy, wz, INF, lamps[k, C_RAD], lamps[k, C_RAD + 1], lamps[k, C_RAD + 2],
             lamps[k, C_ENV_PDF], False)

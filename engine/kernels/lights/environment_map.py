@@ -1,8 +1,7 @@
-"""The world's environment map as compiled scalar kernels: the twin of
-`engine.environment_map.EnvironmentMap` (lookup, direction sampling, pdf) and of
-`engine.piecewise_2d.PiecewiseConstant2D`, on the L[ENV_MAP:] fields of the packed
-light set (`pack.py`). Same operations in the same order as the NumPy code, so results
-agree to rounding (NumPy's matrix products go through BLAS)."""
+"""The world's environment map as compiled scalar kernels: its lookup, direction sampling
+and pdf (the model and the formulas: `engine.environment_map`'s module docstring; the
+2D distribution: `engine.piecewise_2d`'s), on the L[ENV_MAP:] fields of the packed light
+set (`pack.py`)."""
 from __future__ import annotations
 
 import math
@@ -59,7 +58,7 @@ def _to_map(L, x, y, z):
 
 @kernel(allocates=False)
 def map_radiance(L, dx, dy, dz):
-    """EnvironmentMap.radiance along one direction: (r, g, b)."""
+    """The map's radiance along one direction: (r, g, b)."""
     params = L[ENV_MAP]
     mx, my, mz = _to_map(L, dx, dy, dz)
     u, v = direction_to_uv(mx, my, mz)
@@ -69,7 +68,7 @@ def map_radiance(L, dx, dy, dz):
 
 @kernel
 def invert_cdf(cdf, u, guide):
-    """engine.piecewise_2d.invert_cdf for one row: (cell, offset in [0, 1]); the search
+    """The inverse of one CDF row at u: (cell, offset in [0, 1]); the search
     starts from the row's guide (kernels.cdf_search), the same cell as a full search."""
     n = cdf.shape[0] - 1
     i = min(max(last_at_most(cdf, u, guide), 0), n - 1)
@@ -87,7 +86,7 @@ def grid(L):
 
 @kernel(allocates=False)
 def cell_pdf(L, r, c):
-    """PiecewiseConstant2D.cell_pdf: density in (u, v) of cell (r, c)."""
+    """The density in (u, v) of cell (r, c) (engine.piecewise_2d's module docstring)."""
     marginal = L[ENV_MARGINAL]
     cond = L[ENV_CONDITIONAL]
     h, w = grid(L)
@@ -96,7 +95,7 @@ def cell_pdf(L, r, c):
 
 @kernel(allocates=False)
 def sample_map(L, u0, u1):
-    """EnvironmentMap.sample: (wx, wy, wz, solid-angle pdf; 0 = none)."""
+    """A direction sampled from the map: (wx, wy, wz, solid-angle pdf; 0 = none)."""
     h, w = grid(L)
     r, dv = invert_cdf(L[ENV_MARGINAL], u0, L[ENV_MARGINAL_GUIDE])
     c, du = invert_cdf(L[ENV_CONDITIONAL][r], u1, L[ENV_CONDITIONAL_GUIDE][r])
@@ -112,7 +111,7 @@ def sample_map(L, u0, u1):
 
 @kernel(allocates=False)
 def pdf_map(L, dx, dy, dz):
-    """EnvironmentMap.pdf of one unit direction."""
+    """The solid-angle pdf with which `sample_map` produces one unit direction."""
     h, w = grid(L)
     params = L[ENV_MAP]
     mx, my, mz = _to_map(L, dx, dy, dz)
@@ -131,7 +130,7 @@ def pdf_map(L, dx, dy, dz):
 
 @kernel(allocates=False)
 def sample_environment_map(L, u0, u1):
-    """EnvironmentMapLightModel.sample: (wix, wiy, wiz, inf, r, g, b, pdf, delta)."""
+    """The map as a light, sampled: (wix, wiy, wiz, inf, r, g, b, pdf, delta)."""
     wx, wy, wz, pdf = sample_map(L, u0, u1)
     r, g, b = 0.0, 0.0, 0.0
     if pdf > 0.0:

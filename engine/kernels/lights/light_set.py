@@ -94,7 +94,7 @@ def sample_lamp_at(L, k, px, py, pz, u1, u2, time):
 
 @kernel(allocates=False)
 def sample(L, px, py, pz, u_pick, u1, u2, time):
-    """LightSet.sample for one shading point p at shutter time `time`: pick an entry with
+    """Light sampling for one shading point p at shutter time `time`: pick an entry with
     u_pick, sample it with (u1, u2). Returns (k, wix, wiy, wiz, dist, r, g, b, pdf, delta,
     margin): k the entry (-1 for an empty set), dist inf for suns and the world, pdf in
     solid angle including the pick probability (0 = no sample), delta for points and
@@ -161,7 +161,7 @@ def entry_visibility(L, k):
 
 @kernel(allocates=False)
 def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t, time):
-    """LightSet.pdf for one direction at shutter time `time`: solid-angle pdf, pick
+    """The pdf of one direction at shutter time `time`: solid-angle pdf, pick
     probability included, of sampling wi from p towards lamp k hit at distance t (0 when
     k is not a lamp)."""
     lamps = L[LAMPS]
@@ -185,7 +185,7 @@ def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t, time):
 
 @kernel(allocates=False)
 def mesh_pdf(L, prim, px, py, pz, qx, qy, qz):
-    """LightSet.mesh_pdf for one hit: solid-angle pdf, pick probability included, of
+    """The pdf of an emissive triangle's point for one hit: solid-angle pdf, pick probability included, of
     next-event estimation from p sampling the point q of global triangle prim (0 when
     that triangle is not a light)."""
     j = triangle_entry(L, prim)
@@ -196,7 +196,7 @@ def mesh_pdf(L, prim, px, py, pz, qx, qy, qz):
 
 @kernel(allocates=False)
 def environment_pdf(L, dx, dy, dz):
-    """LightSet.environment_pdf for one escaped ray along d: pick probability x the world
+    """The world light's pdf for one escaped ray along d: pick probability x the world
     light's solid-angle pdf, 0 when the world is not a light."""
     env = L[ENV]
     k = int(env[0])
@@ -210,7 +210,7 @@ def environment_pdf(L, dx, dy, dz):
 
 @kernel(allocates=False)
 def is_uniform_world(L, k):
-    """Whether entry k is the uniform world (LightSet.uniform_world): next-event
+    """Whether entry k is the uniform world: next-event
     estimation towards it evaluates refraction on Walter's pairs only."""
     return k >= 0 and int(L[ENV][0]) == k and L[LAMPS][k, C_TYPE] == T_ENV
 
@@ -240,7 +240,7 @@ def environment_radiance(L):
 
 @kernel(allocates=False)
 def n_suns(L):
-    """len(LightSet.suns()): the suns with an angular diameter."""
+    """The number of suns with an angular diameter (L[SUNS])."""
     return L[SUNS].shape[0]
 
 

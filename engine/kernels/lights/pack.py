@@ -98,7 +98,7 @@ T_ENV_MAP = 7       # the world's environment map (L[ENV_MAP] and the following 
 
 # ---------------------------------------------------------------- lamp table columns
 C_TYPE = 0
-C_VISIBLE = 1       # 1: BSDF rays can hit it (hit_surfaces), 0: not (delta, sun, world)
+C_VISIBLE = 1       # 1: BSDF rays can hit it (lamp_hit), 0: not (delta, sun, world)
 C_VISIBILITY = 2    # the ray kinds that see it (engine.visibility mask)
 C_DELTA = 3         # 1 for point and zero-angle sun lights
 C_RAD = 4           # 3: radiance (sphere / disc, sun disc, area, world)

@@ -21,7 +21,7 @@ INF = math.inf
 
 @kernel(allocates=False)
 def spot_factor(lamps, k, dx, dy, dz):
-    """PointLightModel._spot for the direction (dx, dy, dz) from the light."""
+    """The spot cone's smoothstep falloff for the direction (dx, dy, dz) from the light."""
     if lamps[k, C_IS_SPOT] == 0.0:
         return 1.0
     c = dx * lamps[k, C_AXIS] + dy * lamps[k, C_AXIS + 1] + dz * lamps[k, C_AXIS + 2]
@@ -34,7 +34,7 @@ def spot_factor(lamps, k, dx, dy, dz):
 
 @kernel
 def sphere_one_minus_cos(radius, d2):
-    """PointLightModel._cone: 1 - cos(theta_max) of the subtended cone."""
+    """1 - cos(theta_max) of the cone a sphere lamp subtends, without cancellation."""
     sin2 = radius * radius / (1e-300 if d2 < 1e-300 else d2)
     if sin2 > 1.0:
         sin2 = 1.0
@@ -75,7 +75,7 @@ def _sample_disc(lamps, k, px, py, pz, u0, u1, ax, ay, az, dist_c):
 
 @kernel(allocates=False)
 def sample_point(lamps, k, px, py, pz, u0, u1):
-    """PointLightModel.sample for one point:
+    """A sample of point, spot, sphere or disc lamp k from one point:
     (wix, wiy, wiz, dist, r, g, b, pdf, delta), pdf in solid angle (1 for a delta)."""
     tox = lamps[k, C_POS] - px
     toy = lamps[k, C_POS + 1] - py
@@ -116,7 +116,7 @@ def sample_point(lamps, k, px, py, pz, u0, u1):
 
 @kernel(allocates=False)
 def intersect_point(lamps, k, ox, oy, oz, dx, dy, dz):
-    """PointLightModel.intersect for one ray: (t or inf, r, g, b)."""
+    """Where one ray meets sphere or disc lamp k: (t or inf, r, g, b)."""
     if lamps[k, C_TYPE] == T_POINT:
         return INF, 0.0, 0.0, 0.0
     px, py, pz = lamps[k, C_POS], lamps[k, C_POS + 1], lamps[k, C_POS + 2]
@@ -153,7 +153,7 @@ def intersect_point(lamps, k, ox, oy, oz, dx, dy, dz):
 
 @kernel(allocates=False)
 def pdf_point(lamps, k, px, py, pz, wix, wiy, wiz, t):
-    """PointLightModel.pdf: solid-angle pdf of sampling wi (light hit at distance t)."""
+    """The solid-angle pdf of sampling wi (light hit at distance t)."""
     kind = lamps[k, C_TYPE]
     if kind == T_POINT:
         return 0.0

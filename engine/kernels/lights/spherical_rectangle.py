@@ -1,12 +1,34 @@
-"""The spherical rectangle an area lamp subtends from a point, one point at a time
-(`engine.lights.SphericalRectangle`, Urena, Fajardo, King 2013, in the cancellation-free
-form documented there): its solid angle and the area-preserving sampling map.
+"""The spherical rectangle an area lamp subtends from a point, one point at a time:
+its solid angle and the area-preserving sampling map (Urena, Fajardo, King 2013), in a
+cancellation-free form.
 
-The four corner angles g_i = atan2(z r_i, +-x_i y_i) enter only as their sum (the solid
-angle is g0 + g1 + g2 + g3 - 2 pi) and as g2 + g3 (the map's starting angle, k = 2 pi -
-g2 - g3, through its cosine and sine): so they are added as the arguments of complex
-numbers, multiplied, and one atan2 gives the solid angle, one sincos the sample's angle
-(four atan2, a cos and a sin before 2026-11-26: the results agree to 1e-11 relative).
+Local frame: x, y along the rectangle's edges (lengths lx, ly) from its corner c,
+z = x cross y; with (x0, y0, z') = (c - p) in that frame, the rectangle is
+[x0, x1] x [y0, y1] at height z' (x1 = x0 + lx, y1 = y0 + ly); z = |z'|.
+
+Solid angle omega = g0 + g1 + g2 + g3 - 2 pi with the interior angles g_i at the
+corners, here as atan2(|n_i x n_j|, -n_i . n_j) of the edge-plane normals, which
+simplifies to  g = atan2(z |v|, s x y)  at a corner v = (x, y, z) with the sign s
+alternating (+, -, +, -) over (x1, y0), (x1, y1), (x0, y1), (x0, y0): exact even
+when z -> 0 or omega -> 0 (acos of a dot product would lose half the digits). The
+angles are added as arguments of the complex numbers c = s x y + i z |v|: omega is
+the argument of c0 c1 c2 c3 (one atan2, taken in [0, 2 pi); an argument just below 0
+is rounding, a solid angle of 0), and the map's starting angle k = 2 pi - g2 - g3
+enters through its cosine and sine, those of the conjugate of c2 c3.
+
+Sampling u -> (xu, yv) (the paper's eqs. with cancellation-free rewrites):
+  k = 2 pi - g2 - g3,  au = u0 omega + k  (cos and sin of au from those of u0 omega
+  and of k),
+  N = cos(au) b0 - b1,  D = sin(au),  b0 = -y0 / sqrt(y0^2 + z^2),
+  b1 = y1 / sqrt(y1^2 + z^2),  1 - b0^2 = z^2 / (y0^2 + z^2),
+  xu = sign(N) z D / sqrt(N^2 - (1 - b0^2) D^2)   [= -cu z0 / sqrt(1 - cu^2) of the
+       paper with cu = sign(fu) / sqrt(fu^2 + b0^2), fu = N / D; no division by D]
+  dd = sqrt(xu^2 + z^2), h_i = y_i / sqrt(dd^2 + y_i^2), hv = h0 + u1 (h1 - h0),
+  yv = hv dd / sqrt((1 - hv)(1 + hv)),  with 1 -+ hv interpolated from 1 -+ h_i, each
+  computed without cancellation.
+Both steps are continuous and monotonic in u; the result is uniform in solid angle.
+
+(Four atan2, a cos and a sin before 2026-11-26; the results agree to 1e-11 relative.)
 """
 from __future__ import annotations
 

@@ -14,7 +14,7 @@ INF = math.inf
 
 @kernel(allocates=False)
 def sample_sun(lamps, k, u0, u1):
-    """SunLightModel.sample: (wix, wiy, wiz, dist = inf, r, g, b, pdf, delta)."""
+    """A direction towards sun k: (wix, wiy, wiz, dist = inf, r, g, b, pdf, delta)."""
     if lamps[k, C_TYPE] == T_SUN_DELTA:
         return (lamps[k, C_TO_LIGHT], lamps[k, C_TO_LIGHT + 1], lamps[k, C_TO_LIGHT + 2],
                 INF, lamps[k, C_IRRADIANCE], lamps[k, C_IRRADIANCE + 1],
@@ -30,7 +30,7 @@ def sample_sun(lamps, k, u0, u1):
 
 @kernel(allocates=False)
 def inside_sun(lamps, k, dx, dy, dz):
-    """SunLightModel._inside: d within the sun's disc (1 - cos compared exactly)."""
+    """Whether d is within the sun's disc (1 - cos compared exactly)."""
     ex = dx - lamps[k, C_TO_LIGHT]
     ey = dy - lamps[k, C_TO_LIGHT + 1]
     ez = dz - lamps[k, C_TO_LIGHT + 2]
@@ -39,7 +39,7 @@ def inside_sun(lamps, k, dx, dy, dz):
 
 @kernel(allocates=False)
 def pdf_sun(lamps, k, wix, wiy, wiz):
-    """SunLightModel.pdf: solid-angle pdf of sampling wi (0 for a delta sun)."""
+    """The solid-angle pdf of sampling wi (0 for a delta sun)."""
     if lamps[k, C_TYPE] == T_SUN_DELTA:
         return 0.0
     if inside_sun(lamps, k, wix, wiy, wiz):
@@ -49,7 +49,7 @@ def pdf_sun(lamps, k, wix, wiy, wiz):
 
 @kernel(allocates=False)
 def escaped_sun(lamps, k, dx, dy, dz):
-    """SunLightModel.escaped: the radiance an escaping ray d sees (0 off the disc)."""
+    """The radiance an escaping ray d sees (0 off the disc)."""
     if lamps[k, C_TYPE] == T_SUN_DELTA or not inside_sun(lamps, k, dx, dy, dz):
         return 0.0, 0.0, 0.0
     return lamps[k, C_RAD], lamps[k, C_RAD + 1], lamps[k, C_RAD + 2]

@@ -12,7 +12,7 @@ from .pack import (TRI_AREA, TRI_E1, TRI_E2, TRI_ENTRY, TRI_NORMAL, TRI_RADIANCE
 
 @kernel
 def square_to_triangle(u0, u1):
-    """EmissiveTriangles.square_to_triangle: edge weights (b1, b2), uniform in area."""
+    """Heitz's square-to-triangle map: edge weights (b1, b2), uniform in area."""
     if u1 > u0:
         return 0.5 * u0, u1 - 0.5 * u0
     return u0 - 0.5 * u1, 0.5 * u1
@@ -20,7 +20,7 @@ def square_to_triangle(u0, u1):
 
 @kernel(allocates=False)
 def sample_triangle(L, j, px, py, pz, u0, u1):
-    """EmissiveTriangles.sample for triangle entry j (pick probability NOT included):
+    """A uniform point of triangle entry j, seen from p (pick probability NOT included):
     (wix, wiy, wiz, dist, r, g, b, pdf, margin)."""
     v0, e1, e2, nrm = L[TRI_V0], L[TRI_E1], L[TRI_E2], L[TRI_NORMAL]
     b1, b2 = square_to_triangle(u0, u1)
@@ -46,7 +46,7 @@ def sample_triangle(L, j, px, py, pz, u0, u1):
 
 @kernel(allocates=False)
 def triangle_entry(L, prim):
-    """EmissiveTriangles.entry_of: triangle entry of global triangle id prim, or -1."""
+    """The light entry of global triangle id prim, or -1."""
     entry = L[TRI_ENTRY]
     if prim >= 0 and prim < entry.shape[0]:
         return entry[prim]
@@ -55,7 +55,7 @@ def triangle_entry(L, prim):
 
 @kernel(allocates=False)
 def pdf_triangle(L, j, px, py, pz, qx, qy, qz):
-    """EmissiveTriangles.pdf_area_to_solid_angle: solid-angle pdf at p of the point q
+    """The solid-angle pdf at p of the point q
     on triangle entry j, d^3 / (A |n . (q - p)|)."""
     tx, ty, tz = qx - px, qy - py, qz - pz
     d2 = tx * tx + ty * ty + tz * tz
