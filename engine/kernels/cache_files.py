@@ -20,6 +20,7 @@ cache has no code for this CPU.
 """
 from __future__ import annotations
 
+import functools
 import io
 import os
 import pickle
@@ -68,9 +69,11 @@ def _features(text: str) -> set[str]:
     return {f[1:] for f in text.split(",") if f.startswith("+")}
 
 
-def host_features() -> set[str]:
+@functools.lru_cache(maxsize=1)
+def host_features() -> frozenset[str]:
+    """The instruction-set features of this CPU (asked of LLVM once per process)."""
     from llvmlite import binding as ll
-    return {name for name, on in ll.get_host_cpu_features().items() if on}
+    return frozenset(name for name, on in ll.get_host_cpu_features().items() if on)
 
 
 def compatible(magic, host_magic, host: set[str]) -> bool:
@@ -87,8 +90,9 @@ def compatible(magic, host_magic, host: set[str]) -> bool:
 
 
 class RelocatableCacheFile(caching.IndexDataCacheFile):
-    """Numba's index and data files, read with `RelocatingUnpickler`; `fallback_keys`
-    finds, for a key of this CPU, the key of code compiled for a compatible one."""
+    """Numba's index and data files, read with `RelocatingUnpickler`; `compatible_key`
+    finds, for a key of this CPU, the key of code compiled for a compatible one, and
+    `load_compatible` loads that code reading the index once."""
 
     def _load_index(self):
         try:
@@ -109,12 +113,25 @@ class RelocatableCacheFile(caching.IndexDataCacheFile):
         with open(self._data_path(name), "rb") as f:
             return relocating_loads(f.read())
 
-    def compatible_key(self, key, exact=False):
+    def load_compatible(self, key, exact=False):
+        """The cached data of `compatible_key(key, exact)`, or None (the index is read
+        once: Numba's `load` would read it again)."""
+        overloads = self._load_index()
+        found = self.compatible_key(key, exact, overloads)
+        if found is None:
+            return None
+        try:
+            return self._load_data(overloads[found])
+        except OSError:                            # removed meanwhile: compile instead
+            return None
+
+    def compatible_key(self, key, exact=False, overloads=None):
         """The index's key for the same signature and code compiled for a CPU this one
         can run (the host's own first, then the tier with the most features; only the
-        host's own when `exact`), or None."""
+        host's own when `exact`), or None. `overloads`: the index, if already read."""
         sig, host_magic, code = key
-        overloads = self._load_index()
+        if overloads is None:
+            overloads = self._load_index()
         if key in overloads or exact:
             return key if key in overloads else None
         host = host_features()

@@ -170,8 +170,7 @@ class EngineFunctionCache(caching.FunctionCache):
             return None
         key = self._index_key(sig, target_context.codegen())
         for files, exact in ((self._cache_file, True), (self._shipped, False)):
-            found = files.compatible_key(key, exact) if files is not None else None
-            data = files.load(found) if found is not None else None
+            data = files.load_compatible(key, exact) if files is not None else None
             if data is not None:
                 return self._impl.rebuild(target_context, data)
         return None
