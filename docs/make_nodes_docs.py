@@ -79,8 +79,7 @@ KNOWN = """## Known differences
   in its largest block, a bumped glossy sphere under a low sun to 0.09% and 0.6%
   (`tests/test_bump_vs_cycles.py`).
   Texture Coordinate's Normal is not moved at the offset hits (Cycles moves it with
-  the interpolated normal), and the NumPy reference integrator has no footprints
-  (its bumps are flat).
+  the interpolated normal).
 - **Inputs that vary per hit but feed a parameter DRT keeps per material** (IOR,
   Transmission, Specular IOR Level, Emission Strength, a Mix Shader's Fac) take the
   graph's average over the unit square of UV and generated coordinates (reported).

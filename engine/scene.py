@@ -119,8 +119,8 @@ class Material:
     # mix: (Material, Material), a Mix Shader whose Fac varies per hit (the program's
     # "mix" output): each hit is shaded by one of the two, the second with probability
     # Fac (an unbiased estimate of Cycles' weighted sum). The parent's own parameters
-    # are the mixture at the Fac's average: the NumPy reference renders that, and its
-    # alpha and emission are the hit's.
+    # are the mixture at the Fac's average (its summary); its alpha and emission are
+    # the hit's.
 
     def textures(self) -> dict:
         """{parameter name: TextureInput} of the textured parameters."""

@@ -97,17 +97,3 @@ def shadow_origin(positions, corners, corner_normals, cutoff, prim, u, v, px, py
             if not ngl > 0.0:
                 return px, py, pz    # the light is under the plane: its own triangle counts
     return offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
-
-
-@kernel
-def shadow_origins(positions, corners, corner_normals, cutoff, prim, bary, position, ng, ns,
-                   scale, wi):
-    """`shadow_origin` for hits given as arrays (the NumPy reference): (n, 3)."""
-    out = np.empty_like(position)
-    for i in range(prim.shape[0]):
-        x, y, z = shadow_origin(positions, corners, corner_normals, cutoff, prim[i],
-                                bary[i, 0], bary[i, 1], position[i, 0], position[i, 1],
-                                position[i, 2], ng[i, 0], ng[i, 1], ng[i, 2], ns[i, 0],
-                                ns[i, 1], ns[i, 2], scale[i], wi[i, 0], wi[i, 1], wi[i, 2])
-        out[i, 0], out[i, 1], out[i, 2] = x, y, z
-    return out
