@@ -14,6 +14,8 @@ is no noise), and the comparison fails when every light sample weighs 10% too mu
 the MIS image (the control)."""
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from engine import (AreaLight, Material, PointLight, RenderContext, RenderSettings, SunLight,
@@ -50,6 +52,13 @@ def _materials_scene(size=24):
                  AreaLight(m, (10, 10, 10), "ELLIPSE", 0.4, 0.2, visible_camera=False)]
     s.world = World((0.2, 0.25, 0.3))
     return s
+
+
+@functools.lru_cache(maxsize=None)
+def _materials_image_mean(mode, light_scale=1.0):
+    """`_image_mean` of the materials scene at SAMPLES, rendered once per (mode, scale)
+    for the module: the agreement test and its control share the BSDF-only image."""
+    return _image_mean(_materials_scene(), mode, SAMPLES, light_scale)
 
 
 def _image_mean(scene, mode, samples, light_scale=1.0):
@@ -91,8 +100,7 @@ def _agree(a, b):
 
 
 def test_light_bsdf_and_mis_estimators_agree():
-    scene = _materials_scene()
-    got = {mode: _image_mean(scene, mode, SAMPLES) for mode in ("mis", "light", "bsdf")}
+    got = {mode: _materials_image_mean(mode) for mode in ("mis", "light", "bsdf")}
     for mode, (m, se) in got.items():
         print(mode, m.round(5), "se", se.round(5))
     assert got["mis"][0].min() > 0.05                    # a lit scene
@@ -103,9 +111,8 @@ def test_light_bsdf_and_mis_estimators_agree():
 
 
 def test_a_light_sampling_error_is_caught():
-    scene = _materials_scene()
-    right = _image_mean(scene, "bsdf", SAMPLES)
-    wrong = _image_mean(scene, "mis", SAMPLES, light_scale=1.1)
+    right = _materials_image_mean("bsdf")
+    wrong = _materials_image_mean("mis", light_scale=1.1)
     print("bsdf", right[0].round(5), "mis with light samples x1.1", wrong[0].round(5))
     assert not _agree(right, wrong)
 
