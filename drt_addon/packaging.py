@@ -374,7 +374,8 @@ def package(output_dir: str | None = None, root: str = REPO_ROOT,
             group_wheels = [w for w in wheels if any(w in per_platform[p] for p in group)]
             _stage(root, stage, manifest, group, group_wheels)
             if group == [with_kernels]:
-                shutil.copytree(kernels, os.path.join(stage, prebuilt_kernels.FOLDER))
+                shutil.copytree(kernels, os.path.join(stage, prebuilt_kernels.FOLDER),
+                                ignore=shutil.ignore_patterns("*.lock"))
             _blender_ext(tool, python, "build", "--source-dir", stage, "--output-dir",
                          output_dir, "--split-platforms")
     for zip_path in zips:

@@ -178,3 +178,51 @@ def test_every_kernel_runs_as_plain_python(tmp_path):
     compiled = film.mean()
     assert compiled.max() > 0.05                       # lit: the comparison shows something
     np.testing.assert_allclose(python, compiled, rtol=1e-9, atol=1e-12)
+
+
+TOGETHER_PROBE = """
+import os, sys, time
+import numpy as np
+if sys.argv[1] == "unlocked":
+    import engine.kernels.compile_lock as compile_lock
+    compile_lock.fcntl = None                   # as where no lock can be taken
+from engine.sampling import make_sampler
+from engine.sampling.dispatch import batch_1d
+from engine.kernels import compile_lock
+open(sys.argv[2], "w").close()                  # ready; both start compiling together
+while not all(os.path.exists(p) for p in sys.argv[3:]):
+    time.sleep(0.01)
+s = make_sampler('jittered', 3, 16)
+v = float(s.get_1d(5, np.arange(8), np.arange(8)).sum())
+print(repr(v), sum(batch_1d.stats.cache_hits.values()), len(compile_lock.held()))
+"""
+
+
+def _two_at_once(tmp_path, mode):
+    src = _copy_engine(tmp_path / mode)
+    env = dict(os.environ, PYTHONPATH=str(src), NUMBA_CACHE_DIR=str(tmp_path / mode / "c"))
+    ready = [str(tmp_path / mode / f"ready{k}") for k in range(2)]
+    procs = [subprocess.Popen([sys.executable, "-c", TOGETHER_PROBE, mode, ready[k], *ready],
+                              cwd=src, env=env, stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True)
+             for k in range(2)]
+    out = []
+    for p in procs:
+        stdout, stderr = p.communicate(timeout=600)
+        assert p.returncode == 0, stderr
+        value, hits, held = stdout.split()
+        out.append((float(value), int(hits), int(held)))
+    return out
+
+
+def test_processes_sharing_the_cache_compile_a_kernel_once(tmp_path):
+    """Two processes calling a kernel together on an empty cache: one compiles the kernel (and
+    its callees), the other waits on the compile lock and loads what it saved
+    (engine/kernels/compile_lock.py); neither holds a lock at the end. Without locks
+    (the control) both compile."""
+    locked = _two_at_once(tmp_path, "locked")
+    assert locked[0][0] == locked[1][0]
+    assert sorted(hits for _, hits, _ in locked) == [0, 1]
+    assert all(held == 0 for _, _, held in locked)
+    unlocked = _two_at_once(tmp_path, "unlocked")
+    assert [hits for _, hits, _ in unlocked] == [0, 0]

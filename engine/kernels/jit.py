@@ -18,6 +18,8 @@ When none can be written, kernels compile in memory on every process start inste
 failing. A package's shipped kernels (`engine/kernels/prebuilt`, compiled for CPU tiers by
 `python -m drt_addon package`) are read when that cache has none for this CPU, writable
 or not; files load under any name of the engine package (cache_files.py).
+Processes sharing the cache compile each kernel once: the others wait and load it
+(compile_lock.py).
 `DRT_NUMBA_CACHE=0` compiles every kernel in memory (a test and debug switch).
 `DRT_BORROWING=0` compiles every kernel with reference counting, to measure what
 borrowing saves (docs/borrowing_benchmark.py); it has its own cache fingerprint.
@@ -36,7 +38,7 @@ from numba import njit, types
 from numba.core import caching, event
 from numba.core.runtime import rtsys
 
-from . import cache_files
+from . import cache_files, compile_lock
 
 ENGINE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -152,6 +154,7 @@ class EngineFunctionCache(caching.FunctionCache):
         # nothing can be written: the shipped kernels are then the only ones on disk)
         self._cache_file = (cache_files.RelocatableCacheFile(self._cache_path, base, stamp)
                             if CACHE else None)
+        self._lock_path = os.path.join(self._cache_path, base + ".lock")
         self._shipped = None
         if SHIPPED_ROOT is not None:
             sub = EngineCacheLocator.get_suitable_cache_subpath(inspect.getfile(py_func))
@@ -159,9 +162,18 @@ class EngineFunctionCache(caching.FunctionCache):
                 os.path.join(SHIPPED_ROOT, sub), base, stamp)
 
     def load_overload(self, sig, target_context):
+        """The cached code, or None after taking this kernel's compile lock (another
+        process compiling it meanwhile is waited for, and its code loaded)."""
         rtsys.initialize(target_context)
         with self._guard_against_spurious_io_errors():
-            return self._load_overload(sig, target_context)
+            data = self._load_overload(sig, target_context)
+            if data is None and self._cache_file is not None:
+                self._impl.locator.ensure_cache_path()
+                if compile_lock.acquire(self._lock_path):
+                    data = self._load_overload(sig, target_context)
+                    if data is not None:
+                        compile_lock.release(self._lock_path)
+            return data
 
     def _load_overload(self, sig, target_context):
         """This CPU's code from the writable cache, else code for a CPU tier this one can
@@ -177,7 +189,10 @@ class EngineFunctionCache(caching.FunctionCache):
 
     def _save_overload(self, sig, data):
         if self._cache_file is not None:       # else compiled in memory only
-            super()._save_overload(sig, data)
+            try:
+                super()._save_overload(sig, data)
+            finally:
+                compile_lock.release(self._lock_path)
 
 
 if LOADS and EngineCacheLocator not in caching.CacheImpl._locator_classes:
