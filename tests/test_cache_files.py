@@ -61,6 +61,12 @@ def test_engine_modules_are_read_as_this_package(monkeypatch):
     assert cf.canonical_module("engine") == installed
     assert cf.canonical_module("numba.core.types") == "numba.core.types"
     assert cf.canonical_module("engineering") == "engineering"
+    # what another copy of the add-on saved: a legacy add-on, another extension repository
+    assert cf.canonical_module("drt.engine.kernels.records") == installed + ".kernels.records"
+    assert (cf.canonical_module("bl_ext.studio_repo.drt.engine.kernels.records")
+            == installed + ".kernels.records")
+    assert cf.relocating_loads(b"cdrt.engine.kernels.records\nRecord\n.") is _Record
+    assert cf.canonical_module("other.engine.kernels") == "other.engine.kernels"
 
 
 @pytest.mark.parametrize("tier", ["generic", "x86-64-v3"])

@@ -15,14 +15,11 @@ Blender exits 0 even when a render engine raised (a blank image is saved), so ev
 checked in its log (no Traceback or Error line, `Sample i/N` progress lines, `Saved:`) and
 in its pixels (black sky at the top, the lamp's light on the plane, the red cube).
 
-Numba's kernel cache cannot be shared with the rest of the suite: cached kernels name
-their modules, `engine.*` in this process and `drt.engine.*` in the add-on. Blender's
-kernels are compiled by the first render of a fresh checkout into a cache of their own,
-kept per checkout in the system's temporary folder beside the add-on's link (Numba keys
-its cache by the sources' folder, so that path is kept stable too); later runs load them.
-So that the compile stays short, the scene renders with DRT's Whitted integrator, whose
-kernels compile in about 10 s; the path tracer's take minutes (the bpy-module tests cover
-it; it rendered this scene in Debian's Blender too when tried by hand).
+Blender's DRT shares the suite's kernel cache (the checkout's engine/kernels/__pycache__,
+reached through the add-on's link): cached kernels load under the add-on's module name
+(`drt.engine.*`) as under the suite's (`engine.*`), engine/kernels/cache_files.py, so a
+kernel compiled by either is compiled once (engine/kernels/compile_lock.py). The scene
+renders with DRT's Whitted integrator, on the same compiled tracer as the path tracer.
 Without a `blender` on PATH the tests are skipped, saying that they did not run.
 """
 from __future__ import annotations
@@ -67,7 +64,7 @@ def _link(target: str, link: str) -> None:
 
 class LegacyBlender:
     """The blender binary with DRT as a legacy add-on: throwaway preferences and packages
-    folder per test module; the add-on link and its kernel cache kept per checkout."""
+    folder per test module; the add-on's link kept per checkout."""
 
     def __init__(self, blender: str, home):
         self.blender, self.home = blender, home
@@ -81,8 +78,8 @@ class LegacyBlender:
             for folder in _package_dirs(name):
                 os.symlink(folder, site / os.path.basename(folder))
         self.env = {**os.environ, "BLENDER_USER_SCRIPTS": scripts,
-                    "BLENDER_USER_CONFIG": str(home / "config"), "PYTHONPATH": str(site),
-                    "NUMBA_CACHE_DIR": os.path.join(stable, "numba_cache")}
+                    "BLENDER_USER_CONFIG": str(home / "config"), "PYTHONPATH": str(site)}
+        self.env.pop("NUMBA_CACHE_DIR", None)       # the checkout's own cache
         self.blend = str(home / "scene.blend")
 
     def run(self, *args) -> subprocess.CompletedProcess:

@@ -6,8 +6,9 @@ pickles, and a pickle names the modules of the classes and functions it holds: a
 cached by a source checkout names `engine.kernels.path_vertex`, the same kernel in the
 Blender extension lives in `bl_ext.user_default.drt.engine.kernels.path_vertex` (and the
 repository's name, `user_default`, is the user's choice). `RelocatingUnpickler` reads
-`engine` as whatever this engine package is called (`ENGINE_PACKAGE`), so a cache built
-once, by `python -m drt_addon package`, loads in every installed copy.
+`engine` (and any copy's `...drt.engine`) as whatever this engine package is called
+(`ENGINE_PACKAGE`), so a cache built once, by `python -m drt_addon package`, loads in
+every installed copy, and a cache written by one copy loads in the others.
 
 Numba keys each signature's code by the CPU it was compiled for: its LLVM target triple,
 CPU name and feature list ("magic tuple"), and loads only code compiled for the very CPU
@@ -42,9 +43,14 @@ SHIPPED_TIERS = ("x86-64-v3", "generic")    # what the extension zip holds, best
 
 
 def canonical_module(module: str) -> str:
-    """A module name as it is in this process: `engine.x` -> ENGINE_PACKAGE + `.x`."""
-    if module == "engine" or module.startswith("engine."):
-        return ENGINE_PACKAGE + module[len("engine"):]
+    """A module name as it is in this process: `engine.x`, and the engine of any copy of
+    the add-on (`drt.engine.x` as a legacy add-on, `bl_ext.<repo>.drt.engine.x` as an
+    extension), -> ENGINE_PACKAGE + `.x`. Caches are shared: Debian's Blender and the
+    `bpy` module render from one checkout's cache (tests/test_debian_blender.py)."""
+    parts = module.split(".")
+    for i, part in enumerate(parts):
+        if part == "engine" and (i == 0 or parts[i - 1] == "drt"):
+            return ".".join([ENGINE_PACKAGE, *parts[i + 1:]])
     return module
 
 
