@@ -8,10 +8,11 @@ queries through transparent layers where needed), one kernel adding what got thr
 Python touches each bounce a handful of times whatever the number of paths, and every
 stage releases the GIL, so work units on threads run in parallel.
 
-The estimator is in `engine.kernels.path_vertex`'s docstring. Motion blur: each path keeps the shutter time of its camera ray for
-all its rays, the accelerator places moving objects at that time, hits on them are
-rebuilt there (`kernels.surface.rebuild_at_time`), and a lamp that moves during the
-shutter is its slice at that time (`kernels.lights.light_set.slice_row`).
+The estimator is in `engine.kernels.path_vertex`'s docstring. Motion blur: each path
+keeps the shutter time of its camera ray for all its rays, the accelerator places moving
+objects at that time, hits on them are rebuilt there (`kernels.surface.rebuild_at_time`),
+and a lamp that moves during the shutter is its slice at that time
+(`kernels.lights.light_set.slice_row`).
 """
 from __future__ import annotations
 
@@ -224,7 +225,8 @@ class CompiledPathIntegrator:
         k = n if self.has_volumes else 0
         stacks = np.ascontiguousarray(np.tile(self.start_stack, (k, 1)), np.int32)
         sh_stack = np.full((k, STACK), -1, np.int32)
-        sh_bounce = np.empty(n * self.shadow_rays_per_path, np.int64)
+        ns_max = n * self.shadow_rays_per_path       # the shadow rays one bounce may queue
+        sh_bounce = np.empty(ns_max, np.int64)
         media = (bounce, vbounce, self.vol, stacks, sh_stack, sh_bounce, self.het_runs)
         no_keys = np.zeros(0, np.uint64)
         o = np.ascontiguousarray(origins, dtype=np.float64)
@@ -232,7 +234,6 @@ class CompiledPathIntegrator:
         # a writable copy: a read-only view (np.broadcast_to) would be another type to
         # Numba, and load a second copy of the shading kernel (15 MB, 0.1 s per process)
         tm = np.array(np.broadcast_to(tmax, (n,)), dtype=np.float64)
-        ns_max = n * self.shadow_rays_per_path       # the shadow rays one bounce may queue
         sh_path = np.empty(ns_max, np.int64)
         sh_org, sh_dir = np.empty((ns_max, 3)), np.empty((ns_max, 3))
         sh_far, sh_contrib = np.empty(ns_max), np.empty((ns_max, 3))
@@ -257,10 +258,9 @@ class CompiledPathIntegrator:
                 beta[live] *= factor
             ns, nn = self.vertex(depth, self.cfg, pkey, index, beta, counts, L, coverage,
                            prev_pdf, prev_pos, ray_bits, min_pdf, cont, path_time, live, o, d,
-                           tm,
-                           t, prim, u, v, stopped,
-                           self.geometry, self.params, self.emission, self.textures,
-                           self.tables, self.lights, self.world, media,
+                           tm, t, prim, u, v, stopped, self.geometry, self.params,
+                           self.emission, self.textures, self.tables, self.lights,
+                           self.world, media,
                            sh_path, sh_org, sh_dir, sh_far, sh_contrib,
                            nx_path, nx_org, nx_dir, (used, cone), *self.features)
             if ns:
