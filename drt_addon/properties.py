@@ -16,11 +16,6 @@ INTEGRATOR_ITEMS = [
     ("whitted", "Whitted", "Whitted 1980: hard shadows and mirror reflection/refraction "
      "only (the baseline)"),
 ]
-FILTER_ITEMS = [
-    ("BLACKMAN_HARRIS", "Blackman-Harris", "Blackman-Harris filter, as Cycles"),
-    ("BOX", "Box", "Box filter"),
-]
-
 
 # The engine settings DRT reads from the file's Cycles settings (`scene.cycles`, shown in
 # DRT's Light Paths and Film panels): engine name -> (Cycles property, Cycles' default).
@@ -36,6 +31,8 @@ CYCLES_SHARED = {
     "caustics_reflective": ("caustics_reflective", True),
     "caustics_refractive": ("caustics_refractive", True),
     "film_exposure": ("film_exposure", 1.0),
+    "filter_type": ("pixel_filter_type", "BLACKMAN_HARRIS"),
+    "filter_width": ("filter_width", 1.5),
 }
 
 
@@ -62,9 +59,6 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
                       "different seeds give independent images", default=0, min=0)
     sampler: EnumProperty(name="Sampler", items=SAMPLER_ITEMS, default="jittered")
     integrator: EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="path")
-    filter_type: EnumProperty(name="Filter", items=FILTER_ITEMS, default="BLACKMAN_HARRIS")
-    filter_width: FloatProperty(name="Width", description="Pixel filter width in pixels",
-                                default=1.5, min=0.01, max=10.0, subtype="PIXEL")
     threads: IntProperty(name="Threads", description="Worker threads (0: Blender's own "
                          "fixed thread count (Performance > Threads, or `blender -t N`) "
                          "when set, else all cores)", default=0, min=0, max=256)
@@ -72,8 +66,8 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
     def to_engine_settings(self):
         """The engine's settings: DRT's own, and the file's Cycles settings DRT shares
         with Cycles, in Cycles' own properties (Light Paths: the bounce limits per kind
-        and the clamps, Filter Glossy, the caustics switches; Film > Exposure), Cycles'
-        defaults where the Cycles add-on is off. export/file_settings.py lists every
+        and the clamps, Filter Glossy, the caustics switches; Film > Exposure and Pixel
+        Filter), Cycles' defaults where the Cycles add-on is off. export/file_settings.py lists every
         setting of the file and what DRT does with it."""
         from .engine_link import engine
         cycles = getattr(self.id_data, "cycles", None)
@@ -84,8 +78,7 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
             adaptive_sampling=self.use_adaptive_sampling,
             adaptive_threshold=self.adaptive_threshold,
             adaptive_min_samples=self.adaptive_min_samples, time_limit=self.time_limit,
-            sampler=self.sampler, integrator=self.integrator, filter_type=self.filter_type,
-            filter_width=self.filter_width, threads=self.engine_threads())
+            sampler=self.sampler, integrator=self.integrator, threads=self.engine_threads())
 
     def engine_threads(self) -> int:
         """DRT's Threads; at 0, Blender's fixed thread count when there is one: Render

@@ -69,14 +69,13 @@ class DRT_PT_film(DRTPanel, bpy.types.Panel):
     bl_label = "Film"
 
     def draw(self, context):
-        s = context.scene.drt
         col = self.layout.column()
         col.use_property_split = True
         cycles = getattr(context.scene, "cycles", None)
-        if cycles is not None:                 # the file's Film > Exposure, as in Cycles
+        if cycles is not None:       # the file's Film > Exposure and Pixel Filter, Cycles'
             col.prop(cycles, "film_exposure")
-        col.prop(s, "filter_type")
-        col.prop(s, "filter_width")
+            col.prop(cycles, "pixel_filter_type", text="Pixel Filter")
+            col.prop(cycles, "filter_width", text="Width")
 
 
 class DRT_PT_passes(DRTPanel, bpy.types.Panel):

@@ -7,7 +7,8 @@ variances stay exact and sample ranges rendered apart merge exactly.
 
 Blender's filter width w (scene.cycles.filter_width, default 1.5 px) means, as in Cycles'
 film code: Blackman-Harris over the support [-w, w] (Cycles doubles the width for this
-window), box over [-w/2, w/2].
+window), a Gaussian exp(-8 x^2 / w^2) (standard deviation w/4) over [-1.5 w, 1.5 w] (Cycles
+triples the width for it; exp(-18) at the ends), box over [-w/2, w/2].
 """
 from __future__ import annotations
 
@@ -26,6 +27,16 @@ def blackman_harris(x: np.ndarray, width: float) -> np.ndarray:
     return np.where(np.abs(x) <= width, f, 0.0)
 
 
+def gaussian(x: np.ndarray, width: float) -> np.ndarray:
+    """Cycles' Gaussian pixel filter of width `width`, zero outside [-1.5 w, 1.5 w]."""
+    x = np.asarray(x, dtype=np.float64)
+    v = x * (2.0 / width)
+    return np.where(np.abs(x) <= 1.5 * width, np.exp(-2.0 * v * v), 0.0)
+
+
+KINDS = ("BLACKMAN_HARRIS", "GAUSSIAN", "BOX")
+
+
 @dataclass
 class PixelFilter:
     kind: str = "BLACKMAN_HARRIS"
@@ -34,12 +45,12 @@ class PixelFilter:
     def __post_init__(self):
         if not np.isfinite(self.width) or self.width <= 0:
             raise ValueError(f"pixel filter width must be positive, got {self.width}")
-        if self.kind not in ("BLACKMAN_HARRIS", "BOX"):
+        if self.kind not in KINDS:
             raise ValueError(f"unknown pixel filter {self.kind!r}")
-        if self.kind == "BLACKMAN_HARRIS":
-            self.radius = float(self.width)
+        if self.kind != "BOX":
+            self.radius = float(self.width) * (1.0 if self.kind == "BLACKMAN_HARRIS" else 1.5)
             xs = np.linspace(-self.radius, self.radius, _TABLE_SIZE + 1)
-            f = blackman_harris(xs, self.radius)
+            f = self._shape(xs)
             # Trapezoid CDF of the tabulated filter; inverted by interpolation.
             cdf = np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]))])
             self._xs, self._cdf = xs, cdf / cdf[-1]
@@ -59,6 +70,9 @@ class PixelFilter:
         x = np.asarray(x, dtype=np.float64)
         if self.kind == "BOX":
             return np.where(np.abs(x) <= self.radius, 0.5 / self.radius, 0.0)
-        f = blackman_harris(x, self.radius)
-        norm = np.trapz(blackman_harris(self._xs, self.radius), self._xs)
-        return f / norm
+        return self._shape(x) / np.trapz(self._shape(self._xs), self._xs)
+
+    def _shape(self, x: np.ndarray) -> np.ndarray:
+        if self.kind == "GAUSSIAN":
+            return gaussian(x, float(self.width))
+        return blackman_harris(x, self.radius)

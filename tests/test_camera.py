@@ -162,7 +162,7 @@ def test_lens_sampling_chi_square(blades, rotation):
 
 
 @pytest.mark.parametrize("kind,width", [("BLACKMAN_HARRIS", 1.5), ("BLACKMAN_HARRIS", 0.7),
-                                        ("BOX", 1.0)])
+                                        ("GAUSSIAN", 1.5), ("GAUSSIAN", 3.0), ("BOX", 1.0)])
 def test_filter_importance_sampling_chi_square(kind, width):
     f = PixelFilter(kind, width)
     n, bins = 200_000, 40
@@ -173,6 +173,20 @@ def test_filter_importance_sampling_chi_square(kind, width):
     p_value = chi_square_pvalue(counts, expected)
     print(f"{kind} {width}: chi-square p = {p_value:.3g}")
     assert p_value > ALPHA
+
+
+def test_gaussian_filter_is_cycles_gaussian():
+    """Cycles' Gaussian of width w: exp(-2 (2x/w)^2), a normal density of standard
+    deviation w/4, over [-1.5 w, 1.5 w]: the samples' moments, and the shape."""
+    for width in (0.5, 1.5, 3.0):
+        f = PixelFilter("GAUSSIAN", width)
+        x = f.sample(np.random.default_rng(5).random((400_000, 2)))
+        assert f.radius == 1.5 * width and np.abs(x).max() <= f.radius
+        assert abs(x.mean()) < 0.005 * width
+        assert x.std() == pytest.approx(width / 4, rel=0.005)
+        mid = np.linspace(-width, width, 7)
+        np.testing.assert_allclose(f.pdf_1d(mid), np.exp(-0.5 * (mid / (width / 4)) ** 2)
+                                   / (width / 4 * np.sqrt(2 * np.pi)), rtol=1e-6)
 
 
 def test_chi_square_harness_rejects_a_wrong_pdf():
@@ -249,7 +263,7 @@ def test_guided_lookup_handles_flat_and_steep_cdfs():
 
 @pytest.mark.parametrize("kind,aperture,blades,filt", [
     ("PERSP", 0.0, 0, "BLACKMAN_HARRIS"), ("PERSP", 0.05, 0, "BLACKMAN_HARRIS"),
-    ("PERSP", 0.05, 6, "BOX"), ("ORTHO", 0.0, 0, "BOX")])
+    ("PERSP", 0.05, 6, "BOX"), ("ORTHO", 0.0, 0, "BOX"), ("PERSP", 0.0, 0, "GAUSSIAN")])
 def test_camera_ray_kernel_matches_the_camera_model(kind, aperture, blades, filt):
     """The compiled camera rays (engine/kernels/camera_rays.py) against CameraModel with
     the same sampler numbers and pixel filter."""

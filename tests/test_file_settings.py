@@ -228,7 +228,6 @@ def test_fresh_scene_defaults_are_quiet(bpy_drt):
     (lambda s: setattr(s.render, "use_freestyle", True), "Freestyle"),
     (lambda s: setattr(s.view_layers[0], "samples", 16), "View Layer > Override > Samples"),
     (lambda s: setattr(s.cycles, "samples", 128), "Max Samples is 128, not used"),
-    (lambda s: setattr(s.cycles, "pixel_filter_type", "GAUSSIAN"), "GAUSSIAN"),
 ])
 def test_a_setting_drt_ignores_warns_once(factory_scene, change, expected):
     _quiet_defaults(factory_scene)
@@ -259,6 +258,20 @@ def test_light_paths_and_clamps_are_the_files_own(factory_scene):
             s.transparent_bounces, s.volume_bounces, s.clamp_direct, s.clamp_indirect) \
         == (8, 2, 3, 6, 5, 1, 2.0, 0.0)
     assert not hasattr(factory_scene.drt, "max_bounces")      # one vocabulary
+
+
+@pytest.mark.parametrize("kind,width", [("GAUSSIAN", 2.0), ("BOX", 0.5),
+                                        ("BLACKMAN_HARRIS", 1.5)])
+def test_the_pixel_filter_is_the_files_own(factory_scene, kind, width):
+    """Film > Pixel Filter (type and width) is the file's Cycles setting, which DRT renders
+    with: no warning, and the engine gets it (tests/test_pixel_filter_vs_cycles.py
+    renders each type against Cycles)."""
+    _quiet_defaults(factory_scene)
+    factory_scene.cycles.pixel_filter_type, factory_scene.cycles.filter_width = kind, width
+    assert _warnings(factory_scene) == []
+    s = factory_scene.drt.to_engine_settings()
+    assert (s.filter_type, s.filter_width) == (kind, width)
+    assert not hasattr(factory_scene.drt, "filter_type")      # one vocabulary
 
 
 def test_settings_that_only_matter_with_another_warn_only_then(factory_scene):

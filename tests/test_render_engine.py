@@ -65,7 +65,7 @@ def test_cancel_stops_within_one_work_unit_and_keeps_a_valid_image(bpy_drt):
 def test_extreme_but_legal_settings_render(bpy_drt):
     from drt_addon.render_engine import last_render
     scene = _open(bpy_drt, samples=2)
-    scene.drt.filter_width = 0.01
+    scene.cycles.filter_width = 0.01
     scene.cycles.sample_clamp_indirect = 0.0
     scene.cycles.max_bounces = 0
     bpy_drt.ops.render.render()

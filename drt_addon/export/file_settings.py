@@ -171,10 +171,10 @@ SETTINGS: list[FileSetting] = [
         ("volume_bounces", "Light Paths > Max Bounces > Volume"),
         ("sample_clamp_direct", "Light Paths > Clamping > Direct Light"),
         ("sample_clamp_indirect", "Light Paths > Clamping > Indirect Light"))],
-    _own("pixel_filter_type", "Film > Pixel Filter > Type", "filter_type",
-         "Filter (DRT's Film panel: Blackman-Harris or Box, no Gaussian)", "BLACKMAN_HARRIS"),
-    _own("filter_width", "Film > Pixel Filter > Width", "filter_width",
-         "Width (DRT's Film panel)", 1.5),
+    *[_s(f"scene.cycles.{name}", label, READ, "DRT renders with the file's value, shown "
+         "in DRT's Film panel, as Cycles does (Blackman-Harris, Gaussian or Box)")
+      for name, label in (("pixel_filter_type", "Film > Pixel Filter > Type"),
+                          ("filter_width", "Film > Pixel Filter > Width"))],
     # -- applied by Blender, to DRT's result as to Cycles'
     _s("scene.view_settings", "Color Management (view transform, look, exposure, gamma, "
        "curves)", BLENDER, "Blender maps DRT's scene-linear result for display and for "
