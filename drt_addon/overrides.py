@@ -48,11 +48,15 @@ class Overrides:
 # override field -> (property name on scene.drt / scene.cycles)
 _SAMPLING = {"samples": "samples", "seed": "seed", "min_samples": "adaptive_min_samples",
              "time_limit": "time_limit"}
+# the file's Cycles settings that both engines render with: set there whatever the engine
+_FILES_OWN = {"seed"}
 
 
-def _targets(scene, engine: str) -> list:
+def _targets(scene, engine: str, field: str = "") -> list:
     """The property groups to set, the chosen engine's last (DRT's always: a Cycles
-    reference render with the same --seed keeps the DRT settings in step)."""
+    reference render with the same --samples keeps the DRT settings in step)."""
+    if field in _FILES_OWN:
+        return [getattr(scene, "cycles", None)]
     owners = [getattr(scene, "drt", None)]
     if engine == "CYCLES":
         owners.append(getattr(scene, "cycles", None))
@@ -78,7 +82,8 @@ def apply_overrides(scene, overrides: Overrides) -> list[str]:
         value = getattr(overrides, field)
         if value is None:
             continue
-        applied = [owner is not None and _set(owner, prop, value) for owner in owners]
+        applied = [owner is not None and _set(owner, prop, value)
+                   for owner in _targets(scene, overrides.engine, field)]
         if not applied[-1]:
             missing.append(f"--{field.replace('_', '-')} not applied: this {overrides.engine}"
                            f" has no {prop} setting")

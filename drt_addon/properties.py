@@ -1,4 +1,6 @@
 """DRT's render settings, stored in the .blend as `scene.drt`."""
+import hashlib
+
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
@@ -36,6 +38,19 @@ CYCLES_SHARED = {
 }
 
 
+def file_seed(scene) -> int:
+    """The file's Sampling > Advanced > Seed (`scene.cycles.seed`); with Use Animated Seed,
+    a seed of its own for every frame and subframe, as Cycles hashes the seed with the
+    frame (DRT's random numbers are not Cycles', so neither is the hash: what both give is
+    independent noise from frame to frame, and the same image for the same frame)."""
+    cycles = getattr(scene, "cycles", None)
+    seed = int(getattr(cycles, "seed", 0))
+    if not getattr(cycles, "use_animated_seed", False):
+        return seed
+    key = f"{seed}:{scene.frame_current}:{float(scene.frame_subframe)!r}".encode()
+    return int.from_bytes(hashlib.blake2b(key, digest_size=4).digest(), "little") & 0x7FFFFFFF
+
+
 class DRTRenderSettings(bpy.types.PropertyGroup):
     samples: IntProperty(name="Samples", description="Samples per pixel",
                          default=64, min=1, max=1 << 24, soft_max=4096)
@@ -55,8 +70,6 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
         name="Time Limit", default=0.0, min=0.0, subtype="TIME_ABSOLUTE", unit="TIME_ABSOLUTE",
         description="Stop after this many seconds of tracing, or at Samples, whichever comes "
                     "first (0: no limit; export and acceleration structure do not count)")
-    seed: IntProperty(name="Seed", description="Seed of every random number of the render; "
-                      "different seeds give independent images", default=0, min=0)
     sampler: EnumProperty(name="Sampler", items=SAMPLER_ITEMS, default="jittered")
     integrator: EnumProperty(name="Integrator", items=INTEGRATOR_ITEMS, default="path")
     threads: IntProperty(name="Threads", description="Worker threads (0: Blender's own "
@@ -74,7 +87,7 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
         shared = {key: type(default)(getattr(cycles, name, default))
                   for key, (name, default) in CYCLES_SHARED.items()}
         return engine.RenderSettings(
-            **shared, samples=self.samples, seed=self.seed,
+            **shared, samples=self.samples, seed=file_seed(self.id_data),
             adaptive_sampling=self.use_adaptive_sampling,
             adaptive_threshold=self.adaptive_threshold,
             adaptive_min_samples=self.adaptive_min_samples, time_limit=self.time_limit,

@@ -33,7 +33,11 @@ class DRT_PT_sampling(DRTPanel, bpy.types.Panel):
         sub.prop(s, "adaptive_min_samples")
         col.prop(s, "time_limit")
         col.prop(s, "sampler")
-        col.prop(s, "seed")
+        cycles = getattr(context.scene, "cycles", None)
+        if cycles is not None:                 # the file's own seed, as in Cycles
+            row = col.row(align=True)
+            row.prop(cycles, "seed")
+            row.prop(cycles, "use_animated_seed", text="", icon="TIME")
         col.prop(s, "integrator")
         col.prop(s, "threads")
 

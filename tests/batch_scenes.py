@@ -18,7 +18,7 @@ def build_animated_cornell(bpy, path, video_output=False) -> str:
     r = scene.render
     r.resolution_x, r.resolution_y, r.resolution_percentage = 32, 24, 100
     scene.frame_start, scene.frame_end, scene.frame_current = FRAMES[0], FRAMES[-1], 1
-    scene.drt.samples, scene.drt.seed = 4, 5
+    scene.drt.samples, scene.cycles.seed = 4, 5
     block = bpy.data.objects["ShortBlock"]
     for frame, x in zip(FRAMES, (0.0, 0.3, 0.6)):
         block.location.x = x

@@ -221,7 +221,6 @@ def test_fresh_scene_defaults_are_quiet(bpy_drt):
     (lambda s: (setattr(s.cycles, "use_adaptive_sampling", True),
                 setattr(s.cycles, "adaptive_threshold", 0.05)),
      "Noise Threshold is 0.05, not used: DRT renders with its own Noise Threshold"),
-    (lambda s: setattr(s.cycles, "use_animated_seed", True), "same Seed on every frame"),
     (lambda s: setattr(s.cycles, "use_light_tree", False), "Light Tree is off"),
     (lambda s: setattr(s.cycles, "time_limit", 30.0), "Time Limit is 30"),
     (lambda s: setattr(s.cycles, "use_fast_gi", True), "full global illumination"),
@@ -258,6 +257,52 @@ def test_light_paths_and_clamps_are_the_files_own(factory_scene):
             s.transparent_bounces, s.volume_bounces, s.clamp_direct, s.clamp_indirect) \
         == (8, 2, 3, 6, 5, 1, 2.0, 0.0)
     assert not hasattr(factory_scene.drt, "max_bounces")      # one vocabulary
+
+
+def test_the_seed_is_the_files_own_and_animated_changes_it_per_frame(factory_scene):
+    """Sampling > Advanced > Seed is the file's; with Use Animated Seed every frame (and
+    subframe) has a seed of its own, the same each time that frame renders."""
+    _quiet_defaults(factory_scene)
+    c = factory_scene.cycles
+    c.seed = 7
+    assert _warnings(factory_scene) == []
+    assert factory_scene.drt.to_engine_settings().seed == 7
+    assert not hasattr(factory_scene.drt, "seed")             # one vocabulary
+    c.use_animated_seed = True
+    assert _warnings(factory_scene) == []
+    seeds = []
+    for frame, sub in ((1, 0.0), (2, 0.0), (1, 0.0), (1, 0.5), (3, 0.0)):
+        factory_scene.frame_set(frame, subframe=sub)
+        seeds.append(factory_scene.drt.to_engine_settings().seed)
+    assert seeds[0] == seeds[2] and len(set(seeds)) == 4
+    c.seed = 8
+    factory_scene.frame_set(1)
+    assert factory_scene.drt.to_engine_settings().seed not in seeds
+
+
+def test_animated_seed_changes_the_noise_from_frame_to_frame(bpy_drt):
+    """Two frames of a still scene: the same image without Use Animated Seed, other noise
+    with it (as in Cycles, whose animated seed is what Blender artists render animations
+    with, so that a fixed noise pattern does not sit on the screen)."""
+    from conftest import render_current
+    bpy = bpy_drt
+    images = {}
+    for animated in (False, True):
+        for frame in (1, 2):
+            bpy.ops.wm.open_mainfile(filepath=os.path.join(SAMPLES_DIR, "cornell_box.blend"),
+                                     load_ui=False)
+            scene = bpy.context.scene
+            scene.render.engine = "DRT"
+            scene.render.resolution_percentage = 10
+            scene.drt.samples = 4
+            scene.cycles.use_animated_seed = animated
+            scene.frame_set(frame)
+            images[animated, frame] = render_current(bpy, scene)
+    assert images[False, 1].mean() > 0.01
+    np.testing.assert_array_equal(images[False, 1], images[False, 2])
+    assert np.abs(images[True, 1] - images[True, 2]).mean() > 0.1 * images[True, 1].mean()
+    # the same scene, its noise aside (4 samples on 26 x 26 pixels)
+    assert images[True, 1].mean() == pytest.approx(images[False, 1].mean(), rel=0.2)
 
 
 @pytest.mark.parametrize("kind,width", [("GAUSSIAN", 2.0), ("BOX", 0.5),

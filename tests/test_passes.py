@@ -202,7 +202,7 @@ def test_noise_pass_predicts_the_difference_between_independent_renders(bpy_drt)
         scene.render.resolution_x, scene.render.resolution_y = 48, 36
         scene.drt.sampler = "random"
         scene.drt.samples = 16
-        scene.drt.seed = seed
+        scene.cycles.seed = seed
         scene.view_layers[0].drt.use_pass_noise = True
         composite(bpy, scene, "DRT Noise")
         noise.append(render_and_save(bpy, scene))

@@ -160,7 +160,9 @@ SETTINGS: list[FileSetting] = [
     # -- DRT's own settings (Render Properties with DRT selected) replace these
     _own("samples", "Sampling > Render > Max Samples", "samples",
          "Samples (DRT's Sampling panel)", 4096),
-    _own("seed", "Sampling > Advanced > Seed", "seed", "Seed (DRT's Sampling panel)", 0),
+    _s("scene.cycles.seed", "Sampling > Advanced > Seed", READ, "DRT renders with the "
+       "file's Seed, shown in DRT's Sampling panel (DRT's random numbers are its own: the "
+       "same seed gives the same image in DRT, not Cycles' noise)"),
     *[_s(f"scene.cycles.{name}", label, READ, "DRT renders with the file's value, shown "
          "in DRT's Light Paths panel, as Cycles does") for name, label in (
         ("max_bounces", "Light Paths > Max Bounces > Total"),
@@ -229,9 +231,9 @@ SETTINGS: list[FileSetting] = [
     _ignored("view_layer.samples", "View Layer > Override > Samples",
              "DRT renders every view layer with its own Samples", 0,
              when=("scene.cycles.use_layer_samples", ("USE", "BOUNDED"))),
-    _ignored("scene.cycles.use_animated_seed", "Sampling > Advanced > Use Animated Seed",
-             "DRT uses the same Seed on every frame, so the noise pattern does not change "
-             "from frame to frame", False),
+    _s("scene.cycles.use_animated_seed", "Sampling > Advanced > Use Animated Seed", READ,
+       "DRT takes a seed of its own for every frame (and subframe), as Cycles does: the "
+       "noise changes from frame to frame"),
     _ignored("scene.cycles.sampling_pattern", "Sampling > Advanced > Pattern",
              f"DRT uses its own Sampler; {NOISE_ONLY}", ("AUTOMATIC", "TABULATED_SOBOL")),
     _ignored("scene.cycles.scrambling_distance", "Sampling > Advanced > Scrambling "
