@@ -329,6 +329,9 @@ class World:
     `engine.environment_map` for the projection. `color` is then not used.
     visibility: the ray kinds that see it (engine.visibility; Blender's World > Ray
     Visibility); see `engine.world_light`.
+    camera_texture: what camera rays see instead of `texture` (same strength and
+    mapping), when the world's node graph shows the camera another background than the
+    one that lights the scene (a Light Path node's Is Camera Ray); None = the same.
     sun: a `SunLight` that belongs to the world (a Sky Texture's sun disc,
     `engine.sky_texture`), rendered as one more lamp; None = none.
     light_sampling: whether next-event estimation samples the world (Blender's World >
@@ -340,6 +343,7 @@ class World:
     mapping: Optional[np.ndarray] = None
     visibility: int = 31
     volume: Optional[object] = None      # Volume filling the space outside every mesh
+    camera_texture: Optional[object] = None
     sun: Optional[SunLight] = None
     light_sampling: bool = True
 

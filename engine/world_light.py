@@ -56,8 +56,9 @@ class EnvironmentLightModel(_World):
 class EnvironmentMapLightModel(_World):
     """An environment map as a light (see engine.environment_map)."""
 
-    def __init__(self, env: EnvironmentMap, seen_by=vis.ALL):
+    def __init__(self, env: EnvironmentMap, seen_by=vis.ALL, camera_texture=None):
         self.map = env
+        self.camera_texture = camera_texture     # what camera rays see instead, or None
         self._set_visibility(seen_by)
 
     def power(self, scene_radius):
@@ -71,7 +72,7 @@ def world_model(world):
     seen_by = getattr(world, "visibility", vis.ALL)
     if texture is not None:
         model = EnvironmentMapLightModel(EnvironmentMap(texture, world.strength, world.mapping),
-                                         seen_by)
+                                         seen_by, getattr(world, "camera_texture", None))
     else:
         model = EnvironmentLightModel(getattr(world, "color", world), seen_by)
     # World > Settings > Sampling Method None: not sampled as a light (engine.lights)

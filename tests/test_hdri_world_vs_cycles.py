@@ -180,3 +180,43 @@ def test_procedural_world_matches_cycles(bpy_drt):
             nt.links.remove(link)
     assert not within(_render(bpy_drt, "DRT", CONTROL_SAMPLES, plain, "sky plain"), cycles,
                       "procedural world, its own colour")
+
+
+def _camera_sees_grey(scene):
+    """The procedural sky lights the scene, and through a Light Path node's Is Camera Ray
+    the camera sees a plain grey background instead (a common set-up)."""
+    _procedural_sky(scene)
+    nt = scene.world.node_tree
+    bg = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeBackground")
+    sky = bg.inputs["Color"].links[0].from_socket
+    path = nt.nodes.new("ShaderNodeLightPath")
+    pick = nt.nodes.new("ShaderNodeMix")
+    pick.data_type = "RGBA"
+    pick.inputs["B"].default_value = (0.3, 0.3, 0.3, 1.0)
+    nt.links.new(path.outputs["Is Camera Ray"], pick.inputs["Factor"])
+    nt.links.new(sky, pick.inputs["A"])
+    nt.links.new(pick.outputs["Result"], bg.inputs["Color"])
+
+
+def test_a_world_that_shows_the_camera_another_background_matches_cycles(bpy_drt):
+    """The world's graph gives camera rays a grey background and every other ray the
+    procedural sky (export/world_nodes.py bakes a map for each): the same checks against
+    Cycles. Controls: the grey lighting the scene as well (what DRT rendered before: the
+    Light Path node read as for camera rays everywhere), and the sky seen by the camera
+    too (the Light Path node left out)."""
+    cycles = _render(bpy_drt, "CYCLES", CONTROL_SAMPLES * 4, _camera_sees_grey, "grey cam")
+    drt = _render(bpy_drt, "DRT", CONTROL_SAMPLES * 2, _camera_sees_grey, "grey cam")
+    assert within(drt, cycles, "camera sees grey, the sky lights")
+
+    def grey_everywhere(scene):
+        _camera_sees_grey(scene)
+        bg = next(n for n in scene.world.node_tree.nodes
+                  if n.bl_idname == "ShaderNodeBackground")
+        scene.world.node_tree.links.remove(bg.inputs["Color"].links[0])
+        bg.inputs["Color"].default_value = (0.3, 0.3, 0.3, 1.0)
+
+    def sky_everywhere(scene):
+        _procedural_sky(scene)
+    for name, setup in (("grey everywhere", grey_everywhere), ("sky", sky_everywhere)):
+        wrong = _render(bpy_drt, "DRT", CONTROL_SAMPLES, setup, name)
+        assert not within(wrong, cycles, name)

@@ -173,6 +173,41 @@ def test_a_node_graph_on_the_background_is_baked_into_a_map(bpy_drt):
         np.testing.assert_allclose(px[..., ch].ravel(), expected, atol=1e-5)
 
 
+@pytest.mark.parametrize("output,camera,reported", [
+    ("Is Camera Ray", True, False), ("Is Glossy Ray", False, True), (None, False, False)])
+def test_a_light_path_node_bakes_what_the_camera_sees_apart(bpy_drt, output, camera,
+                                                            reported):
+    """Mix(red, blue) by a Light Path output on the Background's Color: with Is Camera Ray
+    the lighting map is red (as diffuse rays see it) and the camera's own map blue; an
+    output that tells other kinds of rays apart is read as for diffuse rays, and
+    reported; with no Light Path node there is one map."""
+    world, bg = _world(bpy_drt)
+    world.cycles.sample_map_resolution = 64
+    bg.inputs["Strength"].default_value = 1.0
+    tree = world.node_tree
+    mix = tree.nodes.new("ShaderNodeMix")
+    mix.data_type = "RGBA"
+    mix.inputs["A"].default_value = (1.0, 0.0, 0.0, 1.0)
+    mix.inputs["B"].default_value = (0.0, 0.0, 1.0, 1.0)
+    if output is not None:
+        path = tree.nodes.new("ShaderNodeLightPath")
+        tree.links.new(path.outputs[output], mix.inputs["Factor"])
+    else:
+        mix.inputs["Factor"].default_value = 0.0
+    tree.links.new(mix.outputs["Result"], bg.inputs["Color"])
+    w, warnings = _export(world)
+    assert w.texture is not None
+    np.testing.assert_allclose(w.texture.pixels[..., :3].reshape(-1, 3).mean(0),
+                               (1.0, 0.0, 0.0), atol=1e-6)
+    assert (w.camera_texture is not None) == camera
+    if camera:
+        np.testing.assert_allclose(w.camera_texture.pixels[..., :3].reshape(-1, 3).mean(0),
+                                   (0.0, 0.0, 1.0), atol=1e-6)
+    assert bool(warnings) == reported
+    if reported:
+        assert "Is Glossy Ray" in warnings[0]
+
+
 def test_missing_image_is_pink_like_cycles(bpy_drt):
     world, bg = _world(bpy_drt)
     _environment(bpy_drt, world, bg, None)

@@ -7,11 +7,12 @@ map, seen by escaped rays and importance-sampled as a light like an HDRI.
 The world's shading context is Cycles' for a background: the position, the Generated and
 Object coordinates are the ray's direction, the normal faces back along it. The map has
 World > Settings > Sampling > Map Resolution texels across (Cycles' own for sampling the
-world; 1024 by default) and half as many down, linearly interpolated. A Light Path node
-in the graph is read as for camera rays (the world one sees); where the graph gives other
-rays another world (a common set-up: a plain colour for the camera, an image for the
-light) the lighting follows the camera's world, which is reported. What differs is
-detail finer than a texel.
+world; 1024 by default) and half as many down, linearly interpolated. A graph with a
+Light Path node is evaluated twice: as for camera rays, into the map the camera sees,
+and as for diffuse rays, into the map that lights the scene (a common set-up: a plain
+colour for the camera, an image for the light; engine.scene.World.camera_texture). Other
+rays see the lighting map: a graph that tells glossy, transmission or shadow rays apart
+from diffuse ones is reported. What differs is detail finer than a texel.
 """
 from __future__ import annotations
 
@@ -35,9 +36,10 @@ def _map_resolution(world) -> int:
     return int(np.clip(res, 64, 4096))
 
 
-def _uses_light_path(tree) -> bool:
-    return any(n.bl_idname == "ShaderNodeLightPath" and any(o.is_linked for o in n.outputs)
-               for n in tree.nodes)
+def _light_path_outputs(tree) -> set:
+    """The linked outputs of the graph's Light Path nodes."""
+    return {o.name for n in tree.nodes if n.bl_idname == "ShaderNodeLightPath"
+            for o in n.outputs if o.is_linked}
 
 
 def bake_background(world, background, visibility, ctx):
@@ -52,25 +54,44 @@ def bake_background(world, background, visibility, ctx):
         ctx.issue(f"its Background's graph is not evaluated ({e}); using the Background's "
                   "own colour")
         return None
-    if _uses_light_path(world.node_tree):
-        ctx.issue("its Light Path node is read as for camera rays: the world lights the "
-                  "scene as the camera sees it")
+    outputs = _light_path_outputs(world.node_tree)
+    if outputs - {"Is Camera Ray"}:
+        ctx.issue("its Light Path node is read as for a diffuse ray wherever the world "
+                  "lights the scene (" + ", ".join(sorted(outputs - {"Is Camera Ray"}))
+                  + " are not told apart)")
     program = c.build()
-    w = _map_resolution(world)
+    vis = engine.visibility
+    light = _bake(program, color, strength, _map_resolution(world), vis.DIFFUSE if outputs
+                  else vis.CAMERA)
+    camera = _bake(program, color, strength, _map_resolution(world), vis.CAMERA) \
+        if outputs else None
+    tex = _texture(light, f"{world.name} (nodes)")
+    mean = tuple(float(x) for x in light.reshape(-1, 3).mean(axis=0))
+    return engine.World(mean, texture=tex, visibility=visibility,
+                        camera_texture=(None if camera is None or np.array_equal(camera, light)
+                                        else _texture(camera, f"{world.name} (camera)")))
+
+
+def _texture(rgb, name):
+    h, w, _ = rgb.shape
+    pixels = np.ones((h, w, 4), np.float32)
+    pixels[:, :, :3] = rgb
+    return TEXTURES.Texture(pixels, "Linear", "REPEAT", name=name)
+
+
+def _bake(program, color, strength, w, ray) -> np.ndarray:
+    """Color x Strength along every texel's direction of a w x w/2 map, for rays of kind
+    `ray`: (h, w, 3)."""
     h = w // 2
     u, v = np.meshgrid((np.arange(w) + 0.5) / w, (np.arange(h) + 0.5) / h)
     d, _ = ENV.uv_to_direction(np.stack([u.ravel(), v.ravel()], axis=1))
     rgb = np.empty((len(d), 3))
     for start in range(0, len(d), CHUNK):
         dd = d[start:start + CHUNK]
-        hits = CTX.hit_rows(dd, -dd, direction=dd, ray=engine.visibility.CAMERA)
+        hits = CTX.hit_rows(dd, -dd, direction=dd, ray=ray)
         for col in (CTX.H_GENERATED, CTX.H_OBJECT):
             hits[:, col:col + 3] = dd
         values = program.evaluate(color, hits).reshape(-1, 3)
         scale = program.evaluate(strength, hits).reshape(-1, 1)
         rgb[start:start + CHUNK] = values * scale
-    pixels = np.ones((h, w, 4), np.float32)
-    pixels[:, :, :3] = rgb.reshape(h, w, 3)
-    tex = TEXTURES.Texture(pixels, "Linear", "REPEAT", name=f"{world.name} (nodes)")
-    mean = tuple(float(x) for x in rgb.mean(axis=0))
-    return engine.World(mean, texture=tex, visibility=visibility)
+    return rgb.reshape(h, w, 3)

@@ -11,7 +11,7 @@ from ..jit import kernel
 from ..textures import texture_rgba
 from .pack import (ENV_CONDITIONAL, ENV_CONDITIONAL_GUIDE, ENV_MAP, ENV_MARGINAL,
                    ENV_MARGINAL_GUIDE, ENV_PIXELS, ENV_TEXTURE, M_ABS_DET, M_HAS, M_IDENTITY,
-                   M_INVERSE, M_MATRIX, M_STRENGTH)
+                   M_CAMERA, M_INVERSE, M_MATRIX, M_STRENGTH)
 
 PI = math.pi
 TWO_PI = 2.0 * math.pi
@@ -59,10 +59,23 @@ def _to_map(L, x, y, z):
 @kernel(allocates=False)
 def map_radiance(L, dx, dy, dz):
     """The map's radiance along one direction: (r, g, b)."""
+    return texture_radiance(L, 0, dx, dy, dz)
+
+
+@kernel
+def seen_by_camera(L, dx, dy, dz):
+    """What a camera ray sees of the map along one direction: the camera's own image
+    where the world shows the camera another background (M_CAMERA), else the map's."""
+    return texture_radiance(L, 1 if L[ENV_MAP][M_CAMERA] != 0.0 else 0, dx, dy, dz)
+
+
+@kernel
+def texture_radiance(L, index, dx, dy, dz):
+    """Image `index` of L[ENV_TEXTURE] along one direction, times the map's strength."""
     params = L[ENV_MAP]
     mx, my, mz = _to_map(L, dx, dy, dz)
     u, v = direction_to_uv(mx, my, mz)
-    r, g, b, _ = texture_rgba((L[ENV_PIXELS], L[ENV_TEXTURE]), 0, u, v)
+    r, g, b, _ = texture_rgba((L[ENV_PIXELS], L[ENV_TEXTURE]), index, u, v)
     return (r * params[M_STRENGTH], g * params[M_STRENGTH + 1], b * params[M_STRENGTH + 2])
 
 

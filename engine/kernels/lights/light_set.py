@@ -8,11 +8,13 @@ from __future__ import annotations
 
 import math
 
+from ...visibility import CAMERA as CAMERA_RAY
 from ..cdf_search import last_at_most
 from ..jit import kernel
 from .area import intersect_area, pdf_area, sample_area
 from .environment import pdf_environment, sample_environment
-from .environment_map import has_map, map_radiance, pdf_map, sample_environment_map
+from .environment_map import (has_map, map_radiance, pdf_map, sample_environment_map,
+                              seen_by_camera)
 from .pack import (C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, CDF_GUIDE, ENV, LAMPS, LAMP_SLICES,
                    SELECT_PDF, SLICE_OF, SUNS, TRI_VISIBILITY, T_AREA, T_DISC, T_ENV,
                    T_ENV_MAP, T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA)
@@ -224,7 +226,10 @@ def world_escaped(L, world, ray_bit, dx, dy, dz):
     if not int(L[ENV][5]) & ray_bit:
         return 0.0, 0.0, 0.0, 0.0
     if has_map(L):
-        r, g, b = map_radiance(L, dx, dy, dz)
+        if ray_bit == CAMERA_RAY:
+            r, g, b = seen_by_camera(L, dx, dy, dz)
+        else:
+            r, g, b = map_radiance(L, dx, dy, dz)
     else:
         r, g, b = world[0], world[1], world[2]
     return r, g, b, environment_pdf(L, dx, dy, dz)

@@ -27,8 +27,10 @@ every scene):
   bright enough to be a light; empty arrays and M_HAS = 0 without one):
   L[ENV_MAP]     float64 (N_MAP,): the M_* fields below (flags, |det|, strength, matrix
                  M and its inverse, row-major).
-  L[ENV_PIXELS]  float32 (4 W H,): the image's RGBA texels, as `kernels.textures` T[PIXELS].
-  L[ENV_TEXTURE] int64 (1, 6): its row of `kernels.textures` T[TEXTURES] (offset 0).
+  L[ENV_PIXELS]  float32 (4 W H,): the image's RGBA texels, as `kernels.textures` T[PIXELS]
+                 (then the camera's image's, when M_CAMERA).
+  L[ENV_TEXTURE] int64 (1 or 2, 6): its row of `kernels.textures` T[TEXTURES] (offset 0),
+                 and the camera's image's row (M_CAMERA: what camera rays see instead).
   L[ENV_MARGINAL]  float64 (H + 1,), L[ENV_CONDITIONAL] float64 (H, W + 1): the CDFs of
                  its `PiecewiseConstant2D`.
   L[ENV_MARGINAL_GUIDE] int32 (m + 1,), L[ENV_CONDITIONAL_GUIDE] int32 (H, c + 1): their
@@ -84,7 +86,8 @@ M_ABS_DET = 2       # |det M|
 M_STRENGTH = 3      # 3: strength r, g, b
 M_MATRIX = 6        # 9: M (world direction -> lookup vector), row-major
 M_INVERSE = 15      # 9: M^-1
-N_MAP = 24
+M_CAMERA = 24       # 1: camera rays see texture 1 of L[ENV_TEXTURE] instead of texture 0
+N_MAP = 25
 
 # ---------------------------------------------------------------- lamp kinds (C_TYPE)
 T_POINT = 0         # delta point or spot (radius 0)
@@ -268,7 +271,13 @@ def _pack_map(world) -> tuple:
     params[M_INVERSE:M_INVERSE + 9] = env.inverse.reshape(-1)
     tex = env.texture
     pixels = np.ascontiguousarray(tex.pixels, dtype=np.float32).reshape(-1)
-    info = np.array([texture_info(tex, 0)], dtype=np.int64)
+    info = [texture_info(tex, 0)]
+    camera = getattr(world, "camera_texture", None)
+    if camera is not None:
+        params[M_CAMERA] = 1.0
+        info.append(texture_info(camera, len(pixels)))
+        pixels = np.concatenate([pixels, np.asarray(camera.pixels, np.float32).reshape(-1)])
+    info = np.array(info, dtype=np.int64)
     dist = env.distribution
     marginal = _f64(dist.marginal, (-1,))
     conditional = _f64(dist.conditional, dist.conditional.shape)
