@@ -80,8 +80,9 @@ class DRTRenderSettings(bpy.types.PropertyGroup):
         """The engine's settings: DRT's own, and the file's Cycles settings DRT shares
         with Cycles, in Cycles' own properties (Light Paths: the bounce limits per kind
         and the clamps, Filter Glossy, the caustics switches; Film > Exposure and Pixel
-        Filter), Cycles' defaults where the Cycles add-on is off. export/file_settings.py lists every
-        setting of the file and what DRT does with it."""
+        Filter; the Seed, `file_seed`), Cycles' defaults where the Cycles add-on is off.
+        export/file_settings.py lists every setting of the file and what DRT does with
+        it."""
         from .engine_link import engine
         cycles = getattr(self.id_data, "cycles", None)
         shared = {key: type(default)(getattr(cycles, name, default))
