@@ -268,7 +268,7 @@ def known_differences(bpy, tmp, lines):
         "TODO in bsdf_microfacet_eval). Sampling never produces those pairs, so Cycles "
         "adds them through next-event estimation only: 5% more refracted light at normal "
         "incidence and roughness 0.67, 26% at 66 degrees, more from inside the glass. DRT "
-        "now evaluates refraction the same way (`engine/bsdf/dielectric.py`; "
+        "now evaluates refraction the same way (`engine/kernels/bsdf/dielectric.py`; "
         "`tests/test_rough_glass_vs_cycles.py` checks the formula and a lamp through a "
         "rough glass sphere: -0.78% before, -0.04% after with GGX; -1.35% before, +0.22% "
         "after with Blender's defaults). Those pairs are not reciprocal and can add "

@@ -188,7 +188,7 @@ class LightSet:
         # Method is None. Cycles never samples a uniform world (its LightManager disables
         # a background light that does not vary in space; BSDF rays that escape find
         # it); DRT does, for less noise, and evaluates refraction towards it on Walter's
-        # pairs only (`uniform_world`; engine/bsdf/dielectric.py's note), which is what
+        # pairs only (`uniform_world`; engine/kernels/bsdf/dielectric.py's note), which is what
         # Cycles' escaping rays see.
         if self.world is not None and getattr(self.world, "light_sampling", True):
             self.models.append(self.world)

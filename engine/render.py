@@ -25,7 +25,7 @@ import numpy as np
 
 from .accel import Accelerator
 from .adaptive_sampling import AdaptiveSampling
-from .bsdf.principled import MaterialTable
+from .bsdf.material_table import MaterialTable
 from .camera import CameraModel, CameraRays
 from .film import Film
 from .integrators import make_integrator

@@ -47,7 +47,7 @@ class Material:
     glossy_model: the microfacet model of the specular, metal and glass lobes: 'GGX'
     (single scattering, the default here and Blender's "GGX"), 'MULTI_GGX' (Blender's
     default "Multiscatter GGX": GGX with Cycles' energy compensation for the light the
-    single-scattering lobe loses, engine/bsdf/multiscatter.py) or 'BLINN_PHONG' (the
+    single-scattering lobe loses, engine/kernels/bsdf/multiscatter.py) or 'BLINN_PHONG' (the
     lecture's normalised Blinn-Phong lobe in the specular and metal lobes, with the
     exponent n = 2 / alpha^2 - 2 that matches GGX's alpha, Walter et al. 2007; glass
     stays single-scattering GGX) or 'BECKMANN' (the Beckmann distribution in the

@@ -190,7 +190,7 @@ class TextureInput:
 
     scale/offset are per-channel triples for colour parameters and numbers for scalar
     ones. The Texture object is shared by every input that uses the same image (the
-    exporter reads each image's pixels once); `engine.bsdf.principled.MaterialTable`
+    exporter reads each image's pixels once); `engine.bsdf.material_table.MaterialTable`
     gives each distinct Texture an index."""
     texture: Texture
     channel: str = "rgb"

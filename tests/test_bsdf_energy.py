@@ -5,17 +5,21 @@ Directional albedo a(wo) = integral f(wo, wi) |cos theta_i| d(wi) is estimated w
 directions from the normal to 89.9 degrees; "<= 1 within noise" means
 a - 4 standard errors <= 1 + tol, tol covering the tabulated specular albedo of the
 Principled layering (its interpolation error is below 0.5 %). The radiance BTDF of a
-dielectric concentrates radiance by eta^2 on the dense side (see engine/bsdf/dielectric.py),
-so there the flux albedo (1/eta^2 factor removed) is the conserved quantity.
+dielectric concentrates radiance by eta^2 on the dense side (engine/kernels/bsdf/
+dielectric.py), so there the flux albedo (1/eta^2 factor removed) is the conserved
+quantity. Every BSDF here is the compiled one the renderer runs, reached through its
+array drivers (engine/kernels/bsdf/lobe_batch.py, batch.py, table_batch.py).
 """
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from engine.bsdf import blinn_phong, dielectric, fresnel, lambert, microfacet
-from engine.bsdf.lobes import DIFFUSE, TRANSMISSION
-from engine.bsdf.principled import PrincipledBSDF, specular_albedo
+from engine.kernels import bsdf as kb
+from engine.kernels.bsdf import lobe_batch as lb
+from engine.kernels.bsdf.batch import Principled
+from engine.kernels.bsdf.principled import DIFFUSE, TRANSMISSION
+from engine.kernels.bsdf.table_batch import specular_albedo
 from engine.warp import cosine_hemisphere, uniform_sphere
 
 M = 16_000
@@ -54,8 +58,8 @@ def test_lambert_albedo_is_the_albedo():
     rng = rng_for("lambert")
     wo = wo_grid()
     wi = cosine_hemisphere(rng.random((len(wo), 2)))
-    alb = np.full((len(wo), 3), 0.9)
-    w = lambert.eval_f(alb, wo, wi)[:, 0] * wi[:, 2] / lambert.pdf(wo, wi)
+    b = Principled.with_params(np.full((len(wo), 3), 0.9), specular_ior_level=0.0)
+    w = b.eval_f(wo, wi)[:, 0] * wi[:, 2] / b.pdf(wo, wi)
     mean = check_albedo("lambert 0.9", w)
     assert np.allclose(mean, 0.9, rtol=1e-12)
 
@@ -64,9 +68,8 @@ def test_lambert_albedo_is_the_albedo():
 def test_blinn_phong_albedo(exponent):
     rng = rng_for(f"bp{exponent}")
     wo = wo_grid()
-    wi, valid = blinn_phong.sample(wo, rng.random((len(wo), 2)), exponent)
-    f = blinn_phong.eval_f(wo, wi, exponent)
-    p = blinn_phong.pdf(wo, wi, exponent)
+    wi, valid = lb.blinn_phong_sample(wo, rng.random((len(wo), 2)), exponent)
+    f, p = lb.blinn_phong_eval(wo, wi, exponent)
     ok = valid & (p > 0)
     w = np.where(ok, f * np.abs(wi[:, 2]) / np.where(ok, p, 1.0), 0.0)
     mean = check_albedo(f"blinn-phong n={exponent:g}", w)
@@ -81,15 +84,15 @@ def test_ggx_conductor_albedo(alpha):
     rng = rng_for(f"ggx{alpha}")
     wo = wo_grid()
     a = np.full(len(wo), alpha)
-    wi, h, valid = microfacet.reflection_sample(wo, a, rng.random((len(wo), 2)))
-    w = np.where(valid, microfacet.G2_over_G1(wo, wi, a), 0.0)
+    wi, h, valid = lb.ggx_reflection_sample(wo, a, rng.random((len(wo), 2)))
+    w = np.where(valid, lb.ggx_G2_over_G1(wo, wi, a), 0.0)
     assert w.max() <= 1.0 + 1e-12
     mean = check_albedo(f"ggx conductor F=1 alpha={alpha:g}", w)
     if alpha <= 0.05:
         assert np.all(mean[ANGLES <= 55] > 0.99)
     # the same through eval/pdf
-    f, _ = microfacet.reflection_eval(wo, wi, a)
-    p = microfacet.reflection_pdf(wo, wi, a)
+    f, _ = lb.ggx_reflection_eval(wo, wi, a)
+    p = lb.ggx_reflection_pdf(wo, wi, a)
     w2 = np.where(valid, f * wi[:, 2] / np.where(valid, p, 1.0), 0.0)
     assert np.allclose(w, w2, rtol=1e-9, atol=1e-12)
 
@@ -102,8 +105,8 @@ def test_rough_dielectric_energy(eta, alpha):
     rng = rng_for(f"diel{eta}{alpha}")
     wo = wo_grid()
     n = len(wo)
-    wi, w, refr, valid, pdf = dielectric.rough_sample(wo, eta, np.full(n, alpha), rng.random(n),
-                                                      rng.random((n, 2)))
+    wi, w, refr, valid, pdf = lb.rough_dielectric_sample(wo, eta, alpha, rng.random(n),
+                                                         rng.random((n, 2)))
     eta_rel = eta     # wo above: relative index of the side wi refracts into
     flux = np.where(refr, w * eta_rel ** 2, w)
     check_albedo(f"rough dielectric eta={eta:.3g} alpha={alpha:g} flux", flux)
@@ -111,8 +114,8 @@ def test_rough_dielectric_energy(eta, alpha):
         check_albedo(f"rough dielectric eta={eta:.3g} alpha={alpha:g} radiance", w)
     # from inside: relative index 1/eta
     wo_b = wo_grid(below=True)
-    wi, w, refr, valid, pdf = dielectric.rough_sample(wo_b, eta, np.full(n, alpha),
-                                                      rng.random(n), rng.random((n, 2)))
+    wi, w, refr, valid, pdf = lb.rough_dielectric_sample(wo_b, eta, alpha, rng.random(n),
+                                                         rng.random((n, 2)))
     assert np.all(wi[valid & refr, 2] > 0) and np.all(wi[valid & ~refr, 2] < 0)
     flux = np.where(refr, w / eta ** 2, w)
     check_albedo(f"rough dielectric eta={eta:.3g} alpha={alpha:g} inside flux", flux)
@@ -125,11 +128,11 @@ def test_smooth_dielectric_energy(eta):
     rng = rng_for(f"smooth{eta}")
     wo = wo_grid()
     n = len(wo)
-    wi, w, refr, valid = dielectric.smooth_sample(wo, eta, rng.random(n))
+    wi, w, refr, valid = lb.smooth_dielectric_sample(wo, eta, rng.random(n))
     assert valid.all()
     assert np.allclose(w[~refr], 1.0) and np.allclose(w[refr], 1.0 / eta ** 2)
     assert np.allclose(np.where(refr, w * eta ** 2, w), 1.0)
-    F = fresnel.dielectric(wo[:, 2], eta)
+    F = lb.fresnel_dielectric(wo[:, 2], eta)
     frac_r, se = per_angle((~refr).astype(float))
     assert np.all(np.abs(frac_r - F.reshape(-1, M)[:, 0]) < 5 * se + 1e-3)
     # Snell's law and unit length of the refracted directions
@@ -154,9 +157,8 @@ PRINCIPLED_CASES = {
 
 
 def principled(n, m, t, r, ior, level, base=(1.0, 1.0, 1.0), front=True):
-    f = lambda v: np.full(n, v, dtype=np.float64)
-    return PrincipledBSDF(np.tile(base, (n, 1)), f(m), f(t), f(r), f(ior), f(level),
-                          np.full(n, front))
+    """n hits of one Principled material, single-scattering GGX."""
+    return Principled.with_params(np.tile(base, (n, 1)), m, t, r, ior, level, front)
 
 
 @pytest.mark.parametrize("name", list(PRINCIPLED_CASES))
@@ -172,7 +174,7 @@ def test_principled_albedo(name):
         mean = check_albedo(f"principled {name} [{c}]", w[:, c], tol=5e-3)
     if name.startswith("white diffuse"):
         # the diffuse layer takes what the specular layer leaves by Cycles' estimate of
-        # the layer's albedo (principled.py), which ignores the single-scattering lobe's
+        # the layer's albedo (kernels/bsdf/principled.py), which ignores the single-scattering lobe's
         # masking loss: all of it under a smooth layer, up to 12 % less under a rough one
         # (measured at IOR 2.4, roughness 1; Multiscatter GGX gives the loss back,
         # tests/test_multiscatter.py)
@@ -204,10 +206,10 @@ def test_specular_albedo_table_matches_monte_carlo():
         tol = 1e-2 if eta < 1 else 5e-3
         wo = np.tile([np.sqrt(1 - cos_o ** 2), 0.0, cos_o], (n, 1))
         a = np.full(n, alpha)
-        wi, h, v = microfacet.reflection_sample(wo, a, rng.random((n, 2)))
-        F = fresnel.dielectric(np.clip((wo * h).sum(1), 0, 1), eta)
-        e_mc = np.where(v, F * microfacet.G2_over_G1(wo, wi, a), 0.0).mean()
-        e_tab = specular_albedo(np.array([cos_o]), np.array([alpha]), np.array([eta]))[0]
+        wi, h, v = lb.ggx_reflection_sample(wo, a, rng.random((n, 2)))
+        F = lb.fresnel_dielectric(np.clip((wo * h).sum(1), 0, 1), eta)
+        e_mc = np.where(v, F * lb.ggx_G2_over_G1(wo, wi, a), 0.0).mean()
+        e_tab = specular_albedo(cos_o, alpha, eta)
         assert abs(e_mc - e_tab) < tol, (cos_o, alpha, eta, e_mc, e_tab)
 
 
@@ -226,23 +228,23 @@ def test_reciprocity_reflection_lobes():
     n = 50_000
     wo, wi = random_pairs(n, rng)
     alb = rng.random((n, 3))
-    assert np.array_equal(lambert.eval_f(alb, wo, wi), lambert.eval_f(alb, wi, wo))
+    lam = Principled.with_params(alb, specular_ior_level=0.0)
+    assert np.array_equal(lam.eval_f(wo, wi), lam.eval_f(wi, wo))
     for e in (1.0, 50.0, 1e4):
-        a, b = blinn_phong.eval_f(wo, wi, e), blinn_phong.eval_f(wi, wo, e)
+        a, b = lb.blinn_phong_eval(wo, wi, e)[0], lb.blinn_phong_eval(wi, wo, e)[0]
         assert np.allclose(a, b, rtol=1e-10, atol=0), e
         assert (a > 0).any()
     for alpha in (1e-3, 0.2, 1.0):
-        al = np.full(n, alpha)
-        fa, ha = microfacet.reflection_eval(wo, wi, al)
-        fb, hb = microfacet.reflection_eval(wi, wo, al)
+        fa, ha = lb.ggx_reflection_eval(wo, wi, alpha)
+        fb, hb = lb.ggx_reflection_eval(wi, wo, alpha)
         assert np.allclose(fa, fb, rtol=1e-10, atol=0)
         # with a Schlick conductor Fresnel, F(wo.h) = F(wi.h)
-        Fa = fresnel.schlick(alb, (wo * ha).sum(1))
-        Fb = fresnel.schlick(alb, (wi * hb).sum(1))
+        Fa = lb.fresnel_schlick(alb, (wo * ha).sum(1))
+        Fb = lb.fresnel_schlick(alb, (wi * hb).sum(1))
         assert np.allclose(Fa * fa[:, None], Fb * fb[:, None], rtol=1e-10, atol=0)
         # the reflection half of the rough dielectric too
-        ra, ta = dielectric.rough_eval(wo, wi, 1.5, al)
-        rb, tb = dielectric.rough_eval(wi, wo, 1.5, al)
+        ra, ta = lb.rough_dielectric_eval(wo, wi, 1.5, alpha)
+        rb, tb = lb.rough_dielectric_eval(wi, wo, 1.5, alpha)
         assert np.allclose(ra, rb, rtol=1e-10, atol=0) and not ta.any() and not tb.any()
     # the Principled metal lobe, as one BSDF
     b = principled(n, m=1.0, t=0.0, r=0.4, ior=1.5, level=0.5, base=(0.9, 0.6, 0.2))
@@ -257,10 +259,9 @@ def test_generalised_reciprocity_refraction(eta, alpha):
     rng = np.random.default_rng(2)
     n = 50_000
     wo, wi = random_pairs(n, rng, lower_wi=True)
-    al = np.full(n, alpha)
     # Walter's BTDF (Cycles' extra pairs, dielectric.py's note, are not reciprocal)
-    _, f_ab = dielectric.rough_eval(wo, wi, eta, al, as_cycles=False)   # wo out, wi in
-    _, f_ba = dielectric.rough_eval(wi, wo, eta, al, as_cycles=False)   # wo in, wi out
+    _, f_ab = lb.rough_dielectric_eval(wo, wi, eta, alpha, walter=True)   # wo out, wi in
+    _, f_ba = lb.rough_dielectric_eval(wi, wo, eta, alpha, walter=True)   # wo in, wi out
     assert (f_ab > 0).mean() > 0.05          # (refraction needs wo.h > 0 > wi.h)
     # (1 - F) loses relative precision where F -> 1 near grazing: rtol 1e-6
     assert np.allclose(f_ab / 1.0, f_ba / eta ** 2, rtol=1e-6, atol=1e-300)
@@ -281,6 +282,12 @@ def extreme_directions():
     return wo, wi
 
 
+def visible_normal_pdf(wo, h, alpha):
+    """Heitz's density of visible normals, G1(wo) max(0, wo.h) D(h) / wo_z (2014,
+    eq. 2), composed from the kernels' D and G1."""
+    return lb.ggx_G1_over_cos(wo, alpha) * np.maximum((wo * h).sum(1), 0.0) * lb.ggx_D(h, alpha)
+
+
 def assert_finite(*arrays):
     for a in arrays:
         assert np.all(np.isfinite(a)), a[~np.isfinite(a)]
@@ -295,22 +302,22 @@ def test_no_nan_microfacet_dielectric_principled(roughness):
     u = rng.random((n, 2))
     u[:4] = [[0.0, 0.0], [1 - 1e-16, 1 - 1e-16], [0.5, 0.0], [0.0, 0.5]]
     uc = rng.random(n)
-    assert_finite(microfacet.D(microfacet.half_vector(wo, wi)[0], alpha),
-                  microfacet.G1(wo, alpha), microfacet.G2(wo, wi, alpha),
-                  microfacet.G2_over_G1(wo, wi, alpha), microfacet.G1_over_cos(wo, alpha))
+    s = wo + wi
+    h = s / np.maximum(np.linalg.norm(s, axis=1, keepdims=True), 1e-300)
+    assert_finite(lb.ggx_D(h, alpha), lb.ggx_G2_over_G1(wo, wi, alpha),
+                  lb.ggx_G1_over_cos(wo, alpha))
     up = np.where((wo[:, 2] < 0)[:, None], wo * [1, 1, -1], wo)
-    h = microfacet.sample_visible_normal(up, alpha, u)
-    assert_finite(h, microfacet.visible_normal_pdf(up, h, alpha))
+    h = lb.ggx_visible_normal(up, alpha, u)
+    assert_finite(h, visible_normal_pdf(up, h, alpha))
     assert np.allclose((h * h).sum(1), 1.0)
-    assert_finite(*microfacet.reflection_eval(wo, wi, alpha),
-                  microfacet.reflection_pdf(wo, wi, alpha),
-                  *microfacet.reflection_sample(wo, alpha, u)[:2])
+    assert_finite(*lb.ggx_reflection_eval(wo, wi, alpha), lb.ggx_reflection_pdf(wo, wi, alpha),
+                  *lb.ggx_reflection_sample(wo, alpha, u)[:2])
     for eta in (1.5, 1 / 1.5, 1.0 + 1e-9):
-        assert_finite(*dielectric.rough_eval(wo, wi, eta, alpha),
-                      dielectric.rough_pdf(wo, wi, eta, alpha))
-        wi_s, w, _, valid, pdf = dielectric.rough_sample(wo, eta, alpha, uc, u)
+        assert_finite(*lb.rough_dielectric_eval(wo, wi, eta, alpha),
+                      lb.rough_dielectric_pdf(wo, wi, eta, alpha))
+        wi_s, w, _, valid, pdf = lb.rough_dielectric_sample(wo, eta, alpha, uc, u)
         assert_finite(wi_s, w, pdf)
-        wi_s, w, _, valid = dielectric.smooth_sample(wo, eta, uc)
+        wi_s, w, _, valid = lb.smooth_dielectric_sample(wo, eta, uc)
         assert_finite(wi_s, w)
     for front in (True, False):
         b = principled(n, m=0.3, t=0.4, r=roughness, ior=1.5, level=0.7,
@@ -327,50 +334,48 @@ def test_no_nan_blinn_phong(exponent):
     n = len(wo)
     u = np.random.default_rng(4).random((n, 2))
     u[:3] = [[0.0, 0.0], [1 - 1e-16, 0.3], [1e-300, 0.9]]
-    f = blinn_phong.eval_f(wo, wi, exponent)
-    p = blinn_phong.pdf(wo, wi, exponent)
-    w_s, valid = blinn_phong.sample(wo, u, exponent)
-    assert_finite(f, p, w_s, blinn_phong.pdf(wo, w_s, exponent),
-                  blinn_phong.eval_f(wo, w_s, exponent))
+    f, p = lb.blinn_phong_eval(wo, wi, exponent)
+    w_s, valid = lb.blinn_phong_sample(wo, u, exponent)
+    assert_finite(f, p, w_s, *lb.blinn_phong_eval(wo, w_s, exponent))
     # at the mirror direction the peak is finite and equal to (n + 2)/(2 pi) in D
     h = np.array([[0.0, 0.0, 1.0]])
-    assert np.isclose(blinn_phong.D(h, exponent)[0], (exponent + 2) / (2 * np.pi))
+    assert np.isclose(lb.blinn_phong_D(h, exponent)[0], (exponent + 2) / (2 * np.pi))
 
 
 def test_no_nan_fresnel():
     c = np.array([-1.0, -0.5, -1e-12, 0.0, 1e-12, 0.3, 1.0])
     for eta in (1.5, 1 / 1.5, 1.0, 1e-5, 1e5):
-        F, ct, er = fresnel.dielectric_full(c, np.full(len(c), eta))
+        F, ct, er = lb.fresnel_dielectric_full(c, eta)
         assert_finite(F, ct, er)
         assert np.all((F >= 0) & (F <= 1))
-    assert_finite(fresnel.schlick(np.array([[0.0, 0.5, 1.0]] * len(c)), c))
+    assert_finite(lb.fresnel_schlick(np.array([[0.0, 0.5, 1.0]] * len(c)), c))
 
 
 # --- Fresnel and sample-weight consistency ----------------------------------------------
 
 def test_fresnel_values():
     # normal incidence, both sides
-    assert np.isclose(fresnel.dielectric(np.array([1.0]), 1.5)[0], 0.04)
-    assert np.isclose(fresnel.dielectric(np.array([-1.0]), 1.5)[0], 0.04)
+    assert np.isclose(lb.fresnel_dielectric(1.0, 1.5), 0.04)
+    assert np.isclose(lb.fresnel_dielectric(-1.0, 1.5), 0.04)
     # total internal reflection past the critical angle, inside glass
     crit = np.sqrt(1 - 1 / 1.5 ** 2)                    # cos of the critical angle
-    F = fresnel.dielectric(np.array([-(crit - 1e-6), -(crit + 1e-6)]), 1.5)
+    F = lb.fresnel_dielectric(np.array([-(crit - 1e-6), -(crit + 1e-6)]), 1.5)
     assert F[0] == 1.0 and F[1] < 1.0
     # the same interface reflects equally from both sides along one refracted pair
     ci = np.linspace(0.01, 1.0, 50)
-    F_out, ct, _ = fresnel.dielectric_full(ci, 1.5)
-    F_in = fresnel.dielectric(-ct, 1.5)
+    F_out, ct, _ = lb.fresnel_dielectric_full(ci, 1.5)
+    F_in = lb.fresnel_dielectric(-ct, 1.5)
     assert np.allclose(F_out, F_in, atol=1e-12)
     # Brewster: p-polarised reflection vanishes, F = rs^2 / 2
     cb = np.cos(np.arctan(1.5))
-    F_b, ct_b, _ = fresnel.dielectric_full(np.array([cb]), 1.5)
+    F_b, ct_b, _ = lb.fresnel_dielectric_full(cb, 1.5)
     rs = (cb - 1.5 * ct_b[0]) / (cb + 1.5 * ct_b[0])
     assert np.isclose(F_b[0], 0.5 * rs * rs)
     # Schlick ends
     f0 = np.array([[0.9, 0.5, 0.1]])
-    assert np.allclose(fresnel.schlick(f0, np.array([1.0])), f0)
-    assert np.allclose(fresnel.schlick(f0, np.array([0.0])), 1.0)
-    assert np.isclose(fresnel.ior_from_f0(fresnel.f0_from_ior(1.5)), 1.5)
+    assert np.allclose(lb.fresnel_schlick(f0, 1.0), f0)
+    assert np.allclose(lb.fresnel_schlick(f0, 0.0), 1.0)
+    assert np.isclose(lb.ior_from_f0(lb.f0_from_ior(1.5)), 1.5)
 
 
 def test_ggx_normalisation():
@@ -383,11 +388,10 @@ def test_ggx_normalisation():
     h = np.stack([s * np.cos(p), s * np.sin(p), c], -1).reshape(-1, 3)
     dA = (1.0 / 4000) * (2 * np.pi / 256)
     for alpha in (0.1, 0.5, 1.0):
-        a = np.full(len(h), alpha)
-        assert np.isclose((microfacet.D(h, a) * h[:, 2]).sum() * dA, 1.0, rtol=2e-3)
+        assert np.isclose((lb.ggx_D(h, alpha) * h[:, 2]).sum() * dA, 1.0, rtol=2e-3)
         t = np.radians(60)
         wo = np.tile([np.sin(t), 0.0, np.cos(t)], (len(h), 1))
-        assert np.isclose(microfacet.visible_normal_pdf(wo, h, a).sum() * dA, 1.0, rtol=2e-3)
+        assert np.isclose(visible_normal_pdf(wo, h, alpha).sum() * dA, 1.0, rtol=2e-3)
 
 
 def test_sample_weight_equals_f_cos_over_pdf():
@@ -399,18 +403,20 @@ def test_sample_weight_equals_f_cos_over_pdf():
     for sign in (1.0, -1.0):
         w_o = wo * [1, 1, sign]
         alpha = rng.uniform(0.01, 1.0, n)
-        wi, w, refr, valid, pdf = dielectric.rough_sample(w_o, 1.5, alpha, rng.random(n),
-                                                          rng.random((n, 2)))
-        f_r, f_t = dielectric.rough_eval(w_o, wi, 1.5, alpha)
-        p = dielectric.rough_pdf(w_o, wi, 1.5, alpha)
+        wi, w, refr, valid, pdf = lb.rough_dielectric_sample(w_o, 1.5, alpha, rng.random(n),
+                                                             rng.random((n, 2)))
+        f_r, f_t = lb.rough_dielectric_eval(w_o, wi, 1.5, alpha)
+        p = lb.rough_dielectric_pdf(w_o, wi, 1.5, alpha)
         ok = valid & (p > 1e-12)
         assert ok.mean() > 0.8
         assert np.allclose(pdf[ok], p[ok], rtol=1e-7)
         assert np.allclose(w[ok], (f_r + f_t)[ok] * np.abs(wi[ok, 2]) / p[ok], rtol=1e-7)
         assert np.array_equal(refr[ok], (wi[ok, 2] * w_o[ok, 2]) < 0)
     # Principled, all lobes, random materials per point
-    b = PrincipledBSDF(rng.random((n, 3)), rng.random(n), rng.random(n), rng.random(n),
-                       rng.uniform(1.0, 2.5, n), rng.random(n), rng.random(n) < 0.7)
+    rough = rng.random(n)
+    transmission = rng.random(n)
+    b = Principled.with_params(rng.random((n, 3)), rng.random(n), transmission, rough,
+                               rng.uniform(1.0, 2.5, n), rng.random(n), rng.random(n) < 0.7)
     for allowed in (None, rng.random((n, 3)) < 0.7):
         s = b.sample(wo, rng.random(n), rng.random((n, 2)), allowed)
         nd = s.valid & ~s.delta
@@ -420,7 +426,7 @@ def test_sample_weight_equals_f_cos_over_pdf():
         assert np.allclose(s.pdf[nd], p[nd], rtol=1e-9)
         assert np.allclose(s.weight[nd], f[nd] * np.abs(s.wi[nd, 2:3]) / p[nd, None], rtol=1e-9)
         # delta choices come only from smooth glass, never evaluated by eval_f
-        assert np.all(b.glass_smooth[s.delta])
+        assert np.all((rough ** 2 <= 10.0 ** -3.5)[s.delta] & (transmission[s.delta] > 0))
         assert np.all(s.kind[s.valid & (s.wi[:, 2] < 0)] == TRANSMISSION)
         if allowed is not None:
             assert np.all(allowed[s.valid, s.kind[s.valid]])
@@ -428,32 +434,44 @@ def test_sample_weight_equals_f_cos_over_pdf():
 
 # --- the Principled composition ---------------------------------------------------------
 
+def hit_state(front=True, **params):
+    """The Principled kernel's state at one hit seen along the normal."""
+    b = Principled.with_params(np.array([[0.8, 0.4, 0.2]]), front=front, **params)
+    state = np.empty(kb.NSTATE)
+    kb.setup(b.rows[0], front, 0.0, 0.0, 1.0, b.tables, state)
+    return state
+
+
+def lobe_weights(state):
+    """(diffuse, specular, metal, glass) weights of the mixture at a hit."""
+    from engine.kernels.bsdf.state import S_DIFFUSE, S_W_GLASS, S_W_METAL, S_W_SPEC
+    return [float(state[S_DIFFUSE:S_DIFFUSE + 3].max()), float(state[S_W_SPEC]),
+            float(state[S_W_METAL]), float(state[S_W_GLASS])]
+
+
 def test_principled_specular_level_semantics():
+    from engine.kernels.bsdf.state import S_ETA_GLASS, S_ETA_SPEC
     n = 4
     rng = np.random.default_rng(0)
     wo = np.tile([0.0, 0.0, 1.0], (n, 1))
     wi = cosine_hemisphere(rng.random((n, 2)))
     base = np.tile([0.8, 0.4, 0.2], (n, 1))
-    # level 0: no specular at all, plain Lambert, nothing else is evaluated
-    b0 = PrincipledBSDF(base, np.zeros(n), np.zeros(n), np.full(n, 0.5), np.full(n, 1.5),
-                        np.zeros(n))
-    assert b0.diffuse_only and b0.active.tolist() == [True, False, False, False]
-    assert np.allclose(b0.eval_f(wo, wi), base / np.pi)
+    # level 0: no specular at all, plain Lambert
+    b0 = Principled.with_params(base, 0.0, 0.0, 0.5, 1.5, 0.0)
+    assert np.allclose(b0.eval_f(wo, wi), base / np.pi, rtol=1e-12)
+    assert lobe_weights(hit_state(specular_ior_level=0.0))[1:] == [0.0, 0.0, 0.0]
     # level 0.5: the plain IOR; level 1: F0 doubled
     for level, f0 in ((0.5, 0.04), (1.0, 0.08), (0.25, 0.02)):
-        b = PrincipledBSDF(base, np.zeros(n), np.zeros(n), np.full(n, 0.5), np.full(n, 1.5),
-                           np.full(n, level))
-        assert np.allclose(fresnel.f0_from_ior(b.eta_spec), f0)
-        assert b.active.tolist() == [True, True, False, False]
+        state = hit_state(specular_ior_level=level)
+        assert np.isclose(lb.f0_from_ior(state[S_ETA_SPEC]), f0)
+        w = lobe_weights(state)
+        assert w[0] > 0 and w[1] == 1.0 and w[2:] == [0.0, 0.0]
     # metallic 1: no diffuse, no glass; transmission 1: no diffuse
-    bm = PrincipledBSDF(base, np.ones(n), np.ones(n))
-    assert bm.active.tolist() == [False, False, True, False]
-    bt = PrincipledBSDF(base, np.zeros(n), np.ones(n))
-    assert bt.active.tolist() == [False, False, False, True]
+    assert lobe_weights(hit_state(metallic=1.0, transmission=1.0)) == [0.0, 0.0, 1.0, 0.0]
+    assert lobe_weights(hit_state(transmission=1.0)) == [0.0, 0.0, 0.0, 1.0]
     # a back face sees the inverse relative IOR in the glass lobe only
-    bb = PrincipledBSDF(base, np.zeros(n), np.full(n, 0.5), ior=np.full(n, 1.5),
-                        front_facing=np.zeros(n, bool))
-    assert np.allclose(bb.eta_glass, 1 / 1.5) and np.allclose(bb.eta_spec, 1.5)
+    state = hit_state(front=False, transmission=0.5, ior=1.5)
+    assert np.isclose(state[S_ETA_GLASS], 1 / 1.5) and np.isclose(state[S_ETA_SPEC], 1.5)
 
 
 def test_principled_metal_is_schlick_ggx():
@@ -462,29 +480,26 @@ def test_principled_metal_is_schlick_ggx():
     wo, wi = random_pairs(n, rng)
     base = rng.random((n, 3))
     r = rng.uniform(0.05, 1.0, n)
-    b = PrincipledBSDF(base, np.ones(n), np.zeros(n), r, np.full(n, 1.5), np.full(n, 0.5))
-    f, h = microfacet.reflection_eval(wo, wi, r * r)
-    want = fresnel.schlick(base, (wo * h).sum(1)) * f[:, None]
-    assert np.allclose(b.eval_f(wo, wi), want, rtol=1e-12, atol=0)
+    b = Principled.with_params(base, 1.0, 0.0, r, 1.5, 0.5)
+    f, h = lb.ggx_reflection_eval(wo, wi, r * r)
+    want = lb.fresnel_schlick(base, (wo * h).sum(1)) * f[:, None]
+    assert np.allclose(b.eval_f(wo, wi), want, rtol=1e-9, atol=0)
 
 
-def test_principled_diffuse_only_batch_matches_lambert_path():
-    """The fast path for diffuse-only batches equals the general mixture code."""
+def test_plain_diffuse_samples_weigh_its_colour():
+    """A plain diffuse material (specular level 0): every sample weighs its base colour
+    (f |cos| / pdf of the cosine lobe), and nothing is sampled where diffuse is not
+    allowed."""
     rng = np.random.default_rng(10)
     n = 5_000
     wo = cosine_hemisphere(rng.random((n, 2)))
     base = rng.random((n, 3))
-    b = PrincipledBSDF.lambertian(base)
-    assert b.diffuse_only
-    ul, ud = rng.random(n), rng.random((n, 2))
+    b = Principled.with_params(base, specular_ior_level=0.0)
     allowed = rng.random((n, 3)) < 0.8
-    s = b.sample(wo, ul, ud, allowed)
-    b.diffuse_only = False                          # force the general path
-    s2 = b.sample(wo, ul, ud, allowed)
-    assert np.array_equal(s.valid, s2.valid)
-    for k in ("wi", "weight", "pdf", "kind", "delta"):
-        assert np.allclose(getattr(s, k)[s.valid], getattr(s2, k)[s.valid]), k
-    assert np.allclose(s.weight[s.valid], base[s.valid])
+    s = b.sample(wo, rng.random(n), rng.random((n, 2)), allowed)
+    assert s.valid[allowed[:, DIFFUSE]].mean() > 0.999
+    assert np.allclose(s.weight[s.valid], base[s.valid], rtol=1e-12)
+    assert np.all(s.kind[s.valid] == DIFFUSE)
     assert not s.valid[~allowed[:, DIFFUSE]].any()
 
 
@@ -492,15 +507,13 @@ def test_blinn_phong_glossy_model_conserves_energy_and_tracks_ggx():
     """Principled with the lecture's Blinn-Phong distribution: albedo <= 1, and at the
     Walter-equivalent exponent its metal albedo is close to GGX's at low roughness (at
     roughness 0.7 GGX's Smith masking removes more: 0.69 against 0.85 measured)."""
-    from engine.bsdf.principled import PrincipledBSDF
     rng = np.random.default_rng(9)
     n = 16384
     for rough in (0.1, 0.3, 0.7):
         albedo = {}
         for blinn in (False, True):
-            b = PrincipledBSDF(np.tile([1.0, 1.0, 1.0], (n, 1)), np.ones(n), np.zeros(n),
-                               np.full(n, rough), np.full(n, 1.5), np.full(n, 0.5),
-                               np.ones(n, bool), np.full(n, blinn))
+            model = kb.GLOSSY_BLINN_PHONG if blinn else kb.GLOSSY_GGX
+            b = Principled.with_params(np.ones((n, 3)), 1.0, 0.0, rough, 1.5, 0.5, True, model)
             theta = np.radians(45.0)
             wo = np.tile([np.sin(theta), 0.0, np.cos(theta)], (n, 1))
             s = b.sample(wo, rng.random(n), rng.random((n, 2)))

@@ -1,4 +1,6 @@
-"""Chi-square tests of every BSDF sampling routine against its own pdf (tests/chi2.py).
+"""Chi-square tests of every BSDF sampling routine against its own pdf (tests/chi2.py):
+the compiled lobes and the Principled mixture the renderer runs, through their array
+drivers (engine/kernels/bsdf/lobe_batch.py, batch.py).
 
 Each case draws 200k directions for one incident direction (0, 45 and 85 degrees from the
 normal) and compares the histogram over adaptive (cos theta, phi) cells with the pdf
@@ -15,9 +17,10 @@ import numpy as np
 import pytest
 
 from chi2 import chi2_test
-from engine.bsdf import blinn_phong, dielectric, microfacet
-from engine.bsdf.lobes import DIFFUSE, GLOSSY, TRANSMISSION
-from engine.bsdf.principled import PrincipledBSDF
+from engine.kernels import bsdf as kb
+from engine.kernels.bsdf import lobe_batch as lb
+from engine.kernels.bsdf.batch import Principled
+from engine.kernels.bsdf.principled import DIFFUSE, GLOSSY, TRANSMISSION
 from engine.warp import cosine_hemisphere
 
 N = 200_000
@@ -30,10 +33,6 @@ def wo_at(deg, n, below=False):
     return np.tile([np.sin(t), 0.0, z], (n, 1))
 
 
-def full(v, n):
-    return np.full(n, v, dtype=np.float64)
-
-
 # --- the cases ---------------------------------------------------------------------------
 
 def case_cosine(_):
@@ -44,38 +43,42 @@ def case_cosine(_):
 
 def case_blinn_phong(deg, exponent):
     def sample(u):
-        return blinn_phong.sample(wo_at(deg, len(u)), u[:, 1:], exponent)
-    return sample, lambda w: blinn_phong.pdf(wo_at(deg, len(w)), w, exponent)
+        return lb.blinn_phong_sample(wo_at(deg, len(u)), u[:, 1:], exponent)
+    return sample, lambda w: lb.blinn_phong_eval(wo_at(deg, len(w)), w, exponent)[1]
 
 
 def case_vndf(deg, alpha, pdf_alpha=None):
-    """The visible normals themselves: h ~ D_wo(h) = G1(wo) max(0, wo.h) D(h) / wo_z."""
+    """The visible normals themselves: h ~ D_wo(h) = G1(wo) max(0, wo.h) D(h) / wo_z
+    (Heitz 2014, eq. 2, composed here from the kernels' D and G1)."""
     pa = alpha if pdf_alpha is None else pdf_alpha
 
     def sample(u):
-        h = microfacet.sample_visible_normal(wo_at(deg, len(u)), full(alpha, len(u)), u[:, 1:])
+        h = lb.ggx_visible_normal(wo_at(deg, len(u)), alpha, u[:, 1:])
         return h, np.ones(len(u), bool)
-    return sample, lambda w: microfacet.visible_normal_pdf(wo_at(deg, len(w)), w, full(pa, len(w)))
+
+    def pdf(h):
+        wo = wo_at(deg, len(h))
+        return (lb.ggx_G1_over_cos(wo, pa) * np.maximum((wo * h).sum(1), 0.0)
+                * lb.ggx_D(h, pa))
+    return sample, pdf
 
 
 def case_ggx_reflection(deg, alpha):
     def sample(u):
-        wi, _, valid = microfacet.reflection_sample(wo_at(deg, len(u)), full(alpha, len(u)),
-                                                    u[:, 1:])
+        wi, _, valid = lb.ggx_reflection_sample(wo_at(deg, len(u)), alpha, u[:, 1:])
         return wi, valid
-    return sample, lambda w: microfacet.reflection_pdf(wo_at(deg, len(w)), w, full(alpha, len(w)))
+    return sample, lambda w: lb.ggx_reflection_pdf(wo_at(deg, len(w)), w, alpha)
 
 
 def case_rough_dielectric(deg, eta, alpha, below=False, allow_r=True, allow_t=True):
     def sample(u):
-        wi, _, _, valid, _ = dielectric.rough_sample(
-            wo_at(deg, len(u), below), eta, full(alpha, len(u)), u[:, 0], u[:, 1:],
-            allow_r, allow_t)
+        wi, _, _, valid, _ = lb.rough_dielectric_sample(
+            wo_at(deg, len(u), below), eta, alpha, u[:, 0], u[:, 1:], allow_r, allow_t)
         return wi, valid
 
     def pdf(w):     # the sampler's own density (not Cycles' MIS pdf, see dielectric.py)
-        return dielectric.rough_pdf(wo_at(deg, len(w), below), w, eta, full(alpha, len(w)),
-                                    allow_r, allow_t, as_cycles=False)
+        return lb.rough_dielectric_pdf(wo_at(deg, len(w), below), w, eta, alpha, allow_r,
+                                       allow_t, walter=True)
     return sample, pdf
 
 
@@ -108,14 +111,15 @@ ALLOWED = {
 
 
 def make_principled(params, n):
+    """n hits of the material `params`, refraction evaluated on Walter's pairs only (the
+    sampler's own density; Cycles' extra pairs: kernels/bsdf/dielectric.py)."""
     p = params
-    b = PrincipledBSDF(np.tile(p["base_color"], (n, 1)), full(p["metallic"], n),
-                       full(p["transmission"], n), full(p["roughness"], n), full(p["ior"], n),
-                       full(p["specular_ior_level"], n), np.full(n, p["front_facing"]),
-                       np.full(n, p.get("blinn_phong", False)),
-                       np.full(n, p.get("multiscatter", False)))
-    b.as_cycles = False     # the sampler's own density (see engine/bsdf/dielectric.py)
-    return b
+    model = (kb.GLOSSY_BLINN_PHONG if p.get("blinn_phong") else
+             kb.GLOSSY_MULTI_GGX if p.get("multiscatter") else kb.GLOSSY_GGX)
+    return Principled.with_params(np.tile(p["base_color"], (n, 1)), p["metallic"],
+                                  p["transmission"], p["roughness"], p["ior"],
+                                  p["specular_ior_level"], p["front_facing"], model,
+                                  walter=True)
 
 
 def case_principled(deg, name, allowed="all"):

@@ -1,26 +1,27 @@
-"""The compiled Principled BSDF (engine/kernels/bsdf) against the NumPy reference
-(engine.bsdf.principled.PrincipledBSDF): the same values for eval_f, pdf and sample over
-random materials, hits, directions, random numbers and `allowed` masks.
+"""The compiled Principled BSDF (engine/kernels/bsdf) over random materials, hits,
+directions, random numbers and `allowed` masks: the packing of materials into rows, the
+table lookups at the tables' nodes, and what must hold between its three functions with
+no second implementation to compare with: a sample's pdf is `pdf` at the sampled
+direction, its weight is `eval_f` of the allowed lobes times |cos| over that pdf, the
+kinds respect the masks, every output is finite. Closed forms for plain diffuse, the
+Glossy BSDF and the Specular Tint. (Chi-square, furnace and reciprocity tests of the
+same kernels: test_bsdf_sampling.py, test_bsdf_energy.py, test_multiscatter.py.)
 
 Materials are `engine.scene.Material` objects packed through MaterialTable and
-`pack_materials`, so the packing is tested too. The kernels follow the NumPy code
-operation by operation, so the tolerance is tight (RTOL 1e-9, ATOL 1e-12); the only
-looser comparison is the sample weight of a batch of plain diffuse materials, where the
-NumPy class takes a shortcut (weight = albedo) that the mixture estimator
-f |cos| / pdf reproduces only to rounding.
+`pack_materials`, so the packing is tested too.
 """
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from engine.bsdf import layer_albedo, principled as npp
-from engine.bsdf.lobes import DIFFUSE, GLOSSY, TRANSMISSION
-from engine.bsdf.principled import MaterialTable, PrincipledBSDF
+from engine.bsdf import energy_tables as et
+from engine.bsdf import layer_albedo
+from engine.bsdf.material_table import MaterialTable
 from engine.kernels import bsdf as kb
-from engine.bsdf import multiscatter as npms
-from engine.kernels.bsdf import albedo, batch
-from engine.kernels.bsdf import multiscatter as kms
+from engine.kernels.bsdf import batch
+from engine.kernels.bsdf import table_batch as tb
+from engine.kernels.bsdf.principled import DIFFUSE, GLOSSY, TRANSMISSION
 from engine.scene import Material
 
 RTOL = 1e-9
@@ -99,13 +100,12 @@ def case():
     # Filter Glossy's lower bound on the lobes' alpha at a fifth of the hits
     filter_alpha = np.where(np.random.default_rng(8).random(N_HITS) < 0.2,
                             np.random.default_rng(9).uniform(0.0, 0.5, N_HITS), 0.0)
-    ref = PrincipledBSDF.from_materials(table, index, front, filter_alpha=filter_alpha)
-    assert not ref.diffuse_only          # the mixed batch takes the general code path
-    assert (ref.alpha > ref.material_alpha).mean() > 0.1
+    assert ((filter_alpha > 0) & (filter_alpha > kb.pack_materials(table)[index, kb.P_ROUGHNESS]
+                                  ** 2)).mean() > 0.1      # Filter Glossy widens lobes
     rows = kb.pack_materials(table)[index]
     rows[:, kb.P_FILTER_ALPHA] = filter_alpha
     return dict(mats=mats, table=table, index=index, front=front, wo=wo, wi=wi,
-                u_lobe=u_lobe, u_dir=u_dir, allowed=allowed, ref=ref, rows=rows,
+                u_lobe=u_lobe, u_dir=u_dir, allowed=allowed, rows=rows,
                 filter_alpha=filter_alpha, tables=kb.kernel_tables())
 
 
@@ -123,7 +123,7 @@ def assert_close(a, b, what, rtol=RTOL, atol=ATOL):
         bad = np.nonzero(~ok.reshape(len(ok), -1).all(1))[0]
         k = bad[0]
         raise AssertionError(f"{what}: {len(bad)} mismatches, first at {k}: "
-                             f"kernel {a[k]} vs numpy {b[k]}")
+                             f"{a[k]} vs {b[k]}")
 
 
 # --- packing and tables ------------------------------------------------------------------
@@ -151,19 +151,7 @@ def test_pack_materials_columns():
     assert (rows[:, kb.P_FILTER_ALPHA] == 0).all()            # a per-hit value, none packed
 
 
-def test_constants_match_numpy():
-    """The kernels repeat the NumPy model's constants (Numba freezes globals into its
-    cache, so they are not imported): they must agree."""
-    from engine.bsdf import dielectric, microfacet
-    from engine.kernels.bsdf import dielectric as kd, microfacet as km, principled as kp
-    assert (kp.DIFFUSE, kp.GLOSSY, kp.TRANSMISSION) == (DIFFUSE, GLOSSY, TRANSMISSION)
-    assert kp.MIN_SELECTION == npp.MIN_SELECTION
-    assert km.ALPHA_MIN == microfacet.ALPHA_MIN
-    assert (kd.SMOOTH_ALPHA, kd.INDEX_MATCHED) == (dielectric.SMOOTH_ALPHA,
-                                                   dielectric.INDEX_MATCHED)
-
-
-def test_kernel_tables_are_the_numpy_tables():
+def test_kernel_tables_are_the_stored_tables():
     t = kb.kernel_tables()
     assert t is kb.kernel_tables()
     assert t[0] is layer_albedo.get_table(0) and t[1] is layer_albedo.get_table(1)
@@ -171,95 +159,59 @@ def test_kernel_tables_are_the_numpy_tables():
         assert np.array_equal(a, b)
 
 
-def test_specular_albedo_matches():
+def test_lookups_return_the_table_entries_at_its_nodes():
+    """At a node of its grid each lookup returns that entry (to rounding of the node's
+    coordinates), so the coordinates (F0^(1/4), sqrt(alpha), t and the critical-angle
+    axis for eta < 1; z and the side of eta) are the generators' own."""
     rng = np.random.default_rng(3)
-    n = 4000
-    cos_o = np.concatenate([rng.random(n), [0.0, 1.0, 1e-4]])
-    alpha = np.concatenate([rng.random(n) ** 2, [1e-4, 1.0, 0.3]])
-    eta = np.concatenate([rng.uniform(0.3, 3.0, n), [1.0, 0.5, 2.0]])
-    eta[:50] = 1.0 / eta[50:100]
-    ref = layer_albedo.specular_albedo(cos_o, alpha, eta)
-    tables = kb.kernel_tables()
-    got = np.array([albedo.specular_albedo(c, a, e, tables)
-                    for c, a, e in zip(cos_o, alpha, eta)])
-    assert_close(got, ref, "specular albedo")
+    for side in (0, 1):
+        table = layer_albedo.get_table(side)
+        for _ in range(40):
+            i, j, k = (rng.integers(len(g)) for g in (layer_albedo.TABLE_S,
+                                                      layer_albedo.TABLE_R,
+                                                      layer_albedo.TABLE_T))
+            eta = float(layer_albedo._eta_of(layer_albedo.TABLE_S[i] ** 2, side))
+            c = float(layer_albedo._critical_cos(eta))
+            mu = float(layer_albedo._mu_of_t(layer_albedo.TABLE_T[k], c))
+            if mu < 1e-6:
+                continue                           # the table's own floor of cos theta_o
+            got = tb.specular_albedo(mu, layer_albedo.TABLE_R[j] ** 2, eta)
+            assert abs(got - table[i, j, k]) < 1e-9, (side, i, j, k, got, table[i, j, k])
+    tab = et.load()
+    for _ in range(40):
+        i, j = rng.integers(len(et.ROUGH)), rng.integers(1, len(et.T))
+        got = tb.ggx_albedo(et.mu_of_t(et.T[j]), et.ROUGH[i] ** 2)
+        assert abs(got - tab["ggx_E"][i, j]) < 1e-9
+        s, z = rng.integers(2), rng.integers(len(et.GLASS_Z))
+        i, j = rng.integers(len(et.GLASS_ROUGH)), rng.integers(1, len(et.GLASS_T))
+        eta = float(et.eta_of_z(et.GLASS_Z[z], s))
+        args = (et.mu_of_t(et.GLASS_T[j]), et.GLASS_ROUGH[i] ** 2, eta)
+        assert abs(tb.glass_albedo(*args) - tab["glass_E"][s, z, i, j]) < 1e-9
+        assert abs(tb.glass_albedo_avg(*args[1:]) - tab["glass_E_avg"][s, z, i]) < 1e-9
 
 
-def test_multiscatter_lookups_match():
-    """The compiled multiple-scattering and layering tables' lookups and the factor equal
-    NumPy's, on and off the grids, on both sides of eta = 1 and past the grids' ends."""
-    rng = np.random.default_rng(4)
-    n = 3000
-    cos_o = np.concatenate([rng.random(n), [0.0, 1.0, 1e-9, 0.5]])
-    alpha = np.concatenate([rng.random(n) ** 2, [1e-4, 1.0, 0.3, 0.0]])
-    eta = np.concatenate([rng.uniform(0.2, 4.0, n), [1.0, 0.5, 50.0, 1e-3]])
-    tables = kb.kernel_tables()
-    cases = [(npms.ggx_albedo(cos_o, alpha), lambda c, a, e: kms.ggx_albedo(c, a, tables)),
-             (npms.ggx_albedo_avg(alpha), lambda c, a, e: kms.ggx_albedo_avg(a, tables)),
-             (npms.glass_albedo(cos_o, alpha, eta),
-              lambda c, a, e: kms.glass_albedo(c, a, e, tables)),
-             (npms.glass_albedo_avg(alpha, eta),
-              lambda c, a, e: kms.glass_albedo_avg(a, e, tables)),
-             (npms.dielectric_fresnel_avg(eta),
-              lambda c, a, e: kms.dielectric_fresnel_avg(e, tables)),
-             (npms.layer_reflectance(cos_o, alpha, eta),
-              lambda c, a, e: kms.layer_reflectance(c, a, e, tables)),
-             (npms.compensation(cos_o * 0.7 + 0.3, alpha * 0.5 + 0.5, np.minimum(eta / 4, 1)),
-              lambda c, a, e: kms.compensation(c * 0.7 + 0.3, a * 0.5 + 0.5, min(e / 4, 1.0)))]
-    for ref, fn in cases:
-        got = np.array([fn(c, a, e) for c, a, e in zip(cos_o, alpha, eta)])
-        assert np.isfinite(ref).all() and (ref > 0).all()
-        assert_close(got, ref, "multiscatter lookup")
-
-
-def test_case_has_multiscatter_lobes(case):
-    """The random materials include multiple-scattering ones whose factors differ from 1
-    in every lobe (so the comparisons below cover the compensation)."""
-    ref = case["ref"]
-    _, _, comp = ref._wo_state(case["wo"])
-    on = ref.weight > 0
-    for cols, lobe in ((slice(0, 1), npp.L_SPECULAR), (slice(1, 4), npp.L_METAL),
-                       (slice(4, 7), npp.L_GLASS)):
-        rows = ref.multiscatter & on[:, lobe]
-        assert (comp[rows, cols] > 1.01).any(1).sum() > 100, lobe
-        assert (comp[~ref.multiscatter, cols] == 1.0).all()
-
-
-# --- the mixture against NumPy -----------------------------------------------------------
-
-def test_eval_f_matches(case):
+def test_eval_and_pdf_are_finite_and_positive_where_a_lobe_is(case):
     c = case
-    ref = c["ref"].eval_f(c["wo"], c["wi"])
-    got = batch.eval_f_batch(c["rows"], c["front"], c["wo"], c["wi"], c["tables"])
-    assert np.isfinite(got).all() and (got >= 0).all()
-    assert (ref > 0).any(1).mean() > 0.3            # the comparison sees real values
-    assert_close(got, ref, "eval_f")
-
-
-def test_pdf_matches(case):
-    c = case
+    f = batch.eval_f_batch(c["rows"], c["front"], c["wo"], c["wi"], c["tables"])
+    assert np.isfinite(f).all() and (f >= 0).all()
+    assert (f > 0).any(1).mean() > 0.3
     for allowed in (c["allowed"], np.ones_like(c["allowed"])):
-        ref = c["ref"].pdf(c["wo"], c["wi"], allowed)
-        got = batch.pdf_batch(c["rows"], c["front"], c["wo"], c["wi"], allowed, c["tables"])
-        assert np.isfinite(got).all() and (got >= 0).all()
-        assert (ref > 0).mean() > 0.3
-        assert_close(got, ref, "pdf")
+        p = batch.pdf_batch(c["rows"], c["front"], c["wo"], c["wi"], allowed, c["tables"])
+        assert np.isfinite(p).all() and (p >= 0).all()
+        assert (p > 0).mean() > 0.3
 
 
-def test_sample_matches(case):
+def sample_case(c, rows=None):
+    rows = c["rows"] if rows is None else rows
+    return batch.Sample(*batch.sample_batch(rows, c["front"], c["wo"], c["u_lobe"],
+                                            c["u_dir"], c["allowed"], c["tables"]))
+
+
+def test_samples_are_well_formed(case):
     c = case
-    ref = c["ref"].sample(c["wo"], c["u_lobe"], c["u_dir"], c["allowed"])
-    wi, weight, pdf, kind, delta, valid = batch.sample_batch(
-        c["rows"], c["front"], c["wo"], c["u_lobe"], c["u_dir"], c["allowed"], c["tables"])
-    assert np.array_equal(valid, ref.valid)
-    assert np.array_equal(delta, ref.delta)
-    assert np.array_equal(kind, ref.kind)
-    # every field, including the direction of rejected samples
-    assert_close(wi, ref.wi, "sample wi")
-    assert_close(weight, ref.weight, "sample weight")
-    assert_close(pdf, ref.pdf, "sample pdf")
-    # sanity of the outputs
+    wi, weight, pdf, kind, delta, valid = sample_case(c)
     assert np.isfinite(wi).all() and np.isfinite(weight).all()
+    assert np.allclose((wi[valid] ** 2).sum(1), 1.0, rtol=1e-12)
     assert (weight >= 0).all() and (pdf >= 0).all()
     assert np.isinf(pdf[delta]).all() and np.isfinite(pdf[~delta]).all()
     assert (weight[~valid] == 0).all() and (pdf[~valid] == 0).all()
@@ -270,54 +222,71 @@ def test_sample_matches(case):
     for k in (GLOSSY, TRANSMISSION):
         assert (valid & (kind == k) & delta).sum() > 50
     assert (~valid).sum() > 50
-    # the lobe kinds respect the allowed masks
+    # the lobe kinds respect the allowed masks; transmission goes below the surface
     assert c["allowed"][np.nonzero(valid)[0], kind[valid]].all()
+    assert np.array_equal(wi[valid, 2] < 0, kind[valid] == TRANSMISSION)
 
 
-def test_eval_and_pdf_at_sampled_directions(case):
-    """At sampled directions (the lobes' peaks: mirror-like GGX at alpha 1e-4, Blinn-Phong
-    exponents up to 2e8, refraction) eval_f and pdf agree too."""
-    c = case
-    ref = c["ref"].sample(c["wo"], c["u_lobe"], c["u_dir"], c["allowed"])
-    ok = ref.valid & ~ref.delta
+def weight_mismatches(c, s, rows):
+    """Valid non-delta samples whose pdf is not `pdf` at the sampled wi, or whose weight
+    is not f(allowed lobes) |cos| / pdf, with the BSDF of `rows`."""
+    ok = s.valid & ~s.delta
     idx = np.nonzero(ok)[0]
-    sub = PrincipledBSDF.from_materials(c["table"], c["index"][idx], c["front"][idx],
-                                        filter_alpha=c["filter_alpha"][idx])
-    wo, wi, allowed = c["wo"][idx], ref.wi[idx], c["allowed"][idx]
-    rows, front = c["rows"][idx], c["front"][idx]
-    f_ref = sub.eval_f(wo, wi)
-    p_ref = sub.pdf(wo, wi, allowed)
-    f = batch.eval_f_batch(rows, front, wo, wi, c["tables"])
-    p = batch.pdf_batch(rows, front, wo, wi, allowed, c["tables"])
-    assert p_ref.max() > 1e6                       # really near-specular lobes
-    assert_close(f, f_ref, "eval_f at sampled wi")
-    assert_close(p, p_ref, "pdf at sampled wi")
-    assert_close(p, ref.pdf[idx], "pdf at sampled wi vs the sample's pdf")
+    wo, wi, allowed = c["wo"][idx], s.wi[idx], c["allowed"][idx]
+    f = batch.eval_seen_batch(rows[idx], c["front"][idx], wo, wi, allowed, c["tables"])
+    p = batch.pdf_batch(rows[idx], c["front"][idx], wo, wi, allowed, c["tables"])
+    bad_p = ~close(s.pdf[idx], p)
+    bad_w = ~close(s.weight[idx], f * np.abs(wi[:, 2:3]) / p[:, None]).all(1)
+    return idx, p, bad_p | bad_w
 
 
-def test_plain_diffuse_batch():
-    """A batch of plain diffuse materials: NumPy's Lambert-only shortcut."""
+def test_sample_weight_is_f_cos_over_pdf(case):
+    """At every valid non-delta sample (including the lobes' peaks: mirror-like GGX at
+    alpha 1e-4, Blinn-Phong exponents up to 2e8, refraction) the sample's pdf is `pdf`
+    there and its weight is f |cos| / pdf of the allowed lobes."""
+    c = case
+    s = sample_case(c)
+    idx, p, bad = weight_mismatches(c, s, c["rows"])
+    assert len(idx) > 10_000
+    assert p.max() > 1e6                           # really near-specular lobes
+    assert not bad.any(), f"{bad.sum()} of {len(idx)}"
+
+
+def test_negative_control_perturbed_roughness(case):
+    """Samples of the case checked against a BSDF with roughness 1 % off (or the other
+    facing flag) fail the same test."""
+    c = case
+    s = sample_case(c)
+    rows = c["rows"].copy()
+    rows[:, kb.P_ROUGHNESS] *= 1.01
+    assert weight_mismatches(c, s, rows)[2].sum() > 100
+    flipped = dict(c, front=~c["front"])
+    assert weight_mismatches(flipped, s, c["rows"])[2].sum() > 100
+
+
+def test_plain_diffuse_is_lambert():
+    """Plain diffuse materials (Specular IOR Level 0): f = base / pi, pdf = cos / pi
+    where diffuse is allowed, and every sample weighs its base colour."""
     rng = np.random.default_rng(11)
     mats = [Material(base_color=tuple(rng.uniform(0, 1, 3)), specular_ior_level=0.0)
             for _ in range(20)] + [Material(base_color=(0.0, 0.0, 0.0),
                                             specular_ior_level=0.0)]
     table = MaterialTable(mats)
     index, front, wo, wi, u_lobe, u_dir, allowed = random_hits(rng, 5000, len(mats))
-    ref = PrincipledBSDF.from_materials(table, index, front)
-    assert ref.diffuse_only
     rows, tables = kb.pack_materials(table)[index], kb.kernel_tables()
-    assert_close(batch.eval_f_batch(rows, front, wo, wi, tables), ref.eval_f(wo, wi), "f")
-    assert_close(batch.pdf_batch(rows, front, wo, wi, allowed, tables),
-                 ref.pdf(wo, wi, allowed), "pdf")
-    s = ref.sample(wo, u_lobe, u_dir, allowed)
+    base = table.base_color[index]
+    up = wi[:, 2] > 0
+    f = batch.eval_f_batch(rows, front, wo, wi, tables)
+    assert_close(f, np.where(up[:, None], base / np.pi, 0.0), "f")
+    p = batch.pdf_batch(rows, front, wo, wi, allowed, tables)
+    lit = allowed[:, DIFFUSE] & (base.max(1) > 0)
+    assert_close(p, np.where(up & lit, wi[:, 2] / np.pi, 0.0), "pdf")
     wi_k, weight, pdf, kind, delta, valid = batch.sample_batch(
         rows, front, wo, u_lobe, u_dir, allowed, tables)
-    assert np.array_equal(valid, s.valid) and not delta.any() and (kind == DIFFUSE).all()
-    # the shortcut's rejected samples keep a cosine direction, the mixture's (0, 0, 1)
-    assert_close(wi_k[valid], s.wi[valid], "wi")
-    assert_close(pdf, s.pdf, "pdf")
-    # weight = albedo there, = f |cos| / pdf here: equal up to a few ulps
-    assert_close(weight, s.weight, "weight", rtol=1e-14, atol=0.0)
+    assert not delta.any() and (kind[valid] == DIFFUSE).all()
+    assert np.array_equal(valid, lit & (wi_k[:, 2] > 0))
+    assert_close(weight[valid], base[valid], "weight")
+    assert_close(pdf[valid], wi_k[valid, 2] / np.pi, "sample pdf")
 
 
 def test_transmits():
@@ -335,7 +304,8 @@ def test_transmits():
 
 def test_scalar_interface_matches_batch(case):
     """The scalar kernels called one by one (the integrator's interface, argument order
-    and return order) give what the batch drivers give."""
+    and return order) give what the batch drivers give (to rounding: the two are
+    separate compilations, which may contract operations differently)."""
     c = case
     state = np.zeros(kb.NSTATE)
     for k in range(0, N_HITS, 997):
@@ -347,28 +317,14 @@ def test_scalar_interface_matches_batch(case):
         s = kb.sample(state, *o, c["u_lobe"][k], *c["u_dir"][k], *a)
         one = slice(k, k + 1)
         args = (c["rows"][one], c["front"][one], c["wo"][one])
-        assert np.array_equal(f, batch.eval_f_batch(*args, c["wi"][one], c["tables"])[0])
-        assert p == batch.pdf_batch(*args, c["wi"][one], c["allowed"][one], c["tables"])[0]
+        assert_close(np.array(f), batch.eval_f_batch(*args, c["wi"][one], c["tables"])[0], "f")
+        assert_close(np.array([p]), batch.pdf_batch(*args, c["wi"][one], c["allowed"][one],
+                                                    c["tables"]), "pdf")
         bs = batch.sample_batch(*args, c["u_lobe"][one], c["u_dir"][one],
                                 c["allowed"][one], c["tables"])
-        assert s[0:3] == tuple(bs[0][0]) and s[3:6] == tuple(bs[1][0])
-        assert (s[6], s[7], s[8], s[9]) == (bs[2][0], bs[3][0], bs[4][0], bs[5][0])
-
-
-# --- negative control --------------------------------------------------------------------
-
-def test_negative_control_perturbed_roughness(case):
-    """A roughness 1 % off (or a wrong facing flag) is caught by the same comparison."""
-    c = case
-    rows = c["rows"].copy()
-    rows[:, kb.P_ROUGHNESS] *= 1.01
-    ref = c["ref"].eval_f(c["wo"], c["wi"])
-    got = batch.eval_f_batch(rows, c["front"], c["wo"], c["wi"], c["tables"])
-    assert (~close(got, ref)).any(1).sum() > 100
-    got = batch.pdf_batch(rows, c["front"], c["wo"], c["wi"], c["allowed"], c["tables"])
-    assert (~close(got, c["ref"].pdf(c["wo"], c["wi"], c["allowed"]))).sum() > 100
-    got = batch.eval_f_batch(c["rows"], ~c["front"], c["wo"], c["wi"], c["tables"])
-    assert (~close(got, ref)).any(1).sum() > 100
+        assert_close(np.array(s[0:6]), np.concatenate([bs[0][0], bs[1][0]]), "sample")
+        assert_close(np.array([s[6]]), bs[2], "sample pdf")
+        assert (s[7], s[8], s[9]) == (bs[3][0], bs[4][0], bs[5][0])
 
 
 def test_glossy_bsdf_reflects_its_colour_at_every_angle():

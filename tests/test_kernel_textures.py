@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from engine.bsdf.principled import MaterialTable
+from engine.bsdf.material_table import MaterialTable
 from engine.kernels.bsdf.params import P_BASE, P_METALLIC, P_ROUGHNESS, pack_materials
 from engine.kernels.texture_batch import (alpha_at_batch, apply_to_rows_batch,
                                           emission_at_batch, lookup_batch, rgba_batch)

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from chi2 import chi2_test
-from engine.bsdf.principled import MaterialTable
+from engine.bsdf.material_table import MaterialTable
 from engine.kernels import bsdf as kb
 from engine.kernels.bsdf import batch, coat, layers, sheen
 from engine.kernels.bsdf import principled as P
@@ -62,7 +62,7 @@ def sampler_pairs(params, wo, w, front=True):
     """1 where the sampler can produce w from wo, else 0: the kernels evaluate refraction
     as Cycles does, also at pairs whose generalised half vector h ~ wo + eta w (eta the
     IOR on w's side over wo's) is not a microfacet normal that refracts one into the
-    other (wo.h > 0 > w.h fails; engine/bsdf/dielectric.py's note). Those pairs add light
+    other (wo.h > 0 > w.h fails; engine/kernels/bsdf/dielectric.py's note). Those pairs add light
     only through next-event estimation; sampling never produces them."""
     if not params.get("transmission"):
         return np.ones(len(w))

@@ -269,8 +269,9 @@ def test_add_shader(bpy_drt):
 
 
 def test_glossy_and_glass_export_to_the_right_lobes(bpy_drt):
-    from engine.bsdf.principled import (L_DIFFUSE, L_GLASS, L_METAL, L_SPECULAR,
-                                        MaterialTable, PrincipledBSDF)
+    from engine.bsdf.material_table import MaterialTable
+    from engine.kernels.bsdf import state as S
+    from engine.kernels.bsdf.batch import Principled
     bpy = bpy_drt
     _reset(bpy)
     mats = [_export(_single(bpy, "ShaderNodeBsdfGlossy", Color=(0.9, 0.6, 0.2, 1),
@@ -278,18 +279,21 @@ def test_glossy_and_glass_export_to_the_right_lobes(bpy_drt):
             _export(_single(bpy, "ShaderNodeBsdfGlass", Color=(0.7, 0.9, 0.8, 1),
                             Roughness=0.0, IOR=1.45)[0])[0],
             _export(_mix(bpy, "DG", DIFFUSE, GLOSSY, fac=0.25)[0])[0]]
-    bsdf = PrincipledBSDF.from_materials(MaterialTable(mats), np.arange(3))
-    assert close(bsdf.weight[0], [0, 0, 1, 0])            # metal only
-    assert close(bsdf.base_clamped[0], (0.9, 0.6, 0.2))    # F0 = the glossy colour
-    assert bsdf.alpha[0] == pytest.approx(0.09)            # GGX alpha = roughness^2
-    assert close(bsdf.weight[1], [0, 0, 0, 1])            # glass only
-    assert close(bsdf.tint_t[1], (0.7, 0.9, 0.8))          # tint per crossing = colour
-    assert bsdf.eta_glass[1] == pytest.approx(1.45) and bsdf.glass_smooth[1]
-    assert bsdf.weight[2, L_DIFFUSE] == pytest.approx(0.75)
-    assert bsdf.weight[2, L_METAL] == pytest.approx(0.25)
-    assert bsdf.weight[2, L_SPECULAR] == 0.0 and bsdf.weight[2, L_GLASS] == 0.0
-    assert close(bsdf.diffuse_color[2], np.array([0.8, 0.1, 0.1]) * 0.75)
-    assert close(bsdf.base_clamped[2], (1, 1, 1))
+    st = Principled.from_materials(MaterialTable(mats), np.arange(3)).states()
+
+    def weights(k):     # diffuse colour's largest channel, specular, metal, glass
+        return [st[k, S.S_DIFFUSE:S.S_DIFFUSE + 3].max(), st[k, S.S_W_SPEC],
+                st[k, S.S_W_METAL], st[k, S.S_W_GLASS]]
+    assert close(weights(0), [0, 0, 1, 0])                  # metal only
+    assert close(st[0, S.S_METAL_F0:S.S_METAL_F0 + 3], (0.9, 0.6, 0.2))  # F0 = the colour
+    assert st[0, S.S_ALPHA] == pytest.approx(0.09)         # GGX alpha = roughness^2
+    assert close(weights(1), [0, 0, 0, 1])                  # glass only
+    assert close(st[1, S.S_TINT:S.S_TINT + 3], (0.7, 0.9, 0.8))  # tint per crossing = colour
+    assert st[1, S.S_ETA_GLASS] == pytest.approx(1.45) and st[1, S.S_GLASS_SMOOTH] == 1.0
+    assert st[2, S.S_W_METAL] == pytest.approx(0.25)
+    assert st[2, S.S_W_SPEC] == 0.0 and st[2, S.S_W_GLASS] == 0.0
+    assert close(st[2, S.S_DIFFUSE:S.S_DIFFUSE + 3], np.array([0.8, 0.1, 0.1]) * 0.75)
+    assert close(st[2, S.S_METAL_F0:S.S_METAL_F0 + 3], (1, 1, 1))
 
 
 def test_microfacet_distribution_is_exported(bpy_drt):

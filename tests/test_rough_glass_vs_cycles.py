@@ -5,8 +5,8 @@ pixel, DRT 1024; the distribution, Filter Glossy and clamps as named per test.
 
 Cycles evaluates a rough glass's refraction at every pair of directions on opposite
 sides of the surface from the generalised half vector alone, also where that vector is
-not a microfacet normal that refracts one direction into the other (engine/bsdf/
-dielectric.py's note). Sampling never produces those pairs, so they add light through
+not a microfacet normal that refracts one direction into the other (engine/kernels/
+bsdf/dielectric.py's note). Sampling never produces those pairs, so they add light through
 next-event estimation only: a lamp seen through rough glass is brighter in Cycles than
 in an estimator of Walter's BTDF. DRT does the same. Roughness 0.67, DRT against Cycles,
 image mean (DRT with two seeds where given):
@@ -31,7 +31,7 @@ import numpy as np
 import pytest
 
 from conftest import render_current
-from engine.bsdf import dielectric
+from engine.kernels.bsdf import lobe_batch
 from test_closures_vs_cycles import _area, _camera, _fresh, _material, _sphere
 
 MEAN_TOLERANCE = 0.005
@@ -132,8 +132,8 @@ def test_cycles_pairs_add_what_cycles_formula_adds(mu, alpha, ior):
     wo_s, wi_s = wo * [1.0, 1.0, flip], wi * [1.0, 1.0, flip]
     dw = (1.0 / n) * (math.pi / n)
     cos = np.abs(wi[:, 2]) * dw * ior * ior        # flux terms, as Cycles'
-    both = [dielectric.rough_eval(wo_s, wi_s, eta, np.full(len(wi), alpha), as_cycles=a)[1]
-            for a in (True, False)]
+    both = [lobe_batch.rough_dielectric_eval(wo_s, wi_s, eta, alpha, walter=w)[1]
+            for w in (False, True)]
     drt_all, drt_walter = ((f * cos).sum() for f in both)
     cyc_all, cyc_walter = _cycles_refraction(mu, alpha, ior, n)
     print(f"mu {mu}, alpha {alpha}, ior {ior:.3f}: DRT {drt_all:.4f} / {drt_walter:.4f}, "

@@ -30,7 +30,7 @@ with 4 DRT seeds against Cycles (and Cycles against itself with another seed):
 - means: glass_caustics -0.01% (docs/comparisons.md, 128 x 128, since DRT plays Cycles'
   Russian roulette: before, its larger boosts met Clamp Indirect more often, -0.21% to
   -0.32% over 4 seeds; -1.04% before DRT evaluated rough refraction as Cycles does,
-  engine/bsdf/dielectric.py; blocks at its caustics were 7.3% off), glass
+  engine/kernels/bsdf/dielectric.py; blocks at its caustics were 7.3% off), glass
   within 0.09%, ray_visibility within 0.18%; metals, glossy_dielectric, dof, instances
   and world_light within 0.1% (earlier measurement, 16 pairs); node_closures (added
   2026-11-26: Refraction BSDF at its Beckmann default, Glass, Glossy, Specular Tint,

@@ -6,7 +6,9 @@ No Blender needed."""
 import numpy as np
 import pytest
 
-from engine.bsdf.principled import L_GLASS, L_METAL, MaterialTable, PrincipledBSDF
+from engine.bsdf.material_table import MaterialTable
+from engine.kernels.bsdf import state as S
+from engine.kernels.bsdf.batch import Principled
 from engine.render import RenderContext
 from engine.scene import Camera, Material, Scene, SunLight, TriangleMesh, World
 from engine.settings import RenderSettings
@@ -185,13 +187,16 @@ def test_lobe_colours_replace_principleds_own():
         Material("mix", (0.8, 0.1, 0.1), metallic=0.3, metal_color=(1.0, 1.0, 1.0)),
         Material("glass", (0.5, 0.9, 0.5), transmission=1.0, roughness=0.0,
                  glass_color=(0.5, 0.9, 0.5))])
-    b = PrincipledBSDF.from_materials(table, np.array([0, 1, 2]))
-    assert b.weight[0, L_METAL] == 1.0 and b.base_clamped[0] == pytest.approx([0.9, 0.6, 0.2])
-    assert b.weight[1, L_METAL] == pytest.approx(0.3)
-    assert b.base_clamped[1] == pytest.approx([1.0, 1.0, 1.0])     # metal F0: white
-    assert b.diffuse_color[1] == pytest.approx(np.array([0.8, 0.1, 0.1]) * 0.7)
-    assert b.weight[2, L_GLASS] == 1.0
-    assert b.tint_t[2] == pytest.approx([0.5, 0.9, 0.5])           # not sqrt(base)
+    st = Principled.from_materials(table, np.array([0, 1, 2])).states()
+    f0 = st[:, S.S_METAL_F0:S.S_METAL_F0 + 3]
+    assert st[0, S.S_W_METAL] == 1.0 and f0[0] == pytest.approx([0.9, 0.6, 0.2])
+    assert st[1, S.S_W_METAL] == pytest.approx(0.3)
+    assert f0[1] == pytest.approx([1.0, 1.0, 1.0])                 # metal F0: white
+    # the diffuse keeps the base colour: weight 0.7 times what the specular layer leaves
+    scale = st[1, S.S_DIFFUSE:S.S_DIFFUSE + 3] / np.array([0.8, 0.1, 0.1])
+    assert scale == pytest.approx([scale[0]] * 3) and 0.6 < scale[0] < 0.7
+    assert st[2, S.S_W_GLASS] == 1.0
+    assert st[2, S.S_TINT:S.S_TINT + 3] == pytest.approx([0.5, 0.9, 0.5])  # not sqrt(base)
 
 
 # --------------------------------------------------------------------------- in the tracer

@@ -1,8 +1,9 @@
 """Albedo tables of DRT's GGX lobes, for the multiple-scattering energy compensation of
-engine/bsdf/multiscatter.py, and the code that computes them.
+engine/kernels/bsdf/multiscatter.py, and the code that computes them.
 
-The tables are computed here, from DRT's own lobes (engine/bsdf/microfacet.py and
-dielectric.py), by quadrature, and cached in `engine/bsdf/data/ggx_energy.npz` (NumPy
+The tables are computed here, from the compiled lobes the renderer runs
+(engine/kernels/bsdf/microfacet.py and dielectric.py, through lobe_batch.py), by
+quadrature, and cached in `engine/bsdf/data/ggx_energy.npz` (NumPy
 .npy arrays in one archive). Rebuild the file after changing a lobe or a grid:
 
     python -m engine.bsdf.energy_tables
@@ -45,8 +46,7 @@ import threading
 
 import numpy as np
 
-from . import dielectric, fresnel
-from . import microfacet as mf
+from ..kernels.bsdf import lobe_batch as lb
 
 ROUGH = np.linspace(0.01, 1.0, 34)       # sqrt(alpha), from sqrt(ALPHA_MIN)
 T = np.linspace(0.0, 1.0, 33)            # sqrt(cos theta_o)
@@ -54,6 +54,7 @@ GLASS_ROUGH = np.linspace(0.01, 1.0, 23)
 GLASS_T = np.linspace(0.0, 1.0, 23)
 GLASS_Z = np.linspace(0.0, 0.9, 19)      # eta up to (1 + 0.81) / (1 - 0.81) = 9.5
 FRESNEL_Z = np.linspace(0.0, 1.0, 257)   # z = 1: eta = infinity, F = 1
+INDEX_MATCHED = 1e-6                     # kernels/bsdf/dielectric.py: no interface
 MU_MIN = 1e-9                            # cos theta_o used for the node t = 0
 QUAD_GGX = (96, 192)                     # Gauss-Legendre nodes in rho, midpoints in u1
 QUAD_GLASS = (48, 96)
@@ -111,15 +112,20 @@ def reflection_albedo(mu, alpha, quad=QUAD_GGX) -> np.ndarray:
     k = len(w)
     wo = _directions(mu.ravel(), k)
     a = np.repeat(alpha.ravel(), k)
-    wi, _, valid = mf.reflection_sample(wo, a, np.tile(u, (mu.size, 1)))
-    g = np.where(valid, mf.G2_over_G1(wo, wi, a), 0.0)
+    wi, _, valid = lb.ggx_reflection_sample(wo, a, np.tile(u, (mu.size, 1)))
+    g = np.where(valid, lb.ggx_G2_over_G1(wo, wi, a), 0.0)
     return (g.reshape(-1, k) * w).sum(1).reshape(mu.shape)
 
 
 def glass_albedo(mu, alpha, eta, quad=QUAD_GLASS) -> np.ndarray:
     """Flux albedo (m,) of the rough dielectric of relative IOR eta seen from wo above
     the surface: reflection F G2/G1 plus refraction (1 - F) G2/G1 (the refraction weight
-    of `dielectric.rough_sample` times eta^2, undoing the radiance factor)."""
+    of `lobe_batch.rough_dielectric_sample` times eta^2, undoing the radiance factor).
+    Index-matched (|eta - 1| < INDEX_MATCHED), the quadrature is degenerate (every normal
+    refracts wo into -wo); the entry is the limit eta -> 1 of the rough interface: F = 0
+    and every sample refracts along -wo with weight G2(wo, -wo) / G1(wo), so that the
+    table interpolates continuously towards IORs near 1 (the kernels render eta = 1
+    itself as no interface)."""
     u, w = vndf_rule(*quad)
     mu, alpha, eta = np.broadcast_arrays(np.asarray(mu, float), np.asarray(alpha, float),
                                          np.asarray(eta, float))
@@ -129,10 +135,13 @@ def glass_albedo(mu, alpha, eta, quad=QUAD_GLASS) -> np.ndarray:
     e = np.repeat(eta.ravel(), k)
     uu = np.tile(u, (mu.size, 1))
     zero = np.zeros(len(wo))
-    _, w_r, _, ok_r, _ = dielectric.rough_sample(wo, e, a, zero, uu, True, False)
-    _, w_t, _, ok_t, _ = dielectric.rough_sample(wo, e, a, zero, uu, False, True)
+    _, w_r, _, ok_r, _ = lb.rough_dielectric_sample(wo, e, a, zero, uu, True, False)
+    _, w_t, _, ok_t, _ = lb.rough_dielectric_sample(wo, e, a, zero, uu, False, True)
     g = np.where(ok_r, w_r, 0.0) + np.where(ok_t, w_t * e * e, 0.0)
-    return (g.reshape(-1, k) * w).sum(1).reshape(mu.shape)
+    out = (g.reshape(-1, k) * w).sum(1).reshape(mu.shape)
+    wo = _directions(mu.ravel(), 1)
+    limit = lb.ggx_G2_over_G1(wo, -wo, alpha.ravel()).reshape(mu.shape)
+    return np.where(np.abs(eta - 1.0) < INDEX_MATCHED, limit, out)
 
 
 def fresnel_interpolant(mu, alpha, eta, quad=QUAD_GLASS) -> np.ndarray:
@@ -146,9 +155,9 @@ def fresnel_interpolant(mu, alpha, eta, quad=QUAD_GLASS) -> np.ndarray:
     wo = _directions(mu.ravel(), k)
     a = np.repeat(alpha.ravel(), k)
     e = np.repeat(eta.ravel(), k)
-    wi, h, valid = mf.reflection_sample(wo, a, np.tile(u, (mu.size, 1)))
-    F = fresnel.dielectric(np.clip((wo * h).sum(1), 0.0, 1.0), e)
-    F0 = fresnel.f0_from_ior(e)
+    wi, h, valid = lb.ggx_reflection_sample(wo, a, np.tile(u, (mu.size, 1)))
+    F = lb.fresnel_dielectric(np.clip((wo * h).sum(1), 0.0, 1.0), e)
+    F0 = ((e - 1.0) / (e + 1.0)) ** 2
     span = 1.0 - F0
     s = np.clip((F - F0) / np.where(span > 0, span, 1.0), 0.0, 1.0)
     g = np.where(valid & (span > 0), s, 0.0)
@@ -167,7 +176,7 @@ def fresnel_average(eta) -> np.ndarray:
     e = eta[fin][:, None]
     c = np.sqrt(np.clip(1.0 - e * e, 0.0, 1.0))      # critical cosine (0 for eta >= 1)
     mu = c + (1.0 - c) * x * x
-    F = fresnel.dielectric(mu, np.broadcast_to(e, mu.shape))
+    F = lb.fresnel_dielectric(mu, np.broadcast_to(e, mu.shape))
     out[fin] = c[:, 0] ** 2 + 4.0 * (1.0 - c[:, 0]) * (F * mu * x * w).sum(1)
     return out
 

@@ -3,10 +3,12 @@ dielectric Fresnel, single scattering, tabulated once per process and interpolat
 
 E_spec(wo) = integral of F(wo.h) D G2 / (4 cos_o) over the reflected hemisphere, the
 energy the layer reflects for light leaving along wo; the diffuse layer below gets the
-rest (engine/bsdf/principled.py). The tables are built lazily (thread-safe) over
-(cos theta_o, roughness, F0^(1/4), side of eta; for eta < 1 the cos axis is aligned on
-the critical angle) by stratified visible-normal quadrature, and interpolated
-trilinearly; engine/kernels/bsdf/albedo.py is the compiled twin of the lookup.
+rest (engine/kernels/bsdf/principled.py). The tables are built here (thread-safe, on
+first use when the stored file does not match the grids) over (cos theta_o, roughness,
+F0^(1/4), side of eta; for eta < 1 the cos axis is aligned on the critical angle) by
+stratified visible-normal quadrature of the compiled GGX lobe and Fresnel kernels
+(engine/kernels/bsdf/lobe_batch.py); engine/kernels/bsdf/albedo.py interpolates them
+trilinearly.
 
 Building both tables takes about a second, once per process; they are kept in
 `engine/bsdf/data/specular_albedo.npz` with their grids, and loaded from there (a file
@@ -24,8 +26,7 @@ import threading
 
 import numpy as np
 
-from . import fresnel
-from . import microfacet as mf
+from ..kernels.bsdf import lobe_batch as lb
 
 TABLE_T = np.linspace(0.0, 1.0, 33)          # cos theta_o coordinate, see _mu_of_t
 TABLE_R = np.linspace(0.01, 1.0, 17)         # roughness (alpha = r^2 >= ALPHA_MIN)
@@ -53,14 +54,6 @@ def _mu_of_t(t, c):
     return np.where(c > 0, np.where(t <= 0.5, lo, hi), t * t)
 
 
-def _t_of_mu(mu, c):
-    mu = np.clip(np.asarray(mu, dtype=np.float64), 0.0, 1.0)
-    cs = np.where(c > 0, c, 1.0)
-    lo = np.arcsin(np.sqrt(np.clip(mu / cs, 0.0, 1.0))) / np.pi
-    hi = 0.5 + 0.5 * np.sqrt(np.clip((mu - c) / np.maximum(1.0 - c, 1e-300), 0.0, 1.0))
-    return np.where(c > 0, np.where(mu <= c, lo, hi), np.sqrt(mu))
-
-
 def _eta_of(x, side):
     eta = (1.0 + x) / (1.0 - x)
     return 1.0 / eta if side else eta
@@ -85,11 +78,11 @@ def _build_specular_albedo_table(side):
             alpha = np.repeat(rr.reshape(-1) ** 2, len(u))
             wo = np.stack([np.sqrt(np.maximum(0.0, 1.0 - cos_o ** 2)), np.zeros_like(cos_o),
                            cos_o], -1)
-            wi, h, valid = mf.reflection_sample(wo, alpha, np.tile(u, (tt.size, 1)))
-            weight = np.where(valid, mf.G2_over_G1(wo, wi, alpha), 0.0)
+            wi, h, valid = lb.ggx_reflection_sample(wo, alpha, np.tile(u, (tt.size, 1)))
+            weight = np.where(valid, lb.ggx_G2_over_G1(wo, wi, alpha), 0.0)
             cache = {c: (weight, np.clip((wo * h).sum(1), 0.0, 1.0), tt.shape)}
         weight, cos_oh, shape = cache[c]
-        F = fresnel.dielectric(cos_oh, eta)
+        F = lb.fresnel_dielectric(cos_oh, eta)
         table[j] = (F * weight).reshape(-1, len(u)).mean(1).reshape(shape)
     return np.clip(table, 0.0, 1.0)
 
@@ -128,40 +121,6 @@ def save(path=PATH):
     os.makedirs(os.path.dirname(path), exist_ok=True)
     np.savez(path, side0=_build_specular_albedo_table(0),
              side1=_build_specular_albedo_table(1), **_grids())
-
-
-def _lerp_coords(grid, v):
-    f = (np.clip(v, grid[0], grid[-1]) - grid[0]) / (grid[1] - grid[0])
-    i0 = np.minimum(f.astype(np.int64), len(grid) - 2)
-    return i0, f - i0
-
-
-def specular_albedo(cos_o, alpha, eta) -> np.ndarray:
-    """Directional albedo (n,) of GGX reflection with exact dielectric Fresnel of
-    relative IOR `eta`, single scattering, interpolated from the tables."""
-    cos_o = np.asarray(cos_o, dtype=np.float64)
-    eta = np.broadcast_to(np.asarray(eta, dtype=np.float64), cos_o.shape)
-    alpha = np.broadcast_to(mf.clamp_alpha(alpha), cos_o.shape)
-    out = np.zeros(cos_o.shape)
-    for side in (0, 1):
-        sel = (eta < 1.0) if side else (eta >= 1.0)
-        if not sel.any():
-            continue
-        table = get_table(side)
-        e = eta[sel]
-        x = np.abs(e - 1.0) / (e + 1.0)
-        i, fi = _lerp_coords(TABLE_S, np.sqrt(x))
-        j, fj = _lerp_coords(TABLE_R, np.sqrt(alpha[sel]))
-        # each eta node has its own cos axis, aligned on its critical angle: the same
-        # coordinate t is the same position relative to the critical angle in every node
-        k, fk = _lerp_coords(TABLE_T, _t_of_mu(cos_o[sel], _critical_cos(e)))
-        acc = 0.0
-        for di, wi_ in ((0, 1.0 - fi), (1, fi)):
-            for dj, wj in ((0, 1.0 - fj), (1, fj)):
-                for dk, wk in ((0, 1.0 - fk), (1, fk)):
-                    acc = acc + wi_ * wj * wk * table[i + di, j + dj, k + dk]
-        out[sel] = acc
-    return out
 
 
 if __name__ == "__main__":

@@ -138,7 +138,7 @@ class MaterialTable:
         self.maybe_transparent = (self.alpha < 1.0) | alpha_tex
         self.any_transparent = bool(self.maybe_transparent.any())
         # Which lobes any material can produce (a scene of plain diffuse materials never
-        # touches the microfacet code; PrincipledBSDF also skips lobes per batch).
+        # touches the microfacet code).
         self.any_glossy = bool(((self.specular_ior_level > 0) | (self.metallic > 0)
                                 | (self.transmission > 0) | (self.coat_weight > 0)).any()
                                or "metallic" in self.textured)

@@ -36,7 +36,7 @@ import math
 
 import numpy as np
 
-from ..bsdf.lobes import TRANSMISSION
+from .bsdf.principled import TRANSMISSION
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt

@@ -1,6 +1,6 @@
 """Image-texture lookups, scalar: the compiled twin of engine/textures.py (`Texture.lookup`,
 `apply_channel`, `TextureInput.evaluate`) and of the textured part of
-`engine.bsdf.principled.MaterialTable` (`lookup`, `emission_at`, `alpha_at`).
+`engine.bsdf.material_table.MaterialTable` (`lookup`, `emission_at`, `alpha_at`).
 
 Same operations in the same order as the NumPy code (float32 texels widened to float64,
 the same bilinear blend, the CLIP taps multiplied by 0 / 1, sRGB decoded after
@@ -91,7 +91,7 @@ def _triple(value, what):
 
 
 def pack_textures(table) -> tuple:
-    """The tuple T (see the module docstring) of an `engine.bsdf.principled.MaterialTable`.
+    """The tuple T (see the module docstring) of an `engine.bsdf.material_table.MaterialTable`.
 
     Raises ValueError for an input `MaterialTable.lookup` cannot evaluate either: a
     colour channel ('rgb', 'alpha_rgb') or a per-channel scale / offset on a scalar

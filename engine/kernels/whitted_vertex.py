@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..bsdf.lobes import TRANSMISSION
+from .bsdf.principled import TRANSMISSION
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d
 from . import lights as lt

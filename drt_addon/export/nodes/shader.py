@@ -14,7 +14,7 @@ from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _Layers, _sum
 from ..material_params import TOL, NodeParam, _is_tex, _lin, _mean, _same, _scale
 from .links import _link
 
-fresnel = importlib.import_module(engine.__name__ + ".bsdf.fresnel")
+lobes = importlib.import_module(engine.__name__ + ".kernels.bsdf.lobe_batch")
 
 
 def _default(sock, color):
@@ -231,7 +231,7 @@ def _transparent(node, ctx) -> _Closure:
 def _fresnel_average(ior):
     """Hemispherical average of Fresnel reflectance, 2 int_0^1 F(mu) mu dmu."""
     mu = (np.arange(1024) + 0.5) / 1024
-    return float(2.0 * np.mean(fresnel.dielectric(mu, max(float(ior), 1e-5)) * mu))
+    return float(2.0 * np.mean(lobes.fresnel_dielectric(mu, max(float(ior), 1e-5)) * mu))
 
 
 def _mix_factor(node, ctx):

@@ -1,6 +1,8 @@
-"""The Principled BSDF as compiled scalar kernels (the twin of engine/bsdf/): material
-rows (`pack_materials`), a per-hit state (`setup`), and `eval_f`, `pdf`, `sample`,
-`transmits` on it; array drivers in `batch`. See `principled` for the calling protocol."""
+"""The BSDFs, as compiled scalar kernels: material rows (`pack_materials`), a per-hit
+state (`setup`), and `eval_f`, `pdf`, `sample`, `transmits` on it; one module per lobe
+(microfacet, dielectric, fresnel, blinn_phong, beckmann, sheen, ...). Array drivers for
+tests and tables: `batch` (the whole BSDF), `lobe_batch` (single lobes), `table_batch`
+(the table lookups). See `principled` for the model and the calling protocol."""
 from .params import (GLOSSY_BLINN_PHONG, GLOSSY_GGX, GLOSSY_MULTI_GGX, NPARAM, P_BASE,
                      P_FILTER_ALPHA, P_GLASS_COLOR, P_GLOSSY_MODEL, P_HAS_GLASS_COLOR,
                      P_HAS_METAL_COLOR, P_IOR, P_METAL_COLOR, P_METALLIC, P_ROUGHNESS,

@@ -1,7 +1,7 @@
 """Directional albedo of the Principled specular layer (GGX reflection with exact
-dielectric Fresnel), looked up in the tables of engine/bsdf/layer_albedo.py: the compiled
-twin of `layer_albedo.specular_albedo` (same coordinates, same trilinear interpolation).
-The tables reach the kernels in the tuple of `tables.kernel_tables()`.
+dielectric Fresnel), looked up in the tables engine/bsdf/layer_albedo.py integrates, on
+its coordinates, trilinearly. The tables reach the kernels in the tuple of
+`tables.kernel_tables()`.
 """
 from __future__ import annotations
 

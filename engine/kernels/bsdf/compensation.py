@@ -11,7 +11,7 @@ from .state import (S_GLASS_SMOOTH, S_METAL_B, S_METAL_CONST, S_METAL_F0, S_META
 @kernel(allocates=False)
 def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, w_glass,
                tables, state):
-    """The multiple-scattering factors at wo (PrincipledBSDF._compensation): 1 unless
+    """The multiple-scattering factors at wo: 1 unless
     `multiscatter`; the lobe weights, metal F0 and Fresnel kind and the tint must be in
     the state already."""
     state[S_MS_SPEC] = 1.0

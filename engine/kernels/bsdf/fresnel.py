@@ -1,8 +1,21 @@
-"""Fresnel reflectance, scalar: the compiled twin of engine/bsdf/fresnel.py.
+"""Fresnel reflectance: exact unpolarised dielectric, and Schlick's approximation.
 
-Same formulas and the same order of floating-point operations as the NumPy module, so
-results agree to the last bit where the maths library agrees (see that module for the
-sources and the sign conventions of `cos_i` and `eta`).
+Dielectric: the Fresnel equations for an unpolarised wave at a smooth interface between
+two non-absorbing media (Born & Wolf, *Principles of Optics*, sec. 1.5; written as in
+Walter et al. 2007, "Microfacet Models for Refraction through Rough Surfaces", eq. 22),
+as the mean of the s- and p-polarised power reflectances. Dimensionless, in [0, 1].
+
+Conventions: `eta` is the relative index n_t / n_i of the medium on the far side of the
+interface over the medium the light arrives in, for `cos_i > 0`. A negative `cos_i` means
+the wave arrives from the other side: the ratio is inverted and |cos_i| used, so both
+sides of one interface are described by one `eta` (for a material with IOR `ior` seen
+from outside: `eta = ior`; from inside, pass a negative cosine or `eta = 1 / ior`).
+eta < 1 is allowed and gives total internal reflection (F = 1) past the critical angle.
+
+Conductors: Schlick 1994, "An Inexpensive BRDF Model for Physically-based Rendering",
+F = F0 + (1 - F0) (1 - cos)^5 with a per-channel F0 (Blender's metallic base colour).
+
+One cosine at a time, float64.
 """
 from __future__ import annotations
 

@@ -1,11 +1,32 @@
-"""GGX microfacet distribution, Smith masking, visible-normal sampling and the GGX
-reflection lobe, scalar: the compiled twin of engine/bsdf/microfacet.py. Its Beckmann
-twin is beckmann.py; distribution.py picks one of the two per closure.
+"""The GGX (Trowbridge-Reitz) microfacet distribution, Smith masking, and sampling of
+visible normals; plus the GGX reflection lobe built from them, one direction at a time.
+Its Beckmann counterpart is beckmann.py; distribution.py picks one of the two per closure.
 
-Directions are three floats (x, y, z) in the local frame (normal = +Z), pointing away
-from the surface. Same formulas and operation order as the NumPy module (see there for
-the sources: Walter et al. 2007, Heitz 2014 and 2018), including the clamp of alpha to
-[ALPHA_MIN, 1] and every validity test.
+Sources:
+  * D: Trowbridge & Reitz 1975; Walter et al. 2007, "Microfacet Models for Refraction
+    through Rough Surfaces", eq. 33:  D(h) = 1 / (pi a^2 cos^4 t (1 + tan^2 t / a^2)^2),
+    written here as 1 / (pi a^2 (h_z^2 + (h_x^2 + h_y^2) / a^2)^2), which has no tangent
+    and stays finite for every unit h. Units: 1/sr (normalised so that
+    integral D(h) cos(theta_h) d(omega_h) = 1).
+  * Smith G1 (Walter et al. 2007 eq. 34; Heitz 2014, "Understanding the Masking-Shadowing
+    Function in Microfacet-Based BRDFs", JCGT 3(2)): G1 = 2 |z| / (|z| + sqrt(z^2 + a^2 s^2))
+    with s^2 = x^2 + y^2, the same as 2 / (1 + sqrt(1 + a^2 tan^2 theta)) but defined at
+    z = 0 (G1 = 0) and at the normal (G1 = 1).
+  * Height-correlated G2 = 1 / (1 + Lambda(wo) + Lambda(wi)) (Heitz 2014), here
+    2 |zo| |zi| / (|zi| r_o + |zo| r_i) with r = sqrt(z^2 + a^2 s^2).
+  * Visible-normal sampling: Heitz 2018, "Sampling the GGX Distribution of Visible
+    Normals" (JCGT 7(4)), listing 1; pdf of the sampled normal
+    D_wo(h) = G1(wo) max(0, wo.h) D(h) / wo_z.
+
+Directions are three floats (x, y, z), unit, in the local frame (normal = +Z), pointing
+away from the surface. `alpha` is the isotropic GGX roughness (Blender/Cycles:
+alpha = roughness^2), dimensionless. It is clamped to [ALPHA_MIN, 1] = [1e-4, 1]:
+roughness 0 would make D a Dirac delta; at alpha = 1e-4 the lobe is ~0.01 degrees wide
+(a mirror to the eye) while every quantity stays an ordinary finite function (peak
+D = 1/(pi alpha^2) ~ 3e7 /sr, reflection pdf ~ 8e6 /sr), so the reflection lobes need no
+separate delta code path and MIS weights stay meaningful; alpha > 1 is not a Blender
+roughness. Every function is finite for wo at the normal, at grazing angles down to
+wo_z = 0, and for alpha at either clamp.
 """
 from __future__ import annotations
 
@@ -61,6 +82,22 @@ def G1_over_cos(x, y, z, alpha):
     a = clamp_alpha(alpha)
     den = abs(z) + r_len(x, y, z, a * a)
     return 2.0 / max(den, 1e-300)
+
+
+@kernel
+def G2_over_G1(ox, oy, oz, ix, iy, iz, alpha):
+    """G2(wo, wi) / G1(wo) of the height-correlated Smith masking: the weight of a
+    VNDF-sampled reflection or refraction, |wi_z| (|wo_z| + r(wo)) / (|wi_z| r(wo) +
+    |wo_z| r(wi))."""
+    a = clamp_alpha(alpha)
+    a2 = a * a
+    zo = abs(oz)
+    zi = abs(iz)
+    ro = r_len(ox, oy, oz, a2)
+    den = zi * ro + zo * r_len(ix, iy, iz, a2)
+    if not den > 0.0:
+        return 0.0
+    return zi * (zo + ro) / den
 
 
 @kernel

@@ -1,7 +1,43 @@
-"""Multiple-scattering energy compensation of the GGX lobes (Cycles' "Multiscatter GGX"),
-scalar: the compiled twin of engine/bsdf/multiscatter.py (see there for what Cycles does
-and the sources). Same coordinates, same interpolation order and the same formula, so the
-factors agree with NumPy's to the bit; the tables come in `kernel_tables()`.
+"""Multiple-scattering energy compensation of the GGX lobes, as Cycles' "Multiscatter GGX"
+(Blender's default distribution since 4.0): each single-scattering lobe is scaled, per
+outgoing direction wo, by the energy that light bouncing more than once between the
+microfacets would add.
+
+What Cycles does (read in Cycles' sources: kernel/closure/bsdf_microfacet.h,
+`microfacet_ggx_preserve_energy` and the `bsdf_microfacet_setup_fresnel_*` functions;
+kernel/closure/bsdf_util.h, `fresnel_f82_Fss`, `fresnel_dielectric_Fss` and
+`closure_layering_weight`; kernel/svm/closure.h, the Principled BSDF and the Glass and
+Glossy nodes; the tables' definitions in app/cycles_precompute.cpp). With
+  E(wo)   the directional albedo of the lobe with Fresnel 1 (for glass: of the whole
+          dielectric interface, reflection plus refraction, in flux terms),
+  E_avg   its cosine-weighted average over wo, and
+  F_ss    the lobe's hemispherical average Fresnel reflectance 2 int_0^1 F(mu) mu dmu,
+the multiple-scattering Fresnel is F_ms = F_ss E_avg / (1 - F_ss (1 - E_avg)) (Kulla and
+Conty 2017, "Revisiting Physically Based Shading at Imageworks", appendix) and
+
+    f(wo, wi) = f_single(wo, wi) (1 + F_ms (1 - E(wo)) / E(wo)),
+
+which is f_single / E(wo) when F_ss = 1: the missing energy 1 - E(wo) is returned in the
+shape of the single-scattering lobe, coloured by the Fresnel of further bounces. The
+factor depends on wo only, so sampling is unchanged (the compensated BSDF is not exactly
+reciprocal, as in Cycles). F_ss per lobe, as Cycles chooses it:
+  metal      Schlick (Cycles' F82-tint with the default white tint): F0 + (1 - F0) / 21,
+             the exact average of F0 + (1 - F0)(1 - mu)^5;
+  specular   the dielectric layer of the Principled BSDF: the average of the exact
+             dielectric Fresnel of its IOR (Cycles evaluates Kulla and Conty's fitted
+             polynomial; here the integral itself, tabulated);
+  glass      the refraction tint ("the transmissive tint makes up most of the overall
+             colour"), so white glass gets exactly 1 / E(wo).
+The Principled diffuse base lies under the specular layer and gets what that layer
+leaves (`closure_layering_weight`): 1 minus the layer's albedo as Cycles estimates it,
+`layer_reflectance` (the Fresnel averaged over the visible normals, as if the lobe lost
+no energy) times, for Multiscatter GGX, the weight E(wo) (1 + F_ms (1 - E) / E) that the
+compensation leaves on the closure (compensation.py, principled.py).
+
+The tables E, E_avg and the dielectric F_ss are DRT's own, integrated from these kernels'
+lobes (engine/bsdf/energy_tables.py); they come in `kernel_tables()`, and the lookups
+here interpolate (bi/tri)linearly on uniform grids in rough = sqrt(alpha),
+t = sqrt(cos theta_o) and z = F0^(1/4) of the relative IOR (see that module).
 """
 from __future__ import annotations
 

@@ -50,7 +50,7 @@ GLOSSY_BECKMANN = 3      # Beckmann (beckmann.py), never compensated, as in Cycl
 
 def pack_materials(table) -> np.ndarray:
     """(M, NPARAM) float64: the plain value of every parameter of every material of the
-    `engine.bsdf.principled.MaterialTable` `table`."""
+    `engine.bsdf.material_table.MaterialTable` `table`."""
     m = len(table.metallic)
     rows = np.zeros((m, NPARAM), dtype=np.float64)
     rows[:, P_BASE:P_BASE + 3] = table.base_color

@@ -1,14 +1,45 @@
-"""Blender's Principled BSDF as a mixture of lobes, one hit at a time: the compiled twin
-of `engine.bsdf.principled.PrincipledBSDF` (see that module for the model: diffuse under
-a dielectric specular layer with albedo scaling, Schlick metal, smooth or rough glass,
-Cycles' multiple-scattering compensation of the GGX lobes; the lobe selection by albedo
-estimates with the MIN_SELECTION floor; the `allowed` masks). Same formulas, same order
-of operations, so the values agree with the NumPy class to rounding (to the bit where the
-maths library agrees). Coat, sheen, translucency and the Refraction BSDF's refraction-only
-glass (layers.py; rows with P_LAYERS / P_REFRACT_ONLY), the Beckmann distribution
-(beckmann.py), the Glossy BSDF's constant and the Specular Tint's F82-tint metal Fresnel
-(reflection_lobes.py) and the tinted specular layer and glass (specular_tint.py) exist in
-the compiled BSDF only. The state's slots: state.py.
+"""Blender's Principled BSDF as a mixture of lobes, one hit at a time.
+
+Composition (Blender's manual, "Principled BSDF", and Cycles' layering; every lobe in the
+local shading frame, m = metallic, t = transmission, GGX alpha = roughness^2 clamped to
+microfacet.ALPHA_MIN):
+
+  metal         weight  m                   GGX reflection, Schlick Fresnel, F0 = base colour
+                                            clamped to [0, 1] (F82-tint with a Specular Tint,
+                                            reflection_lobes.py; the Glossy BSDF's constant)
+  transmission  weight  (1 - m) t           dielectric interface with the material IOR:
+                                            smooth (delta) if alpha <= SMOOTH_ALPHA, else
+                                            rough GGX (Walter et al. 2007); reflection is
+                                            untinted, refraction tinted by sqrt(base colour)
+                                            per crossing (Cycles' choice: a round trip
+                                            through a closed object gives the base colour)
+  specular      weight  (1 - m)(1 - t)      GGX reflection with exact dielectric Fresnel of
+                                            an IOR adjusted by Specular IOR Level:
+                                            F0' = F0(ior) * 2 level (0.5 = plain IOR, 0 =
+                                            no specular, 1 = twice F0), IOR' = IOR(F0')
+  diffuse       weight  (1 - m)(1 - t)      Lambert with the base colour, under the specular
+                        (1 - E_spec(wo))    layer: it gets only the energy the layer does not
+                                            reflect, E_spec(wo) being that layer's albedo as
+                                            Cycles estimates it (albedo.py, multiscatter.py)
+
+The weights sum to 1 and each part conserves energy, so the whole does. Cycles' E_spec
+for GGX is the Fresnel reflectance averaged over the visible normals, which ignores the
+energy the single-scattering lobe loses to masking: a rough single-scattering plastic
+reflects a little less than 1 in a white furnace, as in Cycles; with Multiscatter GGX
+(compensation.py: the metal, specular and rough glass lobes scaled per wo by
+1 + F_ms (1 - E(wo)) / E(wo)) the furnace is white again. The lecture's Blinn-Phong
+distribution may replace GGX in the reflection lobes (never compensated). Coat, sheen,
+translucency and the Refraction BSDF's refraction-only glass (layers.py; rows with
+P_LAYERS / P_REFRACT_ONLY), the Beckmann distribution (beckmann.py) and the tinted
+specular layer and glass (specular_tint.py) complete Cycles' closures.
+
+Sampling: a lobe is chosen with probability proportional to an estimate of its albedo at
+wo, at least MIN_SELECTION of its weight; the mixture pdf is sum_i q_i pdf_i over the
+allowed lobes (the delta part of a smooth glass has no density: pdf = inf, delta True).
+The allow flags over DIFFUSE / GLOSSY / TRANSMISSION restrict sampling and its pdf to the
+lobe kinds whose bounce budget is not exhausted (Cycles' diffuse, glossy and transmission
+limits; glass reflection counts as GLOSSY, refraction as TRANSMISSION). The state's
+slots: state.py. Tests reach these kernels over arrays through batch.py.
 
 Use, per hit:
     setup(row, front_facing, wox, woy, woz, tables, state)   # fills state[:NSTATE]
@@ -48,11 +79,10 @@ from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX,  # noqa: F
 from .tables import kernel_tables  # noqa: F401  (re-exported)
 from ..warp import INV_PI, cosine_hemisphere
 
-# Constants of the NumPy model, repeated here rather than imported: Numba freezes globals
-# into its on-disk cache, keyed on this file, so an imported value could go stale
-# silently; tests/test_kernel_bsdf.py checks that they agree.
-DIFFUSE, GLOSSY, TRANSMISSION = 0, 1, 2    # lobe kinds, engine/bsdf/lobes.py
-MIN_SELECTION = 0.02                       # engine/bsdf/principled.py
+DIFFUSE, GLOSSY, TRANSMISSION = 0, 1, 2    # lobe kinds
+# Lower bound of a present lobe's selection estimate, relative to its weight, so a lobe
+# that reflects little at this wo (black metal at normal incidence) can still be sampled
+MIN_SELECTION = 0.02
 # Largest float below 1: the rescaled lobe coordinate stays in [0, 1)
 ONE_MINUS_EPS = 1.0 - 2.0 ** -53
 
@@ -61,7 +91,7 @@ ONE_MINUS_EPS = 1.0 - 2.0 ** -53
 @kernel(allocates=False)
 def setup(row, front_facing, wox, woy, woz, tables, state):
     """Fill state[:NSTATE] with the lobes' parameters at this hit for outgoing wo."""
-    # parameters, clamped as PrincipledBSDF.__init__ does
+    # parameters, clamped to their ranges
     m = min(max(row[P_METALLIC], 0.0), 1.0)
     t = min(max(row[P_TRANSMISSION], 0.0), 1.0)
     rough = min(max(row[P_ROUGHNESS], 0.0), 1.0)
@@ -123,7 +153,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     if w_glass > 0.0 and state[S_REFRACT_ONLY] == 0.0 and specular_tint.is_tinted(row):
         specular_tint.glass_setup(row, eta_glass, state)
 
-    # albedo-dependent weights at wo (PrincipledBSDF._wo_state)
+    # albedo-dependent weights at wo
     cos_o = min(max(woz, 0.0), 1.0)
     compensate(row[P_GLOSSY_MODEL] == GLOSSY_MULTI_GGX, woz, cos_o, alpha, eta_spec,
                eta_glass, w_spec, m, w_glass, tables, state)
@@ -131,7 +161,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     est_spec = 0.0
     state[S_SPEC_TINTED] = 0.0
     if w_spec > 0.0:
-        # the layer's albedo as the diffuse sees it (PrincipledBSDF._layer_albedo)
+        # the layer's albedo as the diffuse sees it
         e_spec = specular_albedo(cos_o, alpha, eta_spec, tables)
         if state[S_BLINN] == 0.0:
             if specular_tint.is_tinted(row):
