@@ -45,6 +45,13 @@ CASES = {
                 "1.5.",
     "world": "A world volume: Principled Volume, density 0.05, on the World Output.",
     "camera_inside": "The camera inside the fog (density 0.15): the paths start in it.",
+    "beam": "A spot lamp (1500 W, 40 degrees) through fog of density 0.08, the area lamp "
+            "dimmed to 20 W: the beam is lit fog. Its direct light takes distances by "
+            "transmittance and equiangularly towards the lamp, combined by multiple "
+            "importance sampling (the material's Volume Sampling Method, Cycles' default); "
+            "with distance sampling alone the largest block is 2.9 % off at 512 samples and "
+            "1.6 % at 2048 (tests/test_lit_fog.py measures the noise on a thinner fog: "
+            "a tenth of the squared error at equal samples).",
 }
 
 
@@ -98,7 +105,12 @@ def main(argv=None):
              "volumes they are in (the camera's found by a ray), sample a scattering "
              "distance per colour channel with one-sample MIS, light the scattering points "
              "by next-event estimation with the Henyey-Greenstein phase function (MIS "
-             "against phase sampling) and go on within Light Paths > Max Bounces > Volume "
+             "against phase sampling), and light each segment's direct light once more at "
+             "a distance sampled equiangularly towards the picked lamp (Kulla and Fajardo "
+             "2012), the two distances combined by MIS as the material's or world's "
+             "Settings > Volume > Sampling Method says (Cycles' defaults: Multiple "
+             "Importance for materials, Equiangular for the world; Distance turns it off), "
+             "and go on within Light Paths > Max Bounces > Volume "
              "(Cycles' default 0: direct light in volumes only). Shadow rays are "
              "attenuated by the volumes they cross.", "",
              "A volume whose coefficients vary in space (a texture, or any node graph, on "
@@ -149,9 +161,11 @@ def main(argv=None):
             sections += [f"## {case}", "", text, "", f"![{case}](images/{name})", ""]
     lines += [""] + sections + [
         "## Known differences", "",
-        "- Next-event estimation from scattering points samples the lamps only (Cycles "
-        "adds equiangular sampling): a lamp seen through forward-scattering fog is "
-        "noisier than in Cycles at the same samples.",
+        "- Equiangular sampling serves homogeneous volumes; in a volume that varies in "
+        "space distances are sampled by delta tracking alone, so a lamp inside textured "
+        "fog is noisier there than in homogeneous fog.",
+        "- Equiangular distances are taken towards a lamp's position whatever its cone: "
+        "a narrow spot beam wastes the samples outside the cone (so does Cycles).",
         "- A world volume attenuates sun and world shadow rays over four scene radii "
         "(Cycles: to infinity).",
         "- Blackbody emission and phase functions other than Henyey-Greenstein are not "

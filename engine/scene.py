@@ -152,11 +152,16 @@ class Volume:
     volume_scattering and volume_emission (engine.nodes.program.OUTPUTS) has a
     heterogeneous volume: the program, run at each point inside the medium, gives its
     coefficients there (engine.kernels.medium_density), and these fields are then
-    summaries (its averages)."""
+    summaries (its averages).
+
+    `sampling`: how the direct light of its segments picks distances, Cycles' Volume >
+    Sampling Method: 'DISTANCE' (by transmittance), 'EQUIANGULAR' (towards the lights'
+    positions) or 'MULTIPLE_IMPORTANCE' (both; engine.kernels.medium_vertex)."""
     absorption: tuple = (0.0, 0.0, 0.0)
     scattering: tuple = (0.0, 0.0, 0.0)
     anisotropy: float = 0.0
     emission: tuple = (0.0, 0.0, 0.0)
+    sampling: str = "MULTIPLE_IMPORTANCE"
 
     def is_empty(self) -> bool:
         return not (any(v > 0 for v in self.absorption) or any(v > 0 for v in self.scattering)

@@ -140,6 +140,12 @@ def test_scenes_without_volumes_carry_no_volume_state():
     try:
         assert not ctx.integrator.has_volumes
         assert ctx.integrator.vol.shape[0] == 0
+        assert ctx.integrator.shadow_rays_per_path == 1   # no equiangular light samples
+    finally:
+        ctx.close()
+    ctx = RenderContext(_sphere_scene(Volume(scattering=(0.1,) * 3)), RenderSettings(samples=1))
+    try:
+        assert ctx.integrator.shadow_rays_per_path == 2   # one more per segment in a medium
     finally:
         ctx.close()
 

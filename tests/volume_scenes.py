@@ -139,6 +139,17 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
         v = nt.nodes.new("ShaderNodeVolumePrincipled")
         v.inputs["Density"].default_value = 0.05
         nt.links.new(v.outputs[0], nt.nodes["World Output"].inputs["Volume"])
+    elif case == "beam":
+        # a spot lamp through thin fog, the beam lit fog (the area lamp dimmed to a fill)
+        lamp.data.energy = 20.0
+        spot = bpy.data.objects.new("Spot", bpy.data.lights.new("Spot", "SPOT"))
+        spot.data.energy = 1500.0
+        spot.data.spot_size = math.radians(40.0)
+        spot.data.spot_blend = 0.3
+        spot.location = (0.3, 0.4, 3.5)
+        scene.collection.objects.link(spot)
+        fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled", {"Density": 0.08})
+        cube(bpy, scene, "Fog", *fog_box, fog)
     elif case == "camera_inside":
         fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled", {"Density": 0.15})
         cube(bpy, scene, "Fog", (-5.0, -8.0, -0.5), (5.0, 5.0, 5.0), fog)
@@ -148,4 +159,4 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
 
 
 CASES = ("scatter", "tinted", "multiple", "noise", "absorption_glass", "clear_glass",
-         "emission", "world", "camera_inside")
+         "emission", "world", "camera_inside", "beam")

@@ -218,6 +218,15 @@ def is_heterogeneous(material) -> bool:
     return shader is not None and any(k in shader.outputs for k in VOLUME_OUTPUTS)
 
 
+def volume_sampling(ctx) -> str:
+    """The material's or world's Settings > Volume > Sampling Method (Cycles' defaults:
+    Multiple Importance for materials, Equiangular for the world)."""
+    owner = getattr(ctx, "mat", None) or getattr(ctx, "world", None)
+    default = "EQUIANGULAR" if getattr(ctx, "mat", None) is None else "MULTIPLE_IMPORTANCE"
+    method = getattr(getattr(owner, "cycles", None), "volume_sampling", default)
+    return method if method in ("DISTANCE", "EQUIANGULAR", "MULTIPLE_IMPORTANCE") else default
+
+
 def export_volume(socket, ctx) -> "engine.Volume | None":
     """The Volume behind a Volume socket (None: nothing linked or empty). When it varies
     in space (a material's, ctx.volume_programs), its coefficients are also left in
@@ -231,7 +240,8 @@ def export_volume(socket, ctx) -> "engine.Volume | None":
     ss_mean = float(ss.mean())
     g = c.gs / ss_mean if ss_mean > 0 else 0.0
     v = engine.Volume(tuple(np.maximum(sa, 0.0)), tuple(np.maximum(ss, 0.0)),
-                      min(max(g, -1.0), 1.0), tuple(np.maximum(em, 0.0)))
+                      min(max(g, -1.0), 1.0), tuple(np.maximum(em, 0.0)),
+                      volume_sampling(ctx))
     if c.varies():
         ctx.volume_outputs = {name: alg.vector(x) for name, x in
                               zip(VOLUME_OUTPUTS, (c.sa, c.ss, c.em))}
@@ -245,6 +255,7 @@ class _VolumeCtx(_WorldCtx):
     def __init__(self, world, reporter):
         from .nodes import NodeCompiler
         super().__init__(world, reporter)
+        self.world = world
         self.normal = None
         self.nodes = NodeCompiler(self)
 

@@ -133,8 +133,9 @@ class CompiledPathIntegrator:
 
     @property
     def shadow_rays_per_path(self) -> int:
-        """The most shadow rays the vertex kernel queues per path and bounce."""
-        return 1
+        """The most shadow rays the vertex kernel queues per path and bounce: one, and
+        one more for the equiangular light sample of a segment in a medium."""
+        return 2 if self.has_volumes else 1
 
     @property
     def mis_mode(self) -> str:
@@ -224,8 +225,8 @@ class CompiledPathIntegrator:
         vbounce = np.zeros(n, dtype=np.int64)      # volume scatterings per path
         k = n if self.has_volumes else 0
         stacks = np.ascontiguousarray(np.tile(self.start_stack, (k, 1)), np.int32)
-        sh_stack = np.full((k, STACK), -1, np.int32)
         ns_max = n * self.shadow_rays_per_path       # the shadow rays one bounce may queue
+        sh_stack = np.full((ns_max if k else 0, STACK), -1, np.int32)   # one per shadow ray
         sh_bounce = np.empty(ns_max, np.int64)
         media = (bounce, vbounce, self.vol, stacks, sh_stack, sh_bounce, self.het_runs)
         no_keys = np.zeros(0, np.uint64)

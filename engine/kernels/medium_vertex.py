@@ -5,17 +5,30 @@ the BSDF: next-event estimation (one light sample, one shadow ray through the me
 MIS against phase sampling) and, within Cycles' volume bounce limit, a new direction
 sampled from the phase function. As in Cycles a volume scattering counts as a bounce,
 is seen by lamps as a diffuse ray, and past `volume_bounces` scatterings a path still
-gathers the direct light of its last one but goes no further."""
+gathers the direct light of its last one but goes no further.
+
+The direct light of a homogeneous segment is estimated twice, and the two combined by
+multiple importance sampling over the distance (Cycles' "Multiple Importance" volume
+sampling): at the distance-sampled scattering (`scatter`, when the path scatters), and
+at a distance sampled equiangularly towards the picked light's position
+(`equiangular_light`, for every segment through a scattering medium, whether the path
+scatters or not: one more shadow ray). The light point is sampled alike at either
+distance, with the same pick probabilities, so the weights are the power heuristic of
+the two distance densities; a sun or the world, which has no position, is the distance
+strategy's alone. Heterogeneous segments use the distance strategy alone."""
 from __future__ import annotations
+
+import math
 
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
+from . import equiangular as eq
 from . import lights as lt
 from . import ray_queues
 from .jit import kernel
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, nee_weight,
-                           roulette)
-from .volume import hg_phase, hg_sample
+                           power_heuristic, roulette)
+from .volume import EQUIANGULAR, hg_phase, hg_sample, medium, volume_dim
 
 C_VOLUME_BOUNCES = 14      # cfg entry: Cycles' max volume bounces
 
@@ -24,10 +37,13 @@ C_VOLUME_BOUNCES = 14      # cfg entry: Cycles' max volume bounces
 def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb, g, bounce,
             vbounce, beta, cont, prev_pdf, prev_pos, ray_bits, L, lights, vol, stacks,
             sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns,
-            nx_path, nx_org, nx_dir, nn):
+            nx_path, nx_org, nx_dir, nn, segment):
     """Path p (throughput b, after the segment's weight, shutter time `time`) scattered at
     point x moving along d, by a Henyey-Greenstein phase function of anisotropy g. Writes
-    at most one shadow ray (returned count ns) and one next ray (nn)."""
+    at most one shadow ray (returned count ns) and one next ray (nn). `segment` = (ox,
+    oy, oz, t_max, t, pdf, method): the homogeneous segment the distance t was sampled
+    on, that sample's density and the medium's sampling method, for the weight against
+    equiangular sampling (pdf 0: none, the distance sample's alone)."""
     kind, spp = int(cfg[0]), int(cfg[1])
     mode = int(cfg[8])
     clamp = cfg[6] if bounce[p] == 0 else cfg[7]
@@ -44,8 +60,11 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
         if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0:
             ph = hg_phase(g, dx * wx + dy * wy + dz * wz)
             w = nee_weight(mode, lpdf, ph if goes_on else 0.0, delta) / lpdf * ph
+            w *= distance_weight(lights, k, time, dx, dy, dz, segment)
             cr, cg, cb = br * lr * w, bg * lg * w, bb * lb * w
-            if not seen & SHADOW_BIT:
+            if not w > 0.0:
+                pass                         # the equiangular sample's alone
+            elif not seen & SHADOW_BIT:
                 _add(L, p, cr, cg, cb, clamp)
             else:
                 sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz,
@@ -69,3 +88,71 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
     prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2] = px, py, pz
     prev_pdf[p] = pdf
     return ns, ray_queues.push_next(nn, p, px, py, pz, wx, wy, wz, nx_path, nx_org, nx_dir)
+
+
+@kernel(allocates=False)
+def distance_weight(lights, k, time, dx, dy, dz, segment):
+    """The weight of the distance-sampled scattering's light sample (entry k) against
+    equiangular sampling towards entry k on the same segment: 1 for a light without a
+    position, 0 where the medium samples such lights equiangularly only."""
+    ox, oy, oz, t_max, t, pd, method = segment
+    if not pd > 0.0:
+        return 1.0
+    has, cx, cy, cz = lt.entry_center(lights, k, time)
+    if not has:
+        return 1.0
+    if int(method) == EQUIANGULAR:
+        return 0.0
+    return power_heuristic(pd, eq.pdf(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_max, t))
+
+
+@kernel
+def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, t_max,
+                      br, bg, bb, channels, method, bounce, vbounce, L, lights, vol, stacks,
+                      sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns):
+    """The equiangular half of a homogeneous segment's direct light: path p (throughput
+    b before the segment, roulette applied) travels o + t d, t in [0, t_max], through its
+    medium, whose distance sampling picked the channels with weights `channels` (RGB),
+    with Volume Sampling Method `method` (EQUIANGULAR or MULTIPLE_IMPORTANCE). Picks a
+    light, samples a distance towards its position and a point on it from there, and
+    queues the shadow ray (returned count ns)."""
+    kind, spp = int(cfg[0]), int(cfg[1])
+    mode = int(cfg[8])
+    if lt.n_entries(lights) == 0:
+        return ns
+    u_pick = sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 2))
+    k = lt.pick(lights, u_pick)
+    has, cx, cy, cz = lt.entry_center(lights, k, time)
+    if not has:
+        return ns
+    t, pe = eq.sample(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_max,
+                      sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 3)))
+    if not pe > 0.0:
+        return ns
+    sar, sag, sab, ssr, ssg, ssb, g, _, _, _ = medium(vol, stacks, p)
+    str_, stg, stb = sar + ssr, sag + ssg, sab + ssb
+    wr, wg, wb = channels
+    pd = eq.distance_pdf(str_, stg, stb, wr, wg, wb, t)
+    px, py, pz = ox + dx * t, oy + dy * t, oz + dz * t
+    u1, u2 = sample_2d(kind, pkey[p], spp, index[p], volume_dim(depth, 4))
+    k2, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
+        lights, px, py, pz, u_pick, u1, u2, time)
+    seen = lt.entry_visibility(lights, k2)
+    if not (k2 == k and lpdf > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0):
+        return ns
+    goes_on = bounce[p] < int(cfg[2]) and vbounce[p] < int(cfg[C_VOLUME_BOUNCES])
+    ph = hg_phase(g, dx * wx + dy * wy + dz * wz)
+    w_t = 1.0 if method == EQUIANGULAR else power_heuristic(pe, pd)
+    w = nee_weight(mode, lpdf, ph if goes_on else 0.0, delta) / lpdf * ph * w_t / pe
+    cr = br * ssr * math.exp(-str_ * t) * lr * w
+    cg = bg * ssg * math.exp(-stg * t) * lg * w
+    cb = bb * ssb * math.exp(-stb * t) * lb * w
+    if not seen & SHADOW_BIT:
+        clamp = cfg[6] if bounce[p] == 0 else cfg[7]
+        _add(L, p, cr, cg, cb, clamp)
+        return ns
+    sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz, dist, margin,
+                                             cfg[9])
+    return ray_queues.push(ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr, cg, cb,
+                           sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, stacks,
+                           sh_stack)

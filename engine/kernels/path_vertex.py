@@ -45,13 +45,14 @@ from .bsdf.state import S_WALTER
 from . import ray_queues
 from .frame import dot, length, to_local, to_world
 from .jit import kernel
-from .medium_vertex import scatter
+from .equiangular import distance_pdf
+from .medium_vertex import equiangular_light, scatter
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
                            TRANSMISSION_BIT, _add, _INF, continues, hit_weight, nee_weight,
                            roulette, uncovered)
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
-from .volume import (V_BOUNDARY, V_HAS, in_medium, medium, passed, segment, stack_cross,
-                     volume_dim)
+from .volume import (DISTANCE, V_BOUNDARY, V_HAS, in_medium, medium, passed, sample_method,
+                     segment, stack_cross, volume_dim)
 from .bsdf.params import P_FILTER_ALPHA
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .terminator import shadow_origin
@@ -175,6 +176,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         str_ = stg = stb = wcr = wcg = wcb = 0.0
         g_phase = 0.0
         mfr = mfg = mfb = 1.0                    # a heterogeneous segment's factor at a lamp
+        segment_mis = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)   # no equiangular counterpart
         if volumes is not None and in_medium(stacks, p):
             if het is not None and het_scene and heterogeneous_in(vol, stacks, p):
                 # null-scattering tracking (engine.kernels.medium_density); the factor
@@ -195,8 +197,21 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                     eb = segment(vol, stacks, p, br, bg, bb, t_geom,
                                  sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 0)),
                                  sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 1)))
+                method = sample_method(vol, stacks, p)
                 if scattered:
                     g_phase = medium(vol, stacks, p)[6]
+                    if method != DISTANCE:
+                        segment_mis = (ox, oy, oz, t_geom, t_end,
+                                       distance_pdf(str_, stg, stb, wcr, wcg, wcb, t_end),
+                                       float(method))
+                if vmode == 2 and method != DISTANCE and n_lights > 0 and cont[p] > 0.0:
+                    # the segment's direct light at an equiangular distance (the roulette
+                    # verdict on this ray applies, as at a scattering)
+                    ns_out = equiangular_light(
+                        depth, cfg, pkey, index, p, path_time[p], ox, oy, oz, dx, dy, dz,
+                        t_geom, b0r / cont[p], b0g / cont[p], b0b / cont[p], (wcr, wcg, wcb),
+                        method, bounce, vbounce, L, lights, vol, stacks, sh_path, sh_org,
+                        sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns_out)
             _add(L, p, er, eg, eb, clamp_hit)
         # 1a. area and sphere lamps in front of the geometry: the ray passes through
         # lamps (as in Cycles) and finds every one before what it hits
@@ -230,7 +245,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                                      g_phase, bounce, vbounce, beta, cont, prev_pdf, prev_pos,
                                      ray_bits, L, lights, vol, stacks, sh_path, sh_org, sh_dir,
                                      sh_far, sh_contrib, sh_bounce, sh_stack, ns_out, nx_path,
-                                     nx_org, nx_dir, nn_out)
+                                     nx_org, nx_dir, nn_out, segment_mis)
             continue
         # 1b. escaped rays: the world and sun discs (or, for camera rays on a transparent
         # film, no colour and the coverage left)

@@ -25,7 +25,9 @@ The packed table VOL (materials + 1 rows, the last the world's): absorption RGB,
 scattering RGB, anisotropy g, emission RGB, has-a-volume flag, boundary flag (the
 material has no surface shader), heterogeneous flag (the material's program computes
 its coefficients per point: engine.kernels.medium_density, which also fills the
-majorant and object columns; the row's coefficients are then zeros), majorant, object.
+majorant and object columns; the row's coefficients are then zeros), majorant, object,
+sampling method (V_METHOD: how the direct light of a segment picks distances,
+medium_vertex.py).
 Paths whose media are all homogeneous use this module only.
 Stacks are (paths, STACK) int32 of material rows, -1 for empty slots; the world's row
 sits at the bottom of every stack when it has a volume.
@@ -41,7 +43,11 @@ from .jit import kernel
 
 STACK = 8                          # media one path can be inside at once (Cycles: 4+)
 V_SA, V_SS, V_G, V_EM, V_HAS, V_BOUNDARY = 0, 3, 6, 7, 10, 11
-V_HET, V_MAJ, V_OBJ, NV = 12, 13, 14, 15
+V_HET, V_MAJ, V_OBJ, V_METHOD, NV = 12, 13, 14, 15, 16
+# V_METHOD: how a segment's direct light picks distances (Cycles' Volume Sampling Method)
+DISTANCE, EQUIANGULAR, MULTIPLE_IMPORTANCE = 0, 1, 2
+_METHODS = {"DISTANCE": DISTANCE, "EQUIANGULAR": EQUIANGULAR,
+            "MULTIPLE_IMPORTANCE": MULTIPLE_IMPORTANCE}
 VOLUME_OUTPUTS = ("volume_absorption", "volume_scattering", "volume_emission")
 VOLUME_DIM = 1 << 25               # the volume decisions' own sampler dimensions
 _INV_4PI = 1.0 / (4.0 * math.pi)
@@ -63,6 +69,7 @@ def pack_volumes(materials, world_volume) -> np.ndarray:
             continue
         vol[i, V_G] = min(max(float(v.anisotropy), -0.999), 0.999)
         vol[i, V_HAS] = 1.0
+        vol[i, V_METHOD] = _METHODS.get(getattr(v, "sampling", ""), MULTIPLE_IMPORTANCE)
         vol[i, V_OBJ] = -1.0
         shader = getattr(m, "shader", None) if m is not None else None
         if shader is not None and any(k in shader.outputs for k in VOLUME_OUTPUTS):
@@ -76,7 +83,7 @@ def pack_volumes(materials, world_volume) -> np.ndarray:
 
 @kernel
 def volume_dim(depth, offset):
-    return VOLUME_DIM + depth * 4 + offset
+    return VOLUME_DIM + depth * 8 + offset
 
 
 # --------------------------------------------------------------------------- stacks
@@ -134,6 +141,21 @@ def medium(vol, stacks, p):
 def extinction(vol, stacks, p):
     sar, sag, sab, ssr, ssg, ssb, _, _, _, _ = medium(vol, stacks, p)
     return sar + ssr, sag + ssg, sab + ssb
+
+
+@kernel(allocates=False)
+def sample_method(vol, stacks, p):
+    """The Volume Sampling Method of path p's medium: its media's own when they agree
+    (those that scatter), else multiple importance (as Cycles' volume_stack_sample_method)."""
+    method = -1
+    for k in range(stacks.shape[1]):
+        m = stacks[p, k]
+        if m < 0:
+            break
+        if vol[m, V_SS] + vol[m, V_SS + 1] + vol[m, V_SS + 2] > 0.0 or vol[m, V_HET] != 0.0:
+            mk = int(vol[m, V_METHOD])
+            method = mk if method < 0 or method == mk else MULTIPLE_IMPORTANCE
+    return MULTIPLE_IMPORTANCE if method < 0 else method
 
 
 # --------------------------------------------------------------------------- segments

@@ -39,18 +39,20 @@ Use:
     environment_pdf(L, dx, dy, dz);  environment_radiance(L) -> (r, g, b)
     world_escaped(L, world, ray_bit, dx, dy, dz) -> (r, g, b, pdf)   # escaped rays
     n_suns(L);  sun_escaped(L, j, dx, dy, dz, time) -> (r, g, b, pdf)
-    n_entries(L);  entry_visibility(L, k)
+    n_entries(L);  entry_visibility(L, k);  pick(L, u_pick) -> k (as `sample` picks)
+    entry_center(L, k, time) -> (has_one, x, y, z)   # towards which distances are sampled
 
 Every pdf is in solid angle with the pick probability (LightSet.select_pdf) included. `time` is
 the ray's shutter time in [0, 1]: a lamp that moves during the shutter is its slice at
 that time (pack.py, TimeSlicedLight). Array drivers for tests: `batch`.
 """
-from .light_set import (environment_pdf, environment_radiance, hit_lamps,
+from .light_set import (entry_center, environment_pdf, environment_radiance, hit_lamps,
                         is_uniform_world, lamp_hit, lamp_pdf, entry_visibility, mesh_pdf,
-                        n_entries, n_lamps, n_suns, sample, sun_escaped, world_escaped)
+                        n_entries, n_lamps, n_suns, pick, sample, sun_escaped,
+                        world_escaped)
 from .pack import pack_lights
 
 __all__ = ["pack_lights", "n_entries", "n_lamps", "sample", "hit_lamps", "lamp_hit",
-           "entry_visibility",
+           "entry_visibility", "entry_center", "pick",
            "lamp_pdf", "mesh_pdf", "environment_pdf", "environment_radiance", "n_suns",
            "sun_escaped", "world_escaped", "is_uniform_world"]

@@ -15,9 +15,10 @@ from .area import intersect_area, pdf_area, sample_area
 from .environment import pdf_environment, sample_environment
 from .environment_map import (has_map, map_radiance, pdf_map, sample_environment_map,
                               seen_by_camera)
-from .pack import (C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, CDF_GUIDE, ENV, LAMPS, LAMP_SLICES,
-                   SELECT_PDF, SLICE_OF, SUNS, TRI_VISIBILITY, T_AREA, T_DISC, T_ENV,
-                   T_ENV_MAP, T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA)
+from .pack import (C_CENTER, C_POS, C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, CDF_GUIDE, ENV,
+                   LAMPS, LAMP_SLICES, SELECT_PDF, SLICE_OF, SUNS, TRI_E1, TRI_E2, TRI_V0,
+                   TRI_VISIBILITY, T_AREA, T_DISC, T_ENV, T_ENV_MAP, T_POINT, T_SPHERE,
+                   T_SUN, T_SUN_DELTA)
 from .point import intersect_point, pdf_point, sample_point
 from .sun import escaped_sun, pdf_sun, sample_sun
 from .triangles import pdf_triangle, sample_triangle, triangle_entry
@@ -114,6 +115,29 @@ def sample(L, px, py, pz, u_pick, u1, u2, time):
     wx, wy, wz, dist, r, g, b, pdf, margin = sample_triangle(L, k - lamps.shape[0],
                                                              px, py, pz, u1, u2)
     return k, wx, wy, wz, dist, r, g, b, pdf * select, False, margin
+
+
+@kernel(allocates=False)
+def entry_center(L, k, time):
+    """(has_one, x, y, z): where light entry k is, at shutter time `time`, for sampling
+    distances towards it (kernels/equiangular.py): a point lamp's position, an area
+    lamp's centre, an emissive triangle's centroid; suns and the world have none."""
+    lamps = L[LAMPS]
+    if k < 0:
+        return False, 0.0, 0.0, 0.0
+    if k >= lamps.shape[0]:
+        j = k - lamps.shape[0]
+        v0, e1, e2 = L[TRI_V0], L[TRI_E1], L[TRI_E2]
+        return (True, v0[j, 0] + (e1[j, 0] + e2[j, 0]) / 3.0,
+                v0[j, 1] + (e1[j, 1] + e2[j, 1]) / 3.0, v0[j, 2] + (e1[j, 2] + e2[j, 2]) / 3.0)
+    kind = lamps[k, C_TYPE]
+    sliced, row = lamp_row(L, k, time)
+    table = L[LAMP_SLICES] if sliced else lamps
+    if kind == T_POINT or kind == T_SPHERE or kind == T_DISC:
+        return True, table[row, C_POS], table[row, C_POS + 1], table[row, C_POS + 2]
+    if kind == T_AREA:
+        return True, table[row, C_CENTER], table[row, C_CENTER + 1], table[row, C_CENTER + 2]
+    return False, 0.0, 0.0, 0.0
 
 
 @kernel(allocates=False)
