@@ -10,8 +10,10 @@ layer (Properties > View Layer > Passes):
 - DRT Noise (`view_layer.drt.use_pass_noise`): per pixel and channel, the standard error
   of the pixel's mean radiance (sqrt of engine.film.Film.variance_of_mean); inf where a
   pixel has fewer than two samples.
-Depth, Normal and the denoising passes come from engine.aov (a first-hit query on the
-same camera samples), not from the path tracer.
+- Mist (`use_pass_mist`): Cycles' mist of the first hit, by World > Mist Pass.
+- Position (`use_pass_position`): world-space position of the first hit.
+Depth, Normal, Mist, Position and the denoising passes come from engine.aov (a first-hit
+query on the same camera samples), not from the path tracer.
 
 Border render (Render Region): only the border's pixels are traced; the result covers
 just that rectangle, which Blender places in the frame (or crops to, with Crop to Render
@@ -77,7 +79,19 @@ PASSES = {
     "Denoising Normal": (3, "XYZ", "VECTOR", lambda vl: _drt_layer(vl, "use_pass_denoising_data")),
     "Denoising Albedo": (3, "RGB", "COLOR", lambda vl: _drt_layer(vl, "use_pass_denoising_data")),
     "DRT Noise": (3, "RGB", "COLOR", lambda vl: _drt_layer(vl, "use_pass_noise")),
+    "Mist": (1, "Z", "VALUE", lambda vl: vl.use_pass_mist),
+    "Position": (3, "XYZ", "VECTOR", lambda vl: vl.use_pass_position),
 }
+FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position")
+
+
+def _mist(aov, world):
+    """World > Mist Pass (Blender's defaults without a world) as engine.aov.Mist."""
+    m = getattr(world, "mist_settings", None)
+    if m is None:
+        return aov.Mist()
+    exponent = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}.get(m.falloff, 2.0)
+    return aov.Mist(float(m.start), float(m.depth), exponent)
 
 
 def _drt_layer(view_layer, name) -> bool:
@@ -285,7 +299,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             elif stats.cancelled:
                 last_render["cancelled_in"] = "tracing"
             if not stats.cancelled:
-                self._write_passes(layer, ctx, film, view_layer, description)
+                self._write_passes(layer, ctx, film, view_layer, description, scene.world)
         finally:
             ctx.close()
             self.end_result(result)
@@ -301,20 +315,21 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                            warnings=reporter.warnings, stats=stats, pixels=image,
                            alpha=alpha, export_seconds=export_seconds)
 
-    def _write_passes(self, layer, ctx, film, view_layer, description):
+    def _write_passes(self, layer, ctx, film, view_layer, description, world=None):
         wanted = [name for name in enabled_passes(view_layer)
                   if layer.passes.get(name) is not None]
         if not wanted:
             return
         images = {}
-        if any(n in wanted for n in ("Depth", "Normal", "Denoising Normal", "Denoising Albedo")):
-            self.update_stats("", "DRT: depth, normal and albedo passes")
+        if any(n in wanted for n in FIRST_HIT):
+            self.update_stats("", "DRT: first-hit passes")
             from .engine_link import engine
             aov = import_module(engine.__name__ + ".aov")   # in either package layout
-            first = aov.first_hit_passes(ctx)
+            first = aov.first_hit_passes(ctx, mist=_mist(aov, world))
             images.update({"Depth": first.depth, "Normal": first.normal,
                            "Denoising Albedo": first.albedo,
-                           "Denoising Normal": first.camera_normal(description.camera.matrix)})
+                           "Denoising Normal": first.camera_normal(description.camera.matrix),
+                           "Mist": first.mist, "Position": first.position})
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
         for name in wanted:

@@ -92,7 +92,9 @@ class DRT_PT_passes(DRTPanel, bpy.types.Panel):
         col.use_property_split = True
         col.prop(view_layer, "use_pass_combined")
         col.prop(view_layer, "use_pass_z")
+        col.prop(view_layer, "use_pass_mist")
         col.prop(view_layer, "use_pass_normal")
+        col.prop(view_layer, "use_pass_position")
         drt = getattr(view_layer, "drt", None)
         if drt is not None:
             col.prop(drt, "use_pass_denoising_data")

@@ -12,7 +12,11 @@ intersection each, no shading), with Cycles' meanings:
   nothing, so edge pixels are weighted by coverage as in Cycles;
 - albedo: the diffuse albedo of the Principled BSDF hit, base colour x (1 - metallic) x
   (1 - transmission), averaged the same way (what Cycles writes to Denoising Albedo for
-  a rough surface).
+  a rough surface);
+- position: the world-space hit point, averaged the same way (Cycles' Position);
+- mist: Cycles' Mist, averaged the same way: of the hit's distance d from the camera
+  (along the view axis for an orthographic one), clamp((d - start) / depth, 0, 1) raised
+  to the falloff exponent (`Mist`: World > Mist Pass), 1 where a sample hits nothing.
 Emitting lights (area and sphere lights) are not surfaces here: rays see through them.
 """
 from __future__ import annotations
@@ -28,12 +32,34 @@ DEPTH_MISS = 1.0e10
 AOV_SAMPLES = 16
 
 
+@dataclass(frozen=True)
+class Mist:
+    """World > Mist Pass: where the mist starts and its depth (metres), and the falloff
+    exponent (Blender's Quadratic 2, Linear 1, Inverse Quadratic 0.5)."""
+    start: float = 5.0
+    depth: float = 25.0
+    falloff: float = 2.0
+
+    def of(self, distance: np.ndarray) -> np.ndarray:
+        inv = 1.0 / self.depth if self.depth > 0.0 else 0.0
+        m = np.clip((distance - self.start) * inv, 0.0, 1.0)
+        if self.falloff == 1.0:
+            return m
+        if self.falloff == 2.0:
+            return m * m
+        if self.falloff == 0.5:
+            return np.sqrt(m)
+        return m ** self.falloff
+
+
 @dataclass
 class FirstHitPasses:
     depth: np.ndarray            # (h, w) float64
     normal: np.ndarray           # (h, w, 3) float64, world space
     albedo: np.ndarray           # (h, w, 3) float64
     samples: int                 # camera samples averaged per pixel
+    position: np.ndarray = None  # (h, w, 3) float64, world space
+    mist: np.ndarray = None      # (h, w) float64 in [0, 1]
 
     def camera_normal(self, camera_matrix) -> np.ndarray:
         """The normal pass in camera space (x right, y up, z towards the viewer), as
@@ -55,8 +81,10 @@ def _build(ctx, hits, index, d, time):
     return ctx.surfaces.build(hits, index, d, time=time)
 
 
-def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16) -> FirstHitPasses:
-    """Depth, normal and albedo passes for the scene of `ctx` (an engine.RenderContext)."""
+def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
+                     mist: Mist = Mist()) -> FirstHitPasses:
+    """Depth, normal, albedo, position and mist passes for the scene of `ctx` (an
+    engine.RenderContext)."""
     scene = ctx.scene
     width, height = scene.width, scene.height
     n_pix = width * height
@@ -83,9 +111,13 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16) -> F
             p = rays.origins[hit] + rays.directions[hit] * hits.t[hit, None]
             depth[pix[hit]] = (p - cam[:3, 3]) @ view_axis
 
-    # Normal and albedo: the mean over the first k camera samples of each pixel.
+    # Normal, albedo, position and mist: the mean over the first k camera samples of each
+    # pixel (a sample that hits nothing adds 0, and 1 to the mist).
     normal = np.zeros((n_pix, 3))
     albedo = np.zeros((n_pix, 3))
+    position = np.zeros((n_pix, 3))
+    mist_sum = np.zeros(n_pix)
+    ortho = scene.camera.kind == "ORTHO"
     per_chunk = max(1, chunk // k)
     for start in range(0, n_pix, per_chunk):
         pixels = np.arange(start, min(start + per_chunk, n_pix), dtype=np.int64)
@@ -94,6 +126,7 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16) -> F
         rays, time = camera_rays(ctx, pixel, index)
         hits = _intersect(ctx, rays.origins, rays.directions, rays.tmax, time)
         hit = np.nonzero(hits.hit)[0]
+        mist_sum += np.bincount(pixel, minlength=n_pix)
         if hit.size == 0:
             continue
         si = _build(ctx, hits, hit, rays.directions, time)
@@ -102,7 +135,12 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16) -> F
                                         minlength=n_pix)
             albedo[:, c] += np.bincount(pixel[hit], weights=diffuse[si.material, c],
                                         minlength=n_pix)
-    normal /= k
-    albedo /= k
-    return FirstHitPasses(depth.reshape(height, width), normal.reshape(height, width, 3),
-                          albedo.reshape(height, width, 3), k)
+            position[:, c] += np.bincount(pixel[hit], weights=si.position[:, c],
+                                          minlength=n_pix)
+        offset = si.position - cam[:3, 3]
+        distance = offset @ view_axis if ortho else np.linalg.norm(offset, axis=1)
+        mist_sum -= np.bincount(pixel[hit], weights=1.0 - mist.of(distance), minlength=n_pix)
+    shape = (height, width, 3)
+    return FirstHitPasses(depth.reshape(height, width), (normal / k).reshape(shape),
+                          (albedo / k).reshape(shape), k, (position / k).reshape(shape),
+                          (mist_sum / k).reshape(height, width))

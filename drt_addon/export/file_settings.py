@@ -70,13 +70,11 @@ _NULL_SCATTERING = ("DRT renders volumes without ray marching steps: homogeneous
                     "unbiased as Cycles' default")
 _SIMPLIFY = ("scene.render.use_simplify", (True,))
 _ADAPTIVE = ("scene.cycles.use_adaptive_sampling", (True,))
-WRITTEN_PASSES = "Combined, Depth, Normal, Denoising Data and DRT Noise"
+WRITTEN_PASSES = "Combined, Depth, Mist, Normal, Position, Denoising Data and DRT Noise"
 _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
 
 # Render passes DRT does not write, as (path, label).
 _UNWRITTEN_PASSES = [
-    ("view_layer.use_pass_mist", "Mist"),
-    ("view_layer.use_pass_position", "Position"),
     ("view_layer.use_pass_vector", "Vector"),
     ("view_layer.use_pass_uv", "UV"),
     ("view_layer.use_pass_object_index", "Object Index"),
@@ -157,6 +155,13 @@ SETTINGS: list[FileSetting] = [
     _s("view_layer.use_pass_combined", "Passes > Combined", READ, "written"),
     _s("view_layer.use_pass_z", "Passes > Z", READ, "written: camera-space depth"),
     _s("view_layer.use_pass_normal", "Passes > Normal", READ, "written: world-space normal"),
+    _s("view_layer.use_pass_mist", "Passes > Mist", READ,
+       "written: Cycles' mist of the first hit (World > Mist Pass)"),
+    _s("view_layer.use_pass_position", "Passes > Position", READ,
+       "written: world-space position of the first hit"),
+    *[_s(f"scene.world.mist_settings.{name}", f"World > Mist Pass > {label}", READ,
+         "read by the Mist pass") for name, label in
+      (("start", "Start"), ("depth", "Depth"), ("falloff", "Falloff"))],
     # -- DRT's own settings (Render Properties with DRT selected) replace these
     _own("samples", "Sampling > Render > Max Samples", "samples",
          "Samples (DRT's Sampling panel)", 4096),
