@@ -12,7 +12,9 @@ layer (Properties > View Layer > Passes):
   pixel has fewer than two samples.
 - Mist (`use_pass_mist`): Cycles' mist of the first hit, by World > Mist Pass.
 - Position (`use_pass_position`): world-space position of the first hit.
-Depth, Normal, Mist, Position and the denoising passes come from engine.aov (a first-hit
+- UV (`use_pass_uv`): u, v of the first hit (the active UV map unless a material names
+  one) and its coverage, as Cycles' UV pass.
+Depth, Normal, Mist, Position, UV and the denoising passes come from engine.aov (a first-hit
 query on the same camera samples), not from the path tracer.
 
 Border render (Render Region): only the border's pixels are traced; the result covers
@@ -81,8 +83,10 @@ PASSES = {
     "DRT Noise": (3, "RGB", "COLOR", lambda vl: _drt_layer(vl, "use_pass_noise")),
     "Mist": (1, "Z", "VALUE", lambda vl: vl.use_pass_mist),
     "Position": (3, "XYZ", "VECTOR", lambda vl: vl.use_pass_position),
+    "UV": (3, "UVA", "VECTOR", lambda vl: vl.use_pass_uv),
 }
-FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position")
+FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position",
+             "UV")
 
 
 def _mist(aov, world):
@@ -329,7 +333,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             images.update({"Depth": first.depth, "Normal": first.normal,
                            "Denoising Albedo": first.albedo,
                            "Denoising Normal": first.camera_normal(description.camera.matrix),
-                           "Mist": first.mist, "Position": first.position})
+                           "Mist": first.mist, "Position": first.position, "UV": first.uv})
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
         for name in wanted:

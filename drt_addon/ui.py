@@ -95,6 +95,7 @@ class DRT_PT_passes(DRTPanel, bpy.types.Panel):
         col.prop(view_layer, "use_pass_mist")
         col.prop(view_layer, "use_pass_normal")
         col.prop(view_layer, "use_pass_position")
+        col.prop(view_layer, "use_pass_uv")
         drt = getattr(view_layer, "drt", None)
         if drt is not None:
             col.prop(drt, "use_pass_denoising_data")

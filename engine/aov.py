@@ -1,4 +1,5 @@
-"""First-hit render passes (AOVs): depth, normal and albedo of what each pixel sees.
+"""First-hit render passes (AOVs): depth, normal, albedo, position, mist and UV of what
+each pixel sees.
 
 They are computed by a separate, cheap query on a RenderContext (camera rays and one
 intersection each, no shading), with Cycles' meanings:
@@ -14,6 +15,8 @@ intersection each, no shading), with Cycles' meanings:
   (1 - transmission), averaged the same way (what Cycles writes to Denoising Albedo for
   a rough surface);
 - position: the world-space hit point, averaged the same way (Cycles' Position);
+- uv: (u, v, 1) of the hit's texture coordinates (the mesh's UVs, (0, 0) without any),
+  averaged the same way, so the third channel is the pixel's coverage (Cycles' UV);
 - mist: Cycles' Mist, averaged the same way: of the hit's distance d from the camera
   (along the view axis for an orthographic one), clamp((d - start) / depth, 0, 1) raised
   to the falloff exponent (`Mist`: World > Mist Pass), 1 where a sample hits nothing.
@@ -60,6 +63,7 @@ class FirstHitPasses:
     samples: int                 # camera samples averaged per pixel
     position: np.ndarray = None  # (h, w, 3) float64, world space
     mist: np.ndarray = None      # (h, w) float64 in [0, 1]
+    uv: np.ndarray = None        # (h, w, 3) float64: u, v, coverage
 
     def camera_normal(self, camera_matrix) -> np.ndarray:
         """The normal pass in camera space (x right, y up, z towards the viewer), as
@@ -83,7 +87,7 @@ def _build(ctx, hits, index, d, time):
 
 def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
                      mist: Mist = Mist()) -> FirstHitPasses:
-    """Depth, normal, albedo, position and mist passes for the scene of `ctx` (an
+    """Depth, normal, albedo, position, mist and UV passes for the scene of `ctx` (an
     engine.RenderContext)."""
     scene = ctx.scene
     width, height = scene.width, scene.height
@@ -116,6 +120,7 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
     normal = np.zeros((n_pix, 3))
     albedo = np.zeros((n_pix, 3))
     position = np.zeros((n_pix, 3))
+    uv = np.zeros((n_pix, 3))
     mist_sum = np.zeros(n_pix)
     ortho = scene.camera.kind == "ORTHO"
     per_chunk = max(1, chunk // k)
@@ -137,10 +142,14 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
                                         minlength=n_pix)
             position[:, c] += np.bincount(pixel[hit], weights=si.position[:, c],
                                           minlength=n_pix)
+        uv[:, 2] += np.bincount(pixel[hit], minlength=n_pix)
+        if si.uv is not None:
+            for c in range(2):
+                uv[:, c] += np.bincount(pixel[hit], weights=si.uv[:, c], minlength=n_pix)
         offset = si.position - cam[:3, 3]
         distance = offset @ view_axis if ortho else np.linalg.norm(offset, axis=1)
         mist_sum -= np.bincount(pixel[hit], weights=1.0 - mist.of(distance), minlength=n_pix)
     shape = (height, width, 3)
     return FirstHitPasses(depth.reshape(height, width), (normal / k).reshape(shape),
                           (albedo / k).reshape(shape), k, (position / k).reshape(shape),
-                          (mist_sum / k).reshape(height, width))
+                          (mist_sum / k).reshape(height, width), (uv / k).reshape(shape))

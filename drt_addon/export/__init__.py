@@ -105,7 +105,9 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
 
     het_owner = {}
 
-    cache = MeshCache(reporter)
+    # the UV pass reads every mesh's UVs (its active map, where no material names one)
+    cache = MeshCache(reporter, uv_pass=bool(getattr(depsgraph.view_layer, "use_pass_uv",
+                                                     False)))
     meshes, lights = [], []
     left_out = LeftOut()
     holdouts = 0

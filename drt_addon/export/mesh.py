@@ -151,15 +151,18 @@ def _cache_key(obj):
 class MeshCache:
     """Object-space arrays per evaluated geometry, for the length of one export."""
 
-    def __init__(self, reporter=None):
+    def __init__(self, reporter=None, uv_pass=False):
         self._local = {}
         self.reporter = reporter
+        self.uv_pass = uv_pass    # every mesh's UVs: the UV pass reads them
         self.evaluations = 0      # to_mesh calls
         self.reuses = 0           # instances served from the cache
 
     def local(self, obj) -> Optional[LocalMesh]:
         key = _cache_key(obj)
         want_uv = uv_request(obj)
+        if want_uv is None and self.uv_pass:
+            want_uv = ""
         want_tangents = wants_tangents(obj)
         want_colors = color_request(obj)
         if key is not None and key in self._local:
