@@ -19,6 +19,7 @@ from scipy import integrate, stats
 
 from engine import Camera, Material, PointLight, RenderSettings, Scene, Volume, World, render
 from engine.kernels import equiangular as eq
+from engine.kernels.volume import distance_pdf
 from engine_scenes import look_at, quad
 
 RAY = (0.0, 0.0, 0.0, 1.0, 0.0, 0.0)          # origin, unit direction (+x)
@@ -85,7 +86,7 @@ def test_equiangular_samples_follow_the_density(where):
 
 def test_distance_density_integrates_to_the_scattering_probability():
     st, w, t_max = (0.3, 1.2, 0.05), (0.5, 0.3, 0.2), 3.0
-    total = integrate.quad(lambda t: eq.distance_pdf(*st, *w, t), 0.0, t_max)[0]
+    total = integrate.quad(lambda t: distance_pdf(*st, *w, t), 0.0, t_max)[0]
     assert total == pytest.approx(sum(wc * (1 - math.exp(-s * t_max)) for s, wc in zip(st, w)))
 
 

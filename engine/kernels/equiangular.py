@@ -1,6 +1,6 @@
 """Equiangular sampling of a distance along a ray towards a point light (Kulla and
 Fajardo 2012, "Importance Sampling Techniques for Path Tracing in Participating Media"),
-and the distance-sampling density it is combined with.
+to be combined with the distance sampling of volume.segment (volume.distance_pdf).
 
 In a medium the light a ray's segment scatters towards the camera is an integral over
 the distance t along it. Sampling t by the medium's transmittance (volume.segment) puts
@@ -65,12 +65,3 @@ def pdf(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_max, t):
         return 0.0
     r = t - delta
     return D / (span * (D * D + r * r))
-
-
-@kernel(allocates=False)
-def distance_pdf(str_, stg, stb, wr, wg, wb, t):
-    """The density of volume.segment's scattering distance at t (the one-sample mixture
-    over the colour channels picked with weights w, extinctions st): sum_c w_c st_c
-    exp(-st_c t). Its integral over a segment is the probability of scattering there."""
-    return (wr * str_ * math.exp(-str_ * t) + wg * stg * math.exp(-stg * t)
-            + wb * stb * math.exp(-stb * t))

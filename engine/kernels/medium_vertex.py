@@ -28,7 +28,7 @@ from . import ray_queues
 from .jit import kernel
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, nee_weight,
                            power_heuristic, roulette)
-from .volume import EQUIANGULAR, hg_phase, hg_sample, medium, volume_dim
+from .volume import EQUIANGULAR, distance_pdf, hg_phase, hg_sample, medium, volume_dim
 
 C_VOLUME_BOUNCES = 14      # cfg entry: Cycles' max volume bounces
 
@@ -132,7 +132,7 @@ def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, 
     sar, sag, sab, ssr, ssg, ssb, g, _, _, _ = medium(vol, stacks, p)
     str_, stg, stb = sar + ssr, sag + ssg, sab + ssb
     wr, wg, wb = channels
-    pd = eq.distance_pdf(str_, stg, stb, wr, wg, wb, t)
+    pd = distance_pdf(str_, stg, stb, wr, wg, wb, t)
     px, py, pz = ox + dx * t, oy + dy * t, oz + dz * t
     u1, u2 = sample_2d(kind, pkey[p], spp, index[p], volume_dim(depth, 4))
     k2, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(

@@ -45,14 +45,13 @@ from .bsdf.state import S_WALTER
 from . import ray_queues
 from .frame import dot, length, to_local, to_world
 from .jit import kernel
-from .equiangular import distance_pdf
 from .medium_vertex import equiangular_light, scatter
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
                            TRANSMISSION_BIT, _add, _INF, continues, hit_weight, nee_weight,
                            roulette, uncovered)
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
-from .volume import (DISTANCE, V_BOUNDARY, V_HAS, in_medium, medium, passed, sample_method,
-                     segment, stack_cross, volume_dim)
+from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium, passed,
+                     sample_method, segment, stack_cross, volume_dim)
 from .bsdf.params import P_FILTER_ALPHA
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .terminator import shadow_origin

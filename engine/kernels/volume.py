@@ -212,13 +212,23 @@ def segment(vol, stacks, p, br, bg, bb, t, u_channel, u_distance):
     s = -math.log(max(1.0 - u_distance, 1e-300)) / sc if sc > 0.0 else math.inf
     if s < t:
         Tr, Tg, Tb = math.exp(-str_ * s), math.exp(-stg * s), math.exp(-stb * s)
-        pdf = wr * str_ * Tr + wg * stg * Tg + wb * stb * Tb
+        pdf = distance_pdf(str_, stg, stb, wr, wg, wb, s)
         if not pdf > 0.0:
             return 2, True, s, 0.0, 0.0, 0.0, str_, stg, stb, wr, wg, wb, Er, Eg, Eb
         return (2, True, s, br * ssr * Tr / pdf, bg * ssg * Tg / pdf, bb * ssb * Tb / pdf,
                 str_, stg, stb, wr, wg, wb, Er, Eg, Eb)
     fr, fg, fb = passed(2, str_, stg, stb, wr, wg, wb, t)
     return 2, False, t, br * fr, bg * fg, bb * fb, str_, stg, stb, wr, wg, wb, Er, Eg, Eb
+
+
+@kernel(allocates=False)
+def distance_pdf(str_, stg, stb, wr, wg, wb, t):
+    """The density of `segment`'s scattering distance at t (the one-sample mixture over
+    the colour channels picked with weights w, extinctions st): sum_c w_c st_c
+    exp(-st_c t). Its integral over a segment is the probability of scattering there;
+    equiangular sampling is weighed against it (medium_vertex.py)."""
+    return (wr * str_ * math.exp(-str_ * t) + wg * stg * math.exp(-stg * t)
+            + wb * stb * math.exp(-stb * t))
 
 
 @kernel
