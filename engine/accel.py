@@ -14,6 +14,14 @@ over threads (every kernel releases the GIL). Motion is built here from plain sc
   slice its time falls in (see `engine.motion.DeformMotion` for what that costs).
 The nearest hit across all of them wins. Triangles get global ids in that order.
 
+Instances (engine.instancing): an instanced mesh is one Embree scene in object space,
+and each of its places an Embree instance of it in the static scene, whose transform
+is the place's matrix moved by -center like the static triangles. Its triangles get
+global ids once, after the static ones (the prototypes), and a hit on one reports the
+place too: `Hits.inst`, the place's row in the object table (engine.surface; -1 for a
+hit on a mesh that is not instanced). Memory then grows with the places, not with
+places x triangles.
+
 Many moving objects: a ray does not visit every moving object. A top-level hierarchy
 over the moving objects' swept world bounds (`engine.kernels.motion_tlas`: the bounds
 hold at every time of the shutter, rotation included) is walked by one compiled call per
@@ -44,11 +52,13 @@ import os
 import threading
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from .embree.rays import intersect_batch, occluded_batch
 from .embree.scene import Scene as EmbreeScene
+from .instancing import is_instanced
 from .kernels.motion import pack_motion
 from .kernels.motion_pairs import group_pairs, merge_blocked, merge_hits
 from .kernels.motion_tlas import MotionTLAS, build_tlas
@@ -72,12 +82,34 @@ def _embree_scene(positions: np.ndarray, triangles: np.ndarray, offset=None) -> 
     return scene.commit()
 
 
+class HitArrays(NamedTuple):
+    """The hits of a batch as the vertex kernels take them (engine.kernels.path_vertex)."""
+    t: np.ndarray
+    prim: np.ndarray
+    inst: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+
+
 @dataclass
 class Hits:
     t: np.ndarray          # (n,) float64, inf where missed
     prim: np.ndarray       # (n,) int64 global triangle id, -1 where missed
     u: np.ndarray          # (n,) float64 barycentric weight of vertex 1
     v: np.ndarray          # (n,) float64 barycentric weight of vertex 2
+    inst: np.ndarray = None  # (n,) int64 the instance's object row, -1: none
+
+    def __post_init__(self):
+        if self.inst is None:
+            self.inst = np.full(len(self.prim), -1, np.int64)
+
+    def arrays(self) -> HitArrays:
+        """The hits as the kernels take them (one Numba type: int64 ids, float64 rest)."""
+        return HitArrays(np.ascontiguousarray(self.t, np.float64),
+                         np.ascontiguousarray(self.prim, np.int64),
+                         np.ascontiguousarray(self.inst, np.int64),
+                         np.ascontiguousarray(self.u, np.float64),
+                         np.ascontiguousarray(self.v, np.float64))
 
     @property
     def hit(self) -> np.ndarray:
@@ -123,17 +155,30 @@ def _joined(parts: list, empty_shape, dtype) -> np.ndarray:
         np.zeros(empty_shape, dtype)
 
 
+@dataclass
+class Prototype:
+    """An instanced mesh: its triangles' first global id, its Embree scene (object
+    space), and the object-table row of its first place (the others follow)."""
+    mesh: TriangleMesh
+    prim_offset: int
+    scene: EmbreeScene
+    first_row: int
+
+
 class Accelerator:
-    """All triangles of a scene: static ones in one Embree scene, moving ones apart."""
+    """All triangles of a scene: static ones in one Embree scene (with the instances of
+    instanced meshes), moving ones apart."""
 
     def __init__(self, meshes: list[TriangleMesh], threads: int = 0, time_enabled: bool = False,
                  motion_tlas: bool = True, kernel_triangles: int = KERNEL_TRIANGLES):
         for m in meshes:
             if not np.all(np.isfinite(m.positions)):
                 raise ValueError(f"mesh {m.name!r} has non-finite (NaN or Inf) vertex positions")
-        static = [m for m in meshes if not _is_moving(m, time_enabled)]
-        moving = [m for m in meshes if _is_moving(m, time_enabled)]
-        self.ordered_meshes = static + moving          # the global triangle order
+        static = [m for m in meshes if not _is_moving(m, time_enabled) and not is_instanced(m)]
+        instanced = [m for m in meshes if is_instanced(m)]
+        moving = [m for m in meshes if _is_moving(m, time_enabled) and not is_instanced(m)]
+        self.ordered_meshes = static + instanced + moving    # the global triangle order
+        self.static_meshes = len(static)
         # Every static vertex in world space, and every static triangle's corners as
         # int32 rows of them (Embree's index format); a single static mesh's own arrays
         # are used as they are, not copied (the tracer never writes them).
@@ -149,15 +194,24 @@ class Accelerator:
         # the median vertex, not the middle of the bounds: a few far vertices (a mesh
         # with a vertex at 3.4e38, tests/test_degenerate_input.py) do not move it off
         # the bulk of the geometry
-        self.center = np.median(self.positions, axis=0) if len(self.positions) else np.zeros(3)
+        places = [m.instances.matrices[:, :3, 3] for m in instanced]
+        self.center = (np.median(self.positions, axis=0) if len(self.positions) else
+                       np.median(np.concatenate(places), axis=0) if places else np.zeros(3))
         self.threads = threads or min(os.cpu_count() or 1, 8)
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
         # Embree builds the hierarchy when the scene is committed: here, as part of
         # building the accelerator (and before a cancel can come), not of the first sample
-        self._scene = (_embree_scene(self.positions, self.triangles, self.center)
-                       if len(self.triangles) else None)
-        self.moving: list[MovingObject] = []
+        self.prototypes: list[Prototype] = []
+        self.instance_count = 0
         offset = self.static_count
+        for m in instanced:
+            self.prototypes.append(Prototype(m, offset, _embree_scene(m.positions, m.triangles),
+                                             self.instance_count))
+            offset += len(m.triangles)
+            self.instance_count += len(m.instances)
+        self.moving_start = offset
+        self._scene = self._static_scene() if len(self.triangles) or instanced else None
+        self.moving: list[MovingObject] = []
         for m in moving:
             if isinstance(m.motion, RigidMotion):
                 obj = MovingObject(m, offset, [_embree_scene(m.positions, m.triangles)], [])
@@ -177,7 +231,8 @@ class Accelerator:
         self.pairs_visited = 0
         self.recorder = None
         self._count_lock = threading.Lock()
-        self.scene_count = (self._scene is not None) + sum(len(o.scenes) for o in self.moving)
+        self.scene_count = ((self._scene is not None) + len(self.prototypes)
+                            + sum(len(o.scenes) for o in self.moving))
         # Moving objects packed for the kernels (engine.kernels.motion), and the
         # top-level hierarchy over them (motion_tlas=False: brute force, the reference).
         self.motion = pack_motion(self)
@@ -186,6 +241,28 @@ class Accelerator:
         self.tlas: MotionTLAS | None = None
         if self.moving:
             self.build_tlas()
+
+    def _static_scene(self) -> EmbreeScene:
+        """The static triangles (geometry 0, when there are any) and every place of every
+        instanced mesh, relative to `center`. Fills the maps from an Embree instance id to
+        its prototype's first global triangle id and to its object-table row."""
+        scene = EmbreeScene()
+        ids = []
+        if len(self.triangles):
+            ids.append((scene.add_triangles(self.positions, self.triangles, self.center),
+                        0, -1))
+        shift = np.eye(4)
+        shift[:3, 3] = -self.center
+        for proto in self.prototypes:
+            for k, m in enumerate(proto.mesh.instances.matrices):
+                ids.append((scene.add_instance(proto.scene, shift @ m), proto.prim_offset,
+                            proto.first_row + k))
+        n = max(g for g, _, _ in ids) + 1 if ids else 0
+        self._inst_base = np.zeros(n, np.int64)
+        self._inst_row = np.full(n, -1, np.int64)
+        for g, base, row in ids:
+            self._inst_base[g], self._inst_row[g] = base, row
+        return scene.commit()
 
     def build_tlas(self, swept: bool = True):
         """(Re)build the hierarchy over the moving objects. swept=False is a negative
@@ -240,8 +317,15 @@ class Accelerator:
                 f.result()
         if query == "OCCLUDED":
             return out[0]
-        _, prim, _, t, u, v = out
-        return prim, t, u, v
+        _, prim, inst, t, u, v = out
+        if scene is self._scene and self.prototypes:
+            placed = inst >= 0          # Embree's instance id: the place's geometry id
+            g = inst[placed]
+            prim[placed] += self._inst_base[g]
+            inst[placed] = self._inst_row[g]
+        else:
+            inst[:] = -1
+        return prim, t, u, v, inst
 
     def _run(self, origins, dirs, tmax, query):
         """The static scene's queries, counted (and recorded for a benchmark's replay)."""
@@ -295,8 +379,9 @@ class Accelerator:
         parts = []
         for k in np.flatnonzero(unit_start[1:] > unit_start[:-1]):
             a, b = unit_start[k], unit_start[k + 1]
-            parts.append(self._query(self._unit_scene[k], _ORIGIN, o_unit[a:b], d_unit[a:b],
-                                     far_unit[a:b], None, query))
+            found = self._query(self._unit_scene[k], _ORIGIN, o_unit[a:b], d_unit[a:b],
+                                far_unit[a:b], None, query)
+            parts.append(found if occlusion else found[:4])
         with self._count_lock:
             self.rays_traced[query] += count
         if occlusion:
@@ -313,10 +398,11 @@ class Accelerator:
         t = np.full(n, np.inf)
         prim = np.full(n, MISS, np.int64)
         u, v = np.zeros(n), np.zeros(n)
+        inst = np.full(n, -1, np.int64)
         if n == 0:
-            return Hits(t, prim, u, v)
+            return Hits(t, prim, u, v, inst)
         if self._scene is not None:
-            prim, t, u, v = self._run(origins, dirs, tmax, "INTERSECT")
+            prim, t, u, v, inst = self._run(origins, dirs, tmax, "INTERSECT")
         if self.moving:
             if time is None:
                 raise ValueError("a scene with moving objects needs a time per ray")
@@ -324,7 +410,9 @@ class Accelerator:
             t, prim = np.array(t, np.float64), np.array(prim, np.int64)
             u, v = np.array(u, np.float64), np.array(v, np.float64)
             self._trace_moving(origins, dirs, time, best, t, prim, u, v, _NO_BOOL, False)
-        return Hits(t, prim, u, v)
+            if self.prototypes:
+                inst = np.where(prim >= self.moving_start, -1, inst)
+        return Hits(t, prim, u, v, inst)
 
     def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
                  time: np.ndarray | None = None) -> np.ndarray:

@@ -80,8 +80,9 @@ class EmissiveTriangles:
         # light-sampled: a moving emissive mesh is still seen, blurred, by camera and BSDF
         # rays (with MIS weight 1), just not sampled directly.
         # (getattr: an accelerator without motion support has all meshes, in scene order)
+        # (instanced meshes, after the static ones, emit nothing: engine.instancing)
         ordered = list(getattr(accel, "ordered_meshes", scene.meshes))
-        static_meshes = ordered[:len(ordered) - len(getattr(accel, "moving", ()))]
+        static_meshes = ordered[:getattr(accel, "static_meshes", len(ordered))]
         mat = np.concatenate([m.material_indices for m in static_meshes])
         emissive = np.nonzero((emission.max(axis=1) > 0)[mat])[0]
         p = accel.positions

@@ -28,6 +28,7 @@ from .adaptive_sampling import AdaptiveSampling
 from .bsdf.material_table import MaterialTable
 from .camera import CameraModel, CameraRays
 from .film import Film
+from . import instancing
 from .integrators import make_integrator
 from .kernels.camera_rays import generate as generate_camera_rays
 from .kernels.camera_rays import pack_camera
@@ -97,9 +98,12 @@ class RenderContext:
         if adaptive is not None:
             self.sampler.follow_stops(adaptive.min_samples, adaptive.step)
         self.has_motion = scene.has_motion()
-        self.accel = Accelerator(scene.meshes, threads=1, time_enabled=self.has_motion)
-        self.surfaces = SurfaceBuilder(self.accel, scene.meshes)
         self.materials = MaterialTable(scene.materials)
+        # instanced meshes stay instanced unless they emit or bound a volume
+        meshes = instancing.resolve(scene.meshes,
+                                    _instanceable(scene.materials, self.materials.emission))
+        self.accel = Accelerator(meshes, threads=1, time_enabled=self.has_motion)
+        self.surfaces = SurfaceBuilder(self.accel)
         self.scene_radius = _scene_radius(scene, self.accel)
         # the uniform world's radiance (zeros under an environment map), and the world
         # model (engine.world_light) escaped rays read
@@ -134,8 +138,28 @@ class RenderContext:
         return found
 
 
+def _holds_volume(m) -> bool:
+    return (getattr(m, "volume", None) is not None or not getattr(m, "surface", True)
+            or any(_holds_volume(side) for side in (getattr(m, "mix", None) or ())))
+
+
+def _instanceable(materials, emission):
+    """Whether an instanced mesh may stay instanced (engine.instancing): none of its
+    materials emits (by the emission table the mesh lights read) or holds a volume."""
+    emission = np.asarray(emission, np.float64).reshape(-1, 3)
+    blocked = np.zeros(max(len(materials), len(emission)), bool)
+    blocked[:len(emission)] = emission.max(axis=1) > 0.0
+    blocked[:len(materials)] |= [_holds_volume(m) for m in materials]
+
+    def keep(mesh) -> bool:
+        used = np.unique(mesh.material_indices)
+        return not blocked[used[used < len(blocked)]].any()
+    return keep
+
+
 def _scene_radius(scene: Scene, accel: Accelerator) -> float:
     pts = [accel.positions] if len(accel.positions) else []
+    pts += [np.stack(instancing.world_bounds(p.mesh)) for p in accel.prototypes]
     for l in scene.lights:
         if hasattr(l, "position"):
             pts.append(np.asarray(l.position, dtype=np.float64)[None])

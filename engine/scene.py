@@ -184,8 +184,43 @@ class ObjectInfo:
 
 
 @dataclass
+class Instances:
+    """The K places of one mesh that appears more than once (Blender's collection
+    instances, particles, Geometry Nodes instances, linked duplicates): the mesh is kept
+    once, in object space, and Embree traces it as K instances, so memory grows with K,
+    not with K times its triangles (engine.instancing).
+
+    matrices: (K, 4, 4) float64 object -> world, one per place.
+    colors, randoms, pass_indices: what Object Info reads of each place ((K, 3), (K,),
+    (K,)); None: white, 0 and 0."""
+    matrices: np.ndarray
+    colors: Optional[np.ndarray] = None
+    randoms: Optional[np.ndarray] = None
+    pass_indices: Optional[np.ndarray] = None
+
+    def __post_init__(self):
+        m = np.ascontiguousarray(self.matrices, dtype=np.float64)
+        if m.ndim != 3 or m.shape[1:] != (4, 4):
+            raise ValueError(f"instance matrices must be (K, 4, 4), got {m.shape}")
+        if not np.all(np.isfinite(m[:, :3, :4])):
+            raise ValueError("an instance's matrix is not finite (NaN or Inf)")
+        self.matrices = m
+        k = len(m)
+        self.colors = (np.ones((k, 3)) if self.colors is None
+                       else np.asarray(self.colors, np.float64).reshape(k, -1)[:, :3])
+        self.randoms = (np.zeros(k) if self.randoms is None
+                        else np.asarray(self.randoms, np.float64).reshape(k))
+        self.pass_indices = (np.zeros(k) if self.pass_indices is None
+                             else np.asarray(self.pass_indices, np.float64).reshape(k))
+
+    def __len__(self):
+        return len(self.matrices)
+
+
+@dataclass
 class TriangleMesh:
-    """One evaluated mesh in world space (instances are expanded by the exporter).
+    """One evaluated mesh in world space, or in object space placed K times when
+    `instances` is set.
 
     positions: (V, 3) float64 vertex positions.
     triangles: (T, 3) int32 vertex indices.
@@ -215,6 +250,10 @@ class TriangleMesh:
     # Shadow Terminator > Geometry Offset (Cycles' per-object setting; 0 = off): how far
     # shadow rays start from the curved surface of a smooth mesh (engine.kernels.terminator)
     terminator_offset: float = 0.1
+    # None: one mesh in world space. Instances: positions, corner normals and tangents
+    # are in object space, and the mesh stands at each of its places (`object_info`
+    # then gives only the texture space; Object Info reads the places' own values)
+    instances: Optional[Instances] = None
 
     def __post_init__(self):
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)
@@ -235,6 +274,9 @@ class TriangleMesh:
         if len(self.triangles) and (self.triangles.min() < 0
                                     or self.triangles.max() >= len(self.positions)):
             raise ValueError(f"mesh {self.name!r}: triangle index out of range")
+        if self.instances is not None and self.motion is not None:
+            raise ValueError(f"mesh {self.name!r}: instances cannot move (export moving "
+                             f"places as meshes of their own)")
 
 
 @dataclass

@@ -17,7 +17,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .accel import Accelerator, Hits
-from .motion import inverse3
 
 # Relative offset: 2**-17 ~ 7.6e-6 of the coordinate magnitude, i.e. 64 float32 ulps,
 # comfortably above Embree's watertight-test error and the float32 rounding of vertices
@@ -37,6 +36,7 @@ class SurfaceHit:
     prim: np.ndarray | None = None       # (n,) the triangles hit
     direction: np.ndarray | None = None  # (n, 3) the rays' directions
     bary: np.ndarray | None = None       # (n, 2) barycentrics (u, v) in the triangle
+    inst: np.ndarray | None = None       # (n,) the instances' object rows, -1: none
 
 
 class SurfaceBuilder:
@@ -53,6 +53,11 @@ class SurfaceBuilder:
         self.accel = accel
         ordered = accel.ordered_meshes
         positions, corners, base = [accel.positions], [accel.triangles], len(accel.positions)
+        for proto in accel.prototypes:          # instanced meshes, in object space
+            m = proto.mesh
+            positions.append(m.positions)
+            corners.append(m.triangles.astype(accel.triangles.dtype) + base)
+            base += len(m.positions)
         for obj in accel.moving:
             m = obj.mesh
             positions.append(m.positions if obj.rigid else obj.slice_positions[0])
@@ -71,7 +76,7 @@ class SurfaceBuilder:
         self.visibility = (np.concatenate([np.full(len(m.triangles), m.visibility, np.uint8)
                                            for m in ordered])
                            if any(m.visibility != 31 for m in ordered) else None)
-        self.tri_object, self.objects = _object_table(ordered)
+        self.tri_object, self.objects = _object_table(ordered, accel.prototypes)
         # Tangent space per corner for Normal Maps (sign 0 where a mesh has none), and
         # a color attribute per corner (0 where a mesh has none, as in Cycles)
         self.corner_tangents = _corner_attribute(ordered, "tangents")
@@ -92,6 +97,7 @@ class SurfaceBuilder:
         self.terminator_cutoff = _terminator_cutoff(ordered, accel.static_count)
         # Texture coordinates per triangle corner (Blender's UV map), for the meshes that
         # have them; triangles of meshes without UVs read (0, 0), as in Cycles.
+        self._geometry = None           # geometry(), made on the first build()
         self.corner_uvs = None
         if any(getattr(m, "uvs", None) is not None for m in ordered):
             parts = []
@@ -103,116 +109,71 @@ class SurfaceBuilder:
                     parts.append(np.zeros((t, 3, 2), np.float32))
             self.corner_uvs = np.concatenate(parts)
 
-    def shader_rows(self, si: SurfaceHit, ray=1, depth=0) -> np.ndarray:
-        """The hit rows shader programs read (engine.nodes.context) for the hits si."""
-        from .nodes.context import hit_rows
-        obj = self.tri_object[si.prim] if self.tri_object is not None else None
-        tangent = None
-        if self.corner_tangents is not None:
-            c = self.corner_tangents[si.prim].astype(np.float64)
-            u, v = si.bary[:, :1], si.bary[:, 1:]
-            tangent = (1.0 - u - v) * c[:, 0] + u * c[:, 1] + v * c[:, 2]
-            t = tangent[:, :3]
-            tangent[:, :3] = t / np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-300)
-            tangent[:, 3] = np.sign(tangent[:, 3])
-        color = None
-        if self.corner_colors is not None:
-            c = self.corner_colors[si.prim].astype(np.float64)
-            u, v = si.bary[:, :1], si.bary[:, 1:]
-            color = (1.0 - u - v) * c[:, 0] + u * c[:, 1] + v * c[:, 2]
-        return hit_rows(si.position, si.shading_normal, si.geometric_normal, si.direction,
-                        si.uv, si.front_facing, ray, depth, None, self.objects, obj, tangent,
-                        color)
-
     def vertices(self, prim) -> tuple:
-        """The three corners (n, 3) of triangles `prim` (moving ones: placeholders)."""
+        """The three corners (n, 3) of triangles `prim` as stored (instanced and moving
+        ones: placeholders in object space or at their first slice)."""
         c = self.corners[prim]
         return self.positions[c[:, 0]], self.positions[c[:, 1]], self.positions[c[:, 2]]
 
     def normals(self, prim) -> np.ndarray:
-        """Unit geometric normals (n, 3) of triangles `prim` (moving ones: placeholders)."""
+        """Unit geometric normals (n, 3) of triangles `prim` as stored (see vertices)."""
         return _corner_normals(*self.vertices(prim))
 
-    def scales(self, prim, vertices=None) -> np.ndarray:
-        """The offset scales of triangles `prim`: their coordinates' magnitude, relative to
-        the static scene's centre (engine.accel) for static triangles, absolute for
-        moving ones (at `vertices`, their corners where the ray's time put them)."""
-        v0, v1, v2 = self.vertices(prim) if vertices is None else vertices
-        static = (prim < self.accel.static_count)[:, None]
-        return triangle_scale(v0, v1, v2, np.where(static, self.accel.center, 0.0))
-
-    def _moving_vertices(self, prim, time):
-        """World vertices, normal matrices (or None) of hit triangles at the rays' times."""
-        v0, v1, v2 = self.vertices(prim)
-        normal_m = None
-        for obj in self.accel.moving:
-            lo, hi = obj.prim_offset, obj.prim_offset + len(obj.mesh.triangles)
-            rows = np.nonzero((prim >= lo) & (prim < hi))[0]
-            if rows.size == 0:
-                continue
-            local = prim[rows] - lo
-            tri = obj.mesh.triangles[local]
-            if obj.rigid:
-                m = obj.mesh.motion.at(time[rows])
-                a, t = m[:, :3, :3], m[:, :3, 3]
-                for dst, k in ((v0, 0), (v1, 1), (v2, 2)):
-                    dst[rows] = np.einsum("nij,nj->ni", a, obj.mesh.positions[tri[:, k]]) + t
-                if normal_m is None:
-                    normal_m = np.broadcast_to(np.eye(3), (len(prim), 3, 3)).copy()
-                normal_m[rows] = np.transpose(inverse3(a), (0, 2, 1))
-            else:
-                sl = obj.mesh.motion.slice_of(time[rows])
-                for s in np.unique(sl):
-                    r = rows[sl == s]
-                    pos = obj.slice_positions[s]
-                    tr = tri[sl == s]
-                    v0[r], v1[r], v2[r] = pos[tr[:, 0]], pos[tr[:, 1]], pos[tr[:, 2]]
-        return v0, v1, v2, normal_m
+    def geometry(self, camera=None) -> tuple:
+        """The triangles as the compiled kernels read them (engine.kernels.surface,
+        engine.nodes.shading): (positions, corners, centre, material, corner normals,
+        holdout, corner UVs, moving objects, triangle objects, object table, corner
+        tangents, corner colours, camera, terminator cutoffs); empty arrays for what the
+        scene has not. camera: the packed render camera (engine.kernels.camera_rays),
+        which shader nodes read; None: none."""
+        from .nodes.context import N_OBJ
+        return (self.positions, self.corners,
+                np.asarray(self.accel.center, dtype=np.float64), self.material,
+                _or_empty(self.corner_normals, (0, 3, 3), np.float32),
+                _or_empty(self.holdout, 0, bool),
+                _or_empty(self.corner_uvs, (0, 3, 2), np.float32),
+                self.accel.motion,
+                _or_empty(self.tri_object, 0, np.int32),
+                _or_empty(self.objects, (0, N_OBJ), np.float64),
+                _or_empty(self.corner_tangents, (0, 3, 4), np.float32),
+                _or_empty(self.corner_colors, (0, 3, 4), np.float32),
+                np.zeros(0) if camera is None else camera,
+                _or_empty(self.terminator_cutoff, 0, np.float64))
 
     def build(self, hits: Hits, index: np.ndarray, ray_dirs: np.ndarray,
               time: np.ndarray | None = None) -> SurfaceHit:
-        """Interactions for the rays `index` (which must all have hit); `time` is the
-        per-ray shutter time of all rays (needed when the scene has moving objects)."""
-        prim = hits.prim[index]
-        u = hits.u[index][:, None]
-        v = hits.v[index][:, None]
-        w = 1.0 - u - v
-        normal_m = None
-        if self.accel.moving and (prim >= self.accel.static_count).any():
-            v0, v1, v2, normal_m = self._moving_vertices(prim, time[index])
-            ng = _corner_normals(v0, v1, v2)
-            tri_scale = self.scales(prim, (v0, v1, v2))
-        else:
-            v0, v1, v2 = self.vertices(prim)
-            ng = _corner_normals(v0, v1, v2)
-            tri_scale = self.scales(prim, (v0, v1, v2))
-        pos = w * v0 + u * v1 + v * v2
-        d = ray_dirs[index]
-        front = (ng * d).sum(1) < 0.0
-        sign = np.where(front, 1.0, -1.0)[:, None]
-        ng_f = ng * sign
-        if self.corner_normals is not None:
-            cn = self.corner_normals[prim].astype(np.float64)
-            if normal_m is not None:
-                cn = np.einsum("nij,nkj->nki", normal_m, cn)
-            ns = w * cn[:, 0] + u * cn[:, 1] + v * cn[:, 2]
-            length = np.linalg.norm(ns, axis=1, keepdims=True)
-            ns = np.where(length > 1e-12, ns / np.maximum(length, 1e-300), ng)
-            ns = ns * sign
-            # A shading normal on the far side of the geometric one (possible with
-            # strongly bent custom normals) is replaced by the geometric normal.
-            bad = (ns * ng_f).sum(1) <= 0.0
-            ns[bad] = ng_f[bad]
-        else:
-            ns = ng_f
-        scale = tri_scale              # bounds the hit point's coordinates too
+        """Interactions for the rays `index` (which must all have hit), rebuilt by the
+        kernels' own `rebuild_at_time`; `time` is the per-ray shutter time of all rays
+        (needed when the scene has moving objects)."""
+        from .kernels.surface import rebuild_batch
+        if self._geometry is None:
+            self._geometry = self.geometry()
+        index = np.asarray(index, np.int64)
+        prim = np.ascontiguousarray(hits.prim[index], np.int64)
+        inst = np.ascontiguousarray(hits.inst[index], np.int64)
+        u = np.ascontiguousarray(hits.u[index], np.float64)
+        v = np.ascontiguousarray(hits.v[index], np.float64)
+        d = np.ascontiguousarray(np.asarray(ray_dirs)[index], np.float64)
+        if self.accel.moving and time is None:
+            raise ValueError("a scene with moving objects needs a time per ray")
+        tm = np.zeros(0) if time is None else np.ascontiguousarray(
+            np.broadcast_to(time, (len(ray_dirs),))[index], np.float64)
+        n = len(prim)
+        pos, ng, ns = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
+        front, scale = np.empty(n, bool), np.empty(n)
+        rebuild_batch(self._geometry, prim, inst, u, v, d, tm, pos, ng, ns, front, scale)
         uv = None
         if self.corner_uvs is not None:
             # the same barycentric weights as the position: w vertex 0, u vertex 1, v vertex 2
             cu = self.corner_uvs[prim].astype(np.float64)
-            uv = w * cu[:, 0] + u * cu[:, 1] + v * cu[:, 2]
-        return SurfaceHit(pos, ng_f, ns, front, self.material[prim], scale, uv, prim,
-                          np.asarray(ray_dirs)[index], np.hstack([u, v]))
+            w = (1.0 - u - v)[:, None]
+            uv = w * cu[:, 0] + u[:, None] * cu[:, 1] + v[:, None] * cu[:, 2]
+        return SurfaceHit(pos, ng, ns, front, self.material[prim], scale, uv, prim, d,
+                          np.stack([u, v], axis=1), inst)
+
+
+def _or_empty(a, shape, dtype):
+    return np.ascontiguousarray(a) if a is not None else np.zeros(shape, dtype)
 
 
 def _corner_attribute(ordered, name):
@@ -239,14 +200,19 @@ def _terminator_cutoff(ordered, static_count):
     return cut if (cut > 0.0).any() else None
 
 
-def _object_table(ordered):
+def _object_table(ordered, prototypes=()):
     """(each triangle's object (int32), the object table (engine.nodes.context O_* rows))
-    when some mesh carries ObjectInfo (its materials run shader programs), else (None,
-    None). A mesh without it is the identity object with its bounding box as texture
-    space."""
-    if not any(getattr(m, "object_info", None) is not None for m in ordered):
+    when some mesh carries ObjectInfo (its materials run shader programs) or is
+    instanced, else (None, None). The table holds the places of the instanced meshes
+    first (a hit's `inst` is its row, engine.accel), then one row per mesh; a mesh
+    without ObjectInfo is the identity object with its bounding box as texture space."""
+    if not prototypes and not any(getattr(m, "object_info", None) is not None
+                                  for m in ordered):
         return None, None
+    from .instancing import object_rows
     from .nodes.context import N_OBJ, object_row
+    places = [object_rows(p.mesh) for p in prototypes]
+    first = sum(len(p) for p in places)
     rows = np.zeros((len(ordered), N_OBJ))
     for k, m in enumerate(ordered):
         info = m.object_info
@@ -260,7 +226,8 @@ def _object_table(ordered):
                                  info.pass_index, info.texspace_location,
                                  info.texspace_size)
     counts = [len(m.triangles) for m in ordered]
-    return np.repeat(np.arange(len(ordered), dtype=np.int32), counts), rows
+    return (np.repeat(np.arange(first, first + len(ordered), dtype=np.int32), counts),
+            np.concatenate(places + [rows]))
 
 
 # Triangles per block of the per-triangle normals built from vertex rows: temporaries

@@ -95,6 +95,9 @@ def scaled(scene: Scene, s: float) -> Scene:
     import copy
     out = copy.deepcopy(scene)
     for m in out.meshes:
+        if m.instances is not None:       # object space stays; the places scale
+            m.instances.matrices[:, :3, :] *= s
+            continue
         m.positions = m.positions * s
     for l in out.lights:
         if isinstance(l, AreaLight):
@@ -122,6 +125,9 @@ def translated(scene: Scene, offset) -> Scene:
     out = copy.deepcopy(scene)
     t = np.asarray(offset, dtype=np.float64)
     for m in out.meshes:
+        if m.instances is not None:
+            m.instances.matrices[:, :3, 3] += t
+            continue
         m.positions = m.positions + t
     for l in out.lights:
         if isinstance(l, AreaLight):
@@ -132,3 +138,24 @@ def translated(scene: Scene, offset) -> Scene:
     out.camera.matrix = out.camera.matrix.copy()
     out.camera.matrix[:3, 3] += t
     return out
+
+
+def instanced_boxes(width=24, height=24, light_size=1.0) -> Scene:
+    """The Cornell box whose two boxes are two places of one unit cube
+    (engine.scene.Instances): the tall one scaled and turned 90 degrees about z, the
+    short one scaled; the same boxes as `cornell_box`'s."""
+    import copy
+    from engine.scene import Instances
+    scene = cornell_box(width, height, light_size=light_size)
+    out = copy.deepcopy(scene)
+    cube = box((-0.5, -0.5, 0.0), (0.5, 0.5, 1.0), "cube", 0)
+    tall, short = np.eye(4), np.eye(4)
+    tall[:3, :3] = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]) \
+        @ np.diag([0.6, 0.55, 1.2])
+    tall[:3, 3] = (-0.325, 0.2, 0.0)
+    short[:3, :3] = np.diag([0.55, 0.55, 0.6])
+    short[:3, 3] = (0.375, -0.325, 0.0)
+    cube.instances = Instances(np.array([tall, short]))
+    out.meshes = [m for m in out.meshes if m.name not in ("tall", "short")] + [cube]
+    return out
+

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import visibility
+from ..accel import HitArrays
 from ..kernels import lights as klights
 from ..kernels.bsdf import principled as kbsdf
 from ..bsdf.material_table import flatten_mixes
@@ -30,7 +31,6 @@ from ..kernels.path_weights import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
 from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
 from ..kernels.medium_density import bound_majorants, shadow_keys
 from ..kernels.volume import STACK, V_HET, pack_volumes
-from ..nodes.context import N_OBJ
 from ..nodes.pack import PROG
 from ..nodes.differentials import camera_cones
 from ..sampling.dispatch import pixel_keys
@@ -68,18 +68,7 @@ class CompiledPathIntegrator:
                              float(s.caustics_reflective), float(s.caustics_refractive),
                              s.volume_bounces],
                             dtype=np.float64)
-        self.geometry = (surf.positions, surf.corners,
-                         np.asarray(ctx.accel.center, dtype=np.float64), surf.material,
-                         _or_empty(surf.corner_normals, (0, 3, 3), np.float32),
-                         _or_empty(surf.holdout, 0, bool),
-                         _or_empty(surf.corner_uvs, (0, 3, 2), np.float32),
-                         ctx.accel.motion,
-                         _or_empty(surf.tri_object, 0, np.int32),
-                         _or_empty(surf.objects, (0, N_OBJ), np.float64),
-                         _or_empty(surf.corner_tangents, (0, 3, 4), np.float32),
-                         _or_empty(surf.corner_colors, (0, 3, 4), np.float32),
-                         self.camera,
-                         _or_empty(surf.terminator_cutoff, 0, np.float64))
+        self.geometry = surf.geometry(self.camera)
         self.params = kbsdf.pack_materials(mats)
         self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)
         self.textures = mats.shading()
@@ -152,31 +141,30 @@ class CompiledPathIntegrator:
                              d, tm, hits):
         """Closest hits seen through transparent layers and surfaces the rays do not see
         (engine.kernels.transparency); time: the rays' shutter times (None when nothing
-        moves). Returns (t, prim, u, v, throughput factor (m, 3), stopped (m,))."""
+        moves). Returns (the hits (HitArrays), throughput factor (m, 3), stopped (m,))."""
         m = len(live)
-        t_all, prim_all = hits.t.copy(), hits.prim.copy()
-        u_all, v_all = hits.u.copy(), hits.v.copy()
+        found = HitArrays(hits.t.copy(), hits.prim.copy(), hits.inst.copy(), hits.u.copy(),
+                          hits.v.copy())
         factor, stopped = np.ones((m, 3)), np.zeros(m, bool)
         travelled = np.zeros(m)
         rows = np.arange(m, dtype=np.int64)
-        cur = hits
+        cur = hits.arrays()
         out_rows, out_org, out_far = np.empty(m, np.int64), np.empty((m, 3)), np.empty(m)
         cfg = self.cfg
         layer = 0
         while rows.size:
             k = alpha_pass(depth, layer, self.transparent_limit, int(cfg[0]), int(cfg[1]),
                            paths[0], paths[1], live, used, ray_bits, path_time, rows, d, tm,
-                           cur.t, cur.prim, cur.u, cur.v, travelled, factor, stopped,
+                           cur, travelled, factor, stopped,
                            self.geometry, self.materials, out_rows, out_org, out_far)
             if k == 0:
                 break
             rows = out_rows[:k].copy()
             cur = self.ctx.accel.intersect(out_org[:k], d[rows], out_far[:k],
-                                           None if time is None else time[rows])
-            merge_layer(rows, travelled, cur.t, cur.prim, cur.u, cur.v,
-                        t_all, prim_all, u_all, v_all)
+                                           None if time is None else time[rows]).arrays()
+            merge_layer(rows, travelled, cur, found)
             layer += 1
-        return t_all, prim_all, u_all, v_all, factor, stopped
+        return found, factor, stopped
 
     def _transmittance(self, org, dirs, far, time, stacks, keys):
         """Transmittance (n, 3) of shadow rays through transparent layers and volumes
@@ -194,7 +182,7 @@ class CompiledPathIntegrator:
             h = self.ctx.accel.intersect(o, dirs[rows], remaining,
                                          None if time is None else time[rows])
             k = shadow_pass(layer, self.transparent_limit, rows, o, dirs, ray_time,
-                            remaining, h.t, h.prim, h.u, h.v, trans, self.geometry,
+                            remaining, h.arrays(), trans, self.geometry,
                             self.materials, self.vol, stacks, (keys, self.het_runs),
                             out_rows, out_org, out_far)
             rows = out_rows[:k].copy()
@@ -251,15 +239,15 @@ class CompiledPathIntegrator:
                 break
             ray_time = path_time[live] if moving else None
             hits = ctx.accel.intersect(o, d, tm, ray_time)
-            t, prim, u, v, stopped = hits.t, hits.prim, hits.u, hits.v, no_stop
+            found, stopped = hits.arrays(), no_stop
             if self.any_transparent or self.skips_hits:
-                t, prim, u, v, factor, stopped = self._through_transparent(
+                found, factor, stopped = self._through_transparent(
                     depth, (pkey, index), live, used, ray_bits, path_time, ray_time, o, d,
                     tm, hits)
                 beta[live] *= factor
             ns, nn = self.vertex(depth, self.cfg, pkey, index, beta, counts, L, coverage,
                            prev_pdf, prev_pos, ray_bits, min_pdf, cont, path_time, live, o, d,
-                           tm, t, prim, u, v, stopped, self.geometry, self.params,
+                           tm, found, stopped, self.geometry, self.params,
                            self.emission, self.textures, self.tables, self.lights,
                            self.world, media,
                            sh_path, sh_org, sh_dir, sh_far, sh_contrib,

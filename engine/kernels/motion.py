@@ -71,7 +71,7 @@ def pack_motion(accel) -> PackedMotion:
             info[i] = (DEFORM, step, 0, vert, nv, len(slices))
             verts.extend(np.asarray(p, np.float64).reshape(-1, 3) for p in slices)
             vert += nv * len(slices)
-    prim_start[n] = accel.total_triangles if n else accel.static_count
+    prim_start[n] = accel.total_triangles if n else accel.moving_start
 
     def cat(parts, shape, dtype):
         if not parts:

@@ -90,11 +90,12 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
 
 @kernel
 def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, ray_bits,
-          min_pdf, cont, path_time, live, ro, rd, rt, hit_t, hit_prim, hit_u, hit_v, stopped,
+          min_pdf, cont, path_time, live, ro, rd, rt, hits, stopped,
           geometry, params, emission, textures, tables, lights, world, media,
           sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir, path_info,
           programs, volumes, het):
-    """One bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
+    """One bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`
+    (engine.accel.HitArrays: t, prim, inst, u, v per ray; prim -1 where missed).
 
     cfg: float64 [sampler kind, spp, max_bounces, diffuse, glossy, transmission limits,
     clamp_direct, clamp_indirect, mis mode, scene radius, film transparent, filter glossy,
@@ -141,6 +142,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     shading tables when a material has a shader program; volumes: the volume table
     when the scene has media; het: the same when one of them is heterogeneous."""
     bounce, vbounce, vol, stacks, sh_stack, sh_bounce, het_count = media
+    hit_t, hit_prim, hit_inst, hit_u, hit_v = hits.t, hits.prim, hits.inst, hits.u, hits.v
     het_scene = has_heterogeneous(vol)
     vhit = np.zeros(N_HIT)
     tri_material, holdout, corner_uvs = geometry[3], geometry[5], geometry[6]
@@ -271,7 +273,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 alpha[p] = uncovered(br, bg, bb)
             continue
         px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
-            geometry, prim, hit_u[j], hit_v[j], dx, dy, dz, path_time[p])
+            geometry, prim, hit_inst[j], hit_u[j], hit_v[j], dx, dy, dz,
+            path_time[p])
         m = tri_material[prim]
         if vol.shape[0] > 0 and vol[m, V_BOUNDARY] != 0.0:
             # a volume's boundary: no surface; the ray goes on inside or outside it
@@ -294,8 +297,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         n0x, n0y, n0z = nx, ny, nz               # the surface's own shading normal
         if programs is not None and programmed:
             ms, u_lobe, nx, ny, nz, rx, ry, rz, bent, correct = run_program(
-                programs, params, geometry, counts, path_info, p, m, prim, hit_u[j],
-                hit_v[j], uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front,
+                programs, params, geometry, counts, path_info, p, m, prim, hit_inst[j],
+                hit_u[j], hit_v[j], uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front,
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
         er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,

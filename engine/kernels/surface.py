@@ -1,7 +1,7 @@
 """Surface interactions rebuilt in float64 from Embree's hit, and safe ray origins: the
 compiled form of `engine.surface` (same formulas, one hit at a time), for static
-triangles (`rebuild`) and for triangles of moving objects placed at the ray's time
-(`rebuild_at_time`). See that module for why hit points come from barycentrics and why
+triangles (`rebuild`), and for triangles of instanced meshes placed by their instance
+and of moving objects placed at the ray's time (`rebuild_at_time`). See that module for why hit points come from barycentrics and why
 the ray offset is relative to the coordinates' magnitude."""
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ from .frame import cross, dot
 from .jit import kernel
 from .motion import I_KIND, I_NVERTS, I_SLICES, I_VERT0, RIGID, adjugate_columns, object_of, \
     rigid_at
+from ..nodes.context import O_TO_OBJECT, O_TO_WORLD
 
 
 @kernel(allocates=False)
@@ -72,18 +73,25 @@ def unit_normal(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z):
 
 
 @kernel(allocates=False)
-def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
-    """`rebuild` for any triangle, static or moving, hit at shutter time `time`.
-    geometry: (positions, corners, center, material, corner_normals, holdout, corner_uvs,
-    M) in the accelerator's triangle order, M its moving objects
-    (engine.kernels.motion.PackedMotion; triangles from M.prim_start[0] on move). A
-    moving triangle is placed as SurfaceBuilder.build places it: a rigid object's
-    vertices by its transform at `time`, its corner normals by that transform's
+def rebuild_at_time(geometry, prim, inst, u, v, dx, dy, dz, time):
+    """`rebuild` for any triangle, static, instanced or moving, hit at shutter time
+    `time`. geometry: (positions, corners, center, material, corner_normals, holdout,
+    corner_uvs, M, triangle objects, object table, ...) in the accelerator's triangle
+    order, M its moving objects (engine.kernels.motion.PackedMotion; triangles from
+    M.prim_start[0] on move). inst: the hit's place, its row of the object table, for
+    a triangle of an instanced mesh (engine.instancing; -1 otherwise): its object-space
+    vertices are placed by the row's matrix, its corner normals by the inverse-transpose.
+    A moving triangle is placed as engine.accel's moving objects are traced: a rigid
+    object's vertices by its transform at `time`, its corner normals by that transform's
     inverse-transpose; a deforming object's vertices from the time slice of `time`."""
     positions, corners, center, corner_normals, M = (geometry[0], geometry[1], geometry[2],
                                                      geometry[4], geometry[7])
     if prim < M.prim_start[0]:
-        return rebuild(positions, corners, center, corner_normals, prim, u, v, dx, dy, dz)
+        if inst < 0:
+            return rebuild(positions, corners, center, corner_normals, prim, u, v, dx, dy,
+                           dz)
+        return _rebuild_placed(positions, corners, center, corner_normals, geometry[9][inst],
+                               prim, u, v, dx, dy, dz)
     obj = object_of(M, prim)
     info, verts, tris = M.info, M.verts, M.tris
     local = prim - M.prim_start[0]
@@ -92,10 +100,17 @@ def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
     base = info[obj, I_VERT0]
     a00, a01, a02, a10, a11, a12, a20, a21, a22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
     tx, ty, tz = 0.0, 0.0, 0.0
+    n00, n01, n02, n10, n11, n12, n20, n21, n22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
     if rigid:
         a00, a01, a02, a10, a11, a12, a20, a21, a22, tx, ty, tz = rigid_at(
             info, M.step_time, M.step_trans, M.step_quat, M.step_stretch, M.step_linear,
             obj, time)
+        # the normal matrix, the inverse-transpose: columns r_j / det
+        r0x, r0y, r0z, r1x, r1y, r1z, r2x, r2y, r2z, det = adjugate_columns(
+            a00, a01, a02, a10, a11, a12, a20, a21, a22)
+        n00, n10, n20 = r0x / det, r0y / det, r0z / det
+        n01, n11, n21 = r1x / det, r1y / det, r1z / det
+        n02, n12, n22 = r2x / det, r2y / det, r2z / det
     else:
         slices = info[obj, I_SLICES]
         base += min(max(int(time * slices), 0), slices - 1) * info[obj, I_NVERTS]
@@ -105,7 +120,58 @@ def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
                            a22, tx, ty, tz)
     p2x, p2y, p2z = _place(verts, base + i2, rigid, a00, a01, a02, a10, a11, a12, a20, a21,
                            a22, tx, ty, tz)
-    # the placed triangle's unit geometric normal
+    px, py, pz, fx, fy, fz, sx, sy, sz, front = _placed_hit(
+        p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z, corner_normals, prim, rigid,
+        n00, n01, n02, n10, n11, n12, n20, n21, n22, u, v, dx, dy, dz)
+    tri = max(abs(p0x), abs(p0y), abs(p0z), abs(p1x), abs(p1y), abs(p1z),
+              abs(p2x), abs(p2y), abs(p2z))
+    scale = max(max(abs(px), abs(py), abs(pz)), tri)
+    return px, py, pz, fx, fy, fz, sx, sy, sz, front, scale
+
+
+@kernel(allocates=False)
+def _rebuild_placed(positions, corners, center, corner_normals, o, prim, u, v, dx, dy, dz):
+    """`rebuild` for triangle prim of an instanced mesh (object-space rows of positions)
+    at the place of object row o (engine.nodes.context: O_TO_WORLD its matrix, O_TO_OBJECT
+    the inverse, whose transpose places normals). The offset scale bounds both the world
+    corners' distance from `center` and the float32 error of the object-space corners
+    Embree intersects, carried into the world by the matrix."""
+    a00, a01, a02, tx = o[O_TO_WORLD], o[O_TO_WORLD + 1], o[O_TO_WORLD + 2], o[O_TO_WORLD + 3]
+    a10, a11, a12, ty = o[O_TO_WORLD + 4], o[O_TO_WORLD + 5], o[O_TO_WORLD + 6], \
+        o[O_TO_WORLD + 7]
+    a20, a21, a22, tz = o[O_TO_WORLD + 8], o[O_TO_WORLD + 9], o[O_TO_WORLD + 10], \
+        o[O_TO_WORLD + 11]
+    w0 = O_TO_OBJECT
+    n00, n01, n02 = o[w0], o[w0 + 4], o[w0 + 8]
+    n10, n11, n12 = o[w0 + 1], o[w0 + 5], o[w0 + 9]
+    n20, n21, n22 = o[w0 + 2], o[w0 + 6], o[w0 + 10]
+    i0, i1, i2 = corners[prim, 0], corners[prim, 1], corners[prim, 2]
+    p0x, p0y, p0z = _place(positions, i0, True, a00, a01, a02, a10, a11, a12, a20, a21, a22,
+                           tx, ty, tz)
+    p1x, p1y, p1z = _place(positions, i1, True, a00, a01, a02, a10, a11, a12, a20, a21, a22,
+                           tx, ty, tz)
+    p2x, p2y, p2z = _place(positions, i2, True, a00, a01, a02, a10, a11, a12, a20, a21, a22,
+                           tx, ty, tz)
+    px, py, pz, fx, fy, fz, sx, sy, sz, front = _placed_hit(
+        p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z, corner_normals, prim, True,
+        n00, n01, n02, n10, n11, n12, n20, n21, n22, u, v, dx, dy, dz)
+    cx, cy, cz = center[0], center[1], center[2]
+    scale = max(abs(p0x - cx), abs(p0y - cy), abs(p0z - cz), abs(p1x - cx), abs(p1y - cy),
+                abs(p1z - cz), abs(p2x - cx), abs(p2y - cy), abs(p2z - cz))
+    local = 0.0
+    for k in range(3):
+        local = max(local, abs(positions[i0, k]), abs(positions[i1, k]), abs(positions[i2, k]))
+    norm = max(abs(a00) + abs(a01) + abs(a02), abs(a10) + abs(a11) + abs(a12),
+               abs(a20) + abs(a21) + abs(a22))
+    return px, py, pz, fx, fy, fz, sx, sy, sz, front, max(scale, local * norm)
+
+
+@kernel(allocates=False)
+def _placed_hit(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z, corner_normals, prim, placed,
+                n00, n01, n02, n10, n11, n12, n20, n21, n22, u, v, dx, dy, dz):
+    """The hit at barycentrics (u, v) of the triangle whose corners p0..p2 were placed in
+    the world; its corner normals go through the normal matrix n when `placed`.
+    Returns (position, geometric normal facing the ray, shading normal, front)."""
     gx, gy, gz = unit_normal(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z)
     w = 1.0 - u - v
     px = w * p0x + u * p1x + v * p2x
@@ -120,13 +186,7 @@ def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
         c0x, c0y, c0z = np.float64(c[prim, 0, 0]), np.float64(c[prim, 0, 1]), np.float64(c[prim, 0, 2])
         c1x, c1y, c1z = np.float64(c[prim, 1, 0]), np.float64(c[prim, 1, 1]), np.float64(c[prim, 1, 2])
         c2x, c2y, c2z = np.float64(c[prim, 2, 0]), np.float64(c[prim, 2, 1]), np.float64(c[prim, 2, 2])
-        if rigid:
-            # the normal matrix, the inverse-transpose: columns r_j / det
-            r0x, r0y, r0z, r1x, r1y, r1z, r2x, r2y, r2z, det = adjugate_columns(
-                a00, a01, a02, a10, a11, a12, a20, a21, a22)
-            n00, n10, n20 = r0x / det, r0y / det, r0z / det
-            n01, n11, n21 = r1x / det, r1y / det, r1z / det
-            n02, n12, n22 = r2x / det, r2y / det, r2z / det
+        if placed:
             c0x, c0y, c0z = (n00 * c0x + n01 * c0y + n02 * c0z, n10 * c0x + n11 * c0y + n12 * c0z,
                              n20 * c0x + n21 * c0y + n22 * c0z)
             c1x, c1y, c1z = (n00 * c1x + n01 * c1y + n02 * c1z, n10 * c1x + n11 * c1y + n12 * c1z,
@@ -145,10 +205,24 @@ def rebuild_at_time(geometry, prim, u, v, dx, dy, dz, time):
         # a shading normal bent past the geometric one is replaced by it
         if dot(nx, ny, nz, fx, fy, fz) > 0.0:
             sx, sy, sz = nx, ny, nz
-    tri = max(abs(p0x), abs(p0y), abs(p0z), abs(p1x), abs(p1y), abs(p1z),
-              abs(p2x), abs(p2y), abs(p2z))
-    scale = max(max(abs(px), abs(py), abs(pz)), tri)
-    return px, py, pz, fx, fy, fz, sx, sy, sz, front, scale
+    return px, py, pz, fx, fy, fz, sx, sy, sz, front
+
+
+@kernel
+def rebuild_batch(geometry, prim, inst, u, v, d, time, position, geometric, shading,
+                  front, scale):
+    """`rebuild_at_time` for n hits (time may be empty: 0): writes the hit points, the
+    geometric and shading normals facing the rays (n, 3), front (n,) and the offset
+    scales (n,). What engine.surface.SurfaceBuilder.build returns, compiled once."""
+    timed = time.shape[0] > 0
+    for i in range(prim.shape[0]):
+        px, py, pz, gx, gy, gz, sx, sy, sz, fr, sc = rebuild_at_time(
+            geometry, prim[i], inst[i], u[i], v[i], d[i, 0], d[i, 1], d[i, 2],
+            time[i] if timed else 0.0)
+        position[i, 0], position[i, 1], position[i, 2] = px, py, pz
+        geometric[i, 0], geometric[i, 1], geometric[i, 2] = gx, gy, gz
+        shading[i, 0], shading[i, 1], shading[i, 2] = sx, sy, sz
+        front[i], scale[i] = fr, sc
 
 
 @kernel(inline="always")

@@ -15,16 +15,16 @@ from ..nodes.shading import (apply_rows, pick_closure, program_emission, program
 
 
 @kernel
-def run_program(programs, params, geometry, counts, path_info, p, m, prim, hu, hv, uu, vv,
+def run_program(programs, params, geometry, counts, path_info, p, m, prim, inst, hu, hv, uu, vv,
                 px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bit, b, t_geom,
                 hit_row, regs, u_lobe):
     """Run material m's program at the hit of path p (what its Light Path and geometry
     nodes read: the path's counts, its ray cone at t_geom, the hit), leaving its outputs
-    in regs. Returns (the material shaded (a Mix Shader's pick with u_lobe), u_lobe
+    in regs (inst: the hit's instance, engine.instancing). Returns (the material shaded (a Mix Shader's pick with u_lobe), u_lobe
     rescaled, the shading normal s, the raw bent normal r, bent: s or r differ from n,
     correct: the material's Bump Map Correction)."""
     path_fields(hit_row, counts, path_info[0], p, cone_at(path_info[1], p, t_geom))
-    program_hit(programs, geometry, m, prim, hu, hv, uu, vv, px, py, pz, gx, gy, gz, nx, ny,
+    program_hit(programs, geometry, m, prim, inst, hu, hv, uu, vv, px, py, pz, gx, gy, gz, nx, ny,
                 nz, dx, dy, dz, front, ray_bit, b, t_geom, hit_row, regs)
     ms, u_lobe = pick_closure(programs, m, regs, u_lobe)
     correct = params[ms, P_BUMP_CORRECTION] != 0.0

@@ -49,20 +49,20 @@ def alpha_dim(depth, layer):
 
 
 @kernel
-def _hit_alpha(geometry, materials, prim, u, v, dx, dy, dz, time, ray, depth, length):
+def _hit_alpha(geometry, materials, prim, inst, u, v, dx, dy, dz, time, ray, depth, length):
     """Alpha of the hit (a material program's, run for a ray of kind `ray`, the path's
     bounce depth and the hit's distance), its material and its surface point."""
     tri_material, corner_uvs = geometry[3], geometry[6]
     _, _, alpha_table, _, T, _ = materials
     px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
-        geometry, prim, u, v, dx, dy, dz, time)
+        geometry, prim, inst, u, v, dx, dy, dz, time)
     uu, vv = hit_uv(corner_uvs, prim, u, v)
     m = tri_material[prim]
     a = alpha_at(T, alpha_table, m, uu, vv)
     if has_program(T, m):
         hit = np.zeros(N_HIT)
         regs = np.zeros(max(T[NREGS][0], 1))
-        program_hit(T, geometry, m, prim, u, v, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
+        program_hit(T, geometry, m, prim, inst, u, v, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
                     dx, dy, dz, front, ray, depth, length, hit, regs)
         a = program_alpha(T, m, regs, a)
     return a, m, px, py, pz, gx, gy, gz, scale
@@ -80,12 +80,13 @@ def _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, d
 
 
 @kernel
-def _pass_through(geometry, prim, u, v, d, r, time, far, out_rows, out_org, out_far, n_out):
+def _pass_through(geometry, prim, inst, u, v, d, r, time, far, out_rows, out_org, out_far,
+                  n_out):
     """Ray r (direction d[r]) goes on, unchanged, beyond the triangle it hit; returns
     whether it hit the triangle's front."""
     dx, dy, dz = d[r, 0], d[r, 1], d[r, 2]
-    px, py, pz, gx, gy, gz, _, _, _, front, scale = rebuild_at_time(geometry, prim, u, v,
-                                                                    dx, dy, dz, time)
+    px, py, pz, gx, gy, gz, _, _, _, front, scale = rebuild_at_time(geometry, prim, inst, u,
+                                                                    v, dx, dy, dz, time)
     _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, dx, dy, dz,
           far)
     return front
@@ -93,7 +94,7 @@ def _pass_through(geometry, prim, u, v, d, r, time, far, out_rows, out_org, out_
 
 @kernel
 def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits, path_time,
-               rows, rd, tmax, cur_t, cur_prim, cur_u, cur_v, travelled, factor, stopped,
+               rows, rd, tmax, cur, travelled, factor, stopped,
                geometry, materials, out_rows, out_org, out_far):
     """One transparent layer for the camera or bounce rays `rows` (indices into the
     wavefront `live`) whose current closest hits are cur_*: each ray whose hit surface
@@ -103,6 +104,7 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
     on beyond it as it is. Writes the rays that go on (row, origin, remaining distance);
     returns their count."""
     tri_material, maybe_transparent, _, tcolor, _, tri_vis = materials
+    cur_t, cur_prim, cur_inst, cur_u, cur_v = cur.t, cur.prim, cur.inst, cur.u, cur.v
     n_out = 0
     for i in range(rows.shape[0]):
         r = rows[i]
@@ -111,7 +113,8 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
             continue
         if tri_vis.shape[0] > 0 and not tri_vis[prim] & ray_bits[live[r]]:
             travelled[r] += cur_t[i]
-            _pass_through(geometry, prim, cur_u[i], cur_v[i], rd, r, path_time[live[r]],
+            _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], rd, r,
+                          path_time[live[r]],
                           tmax[r] - travelled[r], out_rows, out_org, out_far, n_out)
             n_out += 1
             continue
@@ -120,7 +123,8 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
         dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
         p = live[r]
         a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(
-            geometry, materials, prim, cur_u[i], cur_v[i], dx, dy, dz, path_time[p],
+            geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], dx, dy, dz,
+            path_time[p],
             ray_bits[p], depth, travelled[r] + cur_t[i])
         if not sample_1d(kind, pkey[p], spp, index[p], alpha_dim(depth, layer)) >= a:
             continue
@@ -139,8 +143,7 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
 
 
 @kernel
-def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur_t, cur_prim, cur_u,
-                cur_v, trans, geometry, materials, vol, stacks, tracking, out_rows, out_org,
+def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geometry, materials, vol, stacks, tracking, out_rows, out_org,
                 out_far):
     """One layer of transparent shadows for the shadow rays `rows`: an opaque surface (or
     one past `limit` transparent layers) blocks; a transparent one multiplies the
@@ -153,6 +156,7 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur_t, cur_prim
     rays whose media include a heterogeneous one (ratio tracking)."""
     tri_material, maybe_transparent, _, tcolor, T, tri_vis = materials
     keys, het_count = tracking
+    cur_t, cur_prim, cur_inst, cur_u, cur_v = cur.t, cur.prim, cur.inst, cur.u, cur.v
     het_scene = stacks.shape[0] > 0 and has_heterogeneous(vol)
     hit = np.zeros(N_HIT if het_scene else 0)
     regs = np.zeros(max(T[NREGS][0], 1) if het_scene else 0)
@@ -171,14 +175,15 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur_t, cur_prim
         if reached:
             continue
         if vol.shape[0] > 0 and vol[tri_material[prim], V_BOUNDARY] != 0.0:
-            front = _pass_through(geometry, prim, cur_u[i], cur_v[i], sd, r, ray_time[r],
+            front = _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], sd, r,
+                                  ray_time[r],
                                   remaining[i] - cur_t[i], out_rows, out_org, out_far, n_out)
             n_out += 1
             if stacks.shape[0] > 0:
                 stack_cross(stacks, r, tri_material[prim], front)
             continue
         if tri_vis.shape[0] > 0 and not tri_vis[prim] & SHADOW_BIT:
-            _pass_through(geometry, prim, cur_u[i], cur_v[i], sd, r, ray_time[r],
+            _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], sd, r, ray_time[r],
                           remaining[i] - cur_t[i], out_rows, out_org, out_far, n_out)
             n_out += 1
             continue
@@ -187,7 +192,8 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur_t, cur_prim
             continue
         dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
         a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(
-            geometry, materials, prim, cur_u[i], cur_v[i], dx, dy, dz, ray_time[r],
+            geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], dx, dy, dz,
+            ray_time[r],
             SHADOW_BIT, 0, cur_t[i])
         trans[r, 0] *= (1.0 - a) * tcolor[m, 0]
         trans[r, 1] *= (1.0 - a) * tcolor[m, 1]
@@ -201,13 +207,14 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur_t, cur_prim
 
 
 @kernel
-def merge_layer(rows, travelled, found_t, found_prim, found_u, found_v,
-                t_all, prim_all, u_all, v_all):
-    """The hits beyond a transparent layer replace the rows' hits (t from the start)."""
+def merge_layer(rows, travelled, found, hits):
+    """The hits `found` beyond a transparent layer replace the rows' `hits` (t from the
+    start; both engine.accel.HitArrays)."""
     for i in range(rows.shape[0]):
         r = rows[i]
-        if found_prim[i] >= 0:
-            t_all[r] = travelled[r] + found_t[i]
+        if found.prim[i] >= 0:
+            hits.t[r] = travelled[r] + found.t[i]
         else:
-            t_all[r] = 1e300 * 1e300
-        prim_all[r], u_all[r], v_all[r] = found_prim[i], found_u[i], found_v[i]
+            hits.t[r] = 1e300 * 1e300
+        hits.prim[r], hits.inst[r] = found.prim[i], found.inst[i]
+        hits.u[r], hits.v[r] = found.u[i], found.v[i]

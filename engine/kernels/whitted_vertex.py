@@ -74,16 +74,17 @@ def mirror_row(row):
 
 @kernel
 def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
-                  ray_bits, min_pdf, cont, path_time, live, ro, rd, rt, hit_t, hit_prim,
-                  hit_u, hit_v, stopped, geometry, params, emission, textures, tables,
+                  ray_bits, min_pdf, cont, path_time, live, ro, rd, rt, hits,
+                  stopped, geometry, params, emission, textures, tables,
                   lights, world, media, sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path,
                   nx_org, nx_dir, path_info, programs, volumes, het):
-    """Whitted's bounce for the live paths `live` whose rays (ro, rd, rt) hit (hit_*).
+    """Whitted's bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`.
     The arguments are `path_vertex.shade`'s (read its docstring); this kernel reads no
     roulette verdict, MIS state or volume (min_pdf, cont, prev_pdf, prev_pos, volumes and
     het are unused), and queues up to `lamp_rays(lights)` shadow rays per path, so sh_*
     must hold that many times the live paths. Returns (shadow count, next count)."""
     bounce, sh_bounce, stacks, sh_stack = media[0], media[5], media[3], media[4]
+    hit_t, hit_prim, hit_inst, hit_u, hit_v = hits.t, hits.prim, hits.inst, hits.u, hits.v
     tri_material, holdout, corner_uvs = geometry[3], geometry[5], geometry[6]
     film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
     kind, spp = int(cfg[0]), int(cfg[1])
@@ -130,7 +131,8 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
                 alpha[p] = uncovered(br, bg, bb)
             continue
         px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
-            geometry, prim, hit_u[j], hit_v[j], dx, dy, dz, path_time[p])
+            geometry, prim, hit_inst[j], hit_u[j], hit_v[j], dx, dy, dz,
+            path_time[p])
         m = tri_material[prim]
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         programmed = programs is not None and has_program(programs, m)
@@ -141,8 +143,8 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
         n0x, n0y, n0z = nx, ny, nz
         if programs is not None and programmed:
             ms, u_lobe, nx, ny, nz, rx, ry, rz, bent, correct = run_program(
-                programs, params, geometry, counts, path_info, p, m, prim, hit_u[j],
-                hit_v[j], uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front,
+                programs, params, geometry, counts, path_info, p, m, prim, hit_inst[j],
+                hit_u[j], hit_v[j], uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front,
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
         er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
                                       programmed)

@@ -65,32 +65,56 @@ O_RANDOM = 27
 O_INDEX = 28
 O_TEX_LOCATION = 29  # texture space centre (3)
 O_TEX_SIZE = 32      # texture space half-size (3)
-N_OBJ = 35
+O_TO_WORLD = 35      # 3 x 4 object -> world, row-major (12): where an instance stands
+N_OBJ = 47
+
+
+def object_rows(matrices, colors, randoms, pass_indices, texspace_location,
+                texspace_size):
+    """The O_* rows (K, N_OBJ) of K objects: matrices (K, 4, 4) object -> world, colors
+    (K, 3), randoms and pass_indices (K,); one texture space (centre, half-size) for all."""
+    m = np.asarray(matrices, np.float64).reshape(-1, 4, 4)
+    k = len(m)
+    rows = np.zeros((k, N_OBJ))
+    a = m[:, :3, :3]
+    inv = np.empty_like(a)
+    det = np.linalg.det(a) if k else np.zeros(0)
+    ok = np.abs(det) > 0.0
+    inv[ok] = np.linalg.inv(a[ok])
+    if (~ok).any():
+        inv[~ok] = np.linalg.pinv(a[~ok])
+    t = m[:, :3, 3]
+    rows[:, O_TO_OBJECT:O_TO_OBJECT + 12] = np.concatenate(
+        [inv, -np.einsum("kij,kj->ki", inv, t)[:, :, None]], axis=2).reshape(k, 12)
+    rows[:, O_NORMAL:O_NORMAL + 9] = np.transpose(a, (0, 2, 1)).reshape(k, 9)
+    rows[:, O_LOCATION:O_LOCATION + 3] = t
+    rows[:, O_COLOR:O_COLOR + 3] = np.asarray(colors, np.float64).reshape(k, -1)[:, :3]
+    rows[:, O_RANDOM] = np.asarray(randoms, np.float64).reshape(k)
+    rows[:, O_INDEX] = np.asarray(pass_indices, np.float64).reshape(k)
+    rows[:, O_TEX_LOCATION:O_TEX_LOCATION + 3] = texspace_location
+    size = np.asarray(texspace_size, np.float64)
+    rows[:, O_TEX_SIZE:O_TEX_SIZE + 3] = np.where(np.abs(size) > 1e-12, size, 1.0)
+    rows[:, O_TO_WORLD:O_TO_WORLD + 12] = m[:, :3, :4].reshape(k, 12)
+    return rows
 
 
 def object_row(matrix_world, color=(1.0, 1.0, 1.0), random=0.0, pass_index=0,
                texspace_location=(0.0, 0.0, 0.0), texspace_size=(1.0, 1.0, 1.0)):
     """The O_* row of one object (matrix_world: its 4 x 4 object -> world matrix)."""
-    m = np.asarray(matrix_world, np.float64).reshape(4, 4)
-    row = np.zeros(N_OBJ)
-    a = m[:3, :3]
-    try:
-        inv = np.linalg.inv(a)
-    except np.linalg.LinAlgError:
-        inv = np.linalg.pinv(a)
-    row[O_TO_OBJECT:O_TO_OBJECT + 12] = np.hstack([inv, (-inv @ m[:3, 3])[:, None]]).ravel()
-    row[O_NORMAL:O_NORMAL + 9] = a.T.ravel()
-    row[O_LOCATION:O_LOCATION + 3] = m[:3, 3]
-    row[O_COLOR:O_COLOR + 3] = np.asarray(color, np.float64)[:3]
-    row[O_RANDOM] = random
-    row[O_INDEX] = pass_index
-    row[O_TEX_LOCATION:O_TEX_LOCATION + 3] = texspace_location
-    size = np.asarray(texspace_size, np.float64)
-    row[O_TEX_SIZE:O_TEX_SIZE + 3] = np.where(np.abs(size) > 1e-12, size, 1.0)
-    return row
+    return object_rows(np.asarray(matrix_world, np.float64).reshape(1, 4, 4),
+                       np.asarray(color, np.float64)[None, :3], [random], [pass_index],
+                       texspace_location, texspace_size)[0]
 
 
 IDENTITY_OBJECT = object_row(np.eye(4))
+
+
+@kernel(inline="always")
+def to_world_direction(o, x, y, z):
+    """Direction (x, y, z) of object row o's space in the world (its matrix's 3 x 3)."""
+    w = O_TO_WORLD
+    return (o[w] * x + o[w + 1] * y + o[w + 2] * z, o[w + 4] * x + o[w + 5] * y + o[w + 6] * z,
+            o[w + 8] * x + o[w + 9] * y + o[w + 10] * z)
 
 
 @kernel(allocates=False)

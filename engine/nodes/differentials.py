@@ -26,7 +26,8 @@ from ..kernels.camera_rays import C_CLIP_START, C_H, C_HALF_X, C_HALF_Y, C_PERSP
 from ..kernels.jit import kernel
 from .camera_coords import window
 from .context import (H_CAMERA, H_COLOR, H_DX, H_DY, H_FOOTPRINT, H_GENERATED, H_NG,
-                      H_OBJECT, H_P, H_UV, H_WINDOW, N_DIFF, O_TEX_SIZE, O_TO_OBJECT)
+                      H_OBJECT, H_P, H_UV, H_WINDOW, N_DIFF, O_TEX_SIZE, O_TO_OBJECT,
+                      to_world_direction)
 
 
 @kernel
@@ -106,7 +107,7 @@ def _corner_step(corners, prim, k, b1, b2):
 
 
 @kernel(allocates=False)
-def _fill_step(hit, block, geometry, prim, obj, camera, sx, sy, sz):
+def _fill_step(hit, block, geometry, prim, obj, placed, camera, sx, sy, sz):
     """One block of differentials (H_DX or H_DY): the change of each field over the
     surface step s."""
     positions, corners = geometry[0], geometry[1]
@@ -114,8 +115,12 @@ def _fill_step(hit, block, geometry, prim, obj, camera, sx, sy, sz):
     hit[block + H_P], hit[block + H_P + 1], hit[block + H_P + 2] = sx, sy, sz
     p0, p1, p2 = positions[corners[prim, 0]], positions[corners[prim, 1]], \
         positions[corners[prim, 2]]
-    b1, b2 = _barycentric_step(p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2],
-                               p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2], sx, sy, sz)
+    e1x, e1y, e1z = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
+    e2x, e2y, e2z = p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]
+    if placed:                  # an instance's edges, into the world
+        e1x, e1y, e1z = to_world_direction(objects[obj], e1x, e1y, e1z)
+        e2x, e2y, e2z = to_world_direction(objects[obj], e2x, e2y, e2z)
+    b1, b2 = _barycentric_step(e1x, e1y, e1z, e2x, e2y, e2z, sx, sy, sz)
     if corner_uvs.shape[0] > 0:
         hit[block + H_UV] = _corner_step(corner_uvs, prim, 0, b1, b2)
         hit[block + H_UV + 1] = _corner_step(corner_uvs, prim, 1, b1, b2)
@@ -160,9 +165,10 @@ def orthonormals(nx, ny, nz):
 
 
 @kernel(allocates=False)
-def fill_differentials(hit, geometry, prim, obj, camera):
+def fill_differentials(hit, geometry, prim, obj, placed, camera):
     """The differentials of hit row `hit` (its fields and footprint written) on triangle
-    prim of object row obj (-1: none); camera: the packed render camera (empty: none).
+    prim of object row obj (-1: none); placed: the triangle is an instance's, in object
+    space, placed by obj's matrix; camera: the packed render camera (empty: none).
     All zero without a footprint."""
     for k in range(N_DIFF):
         hit[H_DX + k] = 0.0
@@ -171,5 +177,5 @@ def fill_differentials(hit, geometry, prim, obj, camera):
     if not f > 0.0:
         return
     tx, ty, tz, bx, by, bz = orthonormals(hit[H_NG], hit[H_NG + 1], hit[H_NG + 2])
-    _fill_step(hit, H_DX, geometry, prim, obj, camera, tx * f, ty * f, tz * f)
-    _fill_step(hit, H_DY, geometry, prim, obj, camera, bx * f, by * f, bz * f)
+    _fill_step(hit, H_DX, geometry, prim, obj, placed, camera, tx * f, ty * f, tz * f)
+    _fill_step(hit, H_DY, geometry, prim, obj, placed, camera, bx * f, by * f, bz * f)

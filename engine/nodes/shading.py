@@ -15,7 +15,7 @@ import numpy as np
 from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
 from ..kernels.textures import I_TEXTURE, INPUTS, TEX_EMISSION
-from .context import fill
+from .context import fill, to_world_direction
 from .differentials import fill_differentials
 from .interpreter import reads_differentials, run
 from .pack import MIX, OUTS
@@ -25,14 +25,15 @@ OUT_VOL_SA, OUT_VOL_SS, OUT_VOL_EM = 7, 8, 9      # engine.kernels.medium_densit
 
 
 @kernel(allocates=False)
-def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
-                dx, dy, dz, front, ray, depth, length, hit, regs):
+def program_hit(T, geometry, m, prim, inst, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx, ny,
+                nz, dx, dy, dz, front, ray, depth, length, hit, regs):
     """Fill the hit row of a hit on triangle prim (material m) at barycentrics (bu, bv)
-    and run m's program. The caller has written the row's path fields
+    and run m's program. inst: the instance's object row (engine.instancing), -1 for a
+    mesh that is not instanced. The caller has written the row's path fields
     (context.path_fields; zeros: a path of no bounces and a ray without footprint); the
     differentials are filled only for a program that reads them (a Bump's)."""
     tri_object, objects, corner_tangents = geometry[8], geometry[9], geometry[10]
-    obj = tri_object[prim] if tri_object.shape[0] > 0 else -1
+    obj = inst if inst >= 0 else (tri_object[prim] if tri_object.shape[0] > 0 else -1)
     tx = ty = tz = ts = 0.0
     if corner_tangents.shape[0] > 0:
         c = corner_tangents
@@ -41,6 +42,8 @@ def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx
         ty = b0 * c[prim, 0, 1] + bu * c[prim, 1, 1] + bv * c[prim, 2, 1]
         tz = b0 * c[prim, 0, 2] + bu * c[prim, 1, 2] + bv * c[prim, 2, 2]
         ts = b0 * c[prim, 0, 3] + bu * c[prim, 1, 3] + bv * c[prim, 2, 3]
+        if inst >= 0:        # an object-space tangent, into the world by the place's matrix
+            tx, ty, tz = to_world_direction(objects[inst], tx, ty, tz)
         ln = math.sqrt(tx * tx + ty * ty + tz * tz)
         if ln > 0.0:
             tx, ty, tz = tx / ln, ty / ln, tz / ln
@@ -57,7 +60,7 @@ def program_hit(T, geometry, m, prim, bu, bv, uu, vv, px, py, pz, gx, gy, gz, nx
     fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, uu, vv, front, ray, depth,
          length, objects, obj, camera, tx, ty, tz, ts, cr, cg, cb, ca)
     if reads_differentials(T, m):
-        fill_differentials(hit, geometry, prim, obj, camera)
+        fill_differentials(hit, geometry, prim, obj, inst >= 0, camera)
     run(T, m, hit, regs)
 
 
