@@ -33,7 +33,8 @@ import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path[:0] = [ROOT, os.path.join(ROOT, "tests")]
-from big_scene_benchmarks import (big_mesh, big_mesh_section, many_moving,  # noqa: E402
+from big_scene_benchmarks import (big_mesh, big_mesh_section, many_instances,  # noqa: E402
+                                  many_instances_section, many_moving,
                                   save_big_mesh)
 from stage_profile import gil_bound, table_lines as stage_table  # noqa: E402
 import borrowing_benchmark  # noqa: E402
@@ -204,7 +205,12 @@ def main():
         done("3")
     if "4" not in skip:
         load_now = os.getloadavg()[0]
-        sec_lines, sec_targets = big_mesh_section(big_mesh(), load_now)
+        big = big_mesh()
+        sec_lines, sec_targets = big_mesh_section(big, load_now)
+        lines += sec_lines
+        targets += sec_targets
+        load_now = os.getloadavg()[0]
+        sec_lines, sec_targets = many_instances_section(many_instances(), load_now, big)
         lines += sec_lines
         targets += sec_targets
         done("4")

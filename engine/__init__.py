@@ -4,13 +4,13 @@ Never imports bpy. The input is an `engine.scene.Scene`, the output an `engine.f
 """
 from .film import Film
 from .render import RenderContext, RenderStats, render
-from .scene import (AreaLight, Camera, Material, ObjectInfo, PointLight, Scene, SunLight,
-                    TriangleMesh, Volume, World)
+from .scene import (AreaLight, Camera, Instances, Material, ObjectInfo, PointLight, Scene,
+                    SunLight, TriangleMesh, Volume, World)
 from .settings import RenderSettings
 from . import visibility  # noqa: E402  (the Ray Visibility bits, for exporters)
 from . import sky_texture  # noqa: E402  (Blender's Sky Texture node, for exporters)
 
-__all__ = ["AreaLight", "Camera", "Film", "Material", "ObjectInfo", "PointLight",
+__all__ = ["AreaLight", "Camera", "Film", "Instances", "Material", "ObjectInfo", "PointLight",
            "RenderContext",
            "RenderSettings", "RenderStats", "Scene", "SunLight", "TriangleMesh", "Volume", "World",
            "render"]

@@ -15,8 +15,9 @@ over threads (every kernel releases the GIL). Motion is built here from plain sc
 The nearest hit across all of them wins. Triangles get global ids in that order.
 
 Instances (engine.instancing): an instanced mesh is one Embree scene in object space,
-and each of its places an Embree instance of it in the static scene, whose transform
-is the place's matrix moved by -center like the static triangles. Its triangles get
+and its places one Embree instance array in the static scene (one shared float32
+buffer of transforms, each the place's matrix moved by -center like the static
+triangles). Its triangles get
 global ids once, after the static ones (the prototypes), and a hit on one reports the
 place too: `Hits.inst`, the place's row in the object table (engine.surface; -1 for a
 hit on a mesh that is not instanced). Memory then grows with the places, not with
@@ -243,20 +244,20 @@ class Accelerator:
             self.build_tlas()
 
     def _static_scene(self) -> EmbreeScene:
-        """The static triangles (geometry 0, when there are any) and every place of every
-        instanced mesh, relative to `center`. Fills the maps from an Embree instance id to
-        its prototype's first global triangle id and to its object-table row."""
+        """The static triangles (geometry 0, when there are any) and the places of every
+        instanced mesh (one instance array each), relative to `center`. Fills the maps
+        from an Embree instance array's id to its prototype's first global triangle id
+        and to the object-table row of its first place."""
         scene = EmbreeScene()
         ids = []
         if len(self.triangles):
             ids.append((scene.add_triangles(self.positions, self.triangles, self.center),
                         0, -1))
-        shift = np.eye(4)
-        shift[:3, 3] = -self.center
         for proto in self.prototypes:
-            for k, m in enumerate(proto.mesh.instances.matrices):
-                ids.append((scene.add_instance(proto.scene, shift @ m), proto.prim_offset,
-                            proto.first_row + k))
+            places = proto.mesh.instances.matrices[:, :3, :].copy()
+            places[:, :, 3] -= self.center
+            ids.append((scene.add_instance_array(proto.scene, places), proto.prim_offset,
+                        proto.first_row))
         n = max(g for g, _, _ in ids) + 1 if ids else 0
         self._inst_base = np.zeros(n, np.int64)
         self._inst_row = np.full(n, -1, np.int64)
@@ -303,7 +304,7 @@ class Accelerator:
                                tm[a:b] if len(tm) else tm, out[0][a:b])
         else:
             out = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64),
-                   np.empty(n), np.empty(n), np.empty(n))
+                   np.empty(n, np.int64), np.empty(n), np.empty(n), np.empty(n))
 
             def run(a, b):
                 intersect_batch(scene.handle, center, o[a:b], d[a:b], far[a:b],
@@ -317,12 +318,12 @@ class Accelerator:
                 f.result()
         if query == "OCCLUDED":
             return out[0]
-        _, prim, inst, t, u, v = out
+        _, prim, inst, element, t, u, v = out
         if scene is self._scene and self.prototypes:
-            placed = inst >= 0          # Embree's instance id: the place's geometry id
+            placed = inst >= 0          # the instance array's geometry id, the place's index
             g = inst[placed]
             prim[placed] += self._inst_base[g]
-            inst[placed] = self._inst_row[g]
+            inst[placed] = self._inst_row[g] + element[placed]
         else:
             inst[:] = -1
         return prim, t, u, v, inst

@@ -31,7 +31,8 @@ def expand(mesh: TriangleMesh) -> list[TriangleMesh]:
     instanced: itself). Corner normals go through each place's inverse-transpose and
     tangents through its matrix, not renormalised: hits interpolate them and normalise
     the result, so a hit on a copy is the hit on the instance (as Cycles interpolates
-    an instance's normals in object space)."""
+    an instance's normals in object space). A mirroring place turns the copy's winding
+    (and bitangent signs) over, as the instance's hits turn its geometric normal back."""
     if not is_instanced(mesh):
         return [mesh]
     inst = mesh.instances
@@ -50,14 +51,23 @@ def expand(mesh: TriangleMesh) -> list[TriangleMesh]:
             tan = np.asarray(mesh.tangents, np.float64).reshape(-1, 3, 4).copy()
             tan[..., :3] = tan[..., :3] @ a.T
             tangents = tan.astype(np.float32)
+        order = [0, 1, 2]
+        if np.linalg.det(a) < 0.0:
+            order = [0, 2, 1]
+            if tangents is not None:
+                tangents[..., 3] *= -1.0
+        corner = (lambda x: None if x is None else np.ascontiguousarray(
+            np.asarray(x).reshape(len(mesh.triangles), 3, -1)[:, order]))
         placed_info = None
         if info is not None:
             placed_info = replace(info, matrix_world=m.copy(),
                                   color=tuple(inst.colors[k]), random=float(inst.randoms[k]),
                                   pass_index=int(inst.pass_indices[k]))
         out.append(replace(mesh, name=f"{mesh.name}#{k}", positions=mesh.positions @ a.T + t,
-                           corner_normals=normals, tangents=tangents,
-                           object_info=placed_info, instances=None))
+                           triangles=mesh.triangles[:, order], corner_normals=corner(normals),
+                           uvs=corner(mesh.uvs), tangents=corner(tangents),
+                           colors=corner(mesh.colors), object_info=placed_info,
+                           instances=None))
     return out
 
 

@@ -104,6 +104,19 @@ def sun_and_top_camera(bpy, scene, sun_rotation, sun_angle, ortho_scale, height)
     scene.camera = cam
 
 
+def sun_and_camera(bpy, scene, energy, angle, sun_rotation, location, rotation):
+    """A sun (strength, angular diameter, Euler rotation) and a perspective camera at
+    `location` turned by `rotation`, made the scene's camera."""
+    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+    sun.data.energy, sun.data.angle = energy, angle
+    sun.rotation_euler = sun_rotation
+    scene.collection.objects.link(sun)
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.location, cam.rotation_euler = location, rotation
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+
+
 def render(bpy, scene, engine, samples):
     use_engine(scene, engine, samples)
     return render_current(bpy, scene)

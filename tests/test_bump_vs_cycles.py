@@ -47,14 +47,8 @@ def _bump_scene(bpy):
     nt.links.new(noise.outputs["Fac"], bump.inputs["Height"])
     nt.links.new(bump.outputs["Normal"], bsdf.inputs["Normal"])
     floor.data.materials.append(mat)
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
-    sun.data.energy, sun.data.angle = 3.0, 0.05
-    sun.rotation_euler = (0.7, 0.3, 0.5)
-    scene.collection.objects.link(sun)
-    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    cam.location, cam.rotation_euler = (0.0, -5.0, 3.5), (0.98, 0.0, 0.0)
-    scene.collection.objects.link(cam)
-    scene.camera = cam
+    node_probe.sun_and_camera(bpy, scene, 3.0, 0.05, (0.7, 0.3, 0.5), (0.0, -5.0, 3.5),
+                              (0.98, 0.0, 0.0))
     return scene, nt, bump
 
 

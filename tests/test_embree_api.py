@@ -21,12 +21,12 @@ F32 = np.finfo(np.float32).eps
 
 def trace(scene, o, d, tmax=None, time=None, center=np.zeros(3)):
     n = len(o)
-    out = [np.empty(n, np.int64) for _ in range(3)] + [np.empty(n) for _ in range(3)]
+    out = [np.empty(n, np.int64) for _ in range(4)] + [np.empty(n) for _ in range(3)]
     intersect_batch(scene.handle, center, np.ascontiguousarray(o, np.float64),
                     np.ascontiguousarray(d, np.float64),
                     np.full(n, np.inf) if tmax is None else np.asarray(tmax, np.float64),
                     np.zeros(0) if time is None else np.asarray(time, np.float64), *out)
-    return dict(zip(("geom", "prim", "inst", "t", "u", "v"), out))
+    return dict(zip(("geom", "prim", "inst", "element", "t", "u", "v"), out))
 
 
 def blocked(scene, o, d, tmax, time=None):
@@ -181,8 +181,43 @@ def test_instances_share_one_mesh_and_report_which_was_hit():
     d = np.tile([0.0, 0.0, -1.0], (n, 1))
     h = trace(top, o, d)
     np.testing.assert_array_equal(h["inst"], i)
-    assert (h["geom"] == 0).all() and (h["prim"] == 0).all()
+    assert (h["geom"] == 0).all() and (h["prim"] == 0).all() and (h["element"] == 0).all()
     np.testing.assert_allclose(h["t"], 50.0 - 0.1 * i, rtol=4 * F32)
+
+
+def test_an_instance_array_is_one_geometry_with_one_shared_transform_buffer():
+    """10,000 places of a triangle as one Embree instance array: one geometry in the top
+    scene, one float32 buffer of 12 floats a place shared with Embree, and each hit names
+    its place (the element) beside the array's geometry id."""
+    mesh = Scene()
+    mesh.add_triangles(np.array([[-0.4, -0.4, 0.0], [0.4, -0.4, 0.0], [0.0, 0.4, 0.0]]),
+                       np.array([[0, 1, 2]]))
+    mesh.commit()
+    top = Scene()
+    top.add_triangles(np.array([[-1.0, -1.0, -5.0], [300.0, -1.0, -5.0], [-1.0, 300.0, -5.0]]),
+                      np.array([[0, 1, 2]]))
+    n = 10000
+    i = np.arange(n)
+    places = np.tile(np.eye(4), (n, 1, 1))
+    places[:, :3, 3] = np.c_[i % 100, i // 100, 0.01 * i]
+    places[:, :3, :3] *= (1.0 + 1e-5 * i)[:, None, None]
+    gid = top.add_instance_array(mesh, places)
+    top.commit()
+    assert gid == 1 and top.kinds == ["triangles", "instance array"] and top.counts[1] == n
+    shared = [a for a in top._keep if isinstance(a, np.ndarray) and a.dtype == np.float32
+              and a.size == 12 * n]
+    assert len(shared) == 1 and shared[0].nbytes == 48 * n
+    o = np.c_[i % 100, i // 100, np.full(n, 500.0)]
+    d = np.tile([0.0, 0.0, -1.0], (n, 1))
+    h = trace(top, o, d)
+    np.testing.assert_array_equal(h["element"], i)
+    assert (h["inst"] == gid).all() and (h["geom"] == 0).all() and (h["prim"] == 0).all()
+    np.testing.assert_allclose(h["t"], 500.0 - 0.01 * i, rtol=4 * F32)
+    # beside every place: the ground, a hit of the top scene itself (no instance)
+    h = trace(top, o + [0.5, 0.5, 0.0], d)
+    assert (h["geom"] == 0).all() and (h["inst"] == -1).all() and (h["element"] == -1).all()
+    with pytest.raises(ValueError, match="not finite"):
+        top.add_instance_array(mesh, np.full((2, 4, 4), np.nan))
 
 
 def test_motion_steps_interpolate_vertices_and_instances_over_time():

@@ -182,7 +182,8 @@ def _by_name(scene, name):
 def test_objects_left_out_and_kept(exported):
     bpy, scene, stats, warnings = exported
     names = sorted(m.name.split("#")[0] for m in scene.meshes if not m.holdout)
-    assert names == sorted(["Modified", "Plain", "PlainDuplicate", "Instanced", "Instanced",
+    # the collection's two places are one instanced mesh (test_collection_instances)
+    assert names == sorted(["Modified", "Plain", "PlainDuplicate", "Instanced",
                             "ViewportHidden"]), names
     assert sorted(m.name for m in scene.meshes if m.holdout) == ["Holdout",
                                                                   "InHoldoutCollection"]
@@ -251,15 +252,21 @@ def test_mirrored_duplicate_keeps_its_normals_outwards(exported):
 
 
 def test_collection_instances(exported):
+    """A collection instanced twice is one mesh in object space with two places
+    (engine.scene.Instances), each where Blender puts it."""
     bpy, scene, stats, _ = exported
-    inst = [m for m in scene.meshes if m.name.startswith("Instanced#")]
-    assert len(inst) == 2
-    for m, loc, angle in zip(sorted(inst, key=lambda m: m.positions[:, 0].mean()),
-                             [(0.0, 5.0, 0.0), (2.0, 6.0, 1.0)], [0.0, 0.5]):
+    (m,) = [m for m in scene.meshes if m.name.startswith("Instanced#")]
+    assert m.instances is not None and len(m.instances) == 2
+    assert stats["instances"] == 2
+    np.testing.assert_allclose(np.sort(m.positions, axis=0),
+                               np.sort(np.array(CUBE_V[:4], dtype=np.float64), axis=0))
+    places = sorted(m.instances.matrices, key=lambda a: a[0, 3])
+    for a, loc, angle in zip(places, [(0.0, 5.0, 0.0), (2.0, 6.0, 1.0)], [0.0, 0.5]):
         c, s = math.cos(angle), math.sin(angle)
         rot = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
         expected = np.array(CUBE_V[:4], dtype=np.float64) @ rot.T + loc
-        np.testing.assert_allclose(np.sort(m.positions, axis=0), np.sort(expected, axis=0),
+        world = m.positions @ a[:3, :3].T + a[:3, 3]
+        np.testing.assert_allclose(np.sort(world, axis=0), np.sort(expected, axis=0),
                                    atol=1e-6)
 
 
@@ -267,7 +274,8 @@ def test_instances_reuse_evaluated_meshes(exported):
     """One to_mesh per distinct evaluated geometry: the linked duplicate and the second
     collection instance reuse arrays read before."""
     bpy, scene, stats, _ = exported
-    assert stats["meshes"] == 8                       # 6 rendered + 2 holdouts
+    assert stats["meshes"] == 7                       # 5 rendered (one of them the two
+    #                                                   collection instances) + 2 holdouts
     assert stats["mesh_evaluations"] == 6, stats      # Modified, Plain, Instanced,
     #                                                   ViewportHidden and the 2 holdouts
     assert stats["mesh_reuses"] == 2, stats           # PlainDuplicate, second Instanced
@@ -275,7 +283,8 @@ def test_instances_reuse_evaluated_meshes(exported):
 
 
 def test_many_instances_evaluate_their_mesh_once(bpy_drt):
-    """200 linked duplicates of a 3840-triangle sphere: one evaluation, 199 reuses."""
+    """200 linked duplicates of a 3840-triangle sphere: one evaluation, 199 reuses, and
+    one mesh with 200 places (engine.scene.Instances)."""
     bpy = bpy_drt
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
@@ -293,8 +302,9 @@ def test_many_instances_evaluate_their_mesh_once(bpy_drt):
     s = export_scene(bpy.context.evaluated_depsgraph_get(), stats=stats)
     tris = len(src.data.polygons) * 2 - 2 * 128          # quads + the two fans of triangles
     assert stats["mesh_evaluations"] == 1 and stats["mesh_reuses"] == 199, stats
-    assert s.triangle_count() == 200 * tris
-    print(f"export of {s.triangle_count()} triangles in 200 instances: "
+    assert len(s.meshes) == 1 and len(s.meshes[0].instances) == 200
+    assert s.triangle_count() == tris and stats["instances"] == 200
+    print(f"export of 200 places of {s.triangle_count()} triangles: "
           f"{stats['seconds']:.2f} s")
 
 

@@ -35,20 +35,23 @@ def _rotation(angle, axis):
 
 
 def _balls(material=0):
-    """A smooth unit sphere at four places: scaled unevenly, rotated, one high up."""
+    """A smooth unit sphere at five places: scaled unevenly, rotated, one high up, the
+    last one mirrored."""
     ball = uv_sphere((0, 0, 0), 1.0, 12, 24, "ball", material)
     corners = ball.positions[ball.triangles]
     ball.corner_normals = (corners / np.linalg.norm(corners, axis=2, keepdims=True)
                            ).astype(np.float32)
     places = []
     for k, (x, y, z, s) in enumerate([(-0.6, -0.6, 0.2, 0.2), (0.5, -0.7, 0.15, 0.15),
-                                      (0.0, -0.3, 1.5, 0.25), (0.6, 0.5, 0.9, 0.3)]):
+                                      (0.0, -0.3, 1.5, 0.25), (0.6, 0.5, 0.9, 0.3),
+                                      (-0.4, 0.3, 0.7, -0.25)]):
         m = np.eye(4)
-        m[:3, :3] = np.diag([s, s, 1.5 * s])
+        m[:3, :3] = np.diag([s, abs(s), 1.5 * abs(s)])
         m[:3, 3] = (x, y, z)
         places.append(m @ _rotation(0.4 * k, 2) @ _rotation(0.3, 0))
     ball.instances = Instances(np.array(places), colors=[(0.9, 0.1, 0.1), (0.1, 0.9, 0.1),
-                                                         (0.1, 0.1, 0.9), (0.9, 0.9, 0.1)])
+                                                         (0.1, 0.1, 0.9), (0.9, 0.9, 0.1),
+                                                         (0.1, 0.9, 0.9)])
     return ball
 
 
@@ -86,13 +89,19 @@ def test_hits_on_instances_are_the_hits_on_copies():
     scene = _scene(_balls())
     accel, h, hit, si = _hits(scene)
     accel2, h2, hit2, si2 = _hits(_expanded(scene))
-    assert len(accel.prototypes) == 1 and accel.instance_count == 4
-    assert accel.total_triangles == accel2.total_triangles - 3 * len(scene.meshes[-1].triangles)
+    assert len(accel.prototypes) == 1 and accel.instance_count == 5
+    assert accel.total_triangles == accel2.total_triangles - 4 * len(scene.meshes[-1].triangles)
     assert np.array_equal(hit, hit2)
     # every place is hit, and a hit names its place (its object-table row)
-    assert set(np.unique(h.inst[hit])) == {-1, 0, 1, 2, 3}
+    assert set(np.unique(h.inst[hit])) == {-1, 0, 1, 2, 3, 4}
     on_ball = h.inst[hit] >= 0
     assert on_ball.sum() > 1000
+    # the camera is outside every ball, the mirrored one too: front faces only, and
+    # shading normals out of the ball's centre
+    assert si.front_facing[on_ball].all()
+    centre = scene.meshes[-1].instances.matrices[h.inst[hit][on_ball], :3, 3]
+    out = ((si.shading_normal[on_ball]) * (si.position[on_ball] - centre)).sum(1)
+    assert (out > 0).all()
     # the same surface points, to Embree's float32 barycentrics (1e-5 of the 2 m box)
     assert np.abs(si.position - si2.position).max() < 2e-5
     assert np.abs(si.geometric_normal - si2.geometric_normal).max() < 1e-9
@@ -154,7 +163,7 @@ def test_object_info_and_coordinates_per_place():
     scene = _scene(ball, Material("painted", (0.8,) * 3, shader=_object_program()), size=48)
     settings = RenderSettings(samples=64, seed=3)
     ctx = RenderContext(scene, settings)
-    assert ctx.accel.instance_count == 4 and ctx.surfaces.objects.shape[0] == 4 + 6
+    assert ctx.accel.instance_count == 5 and ctx.surfaces.objects.shape[0] == 5 + 6
     film, stats = render(scene, settings, context=ctx)
     assert not sane(film, stats)
     copies = render(_expanded(scene), settings)[0].mean()
@@ -200,8 +209,8 @@ def test_meshes_that_emit_or_hold_a_volume_are_expanded():
     scene = _scene(glowing, Material("glow", (0.5,) * 3, emission=(2.0, 2.0, 2.0)))
     ctx = RenderContext(scene, RenderSettings(samples=1))
     assert not ctx.accel.prototypes and ctx.accel.total_triangles == (
-        sum(len(m.triangles) for m in scene.meshes[:-1]) + 4 * len(glowing.triangles))
-    assert len(ctx.lights.mesh) == 4 * len(glowing.triangles)   # the copies are lights
+        sum(len(m.triangles) for m in scene.meshes[:-1]) + 5 * len(glowing.triangles))
+    assert len(ctx.lights.mesh) == 5 * len(glowing.triangles)   # the copies are lights
     foggy = _scene(_balls(material=3), Material("fog", surface=False,
                                                 volume=Volume(scattering=(1.0, 1.0, 1.0))))
     assert not RenderContext(foggy, RenderSettings(samples=1)).accel.prototypes

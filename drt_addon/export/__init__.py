@@ -7,6 +7,7 @@ import time
 from ..engine_link import engine
 from .camera import RenderRegion, export_camera, render_region, window_camera
 from .errors import ExportError, Reporter
+from .instances import InstanceGroups, Source, source_key
 from .left_out import LEFT_OUT_TYPES, LeftOut
 from .libraries import missing_library_messages
 from .settings_check import check as check_file_settings
@@ -14,7 +15,7 @@ from .lights import export_light, object_visibility
 from .materials import export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
 from .motion import MotionExport, read_settings
-from .object_info import object_info
+from .object_info import object_info, object_values
 from .volumes import is_heterogeneous, world_volume
 from .world import export_world
 
@@ -109,6 +110,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     cache = MeshCache(reporter, uv_pass=bool(getattr(depsgraph.view_layer, "use_pass_uv",
                                                      False)))
     meshes, lights = [], []
+    groups = InstanceGroups()
     left_out = LeftOut()
     holdouts = 0
     for k, inst in enumerate(depsgraph.object_instances):
@@ -117,6 +119,12 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         obj = inst.object
         if obj.type in GEOMETRY_TYPES:
             if not inst.is_instance and not inst.show_self:
+                continue
+            key = source_key(inst, obj) if tracker is None else None
+            source = groups.known.get(key) if key is not None else None
+            if source is not None:               # a place of a source worked out before
+                holdouts += source.holdout
+                groups.place(source, inst.matrix_world, inst.random_id)
                 continue
             holdout = _is_holdout(inst, obj, view_layer)
             holdouts += holdout
@@ -131,19 +139,31 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             slots = ([material_id(s.material, k) for s in obj.material_slots]
                      or [material_id(None)])
             name = f"{obj.name}#{k}" if inst.is_instance else obj.name
-            meshes.append(instance_mesh(local, inst.matrix_world.copy(), slots, name))
-            meshes[-1].holdout = holdout
             # Object > Shadow Terminator > Geometry Offset (engine.kernels.terminator)
-            meshes[-1].terminator_offset = float(getattr(
-                obj, "shadow_terminator_geometry_offset", 0.1))
-            if any(materials[i].shader is not None for i in slots):
-                meshes[-1].object_info = object_info(inst, obj, inst.matrix_world)
+            offset = float(getattr(obj, "shadow_terminator_geometry_offset", 0.1))
             # an instance is seen by the rays that see both it and its instancer (Cycles)
-            meshes[-1].visibility = object_visibility(obj) & (
+            seen = object_visibility(obj) & (
                 object_visibility(inst.parent) if inst.is_instance and inst.parent is not None
                 else 31)
-            if tracker is not None:
-                tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
+            programmed = any(materials[i].shader is not None for i in slots)
+            if tracker is None:
+                # without motion blur, repeated geometry becomes instances (export.instances)
+                color, pass_index, texspace = object_values(obj)
+                source = Source(groups.group(local, slots, name, holdout, offset, seen,
+                                             programmed, texspace),
+                                color, pass_index, holdout)
+                groups.place(source, inst.matrix_world, inst.random_id)
+                # a volume that varies in space has one material per object: not shared
+                if not any(is_heterogeneous(materials[i]) for i in slots):
+                    groups.known[key] = source
+                continue
+            meshes.append(instance_mesh(local, inst.matrix_world.copy(), slots, name))
+            meshes[-1].holdout = holdout
+            meshes[-1].terminator_offset = offset
+            if programmed:
+                meshes[-1].object_info = object_info(inst, obj, inst.matrix_world)
+            meshes[-1].visibility = seen
+            tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
         elif obj.type in LEFT_OUT_TYPES and (inst.is_instance or inst.show_self):
             left_out.note_object(obj)
         elif obj.type == "LIGHT":
@@ -152,6 +172,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 lights.append(light)
                 if tracker is not None:
                     tracker.note_light(inst, obj, len(lights) - 1)
+    meshes.extend(groups.meshes())
     if left_out.message():
         reporter.warn(left_out.message(), key="left out")
     if not materials:
@@ -167,6 +188,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         stats.update(mesh_evaluations=cache.evaluations, mesh_reuses=cache.reuses,
                      meshes=len(meshes), lights=len(lights), holdouts=holdouts,
                      triangles=int(sum(len(m.triangles) for m in meshes)),
+                     instances=groups.instanced(),
                      seconds=time.perf_counter() - t0)
         if tracker is not None:
             stats["motion"] = tracker.stats

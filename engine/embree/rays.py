@@ -83,13 +83,19 @@ def _set_ray(f, w, ox, oy, oz, dx, dy, dz, tnear, tfar, time):
 @kernel(allocates=False)
 def intersect1(scene, f, w, ox, oy, oz, dx, dy, dz, tnear, tfar, time):
     """The closest hit along origin + t dir, tnear <= t <= tfar (float32 ray): returns
-    (geometry id, primitive id, instance id, t, u, v); a miss has geometry id -1."""
+    (geometry id, primitive id, instance id, element, t, u, v); a miss has geometry id
+    -1. For a hit inside an instance, the instance id is the instance's (or instance
+    array's) geometry id in the top scene and element the instance's index in its array
+    (0 for a single instance); both are -1 for a hit on the top scene's own geometry."""
     _set_ray(f, w, ox, oy, oz, dx, dy, dz, tnear, tfar, time)
     rtc_intersect1(scene, f.ctypes.data, 0)
     if w[GEOM_ID] == INVALID:
-        return -1, -1, -1, np.inf, 0.0, 0.0
-    inst = -1 if w[INST_ID] == INVALID else np.int64(w[INST_ID])
-    return (np.int64(w[GEOM_ID]), np.int64(w[PRIM_ID]), inst, np.float64(f[TFAR]),
+        return -1, -1, -1, -1, np.inf, 0.0, 0.0
+    inst, element = -1, -1
+    if w[INST_ID] != INVALID:
+        inst = np.int64(w[INST_ID])
+        element = 0 if w[INST_PRIM_ID] == INVALID else np.int64(w[INST_PRIM_ID])
+    return (np.int64(w[GEOM_ID]), np.int64(w[PRIM_ID]), inst, element, np.float64(f[TFAR]),
             np.float64(f[HIT_U]), np.float64(f[HIT_V]))
 
 
@@ -102,17 +108,17 @@ def occluded1(scene, f, w, ox, oy, oz, dx, dy, dz, tnear, tfar, time):
 
 
 @kernel
-def intersect_batch(scene, center, o, d, tmax, time, geom, prim, inst, t, u, v):
+def intersect_batch(scene, center, o, d, tmax, time, geom, prim, inst, element, t, u, v):
     """intersect1 for rays (n, 3) float64 whose origins are moved by -center; tmax and
     time (n,) (time may be empty: 0). Writes the hits' ids (-1 where missed) and t (inf
     where missed), u, v."""
     f, w = new_ray_record()
     timed = len(time) > 0
     for i in range(o.shape[0]):
-        g, p, k, ti, ui, vi = intersect1(
+        g, p, k, e, ti, ui, vi = intersect1(
             scene, f, w, o[i, 0] - center[0], o[i, 1] - center[1], o[i, 2] - center[2],
             d[i, 0], d[i, 1], d[i, 2], 0.0, tmax[i], time[i] if timed else 0.0)
-        geom[i], prim[i], inst[i], t[i], u[i], v[i] = g, p, k, ti, ui, vi
+        geom[i], prim[i], inst[i], element[i], t[i], u[i], v[i] = g, p, k, e, ti, ui, vi
 
 
 @kernel

@@ -193,6 +193,27 @@ class Scene:
         self._keep.append(child)
         return self._attach(geom, "instance", 1)
 
+    def add_instance_array(self, child: "Scene", transforms: np.ndarray) -> int:
+        """K instances of a committed scene as one Embree instance array: transforms
+        (K, 4, 4) or (K, 3, 4) object to world, shared with Embree as one float32 buffer
+        (K x 12 floats, column-major), never one geometry per instance. A hit reports
+        the array's geometry id as its instance id and the instance's index as its
+        element (engine.embree.rays.intersect1)."""
+        if not child.committed:
+            raise ValueError("commit a scene before instancing it")
+        m = np.asarray(transforms, np.float64)
+        if m.ndim != 3 or m.shape[1] not in (3, 4) or m.shape[2] != 4:
+            raise ValueError(f"instance transforms must be (K, 4, 4), got {m.shape}")
+        if not np.all(np.isfinite(m[:, :3, :])):
+            raise ValueError("an instance's transform is not finite")
+        cols = np.ascontiguousarray(np.transpose(m[:, :3, :], (0, 2, 1)), dtype=np.float32)
+        geom = self._new(L.GEOMETRY_INSTANCE_ARRAY)
+        self._lib.rtcSetGeometryInstancedScene(geom, child.handle)
+        self._share(geom, L.BUFFER_TRANSFORM, 0, L.FORMAT_FLOAT3X4_COLUMN_MAJOR, cols, 48,
+                    len(cols))
+        self._keep.append(child)
+        return self._attach(geom, "instance array", len(cols))
+
     # -- build ---------------------------------------------------------------------------
     def commit(self) -> "Scene":
         """Build the hierarchy (Embree's builder runs on its own threads)."""

@@ -122,7 +122,7 @@ def rebuild_at_time(geometry, prim, inst, u, v, dx, dy, dz, time):
                            a22, tx, ty, tz)
     px, py, pz, fx, fy, fz, sx, sy, sz, front = _placed_hit(
         p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z, corner_normals, prim, rigid,
-        n00, n01, n02, n10, n11, n12, n20, n21, n22, u, v, dx, dy, dz)
+        n00, n01, n02, n10, n11, n12, n20, n21, n22, u, v, dx, dy, dz, False)
     tri = max(abs(p0x), abs(p0y), abs(p0z), abs(p1x), abs(p1y), abs(p1z),
               abs(p2x), abs(p2y), abs(p2z))
     scale = max(max(abs(px), abs(py), abs(pz)), tri)
@@ -135,7 +135,10 @@ def _rebuild_placed(positions, corners, center, corner_normals, o, prim, u, v, d
     at the place of object row o (engine.nodes.context: O_TO_WORLD its matrix, O_TO_OBJECT
     the inverse, whose transpose places normals). The offset scale bounds both the world
     corners' distance from `center` and the float32 error of the object-space corners
-    Embree intersects, carried into the world by the matrix."""
+    Embree intersects, carried into the world by the matrix. A mirroring place
+    (determinant < 0) turns the placed triangle's winding over; its geometric normal is
+    turned back, so that front faces stay the side the mesh's normals point to (Cycles'
+    negative-scale objects)."""
     a00, a01, a02, tx = o[O_TO_WORLD], o[O_TO_WORLD + 1], o[O_TO_WORLD + 2], o[O_TO_WORLD + 3]
     a10, a11, a12, ty = o[O_TO_WORLD + 4], o[O_TO_WORLD + 5], o[O_TO_WORLD + 6], \
         o[O_TO_WORLD + 7]
@@ -152,9 +155,11 @@ def _rebuild_placed(positions, corners, center, corner_normals, o, prim, u, v, d
                            tx, ty, tz)
     p2x, p2y, p2z = _place(positions, i2, True, a00, a01, a02, a10, a11, a12, a20, a21, a22,
                            tx, ty, tz)
+    det = a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) \
+        + a02 * (a10 * a21 - a11 * a20)
     px, py, pz, fx, fy, fz, sx, sy, sz, front = _placed_hit(
         p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z, corner_normals, prim, True,
-        n00, n01, n02, n10, n11, n12, n20, n21, n22, u, v, dx, dy, dz)
+        n00, n01, n02, n10, n11, n12, n20, n21, n22, u, v, dx, dy, dz, det < 0.0)
     cx, cy, cz = center[0], center[1], center[2]
     scale = max(abs(p0x - cx), abs(p0y - cy), abs(p0z - cz), abs(p1x - cx), abs(p1y - cy),
                 abs(p1z - cz), abs(p2x - cx), abs(p2y - cy), abs(p2z - cz))
@@ -168,11 +173,14 @@ def _rebuild_placed(positions, corners, center, corner_normals, o, prim, u, v, d
 
 @kernel(allocates=False)
 def _placed_hit(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z, corner_normals, prim, placed,
-                n00, n01, n02, n10, n11, n12, n20, n21, n22, u, v, dx, dy, dz):
+                n00, n01, n02, n10, n11, n12, n20, n21, n22, u, v, dx, dy, dz, flip):
     """The hit at barycentrics (u, v) of the triangle whose corners p0..p2 were placed in
-    the world; its corner normals go through the normal matrix n when `placed`.
+    the world; its corner normals go through the normal matrix n when `placed`; flip:
+    the placement mirrored the winding (the geometric normal is turned back).
     Returns (position, geometric normal facing the ray, shading normal, front)."""
     gx, gy, gz = unit_normal(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z)
+    if flip:
+        gx, gy, gz = -gx, -gy, -gz
     w = 1.0 - u - v
     px = w * p0x + u * p1x + v * p2x
     py = w * p0y + u * p1y + v * p2y

@@ -110,6 +110,15 @@ IDENTITY_OBJECT = object_row(np.eye(4))
 
 
 @kernel(inline="always")
+def mirrors(o):
+    """Whether object row o's matrix mirrors (its 3 x 3 has a negative determinant)."""
+    w = O_TO_WORLD
+    return (o[w] * (o[w + 5] * o[w + 10] - o[w + 6] * o[w + 9])
+            - o[w + 1] * (o[w + 4] * o[w + 10] - o[w + 6] * o[w + 8])
+            + o[w + 2] * (o[w + 4] * o[w + 9] - o[w + 5] * o[w + 8])) < 0.0
+
+
+@kernel(inline="always")
 def to_world_direction(o, x, y, z):
     """Direction (x, y, z) of object row o's space in the world (its matrix's 3 x 3)."""
     w = O_TO_WORLD

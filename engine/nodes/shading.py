@@ -15,7 +15,7 @@ import numpy as np
 from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
 from ..kernels.textures import I_TEXTURE, INPUTS, TEX_EMISSION
-from .context import fill, to_world_direction
+from .context import fill, mirrors, to_world_direction
 from .differentials import fill_differentials
 from .interpreter import reads_differentials, run
 from .pack import MIX, OUTS
@@ -44,6 +44,8 @@ def program_hit(T, geometry, m, prim, inst, bu, bv, uu, vv, px, py, pz, gx, gy, 
         ts = b0 * c[prim, 0, 3] + bu * c[prim, 1, 3] + bv * c[prim, 2, 3]
         if inst >= 0:        # an object-space tangent, into the world by the place's matrix
             tx, ty, tz = to_world_direction(objects[inst], tx, ty, tz)
+            if mirrors(objects[inst]):
+                ts = -ts     # the bitangent is a cross product: a mirror turns it over
         ln = math.sqrt(tx * tx + ty * ty + tz * tz)
         if ln > 0.0:
             tx, ty, tz = tx / ln, ty / ln, tz / ln
