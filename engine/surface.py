@@ -94,7 +94,7 @@ class SurfaceBuilder:
                     parts.append(np.repeat(flat[:, None, :], 3, axis=1))
                 offset += t
             self.corner_normals = np.concatenate(parts)
-        self.terminator_cutoff = _terminator_cutoff(ordered, accel.static_count)
+        self.terminator_cutoff = _terminator_cutoff(ordered, accel.moving_start)
         # Texture coordinates per triangle corner (Blender's UV map), for the meshes that
         # have them; triangles of meshes without UVs read (0, 0), as in Cycles.
         self._geometry = None           # geometry(), made on the first build()
@@ -187,16 +187,16 @@ def _corner_attribute(ordered, name):
                            for m in ordered])
 
 
-def _terminator_cutoff(ordered, static_count):
+def _terminator_cutoff(ordered, moving_start):
     """Each triangle's Shadow Terminator Geometry Offset (engine.kernels.terminator), 0
     where there is no curved surface to start shadow rays from: flat meshes and moving
-    objects' triangles (from static_count on); None when no triangle has one."""
+    objects' triangles (from moving_start on); None when no triangle has one."""
     if not any(m.corner_normals is not None for m in ordered):
         return None
     cut = np.concatenate([np.full(len(m.triangles), getattr(m, "terminator_offset", 0.1)
                                   if m.corner_normals is not None else 0.0)
                           for m in ordered])
-    cut[static_count:] = 0.0
+    cut[moving_start:] = 0.0
     return cut if (cut > 0.0).any() else None
 
 

@@ -173,6 +173,37 @@ def test_object_info_and_coordinates_per_place():
     assert np.abs(film.mean() - copies).mean() < 0.05 * control
 
 
+def test_shadow_terminator_offset_on_instances():
+    """Coarse smooth spheres lit from the side: shadow rays start from the curved surface
+    (engine.kernels.terminator) on instances as on copies (rotated places, where the
+    lift in object space placed by the matrix is the lift of the copy); with the offset
+    off the image is another (the control)."""
+    ball = uv_sphere((0, 0, 0), 0.3, 6, 8, "coarse", 0)
+    corners = ball.positions[ball.triangles]
+    ball.corner_normals = (corners / np.linalg.norm(corners, axis=2, keepdims=True)
+                           ).astype(np.float32)
+    places = [np.eye(4) for _ in range(4)]
+    for k, (x, y) in enumerate([(-0.5, -0.5), (0.5, -0.5), (-0.5, 0.4), (0.5, 0.4)]):
+        places[k] = _rotation(0.5 * k + 0.2, 2) @ _rotation(0.3 * k, 0)
+        places[k][:3, 3] = (x, y, 0.6)
+    ball.instances = Instances(np.array(places))
+    scene = _scene(ball, size=48)
+    sun_dir = np.array([1.0, 0.2, -0.15])
+    from engine.scene import SunLight
+    scene.lights = [SunLight(tuple(sun_dir / np.linalg.norm(sun_dir)), (4.0, 4.0, 4.0))]
+    settings = RenderSettings(samples=16, seed=3, diffuse_bounces=0)
+    ctx = RenderContext(scene, settings)
+    assert ctx.accel.prototypes and (ctx.surfaces.terminator_cutoff > 0).any()
+    film = render(scene, settings, context=ctx)[0].mean()
+    copies = render(_expanded(scene), settings)[0].mean()
+    off = copy.deepcopy(scene)
+    off.meshes[-1].terminator_offset = 0.0
+    control = np.abs(render(off, settings)[0].mean() - copies).mean()
+    print(f"instances against copies {np.abs(film - copies).mean():.2e}, offset off "
+          f"{control:.2e}")
+    assert np.abs(film - copies).mean() < 0.05 * control
+
+
 def test_memory_grows_with_places_not_triangles():
     """20,000 places of a 4,992-triangle sphere: as copies 1e8 triangles (4.8 GB of
     float64 positions alone); instanced, the accelerator and the object table take

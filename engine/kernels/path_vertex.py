@@ -358,9 +358,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             # shadow ray leaving from the curved surface the normals describe
             if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0:
                 sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[4],
-                                              geometry[13], prim, hit_u[j], hit_v[j], px,
-                                              py, pz, gx, gy, gz, n0x, n0y, n0z, scale, wx,
-                                              wy, wz)
+                                              geometry[13], geometry[9], prim, hit_inst[j],
+                                              hit_u[j], hit_v[j], px, py, pz, gx, gy, gz,
+                                              n0x, n0y, n0z, scale, wx, wy, wz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy,
                                                          wz, dist, margin, scene_radius)
                 bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,

@@ -17,12 +17,15 @@ triangle as every ray is (`surface.offset_origin`).
 
 `cutoff` holds each triangle's Geometry Offset, 0 where there is nothing to lift: flat
 shading, a moving object's triangles (their corners are placed per ray elsewhere), an
-object with the offset off.
+object with the offset off. An instance's lift is worked out in its object space, from
+the mesh's own corners and normals, and placed in the world by the instance's matrix, as
+Cycles lifts the triangles of objects whose transform is not applied.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..nodes.context import O_NORMAL, to_world_direction
 from .frame import dot
 from .jit import kernel
 from .surface import offset_origin
@@ -73,12 +76,31 @@ def smooth_lift(positions, corners, c, prim, u, v, px, py, pz, gx, gy, gz):
 
 
 @kernel(allocates=False)
-def shadow_origin(positions, corners, corner_normals, cutoff, prim, u, v, px, py, pz, gx,
-                  gy, gz, nx, ny, nz, scale, wx, wy, wz):
+def _placed_lift(positions, corners, c, o, prim, u, v, fx, fy, fz):
+    """smooth_lift of an instance's triangle (object row o): in object space, at the hit's
+    object-space point, towards the facing normal f taken into object space (O_NORMAL),
+    and the lift placed in the world by the instance's matrix."""
+    w = 1.0 - u - v
+    i0, i1, i2 = corners[prim, 0], corners[prim, 1], corners[prim, 2]
+    qx = w * positions[i0, 0] + u * positions[i1, 0] + v * positions[i2, 0]
+    qy = w * positions[i0, 1] + u * positions[i1, 1] + v * positions[i2, 1]
+    qz = w * positions[i0, 2] + u * positions[i1, 2] + v * positions[i2, 2]
+    n = O_NORMAL
+    hx = o[n] * fx + o[n + 1] * fy + o[n + 2] * fz
+    hy = o[n + 3] * fx + o[n + 4] * fy + o[n + 5] * fz
+    hz = o[n + 6] * fx + o[n + 7] * fy + o[n + 8] * fz
+    lx, ly, lz = smooth_lift(positions, corners, c, prim, u, v, qx, qy, qz, hx, hy, hz)
+    return to_world_direction(o, lx, ly, lz)
+
+
+@kernel(allocates=False)
+def shadow_origin(positions, corners, corner_normals, cutoff, objects, prim, inst, u, v, px,
+                  py, pz, gx, gy, gz, nx, ny, nz, scale, wx, wy, wz):
     """The origin of a shadow ray from hit p (barycentrics (u, v) of triangle prim, whose
     corners are rows corners[prim] of positions (engine.surface.SurfaceBuilder);
     geometric normal g and the surface's own shading normal n, both facing the incoming
-    ray) towards the light direction w (unit)."""
+    ray) towards the light direction w (unit). inst: the hit's instance, its row of
+    `objects` (-1: a mesh in world space)."""
     off = cutoff[prim] if cutoff.shape[0] > 0 else 0.0
     if off > 0.0:
         nl = dot(nx, ny, nz, wx, wy, wz)
@@ -91,8 +113,12 @@ def shadow_origin(positions, corners, corner_normals, cutoff, prim, u, v, px, py
         else:
             amount = min(max(1.0 - ngl / off, 0.0), 1.0)
         if amount > 0.0:
-            lx, ly, lz = smooth_lift(positions, corners, corner_normals, prim, u, v, px, py,
-                                     pz, fx, fy, fz)
+            if inst < 0:
+                lx, ly, lz = smooth_lift(positions, corners, corner_normals, prim, u, v, px,
+                                         py, pz, fx, fy, fz)
+            else:
+                lx, ly, lz = _placed_lift(positions, corners, corner_normals, objects[inst],
+                                          prim, u, v, fx, fy, fz)
             px, py, pz = px + lx * amount, py + ly * amount, pz + lz * amount
             if not ngl > 0.0:
                 return px, py, pz    # the light is under the plane: its own triangle counts
