@@ -14,8 +14,11 @@ layer (Properties > View Layer > Passes):
 - Position (`use_pass_position`): world-space position of the first hit.
 - UV (`use_pass_uv`): u, v of the first hit (the active UV map unless a material names
   one) and its coverage, as Cycles' UV pass.
-Depth, Normal, Mist, Position, UV and the denoising passes come from engine.aov (a first-hit
-query on the same camera samples), not from the path tracer.
+- Object Index and Material Index (`use_pass_object_index`, `use_pass_material_index`;
+  named IndexOB and IndexMA before Blender 5.0, as Cycles names them): the Pass Index of the object and of the material the
+  pixel's first camera sample hits, as Cycles writes them (sample 0 alone).
+Depth, Normal, Mist, Position, UV, the index passes and the denoising passes come from
+engine.aov (a first-hit query on the same camera samples), not from the path tracer.
 
 Border render (Render Region): only the border's pixels are traced; the result covers
 just that rectangle, which Blender places in the frame (or crops to, with Crop to Render
@@ -33,7 +36,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
-from .blender_compat import set_pass_pixels
+from .blender_compat import MATERIAL_INDEX_PASS, OBJECT_INDEX_PASS, set_pass_pixels
 
 # The tracer (engine: kernels compiled by Numba, Embree through its C API) and the export
 # are imported by the first DRT render, not when Blender registers the add-on: a Blender
@@ -84,9 +87,11 @@ PASSES = {
     "Mist": (1, "Z", "VALUE", lambda vl: vl.use_pass_mist),
     "Position": (3, "XYZ", "VECTOR", lambda vl: vl.use_pass_position),
     "UV": (3, "UVA", "VECTOR", lambda vl: vl.use_pass_uv),
+    OBJECT_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_object_index),
+    MATERIAL_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_material_index),
 }
 FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position",
-             "UV")
+             "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS)
 
 
 def _mist(aov, world):
@@ -333,7 +338,9 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             images.update({"Depth": first.depth, "Normal": first.normal,
                            "Denoising Albedo": first.albedo,
                            "Denoising Normal": first.camera_normal(description.camera.matrix),
-                           "Mist": first.mist, "Position": first.position, "UV": first.uv})
+                           "Mist": first.mist, "Position": first.position, "UV": first.uv,
+                           OBJECT_INDEX_PASS: first.object_index,
+                           MATERIAL_INDEX_PASS: first.material_index})
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
         for name in wanted:

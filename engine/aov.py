@@ -19,7 +19,10 @@ intersection each, no shading), with Cycles' meanings:
   averaged the same way, so the third channel is the pixel's coverage (Cycles' UV);
 - mist: Cycles' Mist, averaged the same way: of the hit's distance d from the camera
   (along the view axis for an orthographic one), clamp((d - start) / depth, 0, 1) raised
-  to the falloff exponent (`Mist`: World > Mist Pass), 1 where a sample hits nothing.
+  to the falloff exponent (`Mist`: World > Mist Pass), 1 where a sample hits nothing;
+- object_index, material_index: the Pass Index of the object and of the material that
+  the pixel's first camera sample hits (0 where it hits nothing), not averaged: Cycles
+  writes its Object Index and Material Index passes from sample 0 alone.
 Emitting lights (area and sphere lights) are not surfaces here: rays see through them.
 """
 from __future__ import annotations
@@ -64,6 +67,8 @@ class FirstHitPasses:
     position: np.ndarray = None  # (h, w, 3) float64, world space
     mist: np.ndarray = None      # (h, w) float64 in [0, 1]
     uv: np.ndarray = None        # (h, w, 3) float64: u, v, coverage
+    object_index: np.ndarray = None    # (h, w) float64
+    material_index: np.ndarray = None  # (h, w) float64
 
     def camera_normal(self, camera_matrix) -> np.ndarray:
         """The normal pass in camera space (x right, y up, z towards the viewer), as
@@ -122,6 +127,9 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
     position = np.zeros((n_pix, 3))
     uv = np.zeros((n_pix, 3))
     mist_sum = np.zeros(n_pix)
+    object_index, material_index = np.zeros(n_pix), np.zeros(n_pix)
+    material_pass = np.array([float(getattr(m, "pass_index", 0)) for m in scene.materials]
+                             or [0.0])
     ortho = scene.camera.kind == "ORTHO"
     per_chunk = max(1, chunk // k)
     for start in range(0, n_pix, per_chunk):
@@ -146,10 +154,17 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
         if si.uv is not None:
             for c in range(2):
                 uv[:, c] += np.bincount(pixel[hit], weights=si.uv[:, c], minlength=n_pix)
+        first = index[hit] == 0            # the pixels' sample 0: the index passes
+        object_index[pixel[hit][first]] = ctx.surfaces.pass_indices(si.prim[first],
+                                                                    si.inst[first])
+        material_index[pixel[hit][first]] = material_pass[
+            np.minimum(si.material[first], len(material_pass) - 1)]
         offset = si.position - cam[:3, 3]
         distance = offset @ view_axis if ortho else np.linalg.norm(offset, axis=1)
         mist_sum -= np.bincount(pixel[hit], weights=1.0 - mist.of(distance), minlength=n_pix)
     shape = (height, width, 3)
     return FirstHitPasses(depth.reshape(height, width), (normal / k).reshape(shape),
                           (albedo / k).reshape(shape), k, (position / k).reshape(shape),
-                          (mist_sum / k).reshape(height, width), (uv / k).reshape(shape))
+                          (mist_sum / k).reshape(height, width), (uv / k).reshape(shape),
+                          object_index.reshape(height, width),
+                          material_index.reshape(height, width))

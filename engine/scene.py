@@ -110,6 +110,7 @@ class Material:
     mix: Optional[tuple] = None
     volume: Optional[object] = None      # Volume: the medium inside its meshes
     surface: bool = True                 # False: no surface shader, a volume's boundary
+    pass_index: int = 0                  # Blender's material Pass Index (IndexMA pass)
 
     TEXTURED = ("base_color", "metallic", "roughness", "emission", "alpha")
 
@@ -254,6 +255,7 @@ class TriangleMesh:
     # are in object space, and the mesh stands at each of its places (`object_info`
     # then gives only the texture space; Object Info reads the places' own values)
     instances: Optional[Instances] = None
+    pass_index: int = 0            # Blender's object Pass Index (IndexOB pass)
 
     def __post_init__(self):
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)

@@ -98,6 +98,7 @@ class SurfaceBuilder:
         # Texture coordinates per triangle corner (Blender's UV map), for the meshes that
         # have them; triangles of meshes without UVs read (0, 0), as in Cycles.
         self._geometry = None           # geometry(), made on the first build()
+        self._tri_pass = None           # each triangle's object Pass Index, on first use
         self.corner_uvs = None
         if any(getattr(m, "uvs", None) is not None for m in ordered):
             parts = []
@@ -118,6 +119,21 @@ class SurfaceBuilder:
     def normals(self, prim) -> np.ndarray:
         """Unit geometric normals (n, 3) of triangles `prim` as stored (see vertices)."""
         return _corner_normals(*self.vertices(prim))
+
+    def pass_indices(self, prim, inst) -> np.ndarray:
+        """The objects' Pass Index (float64, as Cycles' Object Index pass) of hits on
+        triangles `prim` of places `inst` (-1: not an instance)."""
+        if self._tri_pass is None:
+            ordered = self.accel.ordered_meshes
+            self._tri_pass = np.repeat(
+                np.array([getattr(m, "pass_index", 0) for m in ordered], np.int32),
+                [len(m.triangles) for m in ordered])
+        out = self._tri_pass[prim].astype(np.float64)
+        placed = inst >= 0
+        if placed.any():
+            from .nodes.context import O_INDEX
+            out[placed] = self.objects[inst[placed], O_INDEX]
+        return out
 
     def geometry(self, camera=None) -> tuple:
         """The triangles as the compiled kernels read them (engine.kernels.surface,

@@ -163,6 +163,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             if programmed:
                 meshes[-1].object_info = object_info(inst, obj, inst.matrix_world)
             meshes[-1].visibility = seen
+            meshes[-1].pass_index = int(getattr(obj, "pass_index", 0))
             tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
         elif obj.type in LEFT_OUT_TYPES and (inst.is_instance or inst.show_self):
             left_out.note_object(obj)

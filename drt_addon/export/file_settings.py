@@ -70,15 +70,13 @@ _NULL_SCATTERING = ("DRT renders volumes without ray marching steps: homogeneous
                     "unbiased as Cycles' default")
 _SIMPLIFY = ("scene.render.use_simplify", (True,))
 _ADAPTIVE = ("scene.cycles.use_adaptive_sampling", (True,))
-WRITTEN_PASSES = ("Combined, Depth, Mist, Normal, Position, UV, Denoising Data and DRT "
-                  "Noise")
+WRITTEN_PASSES = ("Combined, Depth, Mist, Normal, Position, UV, Object Index, Material "
+                  "Index, Denoising Data and DRT Noise")
 _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
 
 # Render passes DRT does not write, as (path, label).
 _UNWRITTEN_PASSES = [
     ("view_layer.use_pass_vector", "Vector"),
-    ("view_layer.use_pass_object_index", "Object Index"),
-    ("view_layer.use_pass_material_index", "Material Index"),
     ("view_layer.use_pass_diffuse_direct", "Diffuse Direct"),
     ("view_layer.use_pass_diffuse_indirect", "Diffuse Indirect"),
     ("view_layer.use_pass_diffuse_color", "Diffuse Color"),
@@ -162,6 +160,12 @@ SETTINGS: list[FileSetting] = [
     _s("view_layer.use_pass_uv", "Passes > UV", READ,
        "written: UV of the first hit (the active UV map unless a material names one) and "
        "its coverage"),
+    _s("view_layer.use_pass_object_index", "Passes > Object Index", READ,
+       "written: the Pass Index of the object the pixel's first sample hits (Cycles' "
+       "IndexOB)"),
+    _s("view_layer.use_pass_material_index", "Passes > Material Index", READ,
+       "written: the Pass Index of the material the pixel's first sample hits (Cycles' "
+       "IndexMA)"),
     *[_s(f"scene.world.mist_settings.{name}", f"World > Mist Pass > {label}", READ,
          "read by the Mist pass") for name, label in
       (("start", "Start"), ("depth", "Depth"), ("falloff", "Falloff"))],

@@ -123,6 +123,7 @@ def _settings(mesh, g: Group):
 def _single(g: Group):
     m, randoms = g.arrays()
     mesh = _settings(instance_mesh(g.local, m[0], g.slots, g.name), g)
+    mesh.pass_index = g.pass_indices[0]
     if g.with_info:
         mesh.object_info = engine.ObjectInfo(m[0], g.colors[0], float(randoms[0]),
                                              g.pass_indices[0], *g.texspace)

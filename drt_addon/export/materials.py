@@ -202,6 +202,7 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
     if ctx.issues and reporter is not None:
         reporter.warn(f"DRT: material {name!r}: " + "; ".join(ctx.issues),
                       key=(name, "material"))
+    result.pass_index = int(getattr(mat, "pass_index", 0))     # the Material Index pass
     return result
 
 
