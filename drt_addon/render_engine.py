@@ -17,8 +17,14 @@ layer (Properties > View Layer > Passes):
 - Object Index and Material Index (`use_pass_object_index`, `use_pass_material_index`;
   named IndexOB and IndexMA before Blender 5.0, as Cycles names them): the Pass Index of the object and of the material the
   pixel's first camera sample hits, as Cycles writes them (sample 0 alone).
-Depth, Normal, Mist, Position, UV, the index passes and the denoising passes come from
-engine.aov (a first-hit query on the same camera samples), not from the path tracer.
+- Cryptomatte Object, Material and Asset (`use_pass_cryptomatte_*`, Levels:
+  `pass_cryptomatte_depth`): CryptoObject00, 01, ... as Cycles writes them, (id,
+  coverage) pairs of the names each pixel shows, with the manifest in the render
+  result's metadata, so that Blender's Cryptomatte node picks mattes by name
+  (engine.cryptomatte).
+Depth, Normal, Mist, Position, UV, the index passes, Cryptomatte and the denoising passes
+come from engine.aov (a first-hit query on the same camera samples), not from the path
+tracer.
 
 Border render (Render Region): only the border's pixels are traced; the result covers
 just that rectangle, which Blender places in the frame (or crops to, with Crop to Render
@@ -92,6 +98,18 @@ PASSES = {
 }
 FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position",
              "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS)
+
+
+CRYPTOMATTE = {"object": "Object", "material": "Material", "asset": "Asset"}
+
+
+def cryptomatte_passes(view_layer) -> dict:
+    """{kind: its pass names} of the Cryptomatte layers the view layer asks for: Levels
+    names, two to a pass (CryptoObject00, CryptoObject01, ...), as Cycles names them."""
+    depth = int(getattr(view_layer, "pass_cryptomatte_depth", 6))
+    return {kind: [f"Crypto{label}{i:02d}" for i in range((depth + 1) // 2)]
+            for kind, label in CRYPTOMATTE.items()
+            if getattr(view_layer, f"use_pass_cryptomatte_{kind}", False)}
 
 
 def _mist(aov, world):
@@ -177,12 +195,15 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         for name in enabled_passes(renderlayer):
             channels, chan_id, kind, _ = PASSES[name]
             self.register_pass(scene, renderlayer, name, channels, chan_id, kind)
+        for names in cryptomatte_passes(renderlayer).values():
+            for name in names:
+                self.register_pass(scene, renderlayer, name, 4, "RGBA", "COLOR")
 
     def render(self, depsgraph):
         from .export import ExportError
         last_render.update(ok=False, error=None, warnings=[], stats=None, pixels=None,
                            scene=None, export_stats=None, passes={}, region=None, progress=[],
-                           cancelled_in=None, phase=None, compile_said=None)
+                           cancelled_in=None, phase=None, compile_said=None, metadata={})
         try:
             self._render(depsgraph)
         except RenderCancelled as e:
@@ -301,14 +322,15 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                                         compiling=compiling)
             image, alpha = film.mean(), film.mean_alpha()
             set_pass_pixels(combined, _rgba_bottom_up(image, alpha))
-            if not stats.cancelled and enabled_passes(view_layer) and \
-                    self._polled("passes"):
+            extra = enabled_passes(view_layer) or cryptomatte_passes(view_layer)
+            if not stats.cancelled and extra and self._polled("passes"):
                 stats.cancelled = True             # cancelled before the extra passes
                 last_render["cancelled_in"] = "passes"
             elif stats.cancelled:
                 last_render["cancelled_in"] = "tracing"
             if not stats.cancelled:
                 self._write_passes(layer, ctx, film, view_layer, description, scene.world)
+                self._write_cryptomatte(result, layer, ctx, view_layer)
         finally:
             ctx.close()
             self.end_result(result)
@@ -323,6 +345,34 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         last_render.update(ok=not stats.cancelled, error="cancelled" if stats.cancelled else None,
                            warnings=reporter.warnings, stats=stats, pixels=image,
                            alpha=alpha, export_seconds=export_seconds)
+
+    def _write_cryptomatte(self, result, layer, ctx, view_layer):
+        """The Cryptomatte passes the view layer asks for, and their metadata."""
+        wanted = cryptomatte_passes(view_layer)
+        if not wanted:
+            return
+        self.update_stats("", "DRT: Cryptomatte")
+        from .engine_link import engine
+        aov = import_module(engine.__name__ + ".aov")
+        crypto = import_module(engine.__name__ + ".cryptomatte")
+        depth = int(view_layer.pass_cryptomatte_depth)
+        layers = aov.cryptomatte(ctx, list(wanted), depth)
+        for kind, names in wanted.items():
+            ids, coverage = layers[kind]
+            for i, name in enumerate(names):
+                rgba = np.zeros(ids.shape[:2] + (4,), np.float32)
+                for j in range(2):
+                    if 2 * i + j < depth:
+                        rgba[..., 2 * j] = ids[..., 2 * i + j]
+                        rgba[..., 2 * j + 1] = coverage[..., 2 * i + j]
+                if layer.passes.get(name) is not None:
+                    set_pass_pixels(layer.passes[name], _bottom_up(rgba))
+                last_render["passes"][name] = rgba
+            fields = crypto.metadata(f"{view_layer.name}.Crypto{CRYPTOMATTE[kind]}",
+                                     layers["names"][kind])
+            for key, value in fields.items():
+                result.stamp_data_add_field(key, value)
+            last_render["metadata"].update(fields)
 
     def _write_passes(self, layer, ctx, film, view_layer, description, world=None):
         wanted = [name for name in enabled_passes(view_layer)

@@ -90,6 +90,46 @@ def _build(ctx, hits, index, d, time):
     return ctx.surfaces.build(hits, index, d, time=time)
 
 
+def sample_hits(ctx, k: int, chunk: int = 1 << 16):
+    """The first hits of the first k camera samples of every pixel, a chunk at a time:
+    (pixel and sample index of each sample, the samples that hit something, their
+    engine.surface.SurfaceHit); chunks where nothing is hit are left out."""
+    n_pix = ctx.scene.width * ctx.scene.height
+    per_chunk = max(1, chunk // k)
+    for start in range(0, n_pix, per_chunk):
+        pixels = np.arange(start, min(start + per_chunk, n_pix), dtype=np.int64)
+        pixel = np.repeat(pixels, k)
+        index = np.tile(np.arange(k, dtype=np.int64), len(pixels))
+        rays, time = camera_rays(ctx, pixel, index)
+        hits = _intersect(ctx, rays.origins, rays.directions, rays.tmax, time)
+        hit = np.nonzero(hits.hit)[0]
+        if hit.size:
+            yield pixel, index, hit, _build(ctx, hits, hit, rays.directions, time)
+
+
+def cryptomatte(ctx, kinds, depth: int, samples: int = AOV_SAMPLES) -> dict:
+    """{kind: (ids, coverage)} of the Cryptomatte layers `kinds` (engine.cryptomatte:
+    'object', 'material', 'asset'), each (h, w, depth) float32, from the first
+    min(samples, settings.samples) camera samples of each pixel; and the names each kind
+    met, under the key "names"."""
+    from .cryptomatte import HitNames, ranked
+    names = HitNames(ctx)
+    k = int(max(1, min(samples, ctx.settings.samples)))
+    w, h = ctx.scene.width, ctx.scene.height
+    found = {kind: ([], []) for kind in kinds}
+    for pixel, _, hit, si in sample_hits(ctx, k):
+        for kind in kinds:
+            found[kind][0].append(pixel[hit])
+            found[kind][1].append(names.of(kind, si.prim, si.inst, si.material))
+    out = {}
+    for kind, (pixels, ids) in found.items():
+        cat = (lambda parts, dtype: np.concatenate(parts) if parts else np.zeros(0, dtype))
+        i, c = ranked(cat(pixels, np.int64), cat(ids, np.float32), w * h, k, depth)
+        out[kind] = (i.reshape(h, w, depth), c.reshape(h, w, depth))
+    out["names"] = names.names
+    return out
+
+
 def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
                      mist: Mist = Mist()) -> FirstHitPasses:
     """Depth, normal, albedo, position, mist and UV passes for the scene of `ctx` (an
@@ -126,23 +166,12 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
     albedo = np.zeros((n_pix, 3))
     position = np.zeros((n_pix, 3))
     uv = np.zeros((n_pix, 3))
-    mist_sum = np.zeros(n_pix)
+    mist_sum = np.full(n_pix, float(k))           # a sample that hits nothing adds 1
     object_index, material_index = np.zeros(n_pix), np.zeros(n_pix)
     material_pass = np.array([float(getattr(m, "pass_index", 0)) for m in scene.materials]
                              or [0.0])
     ortho = scene.camera.kind == "ORTHO"
-    per_chunk = max(1, chunk // k)
-    for start in range(0, n_pix, per_chunk):
-        pixels = np.arange(start, min(start + per_chunk, n_pix), dtype=np.int64)
-        pixel = np.repeat(pixels, k)
-        index = np.tile(np.arange(k, dtype=np.int64), len(pixels))
-        rays, time = camera_rays(ctx, pixel, index)
-        hits = _intersect(ctx, rays.origins, rays.directions, rays.tmax, time)
-        hit = np.nonzero(hits.hit)[0]
-        mist_sum += np.bincount(pixel, minlength=n_pix)
-        if hit.size == 0:
-            continue
-        si = _build(ctx, hits, hit, rays.directions, time)
+    for pixel, index, hit, si in sample_hits(ctx, k, chunk):
         for c in range(3):
             normal[:, c] += np.bincount(pixel[hit], weights=si.shading_normal[:, c],
                                         minlength=n_pix)

@@ -58,6 +58,9 @@ def expand(mesh: TriangleMesh) -> list[TriangleMesh]:
                 tangents[..., 3] *= -1.0
         corner = (lambda x: None if x is None else np.ascontiguousarray(
             np.asarray(x).reshape(len(mesh.triangles), 3, -1)[:, order]))
+        names = {}
+        if inst.names is not None and inst.name_ids is not None:
+            names = dict(zip(("object_name", "asset_name"), inst.names[inst.name_ids[k]]))
         placed_info = None
         if info is not None:
             placed_info = replace(info, matrix_world=m.copy(),
@@ -67,7 +70,7 @@ def expand(mesh: TriangleMesh) -> list[TriangleMesh]:
                            triangles=mesh.triangles[:, order], corner_normals=corner(normals),
                            uvs=corner(mesh.uvs), tangents=corner(tangents),
                            colors=corner(mesh.colors), object_info=placed_info,
-                           instances=None))
+                           instances=None, **names))
     return out
 
 

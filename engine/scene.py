@@ -193,11 +193,15 @@ class Instances:
 
     matrices: (K, 4, 4) float64 object -> world, one per place.
     colors, randoms, pass_indices: what Object Info reads of each place ((K, 3), (K,),
-    (K,)); None: white, 0 and 0."""
+    (K,)); None: white, 0 and 0.
+    names, name_ids: the (object name, asset name) pairs of the places (Cryptomatte,
+    engine.cryptomatte) and each place's pair (K,) int; None: the mesh's own names."""
     matrices: np.ndarray
     colors: Optional[np.ndarray] = None
     randoms: Optional[np.ndarray] = None
     pass_indices: Optional[np.ndarray] = None
+    names: Optional[tuple] = None
+    name_ids: Optional[np.ndarray] = None
 
     def __post_init__(self):
         m = np.ascontiguousarray(self.matrices, dtype=np.float64)
@@ -213,6 +217,11 @@ class Instances:
                         else np.asarray(self.randoms, np.float64).reshape(k))
         self.pass_indices = (np.zeros(k) if self.pass_indices is None
                              else np.asarray(self.pass_indices, np.float64).reshape(k))
+        if self.name_ids is not None:
+            self.name_ids = np.asarray(self.name_ids, np.int64).reshape(k)
+            if self.names is None or (k and not 0 <= self.name_ids.min() <= self.name_ids.max()
+                                      < len(self.names)):
+                raise ValueError("instance name ids must index `names`")
 
     def __len__(self):
         return len(self.matrices)
@@ -256,6 +265,10 @@ class TriangleMesh:
     # then gives only the texture space; Object Info reads the places' own values)
     instances: Optional[Instances] = None
     pass_index: int = 0            # Blender's object Pass Index (IndexOB pass)
+    # the names Cryptomatte gives its hits (engine.cryptomatte): the Blender object's and
+    # its topmost parent's ("": the mesh's name, and the object name)
+    object_name: str = ""
+    asset_name: str = ""
 
     def __post_init__(self):
         self.positions = np.ascontiguousarray(self.positions, dtype=np.float64).reshape(-1, 3)

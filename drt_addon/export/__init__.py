@@ -42,6 +42,16 @@ def _is_holdout(inst, obj, view_layer) -> bool:
         return False
 
 
+def crypto_names(inst, obj) -> tuple:
+    """(object name, asset name) of an instance as Cycles' Cryptomatte names it: the
+    object's own name (an instance: its source object's) and its topmost parent's."""
+    source = obj.original if obj.original is not None else obj
+    top = source
+    while top.parent is not None:
+        top = top.parent
+    return source.name, top.name
+
+
 def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
                  region: RenderRegion | None = None, stats: dict | None = None,
                  render_engine=None, check_cancel=None) -> "engine.Scene":
@@ -151,7 +161,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 color, pass_index, texspace = object_values(obj)
                 source = Source(groups.group(local, slots, name, holdout, offset, seen,
                                              programmed, texspace),
-                                color, pass_index, holdout)
+                                color, pass_index, holdout, crypto_names(inst, obj))
                 groups.place(source, inst.matrix_world, inst.random_id)
                 # a volume that varies in space has one material per object: not shared
                 if not any(is_heterogeneous(materials[i]) for i in slots):
@@ -164,6 +174,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 meshes[-1].object_info = object_info(inst, obj, inst.matrix_world)
             meshes[-1].visibility = seen
             meshes[-1].pass_index = int(getattr(obj, "pass_index", 0))
+            meshes[-1].object_name, meshes[-1].asset_name = crypto_names(inst, obj)
             tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
         elif obj.type in LEFT_OUT_TYPES and (inst.is_instance or inst.show_self):
             left_out.note_object(obj)

@@ -71,7 +71,7 @@ _NULL_SCATTERING = ("DRT renders volumes without ray marching steps: homogeneous
 _SIMPLIFY = ("scene.render.use_simplify", (True,))
 _ADAPTIVE = ("scene.cycles.use_adaptive_sampling", (True,))
 WRITTEN_PASSES = ("Combined, Depth, Mist, Normal, Position, UV, Object Index, Material "
-                  "Index, Denoising Data and DRT Noise")
+                  "Index, Cryptomatte, Denoising Data and DRT Noise")
 _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
 
 # Render passes DRT does not write, as (path, label).
@@ -99,9 +99,6 @@ _UNWRITTEN_PASSES = [
     ("view_layer.use_pass_ambient_occlusion", "Ambient Occlusion"),
     ("view_layer.use_pass_shadow", "Shadow"),
     ("view_layer.cycles.use_pass_shadow_catcher", "Shadow Catcher"),
-    ("view_layer.use_pass_cryptomatte_object", "Cryptomatte Object"),
-    ("view_layer.use_pass_cryptomatte_material", "Cryptomatte Material"),
-    ("view_layer.use_pass_cryptomatte_asset", "Cryptomatte Asset"),
     ("view_layer.cycles.denoising_store_passes", "Denoising Data (Cycles')"),
     ("view_layer.cycles.pass_debug_sample_count", "Sample Count"),
     ("view_layer.cycles.pass_render_time", "Render Time"),
@@ -324,8 +321,14 @@ SETTINGS: list[FileSetting] = [
     *_part_of("Stereoscopy", ["views_format", "use_spherical_stereo"],
               prefix="scene.render"),
     *_part_of("Freestyle", ["use_freestyle"], prefix="view_layer"),
-    *_part_of("Passes > Cryptomatte", ["use_pass_cryptomatte_accurate",
-              "pass_cryptomatte_depth"], prefix="view_layer"),
+    *[_s(f"view_layer.use_pass_cryptomatte_{kind}", f"Passes > Cryptomatte > {kind.title()}",
+         READ, f"written: Crypto{kind.title()}00, 01, ... with the manifest in the metadata "
+         "(Blender's Cryptomatte node picks mattes from them); coverage from the first 16 "
+         "camera samples of each pixel") for kind in ("object", "material", "asset")],
+    _s("view_layer.pass_cryptomatte_depth", "Passes > Cryptomatte > Levels", READ,
+       "read: the names kept per pixel"),
+    _s("view_layer.use_pass_cryptomatte_accurate", "Passes > Cryptomatte > Accurate",
+       NO_EFFECT, "DRT's Cryptomatte always ranks every name of a pixel's samples"),
     _ignored("view_layer.material_override", "View Layer > Override > Material",
              "DRT renders each object's own materials", None),
     _ignored("view_layer.world_override", "View Layer > Override > World",

@@ -43,12 +43,15 @@ class Group:
     random_ids: list = field(default_factory=list)    # Blender's random id of each place
     colors: list = field(default_factory=list)        # Object Info colour of each place
     pass_indices: list = field(default_factory=list)
+    name_ids: list = field(default_factory=list)      # each place's (object, asset) names
+    names: dict = field(default_factory=dict)         # (object, asset) name -> its id
 
-    def place(self, matrix_world, random_id: int, color, pass_index: int) -> None:
+    def place(self, matrix_world, random_id: int, color, pass_index: int, names) -> None:
         self.matrices.append(matrix_world.copy())
         self.random_ids.append(random_id)
         self.colors.append(color)
         self.pass_indices.append(pass_index)
+        self.name_ids.append(self.names.setdefault(names, len(self.names)))
 
     def arrays(self):
         """(matrices (K, 4, 4), randoms (K,)), checked finite."""
@@ -65,6 +68,7 @@ class Source:
     color: tuple
     pass_index: int
     holdout: bool
+    names: tuple              # (object name, asset name): what Cryptomatte calls it
 
 
 class InstanceGroups:
@@ -88,7 +92,8 @@ class InstanceGroups:
         return found
 
     def place(self, source: Source, matrix_world, random_id: int) -> None:
-        source.group.place(matrix_world, random_id, source.color, source.pass_index)
+        source.group.place(matrix_world, random_id, source.color, source.pass_index,
+                           source.names)
         self.places += 1
 
     def meshes(self) -> list:
@@ -124,6 +129,7 @@ def _single(g: Group):
     m, randoms = g.arrays()
     mesh = _settings(instance_mesh(g.local, m[0], g.slots, g.name), g)
     mesh.pass_index = g.pass_indices[0]
+    mesh.object_name, mesh.asset_name = next(iter(g.names))
     if g.with_info:
         mesh.object_info = engine.ObjectInfo(m[0], g.colors[0], float(randoms[0]),
                                              g.pass_indices[0], *g.texspace)
@@ -136,7 +142,8 @@ def _instanced(g: Group):
     slots = np.asarray(g.slots if len(g.slots) else [0], dtype=np.int32)
     materials = slots[np.clip(local.material, 0, len(slots) - 1)]
     places = engine.Instances(m, colors=np.array(g.colors, np.float64),
-                              randoms=randoms, pass_indices=np.array(g.pass_indices))
+                              randoms=randoms, pass_indices=np.array(g.pass_indices),
+                              names=tuple(g.names), name_ids=np.array(g.name_ids))
     mesh = engine.TriangleMesh(g.name, local.positions, local.triangles, materials,
                                corner_normals=local.normals, uvs=local.uvs,
                                tangents=local.tangents, colors=local.colors,
