@@ -130,7 +130,9 @@ def supported_nodes(bpy):
 # tests of its feature
 SHADERS_ROW = ("| Shader | Principled BSDF, Diffuse BSDF, Glossy BSDF, Glass BSDF, "
                "Refraction BSDF (GGX, Multiscatter GGX, Beckmann), Sheen BSDF, "
-               "Translucent BSDF, Emission, Transparent BSDF, Mix Shader, Add Shader; "
+               "Translucent BSDF, Emission, Transparent BSDF, Holdout (as the whole "
+               "Surface; mixed with other shaders it renders black, without its hole), "
+               "Mix Shader, Add Shader; "
                "Principled Volume, Volume Scatter, Volume Absorption, Volume "
                "Coefficients; Background |")
 

@@ -103,7 +103,8 @@ class RenderContext:
         meshes = instancing.resolve(scene.meshes,
                                     _instanceable(scene.materials, self.materials.emission))
         self.accel = Accelerator(meshes, threads=1, time_enabled=self.has_motion)
-        self.surfaces = SurfaceBuilder(self.accel)
+        self.surfaces = SurfaceBuilder(self.accel, [getattr(m, "holdout", False)
+                                                    for m in scene.materials])
         self.scene_radius = _scene_radius(scene, self.accel)
         # the uniform world's radiance (zeros under an environment map), and the world
         # model (engine.world_light) escaped rays read

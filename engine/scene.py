@@ -111,6 +111,8 @@ class Material:
     volume: Optional[object] = None      # Volume: the medium inside its meshes
     surface: bool = True                 # False: no surface shader, a volume's boundary
     pass_index: int = 0                  # Blender's material Pass Index (IndexMA pass)
+    holdout: bool = False                # a Holdout shader: a hole in the alpha where the
+    #                                      camera sees it, black to every other ray
 
     TEXTURED = ("base_color", "metallic", "roughness", "emission", "alpha")
 
@@ -451,7 +453,9 @@ class Scene:
             or self.world.volume is not None
 
     def has_holdouts(self) -> bool:
-        return any(m.holdout for m in self.meshes)
+        """Whether an object is a holdout, or a material is a Holdout shader."""
+        return (any(m.holdout for m in self.meshes)
+                or any(getattr(m, "holdout", False) for m in self.materials))
 
     def needs_alpha(self) -> bool:
         """Whether samples carry a coverage (alpha) below one anywhere."""

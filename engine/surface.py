@@ -49,7 +49,7 @@ class SurfaceBuilder:
     slice for a deforming one: placeholders, its hits are rebuilt at the ray's time in
     build()); `corners` (T, 3) holds each triangle's three rows of it."""
 
-    def __init__(self, accel: Accelerator, meshes=None):
+    def __init__(self, accel: Accelerator, holdout_materials=None):
         self.accel = accel
         ordered = accel.ordered_meshes
         positions, corners, base = [accel.positions], [accel.triangles], len(accel.positions)
@@ -69,9 +69,15 @@ class SurfaceBuilder:
         # compiled kernels likewise), not stored per triangle.
         self.material = (np.concatenate([m.material_indices for m in ordered]).astype(np.int64)
                          if ordered else np.zeros(0, np.int64))
-        # Holdout triangles (None when the scene has none): camera rays end there.
-        self.holdout = (np.concatenate([np.full(len(m.triangles), m.holdout) for m in ordered])
-                        if any(m.holdout for m in ordered) else None)
+        # Holdout triangles (None when the scene has none): camera rays end there; those
+        # of holdout objects, and of materials that are a Holdout shader
+        # (holdout_materials: a flag per material)
+        held = (np.zeros(1, bool) if holdout_materials is None
+                else np.append(np.asarray(holdout_materials, bool), False))
+        self.holdout = (np.concatenate([
+            np.full(len(m.triangles), True) if m.holdout
+            else held[np.minimum(m.material_indices, len(held) - 1)] for m in ordered])
+            if any(m.holdout for m in ordered) or held.any() else None)
         # The ray kinds that see each triangle (engine.visibility); None when all see all.
         self.visibility = (np.concatenate([np.full(len(m.triangles), m.visibility, np.uint8)
                                            for m in ordered])

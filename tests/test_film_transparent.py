@@ -88,3 +88,52 @@ def test_holdout_matches_cycles(bpy_drt):
     assert np.abs(a_drt - a_cyc).mean() < 0.02
     rgb_drt, rgb_cyc = out["DRT"][:, :3].mean(0), out["CYCLES"][:, :3].mean(0)
     assert np.all(np.abs(rgb_drt - rgb_cyc) / rgb_cyc < 0.05), (rgb_drt, rgb_cyc)
+
+
+def _holdout_box(bpy, engine, shader):
+    """The Cornell box, its tall block a hole: by a Holdout shader as its material
+    (shader=True) or by its object's Holdout flag; Blender's default bounces."""
+    bpy.ops.wm.open_mainfile(filepath=os.path.join(SAMPLES_DIR, "cornell_box.blend"),
+                             load_ui=False)
+    scene = bpy.context.scene
+    block = bpy.data.objects["TallBlock"]
+    if shader:
+        mat = bpy.data.materials.new("Hole")
+        if bpy.app.version < (5, 0, 0):
+            mat.use_nodes = True
+        nt = mat.node_tree
+        for node in list(nt.nodes):
+            if node.bl_idname != "ShaderNodeOutputMaterial":
+                nt.nodes.remove(node)
+        hole = nt.nodes.new("ShaderNodeHoldout")
+        nt.links.new(hole.outputs[0], nt.nodes["Material Output"].inputs["Surface"])
+        block.data.materials.clear()
+        block.data.materials.append(mat)
+    else:
+        block.is_holdout = True
+    scene.render.engine = engine
+    scene.render.resolution_percentage = 25
+    scene.cycles.samples = 256
+    scene.cycles.use_denoising = False
+    scene.drt.samples = 128
+    bpy.ops.render.render()
+    return read_render_rgba(bpy, scene)
+
+
+def test_holdout_shader_matches_cycles(bpy_drt):
+    """A Holdout shader as the tall block's material: a zero-alpha hole with no colour for
+    the camera, as the object flag makes one, but black to every other ray (it reflects
+    no light onto the walls); Cycles' RGBA against DRT's. The control: the object flag's
+    hole, whose block still lights the walls, is brighter than Cycles' Holdout shader."""
+    bpy = bpy_drt
+    drt, cycles = (_holdout_box(bpy, engine, True) for engine in ("DRT", "CYCLES"))
+    a_drt, a_cyc = drt[:, 3], cycles[:, 3]
+    hole = a_cyc < 0.01
+    assert hole.sum() > 50 and (a_drt[hole] < 0.05).mean() > 0.95
+    assert (drt[hole, :3] < 0.02).all()
+    assert np.abs(a_drt - a_cyc).mean() < 0.02
+    rgb_drt, rgb_cyc = drt[:, :3].mean(0), cycles[:, :3].mean(0)
+    flagged = _holdout_box(bpy, "DRT", False)[:, :3].mean(0)
+    print(f"Holdout shader: DRT {rgb_drt}, Cycles {rgb_cyc}; the object flag {flagged}")
+    assert np.all(np.abs(rgb_drt - rgb_cyc) / rgb_cyc < 0.03), (rgb_drt, rgb_cyc)
+    assert np.all(flagged / rgb_cyc - 1.0 > 0.03), (flagged, rgb_cyc)

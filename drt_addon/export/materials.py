@@ -206,6 +206,11 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
     return result
 
 
+def _is_holdout(socket) -> bool:
+    found = _link(socket)
+    return found is not None and found[0].bl_idname == "ShaderNodeHoldout"
+
+
 def _from_nodes(mat, ctx, fallback) -> "engine.Material":
     """The material from its node tree (see the module docstring)."""
     name = mat.name
@@ -215,6 +220,10 @@ def _from_nodes(mat, ctx, fallback) -> "engine.Material":
     if out is None:
         ctx.issue("it has no Material Output node; using its viewport colour")
         result = fallback
+    elif _is_holdout(out.inputs["Surface"]):
+        # Cycles' Holdout: a hole in the alpha for the camera, black to other rays
+        result = engine.Material(name, (0.0, 0.0, 0.0), specular_ior_level=0.0,
+                                 holdout=True)
     else:
         result = _material(_closure(out.inputs["Surface"], ctx), ctx, name)
         disp = out.inputs.get("Displacement")
