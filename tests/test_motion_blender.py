@@ -416,13 +416,9 @@ def test_motion_steps_and_per_object_toggles(bpy_drt):
     assert _mesh(s, "Cube").motion is None and not s.has_motion()
 
 
-def test_moving_instancer_blurs_its_instances_mirrored_ones_too(bpy_drt):
-    """A collection instanced twice by a moving empty (once mirrored): every instance gets
-    a rigid motion whose middle transform places it where the static export does, with
-    the same triangle winding (geometric normals pointing the same way)."""
-    from engine.instancing import expand
-    from engine.motion import RigidMotion
-    bpy = bpy_drt
+def _cube_collection(bpy):
+    """The motion cube's file with the cube, its animation cleared, alone in a collection
+    the view layer excludes (for instancers to instance): (scene, collection)."""
     bpy.ops.wm.open_mainfile(filepath=CUBE, load_ui=False)
     scene = bpy.context.scene
     cube = bpy.data.objects["Cube"]
@@ -431,8 +427,18 @@ def test_moving_instancer_blurs_its_instances_mirrored_ones_too(bpy_drt):
     scene.collection.children.link(coll)
     scene.collection.objects.unlink(cube)
     coll.objects.link(cube)
-    coll.hide_render = False
     scene.view_layers[0].layer_collection.children["Group"].exclude = True
+    return scene, coll
+
+
+def test_moving_instancer_blurs_its_instances_mirrored_ones_too(bpy_drt):
+    """A collection instanced twice by a moving empty (once mirrored): every instance gets
+    a rigid motion whose middle transform places it where the static export does, with
+    the same triangle winding (geometric normals pointing the same way)."""
+    from engine.instancing import expand
+    from engine.motion import RigidMotion
+    bpy = bpy_drt
+    scene, coll = _cube_collection(bpy)
     for i, sx in enumerate((1.0, -1.0)):
         empty = bpy.data.objects.new(f"Spawner{i}", None)
         empty.instance_type = "COLLECTION"
@@ -593,3 +599,45 @@ def test_default_shutter_curve_is_a_box_shutter(bpy_drt):
     assert curve.shape == (256,)
     np.testing.assert_allclose(curve, np.arange(256) / 255, atol=0.01)
     assert math.isclose(bpy.context.scene.render.motion_blur_shutter, SHUTTER)
+
+
+def test_still_instances_stay_instances_with_motion_blur_on(bpy_drt):
+    """A collection instanced by three empties that stand still and one that moves, with
+    motion blur on: the still places are one instanced mesh of three places
+    (export.instances.regroup_still, where Blender puts them), the moving one a mesh of
+    its own with its motion; the same samples render the scene with the still places
+    expanded into copies to 1e-3 of the image."""
+    import copy as copying
+    from engine import RenderSettings, render
+    from engine.instancing import expand
+    from engine.motion import RigidMotion
+    bpy = bpy_drt
+    scene, coll = _cube_collection(bpy)
+    for i in range(4):
+        empty = bpy.data.objects.new(f"Spawner{i}", None)
+        empty.instance_type = "COLLECTION"
+        empty.instance_collection = coll
+        empty.location = (0.0, 0.7 * i, 0.0)
+        scene.collection.objects.link(empty)
+        if i == 3:
+            for frame in (0, 2):
+                empty.location = ((frame - 1) * CUBE_SPEED, 0.7 * i, 0.0)
+                empty.keyframe_insert("location", frame=frame)
+            _linear(empty)
+    scene.frame_set(1)
+    assert scene.render.use_motion_blur
+    blurred = _export(bpy)
+    cubes = [m for m in blurred.meshes if m.name.startswith("Cube#")]
+    still = [m for m in cubes if m.instances is not None]
+    moving = [m for m in cubes if m.instances is None]
+    assert len(still) == 1 and len(still[0].instances) == 3
+    assert len(moving) == 1 and isinstance(moving[0].motion, RigidMotion)
+    places = sorted(still[0].instances.matrices[:, 1, 3])
+    np.testing.assert_allclose(places, [0.0, 0.7, 1.4], atol=1e-6)
+    assert blurred.has_motion()
+    copies = copying.copy(blurred)
+    copies.meshes = [c for m in blurred.meshes for c in expand(m)]
+    settings = RenderSettings(samples=16, seed=5)
+    a, b = (render(s, settings)[0].mean() for s in (blurred, copies))
+    assert a.mean() > 0.01
+    assert np.abs(a - b).mean() < 1e-3 * a.mean()

@@ -7,7 +7,7 @@ import time
 from ..engine_link import engine
 from .camera import RenderRegion, export_camera, render_region, window_camera
 from .errors import ExportError, Reporter
-from .instances import InstanceGroups, Source, source_key
+from .instances import InstanceGroups, Source, regroup_still, source_key
 from .left_out import LEFT_OUT_TYPES, LeftOut
 from .libraries import missing_library_messages
 from .settings_check import check as check_file_settings
@@ -121,6 +121,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                                                      False)))
     meshes, lights = [], []
     groups = InstanceGroups()
+    held = []
     left_out = LeftOut()
     holdouts = 0
     for k, inst in enumerate(depsgraph.object_instances):
@@ -156,12 +157,12 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 object_visibility(inst.parent) if inst.is_instance and inst.parent is not None
                 else 31)
             programmed = any(materials[i].shader is not None for i in slots)
+            color, pass_index, texspace = object_values(obj)
+            source = Source(groups.group(local, slots, name, holdout, offset, seen,
+                                         programmed, texspace),
+                            color, pass_index, holdout, crypto_names(inst, obj))
             if tracker is None:
                 # without motion blur, repeated geometry becomes instances (export.instances)
-                color, pass_index, texspace = object_values(obj)
-                source = Source(groups.group(local, slots, name, holdout, offset, seen,
-                                             programmed, texspace),
-                                color, pass_index, holdout, crypto_names(inst, obj))
                 groups.place(source, inst.matrix_world, inst.random_id)
                 # a volume that varies in space has one material per object: not shared
                 if not any(is_heterogeneous(materials[i]) for i in slots):
@@ -176,6 +177,9 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             meshes[-1].pass_index = int(getattr(obj, "pass_index", 0))
             meshes[-1].object_name, meshes[-1].asset_name = crypto_names(inst, obj)
             tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
+            # with motion blur, each place is a mesh of its own until the shutter is
+            # sampled; those that do not move become instances then (regroup_still)
+            held.append((len(meshes) - 1, source, inst.matrix_world.copy(), inst.random_id))
         elif obj.type in LEFT_OUT_TYPES and (inst.is_instance or inst.show_self):
             left_out.note_object(obj)
         elif obj.type == "LIGHT":
@@ -192,7 +196,10 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     world = export_world(scene.world, reporter)
     if scene.world is not None:
         world.volume = world_volume(scene.world, reporter)
-    shutter = tracker.finish(meshes, camera, lights) if tracker is not None else None
+    shutter = None
+    if tracker is not None:
+        shutter = tracker.finish(meshes, camera, lights)
+        meshes = regroup_still(meshes, held, groups)
     dark = dark_scene_message(meshes, materials, lights, world)
     if dark:
         reporter.warn(dark, key=BLACK_IMAGE)

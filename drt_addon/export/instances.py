@@ -100,11 +100,31 @@ class InstanceGroups:
         """One engine.TriangleMesh per group: in world space for a single place, in
         object space with its Instances for more."""
         return [_single(g) if len(g.matrices) == 1 else _instanced(g)
-                for g in self._groups.values()]
+                for g in self._groups.values() if g.matrices]
 
     def instanced(self) -> int:
         """How many places are exported as instances (groups of two or more)."""
         return sum(len(g.matrices) for g in self._groups.values() if len(g.matrices) > 1)
+
+
+def regroup_still(meshes: list, held: list, groups: InstanceGroups) -> list:
+    """With motion blur on, every place was exported as a world-space mesh of its own, so
+    that the shutter's samples could give it motion (export.motion). `held`: (index in
+    meshes, its Source, its matrix, its random id) of each. The places left without
+    motion that share a group with another still place become that group's instances,
+    as without motion blur; the moving ones, and a still place alone, stay as they are."""
+    still = [h for h in held if meshes[h[0]].motion is None]
+    count: dict = {}
+    for _, source, _, _ in still:
+        count[id(source.group)] = count.get(id(source.group), 0) + 1
+    grouped = set()
+    for index, source, matrix, random_id in still:
+        if count[id(source.group)] > 1:
+            groups.place(source, matrix, random_id)
+            grouped.add(index)
+    if not grouped:
+        return meshes
+    return [m for i, m in enumerate(meshes) if i not in grouped] + groups.meshes()
 
 
 def source_key(inst, obj):
