@@ -17,6 +17,8 @@ layer (Properties > View Layer > Passes):
 - Object Index and Material Index (`use_pass_object_index`, `use_pass_material_index`;
   named IndexOB and IndexMA before Blender 5.0, as Cycles names them): the Pass Index of the object and of the material the
   pixel's first camera sample hits, as Cycles writes them (sample 0 alone).
+- Environment (`use_pass_environment`; Env before Blender 5.0): the world as camera rays
+  that hit nothing see it, as Cycles' Environment pass.
 - Cryptomatte Object, Material and Asset (`use_pass_cryptomatte_*`, Levels:
   `pass_cryptomatte_depth`): CryptoObject00, 01, ... as Cycles writes them, (id,
   coverage) pairs of the names each pixel shows, with the manifest in the render
@@ -42,7 +44,8 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
-from .blender_compat import MATERIAL_INDEX_PASS, OBJECT_INDEX_PASS, set_pass_pixels
+from .blender_compat import (ENVIRONMENT_PASS, MATERIAL_INDEX_PASS, OBJECT_INDEX_PASS,
+                             set_pass_pixels)
 
 # The tracer (engine: kernels compiled by Numba, Embree through its C API) and the export
 # are imported by the first DRT render, not when Blender registers the add-on: a Blender
@@ -95,9 +98,10 @@ PASSES = {
     "UV": (3, "UVA", "VECTOR", lambda vl: vl.use_pass_uv),
     OBJECT_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_object_index),
     MATERIAL_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_material_index),
+    ENVIRONMENT_PASS: (3, "RGB", "COLOR", lambda vl: vl.use_pass_environment),
 }
 FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position",
-             "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS)
+             "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, ENVIRONMENT_PASS)
 
 
 CRYPTOMATTE = {"object": "Object", "material": "Material", "asset": "Asset"}
@@ -390,7 +394,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                            "Denoising Normal": first.camera_normal(description.camera.matrix),
                            "Mist": first.mist, "Position": first.position, "UV": first.uv,
                            OBJECT_INDEX_PASS: first.object_index,
-                           MATERIAL_INDEX_PASS: first.material_index})
+                           MATERIAL_INDEX_PASS: first.material_index,
+                           ENVIRONMENT_PASS: first.environment})
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
         for name in wanted:

@@ -22,7 +22,11 @@ intersection each, no shading), with Cycles' meanings:
   to the falloff exponent (`Mist`: World > Mist Pass), 1 where a sample hits nothing;
 - object_index, material_index: the Pass Index of the object and of the material that
   the pixel's first camera sample hits (0 where it hits nothing), not averaged: Cycles
-  writes its Object Index and Material Index passes from sample 0 alone.
+  writes its Object Index and Material Index passes from sample 0 alone;
+- environment: what camera rays that hit nothing see of the world (Cycles'
+  Environment pass: the background seen directly, as the camera sees it), averaged the
+  same way; 0 where a sample hits a surface (through a transparent one too, which
+  Cycles looks through).
 Emitting lights (area and sphere lights) are not surfaces here: rays see through them.
 """
 from __future__ import annotations
@@ -69,6 +73,7 @@ class FirstHitPasses:
     uv: np.ndarray = None        # (h, w, 3) float64: u, v, coverage
     object_index: np.ndarray = None    # (h, w) float64
     material_index: np.ndarray = None  # (h, w) float64
+    environment: np.ndarray = None     # (h, w, 3) float64
 
     def camera_normal(self, camera_matrix) -> np.ndarray:
         """The normal pass in camera space (x right, y up, z towards the viewer), as
@@ -90,10 +95,19 @@ def _build(ctx, hits, index, d, time):
     return ctx.surfaces.build(hits, index, d, time=time)
 
 
+def _world_seen(ctx, directions) -> np.ndarray:
+    """What camera rays along `directions` see of the world (the integrator's packed
+    world light, engine.kernels.lights)."""
+    from .kernels.lights.batch import world_escaped_batch
+    from .visibility import CAMERA
+    integ = ctx.integrator
+    return world_escaped_batch(integ.lights, integ.world, directions, CAMERA)[0]
+
+
 def sample_hits(ctx, k: int, chunk: int = 1 << 16):
     """The first hits of the first k camera samples of every pixel, a chunk at a time:
     (pixel and sample index of each sample, the samples that hit something, their
-    engine.surface.SurfaceHit); chunks where nothing is hit are left out."""
+    engine.surface.SurfaceHit or None when none did, the rays' directions)."""
     n_pix = ctx.scene.width * ctx.scene.height
     per_chunk = max(1, chunk // k)
     for start in range(0, n_pix, per_chunk):
@@ -103,8 +117,8 @@ def sample_hits(ctx, k: int, chunk: int = 1 << 16):
         rays, time = camera_rays(ctx, pixel, index)
         hits = _intersect(ctx, rays.origins, rays.directions, rays.tmax, time)
         hit = np.nonzero(hits.hit)[0]
-        if hit.size:
-            yield pixel, index, hit, _build(ctx, hits, hit, rays.directions, time)
+        si = _build(ctx, hits, hit, rays.directions, time) if hit.size else None
+        yield pixel, index, hit, si, rays.directions
 
 
 def cryptomatte(ctx, kinds, depth: int, samples: int = AOV_SAMPLES) -> dict:
@@ -117,7 +131,9 @@ def cryptomatte(ctx, kinds, depth: int, samples: int = AOV_SAMPLES) -> dict:
     k = int(max(1, min(samples, ctx.settings.samples)))
     w, h = ctx.scene.width, ctx.scene.height
     found = {kind: ([], []) for kind in kinds}
-    for pixel, _, hit, si in sample_hits(ctx, k):
+    for pixel, _, hit, si, _ in sample_hits(ctx, k):
+        if si is None:
+            continue
         for kind in kinds:
             found[kind][0].append(pixel[hit])
             found[kind][1].append(names.of(kind, si.prim, si.inst, si.material))
@@ -171,7 +187,17 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
     material_pass = np.array([float(getattr(m, "pass_index", 0)) for m in scene.materials]
                              or [0.0])
     ortho = scene.camera.kind == "ORTHO"
-    for pixel, index, hit, si in sample_hits(ctx, k, chunk):
+    environment = np.zeros((n_pix, 3))
+    for pixel, index, hit, si, directions in sample_hits(ctx, k, chunk):
+        missed = np.ones(len(pixel), bool)
+        missed[hit] = False
+        if missed.any():
+            seen = _world_seen(ctx, directions[missed])
+            for c in range(3):
+                environment[:, c] += np.bincount(pixel[missed], weights=seen[:, c],
+                                                 minlength=n_pix)
+        if si is None:
+            continue
         for c in range(3):
             normal[:, c] += np.bincount(pixel[hit], weights=si.shading_normal[:, c],
                                         minlength=n_pix)
@@ -196,4 +222,5 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
                           (albedo / k).reshape(shape), k, (position / k).reshape(shape),
                           (mist_sum / k).reshape(height, width), (uv / k).reshape(shape),
                           object_index.reshape(height, width),
-                          material_index.reshape(height, width))
+                          material_index.reshape(height, width),
+                          (environment / k).reshape(shape))

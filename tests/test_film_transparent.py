@@ -137,3 +137,43 @@ def test_holdout_shader_matches_cycles(bpy_drt):
     print(f"Holdout shader: DRT {rgb_drt}, Cycles {rgb_cyc}; the object flag {flagged}")
     assert np.all(np.abs(rgb_drt - rgb_cyc) / rgb_cyc < 0.03), (rgb_drt, rgb_cyc)
     assert np.all(flagged / rgb_cyc - 1.0 > 0.03), (flagged, rgb_cyc)
+
+
+def _environment(bpy, engine, strength=1.0):
+    """The Environment pass of world_light.blend (an HDRI world, no lamps; the view shows
+    background around the objects), and its Combined."""
+    from drt_addon.blender_compat import ENVIRONMENT_PASS
+    from test_passes import composite
+    bpy.ops.wm.open_mainfile(filepath=os.path.join(SAMPLES_DIR, "world_light.blend"),
+                             load_ui=False)
+    scene = bpy.context.scene
+    scene.render.use_motion_blur = False
+    scene.render.resolution_percentage = 25
+    scene.render.engine = engine
+    scene.cycles.samples = scene.drt.samples = 32
+    scene.cycles.use_denoising = False
+    background = scene.world.node_tree.nodes["Background"].inputs["Strength"]
+    background.default_value *= strength
+    scene.view_layers[0].use_pass_environment = True
+    composite(bpy, scene, ENVIRONMENT_PASS)
+    bpy.ops.render.render()
+    return read_render_rgba(bpy, scene)[:, :3]
+
+
+def test_environment_pass_matches_cycles(bpy_drt):
+    """Cycles' Environment pass against DRT's at 32 samples: the world where the camera
+    sees it, 0 on the objects. Measured: DRT's image mean 0.7 % above Cycles', per pixel
+    3 % of the mean (the edges' samples); the control, the world 10 % stronger, is
+    10.8 % above."""
+    bpy = bpy_drt
+    cycles = _environment(bpy, "CYCLES")
+    drt = _environment(bpy, "DRT")
+    brighter = _environment(bpy, "DRT", 1.1)
+    seen = (cycles.max(axis=1) > 0).mean()
+    assert 0.05 < seen < 0.95                            # background and objects
+    ratio = drt.mean() / cycles.mean()
+    mad = np.abs(drt - cycles).mean() / cycles.mean()
+    print(f"Environment: DRT/Cycles {ratio:.4f}, per pixel {mad:.4f} of the mean, "
+          f"the world 10 % stronger {brighter.mean() / cycles.mean():.4f}")
+    assert abs(ratio - 1.0) < 0.02 and mad < 0.05
+    assert brighter.mean() / cycles.mean() > 1.06

@@ -71,7 +71,7 @@ _NULL_SCATTERING = ("DRT renders volumes without ray marching steps: homogeneous
 _SIMPLIFY = ("scene.render.use_simplify", (True,))
 _ADAPTIVE = ("scene.cycles.use_adaptive_sampling", (True,))
 WRITTEN_PASSES = ("Combined, Depth, Mist, Normal, Position, UV, Object Index, Material "
-                  "Index, Cryptomatte, Denoising Data and DRT Noise")
+                  "Index, Environment, Cryptomatte, Denoising Data and DRT Noise")
 _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
 
 # Render passes DRT does not write, as (path, label).
@@ -95,7 +95,6 @@ _UNWRITTEN_PASSES = [
     ("view_layer.cycles.use_pass_volume_transmit", "Volume Transmit"),
     ("view_layer.cycles.use_pass_volume_majorant", "Volume Majorant"),
     ("view_layer.use_pass_emit", "Emission"),
-    ("view_layer.use_pass_environment", "Environment"),
     ("view_layer.use_pass_ambient_occlusion", "Ambient Occlusion"),
     ("view_layer.use_pass_shadow", "Shadow"),
     ("view_layer.cycles.use_pass_shadow_catcher", "Shadow Catcher"),
@@ -160,6 +159,9 @@ SETTINGS: list[FileSetting] = [
     _s("view_layer.use_pass_object_index", "Passes > Object Index", READ,
        "written: the Pass Index of the object the pixel's first sample hits (Cycles' "
        "IndexOB)"),
+    _s("view_layer.use_pass_environment", "Passes > Environment", READ,
+       "written: the world as camera rays that hit nothing see it (Cycles' Environment; "
+       "a sample through a transparent surface adds nothing)"),
     _s("view_layer.use_pass_material_index", "Passes > Material Index", READ,
        "written: the Pass Index of the material the pixel's first sample hits (Cycles' "
        "IndexMA)"),

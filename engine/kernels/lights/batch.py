@@ -109,15 +109,20 @@ def _sun_rows(L, j, d, time):
     return rad, pdf
 
 
+def world_escaped_batch(L, world, d, ray_bit=2):
+    """What n escaped rays along d of kind ray_bit (engine.visibility; diffuse by
+    default) see of the world: (radiance (n, 3), the MIS pdf of the world light along d
+    (n,))."""
+    return _world_rows(L, world, np.ascontiguousarray(d, np.float64), ray_bit)
+
+
 @kernel
-def world_escaped_batch(L, world, d):
-    """What n escaped diffuse rays along d see of the world: (radiance (n, 3), the MIS
-    pdf of the world light along d (n,))."""
+def _world_rows(L, world, d, ray_bit):
     n = d.shape[0]
     rad = np.empty((n, 3))
     pdf = np.empty(n)
     for i in range(n):
-        r, g, b, pd = world_escaped(L, world, 2, d[i, 0], d[i, 1], d[i, 2])
+        r, g, b, pd = world_escaped(L, world, ray_bit, d[i, 0], d[i, 1], d[i, 2])
         rad[i, 0], rad[i, 1], rad[i, 2] = r, g, b
         pdf[i] = pd
     return rad, pdf
