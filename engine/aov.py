@@ -139,8 +139,9 @@ def cryptomatte(ctx, kinds, depth: int, samples: int = AOV_SAMPLES) -> dict:
             found[kind][1].append(names.of(kind, si.prim, si.inst, si.material))
     out = {}
     for kind, (pixels, ids) in found.items():
-        cat = (lambda parts, dtype: np.concatenate(parts) if parts else np.zeros(0, dtype))
-        i, c = ranked(cat(pixels, np.int64), cat(ids, np.float32), w * h, k, depth)
+        i, c = ranked(np.concatenate(pixels) if pixels else np.zeros(0, np.int64),
+                      np.concatenate(ids) if ids else np.zeros(0, np.float32), w * h, k,
+                      depth)
         out[kind] = (i.reshape(h, w, depth), c.reshape(h, w, depth))
     out["names"] = names.names
     return out

@@ -119,8 +119,7 @@ class HitNames:
         mesh_names = [(_object_name(m), _asset_name(m)) for m in ordered]
         self._mesh = {kind: self._ids(kind, [pair[i] for pair in mesh_names])
                       for i, kind in enumerate(("object", "asset"))}
-        self._tri_mesh = np.repeat(np.arange(len(ordered), dtype=np.int32),
-                                   [len(m.triangles) for m in ordered])
+        self._mesh_of = ctx.surfaces.mesh_of
         rows = ctx.accel.instance_count
         self._place = {kind: np.zeros(rows, np.float32) for kind in ("object", "asset")}
         for proto in ctx.accel.prototypes:
@@ -141,7 +140,7 @@ class HitNames:
         material indices `material`."""
         if kind == "material":
             return self._material[np.minimum(material, len(self._material) - 1)]
-        ids = self._mesh[kind][self._tri_mesh[prim]]
+        ids = self._mesh[kind][self._mesh_of(prim)]
         placed = inst >= 0
         if placed.any():
             ids[placed] = self._place[kind][inst[placed]]

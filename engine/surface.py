@@ -104,7 +104,7 @@ class SurfaceBuilder:
         # Texture coordinates per triangle corner (Blender's UV map), for the meshes that
         # have them; triangles of meshes without UVs read (0, 0), as in Cycles.
         self._geometry = None           # geometry(), made on the first build()
-        self._tri_pass = None           # each triangle's object Pass Index, on first use
+        self._tri_mesh = None           # each triangle's mesh (ordered_meshes), on first use
         self.corner_uvs = None
         if any(getattr(m, "uvs", None) is not None for m in ordered):
             parts = []
@@ -126,15 +126,20 @@ class SurfaceBuilder:
         """Unit geometric normals (n, 3) of triangles `prim` as stored (see vertices)."""
         return _corner_normals(*self.vertices(prim))
 
+    def mesh_of(self, prim) -> np.ndarray:
+        """The index in accel.ordered_meshes of the mesh each triangle `prim` belongs to."""
+        if self._tri_mesh is None:
+            ordered = self.accel.ordered_meshes
+            self._tri_mesh = np.repeat(np.arange(len(ordered), dtype=np.int32),
+                                       [len(m.triangles) for m in ordered])
+        return self._tri_mesh[prim]
+
     def pass_indices(self, prim, inst) -> np.ndarray:
         """The objects' Pass Index (float64, as Cycles' Object Index pass) of hits on
         triangles `prim` of places `inst` (-1: not an instance)."""
-        if self._tri_pass is None:
-            ordered = self.accel.ordered_meshes
-            self._tri_pass = np.repeat(
-                np.array([getattr(m, "pass_index", 0) for m in ordered], np.int32),
-                [len(m.triangles) for m in ordered])
-        out = self._tri_pass[prim].astype(np.float64)
+        ordered = self.accel.ordered_meshes
+        index = np.array([getattr(m, "pass_index", 0) for m in ordered] or [0], np.float64)
+        out = index[self.mesh_of(prim)]
         placed = inst >= 0
         if placed.any():
             from .nodes.context import O_INDEX
@@ -151,16 +156,16 @@ class SurfaceBuilder:
         from .nodes.context import N_OBJ
         return (self.positions, self.corners,
                 np.asarray(self.accel.center, dtype=np.float64), self.material,
-                _or_empty(self.corner_normals, (0, 3, 3), np.float32),
-                _or_empty(self.holdout, 0, bool),
-                _or_empty(self.corner_uvs, (0, 3, 2), np.float32),
+                or_empty(self.corner_normals, (0, 3, 3), np.float32),
+                or_empty(self.holdout, 0, bool),
+                or_empty(self.corner_uvs, (0, 3, 2), np.float32),
                 self.accel.motion,
-                _or_empty(self.tri_object, 0, np.int32),
-                _or_empty(self.objects, (0, N_OBJ), np.float64),
-                _or_empty(self.corner_tangents, (0, 3, 4), np.float32),
-                _or_empty(self.corner_colors, (0, 3, 4), np.float32),
+                or_empty(self.tri_object, 0, np.int32),
+                or_empty(self.objects, (0, N_OBJ), np.float64),
+                or_empty(self.corner_tangents, (0, 3, 4), np.float32),
+                or_empty(self.corner_colors, (0, 3, 4), np.float32),
                 np.zeros(0) if camera is None else camera,
-                _or_empty(self.terminator_cutoff, 0, np.float64))
+                or_empty(self.terminator_cutoff, 0, np.float64))
 
     def build(self, hits: Hits, index: np.ndarray, ray_dirs: np.ndarray,
               time: np.ndarray | None = None) -> SurfaceHit:
@@ -194,7 +199,9 @@ class SurfaceBuilder:
                           np.stack([u, v], axis=1), inst)
 
 
-def _or_empty(a, shape, dtype):
+def or_empty(a, shape, dtype):
+    """`a` as a contiguous array, or an empty one of `shape` and `dtype` for None (what the
+    kernels read for an attribute the scene has not)."""
     return np.ascontiguousarray(a) if a is not None else np.zeros(shape, dtype)
 
 

@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import visibility
 from ..accel import HitArrays
+from ..surface import or_empty
 from ..kernels import lights as klights
 from ..kernels.bsdf import principled as kbsdf
 from ..bsdf.material_table import flatten_mixes
@@ -40,10 +41,6 @@ _MODE_IDS = {"mis": MIS, "light": LIGHT_ONLY, "bsdf": BSDF_ONLY}
 MIS_MODES = tuple(_MODE_IDS)
 DIFFUSE_LIMIT = 3           # cfg's diffuse bounce limit (see path_vertex.shade)
 VOLUME_BOUNDS_MAX = 256     # volume boundaries one path may cross (Cycles: 1024)
-
-
-def _or_empty(a, shape, dtype):
-    return np.ascontiguousarray(a) if a is not None else np.zeros(shape, dtype)
 
 
 class CompiledPathIntegrator:
@@ -72,7 +69,7 @@ class CompiledPathIntegrator:
         self.params = kbsdf.pack_materials(mats)
         self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)
         self.textures = mats.shading()
-        vis = _or_empty(surf.visibility, 0, np.uint8)
+        vis = or_empty(surf.visibility, 0, np.uint8)
         self.materials = (surf.material, np.ascontiguousarray(mats.maybe_transparent),
                           np.ascontiguousarray(mats.alpha, dtype=np.float64),
                           np.ascontiguousarray(mats.transparent_color, dtype=np.float64),
