@@ -123,8 +123,6 @@ def main():
             for (head, tail), t_static, t_blur in zip(rows, seconds[0::2], seconds[1::2])]
     print("\n".join(rows))
 
-    from engine.motion import DeformMotion
-    slices = DeformMotion.__dataclass_fields__["slices"].default
     lines = [
         "# Motion blur",
         "",
@@ -174,16 +172,18 @@ def main():
         "What moves, and how DRT traces it:",
         "",
         "- **Transforms** (keyframes, constraints, parenting, drivers, moving instancers): "
-        "the object keeps one Embree scene in object space, and every ray is moved into it "
-        "by the object's transform at the ray's own time, interpolated from the steps by "
-        "translation, rotation (spherical) and stretch. Exact per ray: a spinning object "
-        "blurs along arcs, not chords.",
+        "the object keeps one Embree scene in object space, placed by an Embree instance "
+        "that moves: one transform per motion step, decomposed into translation, rotation "
+        "(a quaternion) and scale (Embree's quaternion decomposition), which Embree "
+        "interpolates at each ray's own time, translation and scale linearly, rotation "
+        "spherically; DRT's kernels place the hit with the same formulas. Exact per ray: a "
+        "spinning object blurs along arcs, not chords.",
         "- **Deformation** (shape keys, armatures, other deform modifiers, geometry nodes "
         "that depend on time; whatever `Object.is_deform_modified` reports, Cycles' own "
         "test) is found by comparing the evaluated vertices at the steps. The mesh gets its "
-        "world-space vertex positions at the steps and is traced in "
-        f"{slices} time slices, each an Embree scene built from the positions at the "
-        "slice's middle. A mesh whose topology changes within the shutter is not blurred "
+        "world-space vertex positions at the steps, one Embree vertex buffer per step, and "
+        "Embree moves each vertex linearly from step to step at each ray's own time, as "
+        "Cycles does. A mesh whose topology changes within the shutter is not blurred "
         "as a deformation (a warning names it); its movement still is.",
         "- **The camera**: its transform at the steps, interpolated per ray, and a "
         "perspective camera's focal length (zoom blur).",
@@ -197,23 +197,18 @@ def main():
         "scene and the tracer takes its static path (one Embree scene, no time dimension), "
         "so a still scene costs exactly what it cost before.",
         "",
-        "## Where time slices err",
+        "## Where deformation errs",
         "",
         "![cube moved by a shape key, DRT](images/motion_cube_deform.png) "
         "![the same, Cycles](images/motion_cube_deform_cycles.png)",
         "",
-        "*The cube's motion made by a shape key (a deformation): DRT (left, "
-        f"{slices} time slices) and Cycles (right, which interpolates the vertices per "
-        "ray).*",
+        "*The cube's motion made by a shape key (a deformation): DRT (left) and Cycles "
+        "(right); both interpolate the vertices per ray.*",
         "",
-        f"A deforming mesh is traced against {slices} frozen copies of itself, one per "
-        f"slice of the shutter, instead of moving continuously: a vertex that travels a "
-        f"distance d over the shutter can be off by up to d / {2 * slices} at any ray's "
-        f"time, so a fast deformation shows as {slices} overlapping copies (banding along "
-        f"the streak) rather than a smooth smear, and vertices are interpolated linearly in "
-        f"world space between motion steps, so a deformation that also rotates the object "
-        f"cuts arcs into chords there. Shading normals of a deforming mesh are those of "
-        f"the shutter's middle. Rigid motion has none of these errors.",
+        "Vertices are interpolated linearly in world space between motion steps, so a "
+        "deformation that also rotates the object cuts arcs into chords between steps "
+        "(raise Steps for it), as in Cycles. Shading normals of a deforming mesh are those "
+        "of the shutter's middle. Rigid motion has neither error.",
         "",
         "## Measured cost",
         "",
@@ -233,14 +228,12 @@ def main():
         "|---|---|---|---|---|---|---|---|---|",
         *rows,
         "",
-        "What the blur costs: a rigidly moving object adds one Embree scene, a deforming "
-        "object one per time slice. A ray does not query every moving object: a hierarchy "
-        "over their swept bounds (valid at every time of the shutter) lists the objects "
-        "whose bounds it crosses before its nearest hit, in compiled code; small objects "
-        "(at most 256 triangles) are intersected there too, larger ones by their Embree "
-        "scene, the ray moved into object space at its own time (a deforming object: its "
-        "slice). A static scene (motion blur off, or nothing moving) builds one Embree "
-        "scene and samples no time.",
+        "What the blur costs: a rigidly moving object adds one Embree scene (its own, in "
+        "object space); a deforming one adds none, its time steps are buffers of the "
+        "scene every ray is traced against. Embree builds its motion hierarchies over "
+        "the moving geometry, so a ray does not query every moving object. A static scene "
+        "(motion blur off, or nothing moving) builds one Embree scene without motion and "
+        "samples no time.",
         "",
         "## DRT against Cycles",
         "",

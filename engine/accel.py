@@ -3,36 +3,26 @@
 
 Batches of rays are traced by one compiled call each (`engine.embree.rays`), at tnear 0:
 ray origins are offset by the caller (`engine.surface.offset_origin`); batches are split
-over threads (every kernel releases the GIL). Motion is built here from plain scenes:
-- static geometry: one shared Embree scene in world space (the only one a scene without
-  motion ever builds, so static scenes pay nothing for motion blur);
-- each rigidly moving object: its own Embree scene in object space; every ray is moved
-  into object space by the inverse of the object's transform at that ray's own time
-  (the ray parameter t is unchanged by an affine map, so distances compare directly);
-- each deforming object: one Embree scene per stratified time slice of the shutter,
-  built from the vertex positions at the slice's middle; a ray is traced against the
-  slice its time falls in (see `engine.motion.DeformMotion` for what that costs).
-The nearest hit across all of them wins. Triangles get global ids in that order.
+over threads (every kernel releases the GIL). Everything is one Embree scene, in world
+space relative to `center`:
+- static triangles: one geometry (the only one a scene without motion or instances
+  builds, so static scenes pay nothing for motion blur);
+- each instanced mesh (engine.instancing): one Embree scene in object space, placed by
+  one Embree instance array (one shared float32 buffer of the places' transforms);
+- each rigidly moving object: its own Embree scene in object space, placed by an Embree
+  instance with one quaternion decomposition per motion step, which Embree interpolates
+  at each ray's time as engine.motion.RigidMotion.at does (translation and scale
+  linearly, rotation spherically);
+- each deforming object: a triangle geometry with one vertex buffer per motion step,
+  which Embree interpolates linearly at each ray's time.
+Embree builds its motion hierarchies over the moving geometry itself (Cycles likewise
+hands motion to Embree). Motion steps are evenly spaced over the shutter, as Embree
+takes them (`evenly_spaced()` resamples others).
 
-Instances (engine.instancing): an instanced mesh is one Embree scene in object space,
-and its places one Embree instance array in the static scene (one shared float32
-buffer of transforms, each the place's matrix moved by -center like the static
-triangles). Its triangles get
-global ids once, after the static ones (the prototypes), and a hit on one reports the
-place too: `Hits.inst`, the place's row in the object table (engine.surface; -1 for a
-hit on a mesh that is not instanced). Memory then grows with the places, not with
-places x triangles.
-
-Many moving objects: a ray does not visit every moving object. A top-level hierarchy
-over the moving objects' swept world bounds (`engine.kernels.motion_tlas`: the bounds
-hold at every time of the shutter, rotation included) is walked by one compiled call per
-batch (`engine.kernels.motion_trace`), which intersects small objects (at most
-KERNEL_TRIANGLES triangles) on the spot in float64 and lists the (ray, object) pairs of
-the large ones, whose bounds the ray crosses before its nearest hit so far; only those
-pairs go to Embree, grouped by object, each ray moved into object space at its own time
-(`engine.kernels.motion_pairs`). `Accelerator(..., motion_tlas=False)` visits every
-moving object with every ray instead: the reference the hierarchy must equal; with
-kernel_triangles=0 as well, every moving object goes through Embree.
+Triangles get global ids in the order static, instanced, moving; a hit's Embree ids
+(geometry, instance, element) map to its global triangle id and to `Hits.inst`, the
+place's row in the object table (engine.surface; -1 for a triangle that is not an
+instanced mesh's). Memory grows with the places, not with places x triangles.
 
 All Embree scenes share one Embree device: one device per scene crashes Embree past
 about a thousand scenes.
@@ -61,18 +51,11 @@ from .embree.rays import intersect_batch, occluded_batch
 from .embree.scene import Scene as EmbreeScene
 from .instancing import is_instanced
 from .kernels.motion import pack_motion
-from .kernels.motion_pairs import group_pairs, merge_blocked, merge_hits
-from .kernels.motion_tlas import MotionTLAS, build_tlas
-from .kernels.motion_trace import trace_moving
 from .motion import DeformMotion, RigidMotion
 from .scene import TriangleMesh
 
 MISS = -1
-# Moving objects of at most this many triangles are intersected inside the compiled
-# traversal (float64, no Embree call); larger ones by their own Embree scene.
-KERNEL_TRIANGLES = 256
-_ORIGIN = np.zeros(3)
-_NO_F64, _NO_I64, _NO_BOOL = np.zeros(0), np.zeros(0, np.int64), np.zeros(0, bool)
+_NO_F64 = np.zeros(0)
 _MIN_SPLIT = 4096      # below this many rays, one thread is faster than two
 
 
@@ -121,12 +104,12 @@ class Hits:
 class MovingObject:
     mesh: TriangleMesh
     prim_offset: int
-    scenes: list             # one Embree scene (rigid) or one per time slice (deform)
-    slice_positions: list    # per slice world positions (deform only)
+    motion: object           # the mesh's motion on evenly spaced steps (Embree's)
+    scene: EmbreeScene = None  # a rigid object's own scene, in object space
 
     @property
     def rigid(self) -> bool:
-        return isinstance(self.mesh.motion, RigidMotion)
+        return isinstance(self.motion, RigidMotion)
 
 
 def _is_moving(mesh: TriangleMesh, time_enabled: bool) -> bool:
@@ -148,6 +131,17 @@ def _static_world_positions(mesh: TriangleMesh) -> np.ndarray:
     return mesh.positions
 
 
+def _places_center(instanced: list, moving: list) -> np.ndarray:
+    """Without static triangles: the median of the instances' places and the moving
+    objects' positions at their middle step (the origin when there are none)."""
+    places = [m.instances.matrices[:, :3, 3] for m in instanced]
+    for m in moving:
+        k = len(m.motion.times) // 2
+        places.append(m.motion.matrices[k:k + 1, :3, 3] if isinstance(m.motion, RigidMotion)
+                      else m.motion.positions[k])
+    return np.median(np.concatenate(places), axis=0) if places else np.zeros(3)
+
+
 def _joined(parts: list, empty_shape, dtype) -> np.ndarray:
     """The arrays one after the other (one array: itself, not a copy)."""
     if len(parts) == 1:
@@ -167,11 +161,10 @@ class Prototype:
 
 
 class Accelerator:
-    """All triangles of a scene: static ones in one Embree scene (with the instances of
-    instanced meshes), moving ones apart."""
+    """All triangles of a scene in one Embree scene: static ones, instanced meshes'
+    places and moving objects (see the module docstring)."""
 
-    def __init__(self, meshes: list[TriangleMesh], threads: int = 0, time_enabled: bool = False,
-                 motion_tlas: bool = True, kernel_triangles: int = KERNEL_TRIANGLES):
+    def __init__(self, meshes: list[TriangleMesh], threads: int = 0, time_enabled: bool = False):
         for m in meshes:
             if not np.all(np.isfinite(m.positions)):
                 raise ValueError(f"mesh {m.name!r} has non-finite (NaN or Inf) vertex positions")
@@ -195,9 +188,8 @@ class Accelerator:
         # the median vertex, not the middle of the bounds: a few far vertices (a mesh
         # with a vertex at 3.4e38, tests/test_degenerate_input.py) do not move it off
         # the bulk of the geometry
-        places = [m.instances.matrices[:, :3, 3] for m in instanced]
-        self.center = (np.median(self.positions, axis=0) if len(self.positions) else
-                       np.median(np.concatenate(places), axis=0) if places else np.zeros(3))
+        self.center = np.median(self.positions, axis=0) if len(self.positions) else \
+            _places_center(instanced, moving)
         self.threads = threads or min(os.cpu_count() or 1, 8)
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
         # Embree builds the hierarchy when the scene is committed: here, as part of
@@ -211,43 +203,35 @@ class Accelerator:
             offset += len(m.triangles)
             self.instance_count += len(m.instances)
         self.moving_start = offset
-        self._scene = self._static_scene() if len(self.triangles) or instanced else None
         self.moving: list[MovingObject] = []
         for m in moving:
-            if isinstance(m.motion, RigidMotion):
-                obj = MovingObject(m, offset, [_embree_scene(m.positions, m.triangles)], [])
-            else:
-                slices = [m.motion.positions_at(t) for t in m.motion.slice_times()]
-                obj = MovingObject(m, offset, [_embree_scene(p, m.triangles) for p in slices],
-                                   slices)
+            motion = m.motion.evenly_spaced()
+            obj = MovingObject(m, offset, motion)
+            if obj.rigid:
+                obj.scene = _embree_scene(m.positions, m.triangles)
             self.moving.append(obj)
             offset += len(m.triangles)
         self.total_triangles = offset
+        self._scene = self._top_scene() if offset else None
         # Rays traced per query kind (all threads), and an optional recorder: a list that
-        # receives (query, origins, dirs, tmax) of every static-scene batch, so that a
-        # benchmark can replay exactly the same rays through bare Embree.
+        # receives (query, origins, dirs, tmax, time) of every batch, so that a benchmark
+        # can replay exactly the same rays through bare Embree.
         self.rays_traced = {"INTERSECT": 0, "OCCLUDED": 0}
-        # (ray, moving object unit) pairs examined: intersected in the kernel or listed
-        # for Embree (all threads).
-        self.pairs_visited = 0
         self.recorder = None
         self._count_lock = threading.Lock()
         self.scene_count = ((self._scene is not None) + len(self.prototypes)
-                            + sum(len(o.scenes) for o in self.moving))
-        # Moving objects packed for the kernels (engine.kernels.motion), and the
-        # top-level hierarchy over them (motion_tlas=False: brute force, the reference).
+                            + sum(o.scene is not None for o in self.moving))
+        # Moving objects packed for the kernels that rebuild their hits
+        # (engine.kernels.motion)
         self.motion = pack_motion(self)
-        self.motion_tlas = motion_tlas
-        self.kernel_triangles = kernel_triangles
-        self.tlas: MotionTLAS | None = None
-        if self.moving:
-            self.build_tlas()
 
-    def _static_scene(self) -> EmbreeScene:
-        """The static triangles (geometry 0, when there are any) and the places of every
-        instanced mesh (one instance array each), relative to `center`. Fills the maps
-        from an Embree instance array's id to its prototype's first global triangle id
-        and to the object-table row of its first place."""
+    def _top_scene(self) -> EmbreeScene:
+        """The scene every ray is traced against, relative to `center`: the static
+        triangles (geometry 0, when there are any), the places of every instanced mesh
+        (one instance array each), every rigidly moving object (a moving instance) and
+        every deforming one (triangles with time steps). Fills the maps from an Embree
+        geometry id to its first global triangle id and, for an instance array, to the
+        object-table row of its first place (-1: not an instanced mesh)."""
         scene = EmbreeScene()
         ids = []
         if len(self.triangles):
@@ -258,56 +242,48 @@ class Accelerator:
             places[:, :, 3] -= self.center
             ids.append((scene.add_instance_array(proto.scene, places), proto.prim_offset,
                         proto.first_row))
+        for obj in self.moving:
+            if obj.rigid:
+                gid = scene.add_moving_instance(obj.scene, obj.motion.embree_steps(self.center))
+            else:
+                gid = scene.add_triangles(list(obj.motion.positions), obj.mesh.triangles,
+                                          self.center)
+            ids.append((gid, obj.prim_offset, -1))
         n = max(g for g, _, _ in ids) + 1 if ids else 0
-        self._inst_base = np.zeros(n, np.int64)
-        self._inst_row = np.full(n, -1, np.int64)
+        self._geom_base = np.zeros(n, np.int64)
+        self._geom_row = np.full(n, -1, np.int64)
         for g, base, row in ids:
-            self._inst_base[g], self._inst_row[g] = base, row
+            self._geom_base[g], self._geom_row[g] = base, row
         return scene.commit()
-
-    def build_tlas(self, swept: bool = True):
-        """(Re)build the hierarchy over the moving objects. swept=False is a negative
-        control for tests: rigid bounds at the motion steps only, which misses hits."""
-        n = len(self.moving)
-        lo, hi = np.zeros((n, 3)), np.zeros((n, 3))
-        for i, obj in enumerate(self.moving):
-            if obj.rigid and len(obj.mesh.positions):
-                lo[i] = obj.mesh.positions.min(axis=0)
-                hi[i] = obj.mesh.positions.max(axis=0)
-        self.tlas = build_tlas(self.motion, lo, hi, swept=swept,
-                               kernel_triangles=self.kernel_triangles)
-        self._unit_scene = [self.moving[o].scenes[s]
-                            for o, s in zip(self.tlas.unit_obj, self.tlas.unit_slice)]
-        self._embree_units = bool((self.tlas.unit_root < 0).any())
 
     def close(self):
         if self._pool is not None:
             self._pool.shutdown(wait=False)
             self._pool = None
 
-    # -- raw queries -------------------------------------------------------------------
-    def _query(self, scene, center, origins, dirs, tmax, time, query):
+    # -- queries ---------------------------------------------------------------------
+    def _query(self, origins, dirs, tmax, time, query):
         """Embree on float64 rays whose origins are moved by -center before rounding to
         float32 (engine.embree.rays), split over the pool for large batches. Returns
-        blocked (n,) for OCCLUDED; (prim, t, u, v) for INTERSECT (prim -1, t inf where
-        missed)."""
+        blocked (n,) for OCCLUDED; Hits for INTERSECT."""
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(dirs, dtype=np.float64)
         n = len(o)
         far = np.array(np.broadcast_to(tmax, (n,)), dtype=np.float64)
-        tm = _NO_F64 if time is None else np.ascontiguousarray(time, dtype=np.float64)
+        tm = _NO_F64 if time is None else np.array(np.broadcast_to(time, (n,)), np.float64)
+        scene, center = self._scene.handle, self.center
         if query == "OCCLUDED":
             out = (np.zeros(n, bool),)
 
             def run(a, b):
-                occluded_batch(scene.handle, center, o[a:b], d[a:b], far[a:b],
+                occluded_batch(scene, center, o[a:b], d[a:b], far[a:b],
                                tm[a:b] if len(tm) else tm, out[0][a:b])
         else:
             out = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64),
                    np.empty(n, np.int64), np.empty(n), np.empty(n), np.empty(n))
 
             def run(a, b):
-                intersect_batch(scene.handle, center, o[a:b], d[a:b], far[a:b],
+                intersect_batch(scene, center, o[a:b], d[a:b], far[a:b],
                                 tm[a:b] if len(tm) else tm, *(x[a:b] for x in out))
         if self._pool is None or n < _MIN_SPLIT:
             run(0, n)
@@ -318,117 +294,49 @@ class Accelerator:
                 f.result()
         if query == "OCCLUDED":
             return out[0]
-        _, prim, inst, element, t, u, v = out
-        if scene is self._scene and self.prototypes:
-            placed = inst >= 0          # the instance array's geometry id, the place's index
-            g = inst[placed]
-            prim[placed] += self._inst_base[g]
-            inst[placed] = self._inst_row[g] + element[placed]
-        else:
-            inst[:] = -1
-        return prim, t, u, v, inst
+        geom, prim, inst, element, t, u, v = out
+        placed = inst >= 0          # an instance's geometry id in the top scene
+        hit = geom >= 0
+        owner = np.where(placed, inst, geom)[hit]   # the top scene's geometry hit
+        prim[hit] += self._geom_base[owner]
+        row = np.full(n, -1, np.int64)
+        row[hit] = self._geom_row[owner]
+        inst = np.where(row >= 0, row + element, -1)
+        return Hits(t, prim, u, v, inst)
 
-    def _run(self, origins, dirs, tmax, query):
-        """The static scene's queries, counted (and recorded for a benchmark's replay)."""
+    def _run(self, origins, dirs, tmax, time, query):
+        """One batch of queries, counted (and recorded for a benchmark's replay)."""
         n = len(origins)
+        if self.moving and time is None:
+            raise ValueError("a scene with moving objects needs a time per ray")
         with self._count_lock:
             self.rays_traced[query] += n
             if self.recorder is not None:
                 self.recorder.append((query, np.array(origins, np.float64),
                                       np.array(dirs, np.float64),
-                                      np.array(np.broadcast_to(tmax, (n,)), np.float64)))
-        return self._query(self._scene, self.center, origins, dirs, tmax, None, query)
+                                      np.array(np.broadcast_to(tmax, (n,)), np.float64),
+                                      None if time is None else np.array(
+                                          np.broadcast_to(time, (n,)), np.float64)))
+        return self._query(origins, dirs, tmax, time if self.moving else None, query)
 
     def replay(self, batches) -> None:
-        """The recorded static-scene batches through bare Embree (a benchmark's reference:
-        the same queries, without DRT's work around them)."""
-        for query, o, d, far in batches:
-            self._query(self._scene, self.center, o, d, far, None, query)
+        """Recorded batches through bare Embree (a benchmark's reference: the same
+        queries, without DRT's work around them)."""
+        for query, o, d, far, time in batches:
+            self._query(o, d, far, time, query)
 
-    # -- motion ------------------------------------------------------------------------
-    def _trace_moving(self, origins, dirs, time, best, t, prim, u, v, blocked, occlusion):
-        """The moving objects against the rays (see the module docstring): the kernel
-        objects inside `trace_moving`, then the Embree objects' (ray, object) pairs it
-        lists, grouped by object. Updates (t, prim, u, v, best) or blocked in place."""
-        n = len(origins)
-        o = np.ascontiguousarray(origins, np.float64)
-        d = np.ascontiguousarray(dirs, np.float64)
-        tm = np.array(np.broadcast_to(time, (n,)), np.float64)   # writable: one kernel type
-        hit_unit = np.full(n, -1, np.int64)
-        cap = 2 * n + 256 if self._embree_units else 0
-        while True:
-            pr, pu = np.empty(cap, np.int64), np.empty(cap, np.int64)
-            visits = np.zeros(1, np.int64)
-            count = trace_moving(self.tlas, self.motion, o, d, tm, best, t, prim, u, v,
-                                 hit_unit, blocked, occlusion, self.motion_tlas, pr, pu,
-                                 visits)
-            if count <= cap:
-                break
-            cap = count
-        with self._count_lock:
-            self.pairs_visited += int(visits[0])
-        if count == 0:
-            return
-        s_ray, s_unit = np.empty(count, np.int64), np.empty(count, np.int64)
-        # each pair's ray in its unit's space, rounded to float32 by group_pairs as Embree
-        # takes it, and kept in float64 arrays, which the ray kernels read as they are
-        o_unit, d_unit, far_unit = np.empty((count, 3)), np.empty((count, 3)), np.empty(count)
-        unit_start = np.empty(len(self._unit_scene) + 1, np.int64)
-        group_pairs(self.motion, self.tlas, pr, pu, count, o, d, best, tm,
-                    s_ray, s_unit, o_unit, d_unit, far_unit, unit_start)
-        query = "OCCLUDED" if occlusion else "INTERSECT"
-        parts = []
-        for k in np.flatnonzero(unit_start[1:] > unit_start[:-1]):
-            a, b = unit_start[k], unit_start[k + 1]
-            found = self._query(self._unit_scene[k], _ORIGIN, o_unit[a:b], d_unit[a:b],
-                                far_unit[a:b], None, query)
-            parts.append(found if occlusion else found[:4])
-        with self._count_lock:
-            self.rays_traced[query] += count
-        if occlusion:
-            merge_blocked(s_ray, np.where(np.concatenate(parts), 0, MISS), blocked)
-        else:
-            merge_hits(self.motion, self.tlas, s_ray, s_unit,
-                       *(np.concatenate([p[i] for p in parts]) for i in range(4)),
-                       t, prim, u, v, best, hit_unit)
-
-    # -- public queries ----------------------------------------------------------------
     def intersect(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
                   time: np.ndarray | None = None) -> Hits:
         n = len(origins)
-        t = np.full(n, np.inf)
-        prim = np.full(n, MISS, np.int64)
-        u, v = np.zeros(n), np.zeros(n)
-        inst = np.full(n, -1, np.int64)
-        if n == 0:
-            return Hits(t, prim, u, v, inst)
-        if self._scene is not None:
-            prim, t, u, v, inst = self._run(origins, dirs, tmax, "INTERSECT")
-        if self.moving:
-            if time is None:
-                raise ValueError("a scene with moving objects needs a time per ray")
-            best = np.array(np.broadcast_to(np.minimum(t, tmax), (n,)), np.float64)
-            t, prim = np.array(t, np.float64), np.array(prim, np.int64)
-            u, v = np.array(u, np.float64), np.array(v, np.float64)
-            self._trace_moving(origins, dirs, time, best, t, prim, u, v, _NO_BOOL, False)
-            if self.prototypes:
-                inst = np.where(prim >= self.moving_start, -1, inst)
-        return Hits(t, prim, u, v, inst)
+        if n == 0 or self._scene is None:
+            return Hits(np.full(n, np.inf), np.full(n, MISS, np.int64), np.zeros(n),
+                        np.zeros(n), np.full(n, -1, np.int64))
+        return self._run(origins, dirs, tmax, time, "INTERSECT")
 
     def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
                  time: np.ndarray | None = None) -> np.ndarray:
         """True where something lies on the segment [0, tmax) of each ray."""
         n = len(origins)
-        blocked = np.zeros(n, dtype=bool)
-        if n == 0:
-            return blocked
-        if self._scene is not None:
-            blocked = self._run(origins, dirs, tmax, "OCCLUDED")
-        if self.moving:
-            if time is None:
-                raise ValueError("a scene with moving objects needs a time per ray")
-            blocked = np.array(blocked, bool)
-            far = np.array(np.broadcast_to(tmax, (n,)), np.float64)
-            self._trace_moving(origins, dirs, time, far, _NO_F64, _NO_I64, _NO_F64, _NO_F64,
-                               blocked, True)
-        return blocked
+        if n == 0 or self._scene is None:
+            return np.zeros(n, dtype=bool)
+        return self._run(origins, dirs, tmax, time, "OCCLUDED")

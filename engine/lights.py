@@ -137,9 +137,8 @@ class AreaLightModel:
 class TimeSlicedLight:
     """A lamp that moves during the shutter: the exporter gives the lamp at the middles of
     K equal slices of the shutter (`light.motion_slices`), and each ray uses the lamp of
-    the slice its time falls in. Like time-sliced deformation (engine.motion) this is
-    exact at the slice middles and off by up to half a slice's movement elsewhere, and
-    it costs nothing for lamps that do not move."""
+    the slice its time falls in. This is exact at the slice middles and off by up to half
+    a slice's movement elsewhere, and it costs nothing for lamps that do not move."""
 
     def __init__(self, slices):
         self.slices = [make_light(l) for l in slices]

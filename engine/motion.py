@@ -7,10 +7,20 @@ draws its own t from the sampler's TIME dimension (stratified and decorrelated f
 pixel and lens dimensions like every other dimension), through the shutter curve.
 
 Rigid motion is exact at each ray's own time: the transforms at the motion steps are
-decomposed into translation, rotation (a unit quaternion) and a symmetric stretch (polar
-decomposition, so scale and even shear survive), and those are interpolated, linearly for
-translation and stretch and by spherical linear interpolation for rotation, never the
-matrix entries (which would shrink a rotating object and cut arcs into chords).
+decomposed into translation, rotation (a unit quaternion) and an upper triangular
+scale-and-skew matrix (A = R U: the QR decomposition with U's diagonal positive, a mirror
+kept in U's last entry), and those are interpolated, linearly for translation and U and
+by spherical linear interpolation for rotation, never the matrix entries (which would
+shrink a rotating object and cut arcs into chords). This is the decomposition Embree
+interpolates (RTCQuaternionDecomposition), so the geometry Embree traces and the hit
+points DRT rebuilds from it agree at every time; between nearly equal rotations
+(quaternion dot above 0.9995) both take the normalised linear interpolation, as Embree
+does. For an object that rotates and scales along its own axes, U is the scale and this
+is Cycles' decomposition too (Cycles takes a symmetric polar stretch; they differ only
+for sheared objects that rotate during the shutter).
+
+Motion steps are evenly spaced over the shutter, as Embree's time steps are (Blender's
+motion steps are); `evenly_spaced()` resamples other step times.
 """
 from __future__ import annotations
 
@@ -83,13 +93,20 @@ def _matrix_from_quat(q: np.ndarray) -> np.ndarray:
     ], axis=1)
 
 
+# Rotations closer than this (quaternion dot) interpolate linearly, then normalised, as
+# Embree's slerp does (common/math/quaternion.h)
+NLERP_DOT = 0.9995
+
+
 def _slerp(q0: np.ndarray, q1: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """Spherical linear interpolation of unit quaternions (n, 4), f (n,) in [0, 1]; the
+    normalised linear one when they are closer than NLERP_DOT."""
     dot = np.clip((q0 * q1).sum(1), -1.0, 1.0)
     theta = np.arccos(dot)
     sin = np.sin(theta)
-    small = sin < 1e-9
-    w0 = np.where(small, 1.0 - f, np.sin((1.0 - f) * theta) / np.where(small, 1.0, sin))
-    w1 = np.where(small, f, np.sin(f * theta) / np.where(small, 1.0, sin))
+    near = (dot > NLERP_DOT) | (sin < 1e-9)
+    w0 = np.where(near, 1.0 - f, np.sin((1.0 - f) * theta) / np.where(near, 1.0, sin))
+    w1 = np.where(near, f, np.sin(f * theta) / np.where(near, 1.0, sin))
     q = w0[:, None] * q0 + w1[:, None] * q1
     return q / np.linalg.norm(q, axis=1, keepdims=True)
 
@@ -121,16 +138,7 @@ class RigidMotion:
             raise ValueError("motion steps must be finite")
         if np.any(np.diff(self.times) <= 0):
             raise ValueError("motion step times must increase")
-        a = self.matrices[:, :3, :3]
-        u, s, vt = np.linalg.svd(a)
-        rot = u @ vt
-        flip = np.linalg.det(rot) < 0           # mirrored: keep the mirror in the stretch
-        u[flip, :, -1] *= -1
-        rot = u @ vt
-        stretch = np.transpose(vt, (0, 2, 1)) @ (s[:, :, None] * vt)
-        stretch[flip] = np.transpose(vt[flip], (0, 2, 1)) @ (
-            (s[flip] * np.array([1, 1, -1]))[:, :, None] * vt[flip])
-        self._decomposed = (self.matrices[:, :3, 3].copy(), _quat_from_matrix(rot), stretch)
+        self._decomposed = decompose(self.matrices)
 
     def is_static(self) -> bool:
         return len(self.times) == 1 or bool(np.all(np.abs(self.matrices - self.matrices[0]) < 1e-12))
@@ -138,7 +146,7 @@ class RigidMotion:
     def at(self, t: np.ndarray) -> np.ndarray:
         """(n, 4, 4) transforms at shutter times t (n,); clamped to the first and last step."""
         t = np.asarray(t, dtype=np.float64)
-        trans, quat, stretch = self._decomposed
+        trans, quat, upper = self._decomposed
         k = len(self.times)
         if k == 1:
             return np.broadcast_to(self.matrices[0], (len(t), 4, 4)).copy()
@@ -146,23 +154,75 @@ class RigidMotion:
         span = self.times[i + 1] - self.times[i]
         f = np.clip((t - self.times[i]) / span, 0.0, 1.0)
         tr = trans[i] + f[:, None] * (trans[i + 1] - trans[i])
-        st = stretch[i] + f[:, None, None] * (stretch[i + 1] - stretch[i])
+        up = upper[i] + f[:, None, None] * (upper[i + 1] - upper[i])
         r = _matrix_from_quat(_slerp(quat[i], quat[i + 1], f))
         out = np.zeros((len(t), 4, 4))
-        out[:, :3, :3] = r @ st
+        out[:, :3, :3] = r @ up
         out[:, :3, 3] = tr
         out[:, 3, 3] = 1.0
         return out
+
+    def evenly_spaced(self) -> "RigidMotion":
+        """The motion on evenly spaced steps from 0 to 1 (itself when its steps are)."""
+        k = _even_count(self.times)
+        if k == len(self.times):
+            return self
+        grid = np.linspace(0.0, 1.0, k)
+        return RigidMotion(grid, self.at(grid))
+
+    def embree_steps(self, shift=None) -> np.ndarray:
+        """(K, 16) rows of Embree's RTCQuaternionDecomposition, one per step: scale x, y,
+        z (U's diagonal), skew xy, xz, yz (U's upper entries), shift 0, quaternion r, i,
+        j, k, translation x, y, z (minus `shift`, the tracer's origin)."""
+        trans, quat, upper = self._decomposed
+        rows = np.zeros((len(self.times), 16))
+        rows[:, 0], rows[:, 1], rows[:, 2] = upper[:, 0, 0], upper[:, 1, 1], upper[:, 2, 2]
+        rows[:, 3], rows[:, 4], rows[:, 5] = upper[:, 0, 1], upper[:, 0, 2], upper[:, 1, 2]
+        rows[:, 9:13] = quat
+        rows[:, 13:16] = trans - (0.0 if shift is None else np.asarray(shift, np.float64))
+        return rows
+
+
+def decompose(matrices: np.ndarray) -> tuple:
+    """(translations (K, 3), rotations (K, 4) w, x, y, z on the shorter arc from one step
+    to the next, upper triangular scale and skew (K, 3, 3)) of transforms (K, 4, 4):
+    A = R U, QR with U's diagonal made positive; a mirroring A keeps its mirror in U[2, 2]
+    (R stays a rotation)."""
+    a = matrices[:, :3, :3]
+    q, u = np.linalg.qr(a)
+    sign = np.where(np.diagonal(u, axis1=1, axis2=2) < 0, -1.0, 1.0)   # (K, 3)
+    q = q * sign[:, None, :]
+    u = u * sign[:, :, None]
+    mirror = np.linalg.det(q) < 0
+    q[mirror, :, 2] *= -1.0
+    u[mirror, 2, :] *= -1.0
+    return matrices[:, :3, 3].copy(), _quat_from_matrix(q), np.triu(u)
+
+
+def _even_count(times: np.ndarray) -> int:
+    """len(times) when the times run evenly from 0 to 1; else the fewest evenly spaced
+    steps from 0 to 1 that hold every one of them (0, 0.3, 1: 11 steps), on which the
+    motion resamples exactly (it is linear, or spherical, between its own steps); at
+    most Embree's 129, an approximation for times on no such grid."""
+    k = len(times)
+    if k < 2 or (times[0] == 0.0 and times[-1] == 1.0 and np.abs(
+            times - np.arange(k) / (k - 1)).max() <= 1e-9):
+        return k
+    for segments in range(k, 129):
+        x = times * segments
+        if np.allclose(x, np.round(x), rtol=0.0, atol=1e-7 * segments) \
+                and times[0] == 0.0 and abs(times[-1] - 1.0) < 1e-9:
+            return segments + 1
+    return 129
 
 
 @dataclass
 class DeformMotion:
     """Vertex positions that change over the shutter: times (K,) increasing in [0, 1],
-    positions (K, V, 3) world space. Traced in `slices` stratified time slices, each with
-    its own acceleration structure built from the positions at the slice's middle."""
+    positions (K, V, 3) world space. A vertex moves linearly from step to step, as
+    Embree traces it (its time steps) and as Cycles' deformation blur moves it."""
     times: np.ndarray
     positions: np.ndarray
-    slices: int = 8
 
     def __post_init__(self):
         self.times = np.asarray(self.times, dtype=np.float64).reshape(-1)
@@ -171,8 +231,8 @@ class DeformMotion:
             raise ValueError("deformation needs (K, V, 3) positions for K times")
         if not np.isfinite(self.positions).all():
             raise ValueError("deformation positions must be finite")
-        if self.slices < 1:
-            raise ValueError("deformation needs at least one time slice")
+        if np.any(np.diff(self.times) <= 0):
+            raise ValueError("deformation step times must increase")
 
     def positions_at(self, t: float) -> np.ndarray:
         k = len(self.times)
@@ -182,8 +242,10 @@ class DeformMotion:
         f = float(np.clip((t - self.times[i]) / (self.times[i + 1] - self.times[i]), 0, 1))
         return self.positions[i] * (1 - f) + self.positions[i + 1] * f
 
-    def slice_of(self, t: np.ndarray) -> np.ndarray:
-        return np.clip((np.asarray(t) * self.slices).astype(np.int64), 0, self.slices - 1)
-
-    def slice_times(self) -> np.ndarray:
-        return (np.arange(self.slices) + 0.5) / self.slices
+    def evenly_spaced(self) -> "DeformMotion":
+        """The deformation on evenly spaced steps from 0 to 1 (itself when its steps are)."""
+        k = _even_count(self.times)
+        if k == len(self.times):
+            return self
+        grid = np.linspace(0.0, 1.0, k)
+        return DeformMotion(grid, np.stack([self.positions_at(t) for t in grid]))

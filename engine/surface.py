@@ -46,7 +46,7 @@ class SurfaceBuilder:
     Triangles are kept as vertex rows, not as per-corner copies: `positions` (V, 3)
     float64 holds the accelerator's static world vertices (the same array, not a copy),
     then each moving object's own vertices (object space for a rigid one, its first time
-    slice for a deforming one: placeholders, its hits are rebuilt at the ray's time in
+    step for a deforming one: placeholders, its hits are rebuilt at the ray's time in
     build()); `corners` (T, 3) holds each triangle's three rows of it."""
 
     def __init__(self, accel: Accelerator, holdout_materials=None):
@@ -60,7 +60,7 @@ class SurfaceBuilder:
             base += len(m.positions)
         for obj in accel.moving:
             m = obj.mesh
-            positions.append(m.positions if obj.rigid else obj.slice_positions[0])
+            positions.append(m.positions if obj.rigid else obj.motion.positions[0])
             corners.append(m.triangles.astype(accel.triangles.dtype) + base)
             base += len(positions[-1])
         self.positions = positions[0] if len(positions) == 1 else np.concatenate(positions)
@@ -118,7 +118,7 @@ class SurfaceBuilder:
 
     def vertices(self, prim) -> tuple:
         """The three corners (n, 3) of triangles `prim` as stored (instanced and moving
-        ones: placeholders in object space or at their first slice)."""
+        ones: placeholders in object space or at their first time step)."""
         c = self.corners[prim]
         return self.positions[c[:, 0]], self.positions[c[:, 1]], self.positions[c[:, 2]]
 

@@ -35,7 +35,7 @@ def test_reachable_follows_callees_and_only_them():
     assert "engine.kernels.path_vertex.shade" in found
     assert "engine.kernels.bsdf.principled.setup" in found        # via a module attribute
     assert "engine.kernels.lights.light_set.sample" in found
-    assert not any(name.startswith("engine.kernels.motion_tlas") for name in found)
+    assert not any(name.startswith("engine.kernels.whitted_vertex") for name in found)
     assert not any(name.startswith("engine.embree") for name in found)
     assert 50 < len(found) < 700
 

@@ -183,7 +183,7 @@ def test_deforming_mesh_matches_cycles(bpy_drt):
     cube = [m for m in render_engine.last_render["scene"].meshes if m.name == "Cube"][0]
     assert isinstance(cube.motion, DeformMotion)
     rel, mad = compare(drt, cycles)
-    print(f"shape-key deformation ({cube.motion.slices} time slices): mean "
+    print(f"shape-key deformation ({len(cube.motion.times)} time steps): mean "
           f"{100 * rel.max():.3f}%, MAD {100 * mad:.2f}%")
     assert (rel <= MEAN_TOLERANCE).all() and mad <= MAD_TOLERANCE, (rel, mad)
     assert not within(render(bpy_drt, CUBE, "DRT", "off", _blur_off, samples=64), cycles)

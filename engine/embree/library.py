@@ -108,6 +108,7 @@ def _prototypes(lib) -> None:
                                               c_size_t, c_size_t, c_size_t]),
         "rtcSetGeometryInstancedScene": (None, [c_void_p, c_void_p]),
         "rtcSetGeometryTransform": (None, [c_void_p, c_uint, c_int, c_void_p]),
+        "rtcSetGeometryTransformQuaternion": (None, [c_void_p, c_uint, c_void_p]),
         "rtcGetSceneBounds": (None, [c_void_p, c_void_p]),
         "rtcGetGeometry": (c_void_p, [c_void_p, c_uint]),
         "rtcGetGeometryBufferData": (c_void_p, [c_void_p, c_int, c_uint]),

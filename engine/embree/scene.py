@@ -8,9 +8,11 @@ vectorised NumPy operation, into a float32 array with the one float of padding E
 16-byte loads need, which Embree then shares. Index arrays are shared as they are
 (int32 rows, read as unsigned).
 
-Motion: a geometry given K vertex arrays (time steps) is linearly interpolated by
-Embree over the ray's time in [0, 1]; an instance given K transforms likewise
-interpolates the matrices. `handle` is the scene's address, which the ray kernels
+Motion: a geometry given K vertex arrays (time steps, evenly spaced over [0, 1]) is
+linearly interpolated by Embree over the ray's time in [0, 1]; an instance given K
+transforms likewise interpolates the matrices, and one given K quaternion
+decompositions (`add_moving_instance`) interpolates translation and scale linearly and
+rotation spherically. `handle` is the scene's address, which the ray kernels
 (`engine.embree.rays`) take.
 """
 from __future__ import annotations
@@ -192,6 +194,32 @@ class Scene:
                                               _pointer(col))
         self._keep.append(child)
         return self._attach(geom, "instance", 1)
+
+    def add_moving_instance(self, child: "Scene", steps: np.ndarray) -> int:
+        """An instance of a committed scene moving rigidly over [0, 1]: steps (K, 16)
+        rows of Embree's RTCQuaternionDecomposition (scale x, y, z; skew xy, xz, yz;
+        shift x, y, z; quaternion r, i, j, k; translation x, y, z), K >= 2 evenly spaced
+        time steps, the transform at a step T R S (engine.motion.RigidMotion.embree_steps).
+        Embree interpolates S and T linearly and R by spherical linear interpolation."""
+        if not child.committed:
+            raise ValueError("commit a scene before instancing it")
+        rows = np.asarray(steps, np.float64)
+        if rows.ndim != 2 or rows.shape[1] != 16 or len(rows) < 2:
+            raise ValueError(f"a moving instance needs (K >= 2, 16) steps, got {rows.shape}")
+        if not np.all(np.isfinite(rows)):
+            raise ValueError("a moving instance's transform is not finite")
+        raw = np.zeros(len(rows) * 16 + 4, np.float32)       # RTC_ALIGN(16) structs
+        start = (-raw.ctypes.data % 16) // 4
+        aligned = raw[start:start + len(rows) * 16].reshape(len(rows), 16)
+        aligned[...] = rows
+        geom = self._new(L.GEOMETRY_INSTANCE)
+        self._lib.rtcSetGeometryInstancedScene(geom, child.handle)
+        self._steps(geom, list(aligned))
+        for k in range(len(aligned)):
+            self._lib.rtcSetGeometryTransformQuaternion(geom, k, _pointer(aligned[k]))
+        check("rtcSetGeometryTransformQuaternion")
+        self._keep.append(child)
+        return self._attach(geom, "moving instance", 1)
 
     def add_instance_array(self, child: "Scene", transforms: np.ndarray) -> int:
         """K instances of a committed scene as one Embree instance array: transforms

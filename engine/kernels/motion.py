@@ -1,5 +1,7 @@
-"""Moving objects, compiled: the transform of a rigidly moving object at one ray's time
-(`engine.motion.RigidMotion.at`, same formulas) and a world ray moved into its space.
+"""Moving objects, compiled: where a moving triangle is at one ray's time, as Embree
+traces it (engine.accel): a rigid object's transform at that time
+(`engine.motion.RigidMotion.at`, same formulas, Embree's quaternion decomposition), and a
+deforming object's vertices interpolated between its time steps.
 
 `pack_motion(accel)` describes the accelerator's moving objects, in its global triangle
 order, as one `PackedMotion` of NumPy arrays with the same types for every scene (empty
@@ -14,6 +16,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..motion import NLERP_DOT
 from .cdf_search import bisect_last
 from .frame import cross
 from .jit import kernel
@@ -21,21 +24,20 @@ from .jit import kernel
 RIGID, DEFORM = 0, 1
 
 # columns of PackedMotion.info
-I_KIND, I_STEP0, I_STEPS, I_VERT0, I_NVERTS, I_SLICES = range(6)
+I_KIND, I_STEP0, I_STEPS, I_VERT0, I_NVERTS = range(5)
 
 
 class PackedMotion(NamedTuple):
     prim_start: np.ndarray    # int64 (n + 1,) first global triangle id of each moving
     #                           object, then the total triangle count
-    info: np.ndarray          # int64 (n, 6) kind (RIGID / DEFORM), first motion step row,
-    #                           step count, first vertex row, vertices per slice, slices
-    step_time: np.ndarray     # float64 (S,) motion step times (rigid objects, concatenated)
-    step_trans: np.ndarray    # float64 (S, 3) translation at each step
+    info: np.ndarray          # int64 (n, 5) kind (RIGID / DEFORM), first motion step row
+    #                           (rigid), step count (evenly spaced over [0, 1]), first
+    #                           vertex row, vertices per step
+    step_trans: np.ndarray    # float64 (S, 3) translation at each step (rigid objects)
     step_quat: np.ndarray     # float64 (S, 4) rotation (w, x, y, z), shorter arc between steps
-    step_stretch: np.ndarray  # float64 (S, 3, 3) symmetric stretch (polar decomposition)
-    step_linear: np.ndarray   # float64 (S, 3, 3) the step's own 3x3 (one-step motions)
+    step_upper: np.ndarray    # float64 (S, 3, 3) upper triangular scale and skew
     verts: np.ndarray         # float64 (V, 3) object-space vertices (rigid) or every time
-    #                           slice's world vertices, one slice after the other (deform)
+    #                           step's world vertices, one step after the other (deform)
     tris: np.ndarray          # int64 (T, 3) per moving triangle (global id - static count)
     #                           its object-local vertex indices
 
@@ -45,32 +47,28 @@ def pack_motion(accel) -> PackedMotion:
     objs = accel.moving
     n = len(objs)
     prim_start = np.empty(n + 1, np.int64)
-    info = np.zeros((n, 6), np.int64)
-    times, trans, quats, stretch, linear, verts, tris = [], [], [], [], [], [], []
+    info = np.zeros((n, 5), np.int64)
+    trans, quats, upper, verts, tris = [], [], [], [], []
     step, vert = 0, 0
     for i, obj in enumerate(objs):
-        mesh = obj.mesh
+        mesh, motion = obj.mesh, obj.motion
         prim_start[i] = obj.prim_offset
         tris.append(np.asarray(mesh.triangles, np.int64).reshape(-1, 3))
+        k = len(motion.times)
         if obj.rigid:
-            motion = mesh.motion
-            tr, q, st = motion._decomposed
-            k = len(motion.times)
-            info[i] = (RIGID, step, k, vert, len(mesh.positions), 1)
-            times.append(motion.times)
+            tr, q, up = motion._decomposed
+            info[i] = (RIGID, step, k, vert, len(mesh.positions))
             trans.append(tr)
             quats.append(q)
-            stretch.append(st)
-            linear.append(motion.matrices[:, :3, :3])
+            upper.append(up)
             verts.append(np.asarray(mesh.positions, np.float64).reshape(-1, 3))
             step += k
             vert += len(mesh.positions)
         else:
-            slices = obj.slice_positions
-            nv = len(slices[0])
-            info[i] = (DEFORM, step, 0, vert, nv, len(slices))
-            verts.extend(np.asarray(p, np.float64).reshape(-1, 3) for p in slices)
-            vert += nv * len(slices)
+            nv = motion.positions.shape[1]
+            info[i] = (DEFORM, 0, k, vert, nv)
+            verts.append(np.asarray(motion.positions, np.float64).reshape(-1, 3))
+            vert += nv * k
     prim_start[n] = accel.total_triangles if n else accel.moving_start
 
     def cat(parts, shape, dtype):
@@ -78,10 +76,21 @@ def pack_motion(accel) -> PackedMotion:
             return np.zeros(shape, dtype)
         return np.ascontiguousarray(np.concatenate(parts), dtype=dtype)
 
-    return PackedMotion(prim_start, info, cat(times, (0,), np.float64),
-                        cat(trans, (0, 3), np.float64), cat(quats, (0, 4), np.float64),
-                        cat(stretch, (0, 3, 3), np.float64), cat(linear, (0, 3, 3), np.float64),
+    return PackedMotion(prim_start, info, cat(trans, (0, 3), np.float64),
+                        cat(quats, (0, 4), np.float64), cat(upper, (0, 3, 3), np.float64),
                         cat(verts, (0, 3), np.float64), cat(tris, (0, 3), np.int64))
+
+
+@kernel(inline="always")
+def step_of(k, t):
+    """(segment a in [0, k - 2], fraction f in [0, 1] of the way to step a + 1) of time
+    t over k evenly spaced steps from 0 to 1 (Embree's time segments); (0, 0) for one
+    step."""
+    if k < 2:
+        return 0, 0.0
+    x = min(max(t, 0.0), 1.0) * (k - 1)
+    a = min(int(x), k - 2)
+    return a, min(max(x - a, 0.0), 1.0)
 
 
 @kernel(inline="always")
@@ -96,54 +105,35 @@ def object_of(M, prim):
 
 
 @kernel(inline="always")
-def step_of(info, times, obj, t):
-    """(first step row a of the interval holding t, fraction f in [0, 1] of the way to
-    step a + 1): searchsorted(times, t, side="right") - 1 clipped to [0, k - 2], as in
-    RigidMotion.at. Objects with one step only: (that step, 0)."""
-    s0 = info[obj, I_STEP0]
-    k = info[obj, I_STEPS]
-    if k < 2:
-        return s0, 0.0
-    j = 0
-    while j < k and times[s0 + j] <= t:
-        j += 1
-    a = s0 + min(max(j - 1, 0), k - 2)
-    f = (t - times[a]) / (times[a + 1] - times[a])
-    return a, min(max(f, 0.0), 1.0)
-
-
-@kernel(inline="always")
-def rigid_at(info, times, trans, quat, stretch, linear, obj, t):
-    """RigidMotion.at for one time t of moving object obj, on the arrays M.info ..
-    M.step_linear: (a00, a01, a02, a10, ..., a22, tx, ty, tz), the 3x3 linear part
-    row-major then the translation. Translation and stretch interpolate linearly,
-    rotation by spherical linear interpolation, clamped to the first and last step."""
-    a, f = step_of(info, times, obj, t)
+def rigid_at(info, trans, quat, upper, obj, t):
+    """RigidMotion.at for one time t of moving object obj, on the arrays M.info,
+    M.step_trans, step_quat, step_upper: (a00, a01, a02, a10, ..., a22, tx, ty, tz), the
+    3x3 linear part row-major then the translation, clamped to the first and last step."""
+    a, f = step_of(info[obj, I_STEPS], t)
+    a += info[obj, I_STEP0]
     if info[obj, I_STEPS] < 2:
-        return (linear[a, 0, 0], linear[a, 0, 1], linear[a, 0, 2], linear[a, 1, 0],
-                linear[a, 1, 1], linear[a, 1, 2], linear[a, 2, 0], linear[a, 2, 1],
-                linear[a, 2, 2], trans[a, 0], trans[a, 1], trans[a, 2])
-    return interpolate_steps(trans, quat, stretch, a, f)
+        return interpolate_steps(trans, quat, upper, a, a, 0.0)
+    return interpolate_steps(trans, quat, upper, a, a + 1, f)
 
 
 @kernel(inline="always")
-def interpolate_steps(trans, quat, stretch, a, f):
-    """The transform between step rows a and a + 1 at fraction f in [0, 1] of the way
-    (the body of RigidMotion.at, same formulas), on M.step_trans, step_quat,
-    step_stretch."""
-    b = a + 1
+def interpolate_steps(trans, quat, upper, a, b, f):
+    """The transform between step rows a and b at fraction f in [0, 1] of the way (the
+    body of RigidMotion.at, same formulas), on M.step_trans, step_quat, step_upper:
+    translation and scale-and-skew linearly, rotation by spherical linear interpolation
+    (normalised linear above NLERP_DOT, as Embree)."""
     tx = trans[a, 0] + f * (trans[b, 0] - trans[a, 0])
     ty = trans[a, 1] + f * (trans[b, 1] - trans[a, 1])
     tz = trans[a, 2] + f * (trans[b, 2] - trans[a, 2])
-    s00 = stretch[a, 0, 0] + f * (stretch[b, 0, 0] - stretch[a, 0, 0])
-    s01 = stretch[a, 0, 1] + f * (stretch[b, 0, 1] - stretch[a, 0, 1])
-    s02 = stretch[a, 0, 2] + f * (stretch[b, 0, 2] - stretch[a, 0, 2])
-    s10 = stretch[a, 1, 0] + f * (stretch[b, 1, 0] - stretch[a, 1, 0])
-    s11 = stretch[a, 1, 1] + f * (stretch[b, 1, 1] - stretch[a, 1, 1])
-    s12 = stretch[a, 1, 2] + f * (stretch[b, 1, 2] - stretch[a, 1, 2])
-    s20 = stretch[a, 2, 0] + f * (stretch[b, 2, 0] - stretch[a, 2, 0])
-    s21 = stretch[a, 2, 1] + f * (stretch[b, 2, 1] - stretch[a, 2, 1])
-    s22 = stretch[a, 2, 2] + f * (stretch[b, 2, 2] - stretch[a, 2, 2])
+    s00 = upper[a, 0, 0] + f * (upper[b, 0, 0] - upper[a, 0, 0])
+    s01 = upper[a, 0, 1] + f * (upper[b, 0, 1] - upper[a, 0, 1])
+    s02 = upper[a, 0, 2] + f * (upper[b, 0, 2] - upper[a, 0, 2])
+    s10 = upper[a, 1, 0] + f * (upper[b, 1, 0] - upper[a, 1, 0])
+    s11 = upper[a, 1, 1] + f * (upper[b, 1, 1] - upper[a, 1, 1])
+    s12 = upper[a, 1, 2] + f * (upper[b, 1, 2] - upper[a, 1, 2])
+    s20 = upper[a, 2, 0] + f * (upper[b, 2, 0] - upper[a, 2, 0])
+    s21 = upper[a, 2, 1] + f * (upper[b, 2, 1] - upper[a, 2, 1])
+    s22 = upper[a, 2, 2] + f * (upper[b, 2, 2] - upper[a, 2, 2])
     # slerp (engine.motion._slerp)
     aw, ax, ay, az = quat[a, 0], quat[a, 1], quat[a, 2], quat[a, 3]
     bw, bx, by, bz = quat[b, 0], quat[b, 1], quat[b, 2], quat[b, 3]
@@ -151,7 +141,7 @@ def interpolate_steps(trans, quat, stretch, a, f):
     d = min(max(d, -1.0), 1.0)
     theta = math.acos(d)
     sn = math.sin(theta)
-    if sn < 1e-9:
+    if d > NLERP_DOT or sn < 1e-9:
         w0, w1 = 1.0 - f, f
     else:
         w0 = math.sin((1.0 - f) * theta) / sn
@@ -187,21 +177,3 @@ def adjugate_columns(a00, a01, a02, a10, a11, a12, a20, a21, a22):
     if not abs(det) > 1e-300:
         det = 1e-300
     return r0x, r0y, r0z, r1x, r1y, r1z, r2x, r2y, r2z, det
-
-
-@kernel(inline="always")
-def object_ray(info, times, trans, quat, stretch, linear, obj, t, ox, oy, oz, dx, dy, dz):
-    """A world ray (o, d) moved into rigid object obj's space at time t: the inverse of
-    the transform at t (`rigid_at`) applied to o - translation and to d. The ray
-    parameter is unchanged by an affine map, so distances compare directly."""
-    a00, a01, a02, a10, a11, a12, a20, a21, a22, tx, ty, tz = rigid_at(
-        info, times, trans, quat, stretch, linear, obj, t)
-    r0x, r0y, r0z, r1x, r1y, r1z, r2x, r2y, r2z, det = adjugate_columns(
-        a00, a01, a02, a10, a11, a12, a20, a21, a22)
-    qx, qy, qz = ox - tx, oy - ty, oz - tz
-    return ((r0x / det) * qx + (r0y / det) * qy + (r0z / det) * qz,
-            (r1x / det) * qx + (r1y / det) * qy + (r1z / det) * qz,
-            (r2x / det) * qx + (r2y / det) * qy + (r2z / det) * qz,
-            (r0x / det) * dx + (r0y / det) * dy + (r0z / det) * dz,
-            (r1x / det) * dx + (r1y / det) * dy + (r1z / det) * dz,
-            (r2x / det) * dx + (r2y / det) * dy + (r2z / det) * dz)

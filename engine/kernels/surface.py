@@ -12,8 +12,8 @@ import numpy as np
 from ..surface import RELATIVE_OFFSET
 from .frame import cross, dot
 from .jit import kernel
-from .motion import I_KIND, I_NVERTS, I_SLICES, I_VERT0, RIGID, adjugate_columns, object_of, \
-    rigid_at
+from .motion import I_KIND, I_NVERTS, I_STEPS, I_VERT0, RIGID, adjugate_columns, object_of, \
+    rigid_at, step_of
 from ..nodes.context import O_TO_OBJECT, O_TO_WORLD
 
 
@@ -83,7 +83,8 @@ def rebuild_at_time(geometry, prim, inst, u, v, dx, dy, dz, time):
     vertices are placed by the row's matrix, its corner normals by the inverse-transpose.
     A moving triangle is placed as engine.accel's moving objects are traced: a rigid
     object's vertices by its transform at `time`, its corner normals by that transform's
-    inverse-transpose; a deforming object's vertices from the time slice of `time`."""
+    inverse-transpose; a deforming object's vertices interpolated between the time steps
+    around `time`."""
     positions, corners, center, corner_normals, M = (geometry[0], geometry[1], geometry[2],
                                                      geometry[4], geometry[7])
     if prim < M.prim_start[0]:
@@ -103,23 +104,26 @@ def rebuild_at_time(geometry, prim, inst, u, v, dx, dy, dz, time):
     n00, n01, n02, n10, n11, n12, n20, n21, n22 = 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0
     if rigid:
         a00, a01, a02, a10, a11, a12, a20, a21, a22, tx, ty, tz = rigid_at(
-            info, M.step_time, M.step_trans, M.step_quat, M.step_stretch, M.step_linear,
-            obj, time)
+            info, M.step_trans, M.step_quat, M.step_upper, obj, time)
         # the normal matrix, the inverse-transpose: columns r_j / det
         r0x, r0y, r0z, r1x, r1y, r1z, r2x, r2y, r2z, det = adjugate_columns(
             a00, a01, a02, a10, a11, a12, a20, a21, a22)
         n00, n10, n20 = r0x / det, r0y / det, r0z / det
         n01, n11, n21 = r1x / det, r1y / det, r1z / det
         n02, n12, n22 = r2x / det, r2y / det, r2z / det
+        p0x, p0y, p0z = _place(verts, base + i0, a00, a01, a02, a10, a11, a12, a20,
+                               a21, a22, tx, ty, tz)
+        p1x, p1y, p1z = _place(verts, base + i1, a00, a01, a02, a10, a11, a12, a20,
+                               a21, a22, tx, ty, tz)
+        p2x, p2y, p2z = _place(verts, base + i2, a00, a01, a02, a10, a11, a12, a20,
+                               a21, a22, tx, ty, tz)
     else:
-        slices = info[obj, I_SLICES]
-        base += min(max(int(time * slices), 0), slices - 1) * info[obj, I_NVERTS]
-    p0x, p0y, p0z = _place(verts, base + i0, rigid, a00, a01, a02, a10, a11, a12, a20, a21,
-                           a22, tx, ty, tz)
-    p1x, p1y, p1z = _place(verts, base + i1, rigid, a00, a01, a02, a10, a11, a12, a20, a21,
-                           a22, tx, ty, tz)
-    p2x, p2y, p2z = _place(verts, base + i2, rigid, a00, a01, a02, a10, a11, a12, a20, a21,
-                           a22, tx, ty, tz)
+        step, f = step_of(info[obj, I_STEPS], time)
+        a = base + step * info[obj, I_NVERTS]
+        b = a + info[obj, I_NVERTS] if info[obj, I_STEPS] > 1 else a
+        p0x, p0y, p0z = _between(verts, a + i0, b + i0, f)
+        p1x, p1y, p1z = _between(verts, a + i1, b + i1, f)
+        p2x, p2y, p2z = _between(verts, a + i2, b + i2, f)
     px, py, pz, fx, fy, fz, sx, sy, sz, front = _placed_hit(
         p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z, corner_normals, prim, rigid,
         n00, n01, n02, n10, n11, n12, n20, n21, n22, u, v, dx, dy, dz, False)
@@ -127,6 +131,15 @@ def rebuild_at_time(geometry, prim, inst, u, v, dx, dy, dz, time):
               abs(p2x), abs(p2y), abs(p2z))
     scale = max(max(abs(px), abs(py), abs(pz)), tri)
     return px, py, pz, fx, fy, fz, sx, sy, sz, front, scale
+
+
+@kernel(inline="always")
+def _between(verts, a, b, f):
+    """Vertex row a moved the fraction f of the way to row b (one deformation step to the
+    next), as Embree interpolates it."""
+    return (verts[a, 0] + f * (verts[b, 0] - verts[a, 0]),
+            verts[a, 1] + f * (verts[b, 1] - verts[a, 1]),
+            verts[a, 2] + f * (verts[b, 2] - verts[a, 2]))
 
 
 @kernel(allocates=False)
@@ -149,11 +162,11 @@ def _rebuild_placed(positions, corners, center, corner_normals, o, prim, u, v, d
     n10, n11, n12 = o[w0 + 1], o[w0 + 5], o[w0 + 9]
     n20, n21, n22 = o[w0 + 2], o[w0 + 6], o[w0 + 10]
     i0, i1, i2 = corners[prim, 0], corners[prim, 1], corners[prim, 2]
-    p0x, p0y, p0z = _place(positions, i0, True, a00, a01, a02, a10, a11, a12, a20, a21, a22,
+    p0x, p0y, p0z = _place(positions, i0, a00, a01, a02, a10, a11, a12, a20, a21, a22,
                            tx, ty, tz)
-    p1x, p1y, p1z = _place(positions, i1, True, a00, a01, a02, a10, a11, a12, a20, a21, a22,
+    p1x, p1y, p1z = _place(positions, i1, a00, a01, a02, a10, a11, a12, a20, a21, a22,
                            tx, ty, tz)
-    p2x, p2y, p2z = _place(positions, i2, True, a00, a01, a02, a10, a11, a12, a20, a21, a22,
+    p2x, p2y, p2z = _place(positions, i2, a00, a01, a02, a10, a11, a12, a20, a21, a22,
                            tx, ty, tz)
     det = a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) \
         + a02 * (a10 * a21 - a11 * a20)
@@ -234,12 +247,9 @@ def rebuild_batch(geometry, prim, inst, u, v, d, time, position, geometric, shad
 
 
 @kernel(inline="always")
-def _place(verts, row, rigid, a00, a01, a02, a10, a11, a12, a20, a21, a22, tx, ty, tz):
-    """Vertex `row` placed in the world: through the affine map for a rigid object, as
-    stored (a time slice's world position) for a deforming one."""
+def _place(verts, row, a00, a01, a02, a10, a11, a12, a20, a21, a22, tx, ty, tz):
+    """Vertex `row` placed in the world through the affine map."""
     x, y, z = verts[row, 0], verts[row, 1], verts[row, 2]
-    if not rigid:
-        return x, y, z
     return (a00 * x + a01 * y + a02 * z + tx, a10 * x + a11 * y + a12 * z + ty,
             a20 * x + a21 * y + a22 * z + tz)
 
