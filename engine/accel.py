@@ -254,6 +254,8 @@ class Accelerator:
         self._geom_row = np.full(n, -1, np.int64)
         for g, base, row in ids:
             self._geom_base[g], self._geom_row[g] = base, row
+        # whether a hit's ids need mapping (anything beside the static triangles)
+        self._remaps = len(ids) > 1 or (len(ids) == 1 and ids[0][1:] != (0, -1))
         return scene.commit()
 
     def close(self):
@@ -295,6 +297,9 @@ class Accelerator:
         if query == "OCCLUDED":
             return out[0]
         geom, prim, inst, element, t, u, v = out
+        if not self._remaps:        # static triangles alone: ids are global already
+            inst.fill(-1)
+            return Hits(t, prim, u, v, inst)
         placed = inst >= 0          # an instance's geometry id in the top scene
         hit = geom >= 0
         owner = np.where(placed, inst, geom)[hit]   # the top scene's geometry hit

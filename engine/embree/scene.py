@@ -214,7 +214,7 @@ class Scene:
         aligned[...] = rows
         geom = self._new(L.GEOMETRY_INSTANCE)
         self._lib.rtcSetGeometryInstancedScene(geom, child.handle)
-        self._steps(geom, list(aligned))
+        self._steps(geom, aligned)
         for k in range(len(aligned)):
             self._lib.rtcSetGeometryTransformQuaternion(geom, k, _pointer(aligned[k]))
         check("rtcSetGeometryTransformQuaternion")

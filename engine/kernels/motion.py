@@ -74,6 +74,8 @@ def pack_motion(accel) -> PackedMotion:
     def cat(parts, shape, dtype):
         if not parts:
             return np.zeros(shape, dtype)
+        if len(parts) == 1:                  # one object's own array, not a copy
+            return np.ascontiguousarray(parts[0], dtype=dtype)
         return np.ascontiguousarray(np.concatenate(parts), dtype=dtype)
 
     return PackedMotion(prim_start, info, cat(trans, (0, 3), np.float64),
