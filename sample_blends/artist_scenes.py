@@ -29,10 +29,11 @@ from build_samples import (_packed_sky, camera, cuboid, mesh_object, principled,
 SIZE = (64, 48)
 
 
-def _new_scene():
-    """An empty scene at SIZE, 256 samples in both engines, Blender's defaults otherwise."""
+def _new_scene(size=SIZE):
+    """An empty scene of `size` pixels, 256 samples in both engines, Blender's defaults
+    otherwise."""
     scene = reset()
-    scene.render.resolution_x, scene.render.resolution_y = SIZE
+    scene.render.resolution_x, scene.render.resolution_y = size
     scene.render.resolution_percentage = 100
     scene.cycles.samples = 256
     if hasattr(scene, "drt"):

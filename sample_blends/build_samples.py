@@ -861,10 +861,12 @@ SCENES["sky_world"] = sky_world
 
 
 def _artist_scenes():
-    """sample_blends/artist_scenes.py's scenes (which use this module's helpers)."""
+    """sample_blends/artist_scenes.py's and volume_scenes.py's scenes (which use this
+    module's helpers)."""
     sys.path.insert(0, HERE)
     import artist_scenes
-    return artist_scenes.SCENES
+    import volume_scenes
+    return {**artist_scenes.SCENES, **volume_scenes.SCENES}
 
 
 if __name__ == "__main__":
@@ -885,6 +887,11 @@ def main(argv=None):
         # The small light scenes are stored compressed (86 KB instead of 440 KB each).
         bpy.ops.wm.save_as_mainfile(filepath=path, compress=name in LIGHT_SCENES
                                     or name in MOTION_SCENES)
+        if bpy.data.volumes:          # their OpenVDB files, named relative to the .blend
+            bpy.ops.file.make_paths_relative()
+            bpy.ops.wm.save_mainfile()
+            if os.path.exists(path + "1"):       # the backup Blender keeps of the first save
+                os.remove(path + "1")
         print(f"built {path}")
     return 0
 

@@ -334,6 +334,17 @@ def _blackbody(nt, p):
     return bb.outputs[0]
 
 
+def _blackbody_varying(nt, p):
+    """Blackbody of a temperature that varies across the tile, 600 K to 12600 K (past
+    both ends of Blender's table): looked up per hit."""
+    bb = p.node(nt, "ShaderNodeBlackbody")
+    m = p.node(nt, "ShaderNodeMath", operation="MULTIPLY_ADD")
+    nt.links.new(axis(nt, p, gen(nt, p), 0), m.inputs[0])
+    m.inputs[1].default_value, m.inputs[2].default_value = 12000.0, 600.0
+    nt.links.new(m.outputs[0], bb.inputs["Temperature"])
+    return bb.outputs[0]
+
+
 def _group(bpy_data, name, build_inner):
     """A shader node group with one float input and one float output."""
     g = bpy_data.node_groups.new(name, "ShaderNodeTree")
@@ -387,7 +398,8 @@ CONVERTER = [(f"math_{o.lower()}", _math(o)) for o in MATH_OPS] + [
     ("clamp_minmax", _clamp("MINMAX")), ("clamp_range", _clamp("RANGE")),
     ("color_rgb", _separate_combine("RGB")), ("color_hsv", _separate_combine("HSV")),
     ("color_hsl", _separate_combine("HSL")), ("rgb_to_bw", _rgb_to_bw),
-    ("blackbody", _blackbody), ("nested_groups", _nested_groups)]
+    ("blackbody", _blackbody), ("blackbody_varying", _blackbody_varying),
+    ("nested_groups", _nested_groups)]
 
 
 # ---------------------------------------------------------------- vector

@@ -330,8 +330,9 @@ def test_nan_vertex_drops_its_triangles_with_a_warning_naming_the_object(bpy_drt
 
 
 def test_hair_volumes_and_point_clouds_are_named_once_and_the_rest_renders(bpy_drt):
-    """What DRT cannot draw yet is never dropped silently: particle hair on a mesh, a hair
-    Curves object and a Volume object are named in one warning, and the render works."""
+    """What DRT cannot draw yet is never dropped silently: particle hair on a mesh and a
+    hair Curves object are named in one warning, a Volume object without a file in its
+    own, and the render works."""
     bpy = bpy_drt
     build_scene(bpy)
     from drt_addon.export import Reporter, export_scene
@@ -350,9 +351,10 @@ def test_hair_volumes_and_point_clouds_are_named_once_and_the_rest_renders(bpy_d
     s = export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
     said = [w for w in reporter.warnings if "not rendered yet" in w]
     assert len(said) == 1, reporter.warnings
-    for part in ("particle hair ('Plain (Fur)')", "Volume objects ('Smoke')",
-                 "hair curves ('Strands')"):
+    for part in ("particle hair ('Plain (Fur)')", "hair curves ('Strands')"):
         assert part in said[0], said[0]
+    smoke = [w for w in reporter.warnings if "Volume object 'Smoke'" in w]
+    assert len(smoke) == 1 and "names no OpenVDB file" in smoke[0], reporter.warnings
     assert _by_name(s, "Plain")                  # the emitter itself still renders
     last = _render_drt(bpy)
     assert last["ok"], last["error"]

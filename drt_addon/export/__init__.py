@@ -12,10 +12,11 @@ from .left_out import LEFT_OUT_TYPES, LeftOut
 from .libraries import missing_library_messages
 from .settings_check import check as check_file_settings
 from .lights import export_light, object_visibility
-from .materials import export_material
+from .materials import export_default_volume, export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
 from .motion import MotionExport, read_settings
 from .object_info import object_info, object_values
+from .volume_objects import density_scale, domain, read_volume
 from .volumes import is_heterogeneous, world_volume
 from .world import export_world
 
@@ -98,9 +99,15 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     view_layer = depsgraph.view_layer
     materials, material_index = [], {}
 
-    def material_id(mat, owner=None):
+    def material_id(mat, owner=None, grids=None, density_scale=1.0):
         """The index of `mat` for object `owner`: a material whose volume varies in space
-        gets one copy per object (the engine evaluates it in that object's coordinates)."""
+        gets one copy per object (the engine evaluates it in that object's coordinates);
+        on a Volume object (its `grids`) it is exported for that object alone."""
+        if grids is not None:
+            materials.append(export_material(mat, reporter, grids, density_scale)
+                             if mat is not None
+                             else export_default_volume(reporter, grids, density_scale))
+            return len(materials) - 1
         key = mat.name_full if mat is not None else None
         if key not in material_index:
             material_index[key] = len(materials)
@@ -128,6 +135,10 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         if check_cancel is not None:
             check_cancel()
         obj = inst.object
+        if obj.type == "VOLUME":
+            if inst.is_instance or inst.show_self:
+                _place_volume(inst, obj, k, groups, material_id, reporter, view_layer)
+            continue
         if obj.type in GEOMETRY_TYPES:
             if not inst.is_instance and not inst.show_self:
                 continue
@@ -214,6 +225,25 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     return engine.Scene(camera, region.width, region.height, meshes, materials, lights, world,
                         pixel_aspect=aspect, shutter=shutter,
                         film_transparent=bool(scene.render.film_transparent))
+
+
+def _place_volume(inst, obj, k, groups, material_id, reporter, view_layer) -> None:
+    """A Volume object: its grids, read from its OpenVDB file, in the box around them,
+    with its materials exported for those grids (export.volume_objects)."""
+    grids = read_volume(obj, reporter)
+    if grids is None:
+        return
+    scale = density_scale(obj, inst.matrix_world)
+    slots = ([material_id(s.material, k, grids, scale) for s in obj.material_slots]
+             or [material_id(None, k, grids, scale)])
+    name = f"{obj.name}#{k}" if inst.is_instance else obj.name
+    holdout = _is_holdout(inst, obj, view_layer)
+    seen = object_visibility(obj)
+    color, pass_index, texspace = object_values(obj)
+    source = Source(groups.group(domain(grids), slots, name, holdout, 0.0, seen, True,
+                                 texspace),
+                    color, pass_index, holdout, crypto_names(inst, obj))
+    groups.place(source, inst.matrix_world, inst.random_id)
 
 
 # the key of the one warning about a black image (said by the export, or after the render)

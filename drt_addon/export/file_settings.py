@@ -64,7 +64,7 @@ def _no_effect(names, how, prefix="scene.cycles"):
     return [_s(f"{prefix}.{name}", name, NO_EFFECT, how) for name in names]
 
 
-_NO_VOLUMES = "DRT renders the volumes of materials and the world, not Volume objects (grids)"
+_NO_VOLUMES = "DRT renders every volume anyway, Volume objects' grids at their full resolution"
 _NULL_SCATTERING = ("DRT renders volumes without ray marching steps: homogeneous ones exactly, "
                     "ones that vary in space (a texture on Density) by null scattering, "
                     "unbiased as Cycles' default")

@@ -1,11 +1,10 @@
 """What the scene holds that DRT does not render yet, named once in Blender's report so
-that nothing is dropped silently: particle hair, hair Curves objects, Volume objects
-(OpenVDB grids, baked smoke) and point clouds. The rest of the scene renders."""
+that nothing is dropped silently: particle hair, hair Curves objects and point clouds.
+The rest of the scene renders. (Volume objects render: export.volume_objects.)"""
 from __future__ import annotations
 
 # object types DRT cannot draw yet, as their kind in the warning
-LEFT_OUT_TYPES = {"VOLUME": "Volume objects", "POINTCLOUD": "point clouds",
-                  "CURVES": "hair curves"}
+LEFT_OUT_TYPES = {"POINTCLOUD": "point clouds", "CURVES": "hair curves"}
 
 
 class LeftOut:

@@ -93,7 +93,7 @@ from .nodes.displacement import displacement_normal
 from .nodes.errors import Unsupported
 from .nodes.links import _all_nodes, _link, _output_node, tree_problems, uses_nodes
 from .nodes.shader import _closure
-from .volumes import export_volume
+from .volumes import default_volume, export_volume
 
 
 
@@ -181,13 +181,18 @@ def _attach_programs(m, ctx, program):
         _attach_programs(side, ctx, program)
 
 
-def export_material(mat, reporter: Reporter) -> "engine.Material":
+def export_material(mat, reporter: Reporter, grids=None,
+                    density_scale: float = 1.0) -> "engine.Material":
     """`mat` (None: an empty slot) as an engine Material, with Cycles' meaning; what is
-    approximated is reported once, in one warning naming the material."""
+    approximated is reported once, in one warning naming the material. On a Volume
+    object, `grids` ({name: engine.volume_grid.VoxelGrid}) are what its Attribute nodes
+    read and `density_scale` its Object-space density (export.volume_objects)."""
     if mat is None:
         return engine.Material("none")
     name = mat.name
     ctx = _Ctx(mat, reporter)
+    ctx.volume_grids = grids or {}
+    ctx.volume_density_scale = float(density_scale)
     fallback = engine.Material(name, tuple(mat.diffuse_color[:3]), metallic=float(mat.metallic),
                                roughness=float(mat.roughness), specular_ior_level=0.5,
                                glossy_model="MULTI_GGX")
@@ -203,6 +208,32 @@ def export_material(mat, reporter: Reporter) -> "engine.Material":
         reporter.warn(f"DRT: material {name!r}: " + "; ".join(ctx.issues),
                       key=(name, "material"))
     result.pass_index = int(getattr(mat, "pass_index", 0))     # the Material Index pass
+    return result
+
+
+class _DefaultVolume:
+    """What a Volume object without a material renders with (Cycles' default volume)."""
+    name = "DRT default volume"
+    diffuse_color = (0.8, 0.8, 0.8, 1.0)
+    metallic, roughness = 0.0, 0.5
+    cycles = None
+
+
+def export_default_volume(reporter: Reporter, grids, density_scale: float
+                          ) -> "engine.Material":
+    """The material of a Volume object with no material: Cycles' default volume shader
+    (export.volumes.default_volume) over its grids, with no surface."""
+    ctx = _Ctx(_DefaultVolume(), reporter)
+    ctx.volume_grids = grids or {}
+    ctx.volume_density_scale = float(density_scale)
+    result = engine.Material(_DefaultVolume.name, (0.0, 0.0, 0.0), specular_ior_level=0.0)
+    result.volume = default_volume(ctx)
+    _attach_programs(result, ctx, ctx.nodes.build())
+    if ctx.volume_outputs:
+        program = result.shader or ctx.nodes.build()
+        result.shader = dataclasses.replace(
+            program, outputs={**program.outputs, **ctx.volume_outputs})
+    result.surface = False
     return result
 
 

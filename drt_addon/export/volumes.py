@@ -5,8 +5,10 @@ read for meaning only):
 Principled Volume
     scattering = Color x Density, Henyey-Greenstein with Anisotropy; absorption =
     max(1 - Color, 0) x max(1 - sqrt(Absorption Color), 0) x Density (the light the
-    colour does not scatter, tinted); emission = Emission Color x Emission Strength.
-    Blackbody emission is not rendered (reported).
+    colour does not scatter, tinted); emission = Emission Color x Emission Strength
+    plus the blackbody emission of the Temperature (`_blackbody`). On a Volume object,
+    the grids its Density, Color and Temperature Attributes name scale those inputs;
+    all its coefficients scale by its Object-space density (export.volume_objects).
 Volume Scatter
     scattering = Color x Density (Henyey-Greenstein; other phase functions reported and
     rendered as Henyey-Greenstein).
@@ -31,11 +33,16 @@ varies is replaced by its average (reported).
 from __future__ import annotations
 
 import importlib
+import math
 
 import numpy as np
 
 from ..engine_link import engine
+from .blackbody import blackbody_rgb
 from .material_params import _is_tex
+from .nodes.converter import blackbody_of
+from .nodes.input import grid_value
+from .volume_objects import attribute_name
 from .nodes.links import _link
 from .nodes.shader import _constant, _input
 from .world import _WorldCtx, world_output
@@ -140,17 +147,62 @@ def _scatter(alg, color, density, g):
     return ss, float(alg.mean(ss).mean()) * g
 
 
+# Cycles' blackbody emission of the Principled Volume: Stefan-Boltzmann's constant, per
+# square micrometre (1e-6), over pi (radiance)
+BLACKBODY_SIGMA = 5.670373e-8 * 1e-6 / math.pi
+
+
+def _grid(ctx, node, socket):
+    """The Volume object's grid that the node's attribute input names, or None."""
+    grids = getattr(ctx, "volume_grids", None) or {}
+    return grids.get(attribute_name(node, socket))
+
+
+def _blackbody(node, ctx, alg):
+    """The Principled Volume's blackbody emission, as Cycles: Tint x sigma x
+    mix(1, T^4, Intensity) x the blackbody colour of T (luminance 1), where T is the
+    Temperature times the temperature grid (when the object has it). Cycles 5 reads the
+    grid by stochastic interpolation (one voxel's value per lookup), so the emission is
+    the trilinear blend of the voxels' emissions, brighter than the emission of the
+    blended temperature where it varies steeply; DRT reads it the same way. (The
+    Density and Color grids, on which the coefficients depend linearly, are read
+    trilinearly: the same expectation, with less noise.)"""
+    intensity = _constant(node, "Blackbody Intensity", ctx, 0.0)
+    if intensity <= 0.0:
+        return _ZERO
+    kelvin = alg.max0(_read(node, "Temperature", ctx, 1000.0))
+    grid = _grid(ctx, node, "Temperature Attribute")
+    if grid is not None:              # read as Cycles 5 reads it: one voxel's value
+        kelvin = alg.mul(kelvin, alg.max0(grid_value(ctx.nodes, grid, "float", True)))
+    if _varies(kelvin):
+        kelvin = ctx.nodes.convert(alg.vector(kelvin), "float")
+        color = blackbody_of(ctx.nodes, kelvin)
+        t2 = alg.mul(kelvin, kelvin)
+        power = alg.add(1.0 - intensity, alg.mul(alg.mul(t2, t2), intensity))
+    else:
+        k = float(np.asarray(kelvin).ravel()[0])
+        color = np.asarray(blackbody_rgb(k))
+        power = (1.0 - intensity) + intensity * k ** 4
+    tint = alg.max0(_read(node, "Blackbody Tint", ctx, (1.0,) * 3, True))
+    return alg.mul(alg.mul(tint, color), alg.mul(power, BLACKBODY_SIGMA))
+
+
 def _principled(node, ctx, alg):
     density = alg.max0(_read(node, "Density", ctx, 1.0))
+    grid = _grid(ctx, node, "Density Attribute")
+    if grid is not None:              # a Volume object's density grid scales the Density
+        density = alg.max0(alg.mul(density, grid_value(ctx.nodes, grid, "float")))
     color = alg.max0(_read(node, "Color", ctx, (0.5,) * 3, True))
+    grid = _grid(ctx, node, "Color Attribute")
+    if grid is not None:
+        color = alg.mul(color, grid_value(ctx.nodes, grid, "color"))
     ss, gs = _scatter(alg, color, density, _constant(node, "Anisotropy", ctx, 0.0))
     absorb = _read(node, "Absorption Color", ctx, (0.0,) * 3, True)
     sa = alg.mul(alg.mul(alg.max0(alg.one_minus(color)),
                          alg.max0(alg.one_minus(alg.sqrt0(absorb)))), density)
     em = alg.max0(alg.mul(_read(node, "Emission Color", ctx, (1.0,) * 3, True),
                           _read(node, "Emission Strength", ctx, 0.0)))
-    if _constant(node, "Blackbody Intensity", ctx, 0.0) > 1e-3:
-        ctx.issue(f"{node.name!r}: blackbody emission is not rendered")
+    em = alg.add(em, _blackbody(node, ctx, alg))
     return _Coeffs(sa, ss, gs, em)
 
 
@@ -235,7 +287,26 @@ def export_volume(socket, ctx) -> "engine.Volume | None":
     if socket is None or _link(socket) is None:
         return None
     alg = _Algebra(ctx.nodes)
-    c = _coeffs(socket, ctx, alg)
+    return _volume_of(_coeffs(socket, ctx, alg), ctx, alg)
+
+
+def default_volume(ctx) -> "engine.Volume | None":
+    """Cycles' default volume shader, which fills a Volume object that has no material:
+    a Principled Volume at its defaults (Density 1 times the object's density grid,
+    Color 0.5; its Blackbody Intensity is 0). ctx as export_volume's."""
+    alg = _Algebra(ctx.nodes)
+    density = 1.0
+    grid = (getattr(ctx, "volume_grids", None) or {}).get("density")
+    if grid is not None:
+        density = alg.max0(grid_value(ctx.nodes, grid, "float"))
+    half = np.full(3, 0.5)
+    return _volume_of(_Coeffs(alg.mul(half, density), alg.mul(half, density)), ctx, alg)
+
+
+def _volume_of(c, ctx, alg):
+    scale = getattr(ctx, "volume_density_scale", 1.0)
+    if scale != 1.0:              # a Volume object's Object-space density (Cycles)
+        c = c.scaled(scale, alg)
     sa, ss, em = alg.mean(c.sa), alg.mean(c.ss), alg.mean(c.em)
     ss_mean = float(ss.mean())
     g = c.gs / ss_mean if ss_mean > 0 else 0.0

@@ -29,7 +29,8 @@ so are the weights, which costs variance, never bias. The bound only decides the
 noise and the number of program runs (about mu times the length). `bound_majorants`
 takes it as 1.5 times the largest value of 4096 jittered samples of the program over
 the row's meshes' bounds (Cycles takes 16 samples per octree voxel, and scales on-the-fly
-estimates by 1.5); a program that is zero everywhere sampled gets MU_FLOOR.
+estimates by 1.5), and at the centres of the largest voxels of the grids the program
+reads (`grid_peaks`); a program that is zero everywhere sampled gets MU_FLOOR.
 
 Paths through homogeneous media only never reach this module: `has_heterogeneous`
 is checked once per kernel call, and each evaluation of a program here counts in the
@@ -41,9 +42,11 @@ import math
 import numpy as np
 
 from .. import visibility
-from ..nodes.context import N_HIT, fill
+from ..nodes.context import N_HIT, O_TO_WORLD, fill
 from ..nodes.interpreter import run
-from ..nodes.pack import NREGS, OUTS
+from ..nodes.pack import GRIDS, NREGS, OPS, OUTS, PROG, VOXELS
+from ..nodes.texture_nodes import TEX_GRID
+from ..volume_grid import G_AFFINE, G_C, G_NX, G_NY, G_NZ, G_OFFSET
 from ..nodes.shading import OUT_VOL_EM, OUT_VOL_SA, OUT_VOL_SS
 from ..sampling.hashing import chain, unit_float
 from .jit import kernel
@@ -53,6 +56,7 @@ MAX_STEPS = 1024           # collisions per segment (Cycles' VOLUME_MAX_STEPS)
 MU_FLOOR = 1e-2            # the majorant of a program found zero everywhere sampled
 MAJORANT_SCALE = 1.5
 BOUND_SAMPLES = 16         # per axis of the jittered grid over a row's bounds
+PEAK_VOXELS = 4096         # largest voxels of each grid a row reads, also sampled
 HET_DIM = 1 << 26          # the tracking's own random numbers (hashed: any count)
 SHADOW = visibility.SHADOW
 
@@ -288,5 +292,51 @@ def bound_majorants(vol, T, tri_material, tri_object, objects, triangles, camera
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         top = _sample_row(vol, int(m), T, objects, camera, np.ascontiguousarray(lo),
                           np.ascontiguousarray(hi), BOUND_SAMPLES, np.uint64(0x5EED))
+        peaks = grid_peaks(T, int(m), objects, int(vol[m, V_OBJ]))
+        if len(peaks):
+            top = max(top, _sample_points(vol, int(m), T, objects, camera, peaks))
         vol[m, V_MAJ] = max(MAJORANT_SCALE * top, MU_FLOOR)
     return vol
+
+
+def grid_peaks(T, m, objects, obj) -> np.ndarray:
+    """World-space centres (k, 3) of the PEAK_VOXELS largest voxels of each grid material
+    m's program reads (a Volume object's density, temperature, ...): a trilinear grid
+    peaks at a voxel centre, so a program that grows with its grids peaks there too,
+    where the jittered samples of a sparse smoke would miss it."""
+    prog = T[PROG]
+    if not (0 <= m < prog.shape[0]) or prog[m, 1] == 0 or T[GRIDS].shape[0] == 0:
+        return np.zeros((0, 3))
+    ops = T[OPS][prog[m, 0]:prog[m, 0] + prog[m, 1]]
+    found = []
+    for g in np.unique(ops[ops[:, 0] == TEX_GRID, 7]):
+        row = T[GRIDS][g]
+        nx, ny, nz, nc = (int(row[G_NX]), int(row[G_NY]), int(row[G_NZ]), int(row[G_C]))
+        start = int(row[G_OFFSET])
+        block = T[VOXELS][start:start + nx * ny * nz * nc].reshape(nx * ny * nz, nc)
+        mag = np.abs(block).max(axis=1)
+        k = min(PEAK_VOXELS, mag.size)
+        idx = np.argpartition(mag, mag.size - k)[mag.size - k:]
+        ijk = np.stack(np.unravel_index(idx, (nx, ny, nz)), 1).astype(np.float64)
+        affine = row[G_AFFINE:G_AFFINE + 12].reshape(3, 4)
+        local = np.linalg.solve(affine[:, :3], (ijk - affine[:, 3]).T).T
+        if 0 <= obj < objects.shape[0]:
+            to_world = objects[obj, O_TO_WORLD:O_TO_WORLD + 12].reshape(3, 4)
+            local = local @ to_world[:, :3].T + to_world[:, 3]
+        found.append(local)
+    return np.ascontiguousarray(np.concatenate(found)) if found else np.zeros((0, 3))
+
+
+@kernel
+def _sample_points(vol, m, T, objects, camera, pts):
+    """The largest extinction or emission channel of row m at the points pts (k, 3)."""
+    hit = np.zeros(N_HIT)
+    regs = np.zeros(max(T[NREGS][0], 1))
+    count = np.zeros(1, np.int64)
+    top = 0.0
+    for i in range(pts.shape[0]):
+        sar, sag, sab, ssr, ssg, ssb, er, eg, eb = row_coefficients(
+            vol, m, T, objects, camera, pts[i, 0], pts[i, 1], pts[i, 2], 0.0, 0.0, -1.0,
+            1, 0, hit, regs, count)
+        top = max(top, sar + ssr, sag + ssg, sab + ssb, er, eg, eb)
+    return top

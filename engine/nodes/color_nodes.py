@@ -13,6 +13,12 @@
   COL_CURVES out, fac, color | table                RGB Curves: Cycles' table (field 6:
                                                     its start, after the curves' x range
                                                     min, max), extrapolated linearly
+  COL_TABLE out, x | table                          a colour tabulated over x (field 6:
+                                                    its start: x0, x1, n, then n RGB
+                                                    rows evenly spaced from x0 to x1),
+                                                    linear between rows, the end rows
+                                                    beyond them (Blackbody of a varying
+                                                    temperature)
 
 The blend modes follow Cycles' node functions (kernel/svm/color_util.h); the factor is
 clamped by the compiler where the node clamps it.
@@ -31,7 +37,8 @@ COL_GAMMA = 204
 COL_BRIGHT_CONTRAST = 205
 COL_HSV = 206
 COL_CURVES = 207
-DATA_OPS = (COL_RAMP_COLOR, COL_RAMP_ALPHA, COL_CURVES)
+COL_TABLE = 208
+DATA_OPS = (COL_RAMP_COLOR, COL_RAMP_ALPHA, COL_CURVES, COL_TABLE)
 
 BLEND_MODES = ("MIX", "DARKEN", "MULTIPLY", "BURN", "LIGHTEN", "SCREEN", "DODGE", "ADD",
                "OVERLAY", "SOFT_LIGHT", "LINEAR_LIGHT", "DIFFERENCE", "EXCLUSION",
@@ -206,6 +213,22 @@ def extrapolated(data, start, f, channel):
     return ramp(data, start, f, 1, channel)
 
 
+@kernel
+def tabulated(data, start, x, channel):
+    """Channel `channel` of the COL_TABLE table at `start`, at x (0 for NaN)."""
+    x0, x1, n = data[start], data[start + 1], int(data[start + 2])
+    if not math.isfinite(x) or n < 1:
+        return 0.0 if n < 1 else data[start + 3 + channel]
+    f = (x - x0) / (x1 - x0) * (n - 1) if x1 != x0 else 0.0
+    f = min(max(f, 0.0), n - 1.0)
+    i = min(int(f), n - 2) if n > 1 else 0
+    t = f - i
+    v = data[start + 3 + 3 * i + channel]
+    if n > 1 and t > 0.0:
+        v = (1.0 - t) * v + t * data[start + 3 + 3 * (i + 1) + channel]
+    return v
+
+
 @kernel(allocates=False)
 def execute(ins, regs, data):
     code, out = ins[0], ins[1]
@@ -238,6 +261,10 @@ def execute(ins, regs, data):
         b = bright - contrast * 0.5
         for k in range(3):
             regs[out + k] = max(a * regs[c + k] + b, 0.0)
+    elif code == COL_TABLE:
+        x = regs[ins[2]]
+        for k in range(3):
+            regs[out + k] = tabulated(data, ins[6], x, k)
     elif code == COL_CURVES:
         t, c, start = regs[ins[2]], ins[3], ins[6]
         lo, hi = data[start], data[start + 1]

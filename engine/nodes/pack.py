@@ -15,16 +15,20 @@ types, so one compilation serves every scene):
   T[NREGS]  int64 (1,): the largest register count (the size of a register file)
   T[MIX]    int64 (n_mat, 2): the two materials a material's Mix Shader picks between
             per hit (MaterialTable.mix_children; -1: none)
+  T[VOXELS] float32: the values of every voxel grid the programs read, concatenated
+  T[GRIDS]  float64 (n_grids, volume_grid.N_GRID): each grid's offset, size and map
+            (engine.volume_grid.pack_grids); grid operations name rows of it
 """
 from __future__ import annotations
 
 import numpy as np
 
 from ..kernels.textures import pack_textures
+from ..volume_grid import pack_grids
 from .bump import BUMP_ENTER, BUMP_NORMAL
 from .color_nodes import DATA_OPS
 from .program import N_OUT, OUTPUTS, WIDTH
-from .texture_nodes import IMAGE_OPS
+from .texture_nodes import GRID_OPS, GRIDS, IMAGE_OPS, VOXELS
 
 OPS = 5
 INIT = 6
@@ -33,6 +37,7 @@ PROG = 8
 OUTS = 9
 NREGS = 10
 MIX = 11
+assert (VOXELS, GRIDS) == (MIX + 1, MIX + 2)
 
 
 def pack_programs(table) -> tuple:
@@ -44,6 +49,7 @@ def pack_programs(table) -> tuple:
     outs = np.full((n_mat, N_OUT), -1, np.int64)
     ops, init, data = [], [], []
     n_ops = n_init = n_data = 0
+    grids, grid_index = [], {}
     for m, p in enumerate(programs):
         if p is None or len(p.ops) == 0:
             continue
@@ -53,6 +59,12 @@ def pack_programs(table) -> tuple:
                 o[k, 7] = table.texture_index[id(p.images[o[k, 7]])]
             if o[k, 0] in DATA_OPS:
                 o[k, 6] += n_data
+            if o[k, 0] in GRID_OPS:
+                grid = p.grids[o[k, 7]]
+                if id(grid) not in grid_index:
+                    grid_index[id(grid)] = len(grids)
+                    grids.append(grid)
+                o[k, 7] = grid_index[id(grid)]
         bumps = bool(np.isin(o[:, 0], (BUMP_ENTER, BUMP_NORMAL)).any())
         prog[m] = (n_ops, len(o), n_init, p.n_regs, bumps)
         for j, name in enumerate(OUTPUTS):
@@ -64,12 +76,14 @@ def pack_programs(table) -> tuple:
         n_ops += len(o)
         n_init += p.n_regs
         n_data += len(p.data)
+    voxels, grid_rows = pack_grids(grids)
     return (np.concatenate(ops) if ops else np.zeros((0, WIDTH), np.int32),
             np.concatenate(init) if init else np.zeros(0),
             np.concatenate(data) if data else np.zeros(0),
             prog, outs, np.array([int(prog[:, 3].max()) if n_mat else 0], np.int64),
             np.ascontiguousarray(getattr(table, "mix_children",
-                                         np.full((n_mat, 2), -1, np.int64)), np.int64))
+                                         np.full((n_mat, 2), -1, np.int64)), np.int64),
+            voxels, grid_rows)
 
 
 def pack_shading(table) -> tuple:

@@ -47,12 +47,14 @@ class ShaderProgram:
     engine.textures.Texture objects that image operations name by index (field 7 of
     their instruction, texture_nodes.IMAGE_OPS); data: float64 tables (a Color Ramp's)
     that table operations (color_nodes.DATA_OPS) address by offset (field 6); outputs:
-    {OUTPUTS name: Value}."""
+    {OUTPUTS name: Value}; grids: the engine.volume_grid.VoxelGrids that grid
+    operations (texture_nodes.GRID_OPS) name by index (field 7)."""
     ops: np.ndarray
     init: np.ndarray
     images: list = field(default_factory=list)
     data: np.ndarray = field(default_factory=lambda: np.zeros(0))
     outputs: dict = field(default_factory=dict)
+    grids: list = field(default_factory=list)
 
     @property
     def n_regs(self) -> int:
@@ -93,6 +95,7 @@ class ProgramBuilder:
         self._image_index = {}
         self.outputs = {}
         self._data = []
+        self.grids = []
 
     def _alloc(self, width):
         reg = len(self._init)
@@ -126,19 +129,28 @@ class ProgramBuilder:
             self.images.append(texture)
         return self._image_index[id(texture)]
 
+    def grid(self, grid) -> int:
+        """The index of an engine.volume_grid.VoxelGrid in this program's grids."""
+        for k, g in enumerate(self.grids):
+            if g is grid:
+                return k
+        self.grids.append(grid)
+        return len(self.grids) - 1
+
     def data(self, values) -> int:
         """Append a float table to the program's data; its offset."""
         offset = len(self._data)
         self._data.extend(float(x) for x in np.asarray(values, np.float64).ravel())
         return offset
 
-    def emit(self, opcode: int, kind: str, operands=(), varying=None, image=None) -> Value:
+    def emit(self, opcode: int, kind: str, operands=(), varying=None, image=None,
+             grid=None) -> Value:
         """One instruction writing a new register of `kind`. operands: up to six ints
         (registers of Values or immediate codes; Values are replaced by their register).
-        varying: defaults to whether any Value operand varies. image: a Texture to read
-        (its index goes to field 7)."""
+        varying: defaults to whether any Value operand varies. image: a Texture to read,
+        or grid: a VoxelGrid (its index goes to field 7)."""
         ops = [o.reg if isinstance(o, Value) else int(o) for o in operands]
-        if len(ops) > WIDTH - 2 - (image is not None):
+        if len(ops) > WIDTH - 2 - (image is not None or grid is not None):
             raise ValueError(f"opcode {opcode}: too many operands")
         if varying is None:
             varying = any(o.varying for o in operands if isinstance(o, Value))
@@ -146,6 +158,8 @@ class ProgramBuilder:
         row = [opcode, out.reg] + ops + [0] * (WIDTH - 2 - len(ops))
         if image is not None:
             row[7] = self.image(image)
+        if grid is not None:
+            row[7] = self.grid(grid)
         self._ops.append(row)
         return out
 
@@ -160,4 +174,5 @@ class ProgramBuilder:
     def build(self) -> ShaderProgram:
         ops = np.array(self._ops, np.int32).reshape(-1, WIDTH)
         return ShaderProgram(ops, np.array(self._init, np.float64), list(self.images),
-                             np.array(self._data, np.float64), dict(self.outputs))
+                             np.array(self._data, np.float64), dict(self.outputs),
+                             list(self.grids))

@@ -7,9 +7,17 @@ when its Vector is unlinked).
   TEX_CHECKER_COLOR out, vector, color1, color2, scale
   TEX_CHECKER_FAC out, vector, scale
   TEX_GRADIENT out, vector, type          Fac of the Gradient Texture (GRADIENT_* types)
+  TEX_GRID out, vector, triple, stochastic | grid
+                                          a voxel grid at the object-space point vector
+                                          (engine.volume_grid): triple 0 writes one
+                                          register, its channels' average; 1 three (a
+                                          scalar grid repeated); stochastic 1: Cycles'
+                                          one-tap interpolation (kernels.voxel_grid)
 
 Image lookups are engine.kernels.textures.texture_rgba (the node's interpolation,
 extension and colour space, baked into the packed texture); field 7 holds the image.
+Grid lookups are engine.kernels.voxel_grid.grid_sample; field 7 holds the grid, whose
+values and rows are the fields VOXELS and GRIDS of T (engine.nodes.pack).
 """
 from __future__ import annotations
 
@@ -17,13 +25,17 @@ import math
 
 from ..kernels.jit import kernel
 from ..kernels.textures import texture_rgba
+from ..kernels.voxel_grid import grid_channels, grid_sample
 
 TEX_IMAGE_COLOR = 100
 TEX_IMAGE_ALPHA = 101
 TEX_CHECKER_COLOR = 102
 TEX_CHECKER_FAC = 103
 TEX_GRADIENT = 104
+TEX_GRID = 105
 IMAGE_OPS = (TEX_IMAGE_COLOR, TEX_IMAGE_ALPHA)
+GRID_OPS = (TEX_GRID,)
+VOXELS, GRIDS = 12, 13     # the grids' fields of the shading tuple T (engine.nodes.pack)
 
 GRADIENT_TYPES = ("LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "SPHERICAL",
                   "QUADRATIC_SPHERE", "RADIAL")
@@ -83,3 +95,18 @@ def execute(ins, regs, T):
         regs[out] = checker(regs[v], regs[v + 1], regs[v + 2], regs[ins[3]])
     elif code == TEX_GRADIENT:
         regs[out] = gradient(regs[v], regs[v + 1], regs[v + 2], ins[3])
+    elif code == TEX_GRID:
+        g, st = ins[7], ins[4] != 0
+        nc = grid_channels(T[GRIDS], g)
+        x, y, z = regs[v], regs[v + 1], regs[v + 2]
+        if nc == 3:
+            r = grid_sample(T[VOXELS], T[GRIDS], g, x, y, z, 0, st)
+            gg = grid_sample(T[VOXELS], T[GRIDS], g, x, y, z, 1, st)
+            b = grid_sample(T[VOXELS], T[GRIDS], g, x, y, z, 2, st)
+        else:
+            r = grid_sample(T[VOXELS], T[GRIDS], g, x, y, z, 0, st)
+            gg, b = r, r
+        if ins[3] == 0:
+            regs[out] = (r + gg + b) / 3.0
+        else:
+            regs[out], regs[out + 1], regs[out + 2] = r, gg, b

@@ -53,8 +53,8 @@ class NodeCompiler:
     def const(self, x, kind=None):
         return self.b.constant(x, kind)
 
-    def emit(self, opcode, kind, operands=(), varying=None, image=None):
-        return self.b.emit(opcode, kind, operands, varying, image)
+    def emit(self, opcode, kind, operands=(), varying=None, image=None, grid=None):
+        return self.b.emit(opcode, kind, operands, varying, image, grid)
 
     def convert(self, value, kind):
         """`value` as a `kind` value ('float', 'color', 'vector'), Cycles' link rules."""

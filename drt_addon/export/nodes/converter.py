@@ -6,11 +6,14 @@ from __future__ import annotations
 
 import importlib
 
+import numpy as np
+
 from ...engine_link import engine
-from ..blackbody import blackbody_rgb
+from ..blackbody import blackbody_rgb, table as blackbody_table
 from .errors import Unsupported
 
 CV = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
+COL = importlib.import_module(engine.__name__ + ".nodes.color_nodes")
 
 
 def _math(c, node, out):
@@ -80,13 +83,20 @@ def _rgb_to_bw(c, node, out):
     return c.input(node, "Color", "float")         # the link converts by luminance
 
 
+def blackbody_of(c, kelvin):
+    """Blender's blackbody colour (luminance 1, export/blackbody.py) of a temperature
+    Value: a constant when it folds to one, else looked up per hit in the table (linear
+    between its 25 K rows, as blackbody_rgb)."""
+    folded = c.fold(kelvin)
+    if folded is not None:
+        return c.const(blackbody_rgb(folded), "color")
+    t, rgb = blackbody_table()
+    offset = c.b.data(np.concatenate([[t[0], t[-1], len(t)], rgb.ravel()]))
+    return c.emit(COL.COL_TABLE, "color", [kelvin, 0, 0, 0, offset])
+
+
 def _blackbody(c, node, out):
-    """Blender's blackbody colour (luminance 1) of a Temperature that does not vary per
-    hit (export/blackbody.py); a varying one is not evaluated."""
-    kelvin = c.fold(c.input(node, "Temperature", "float"))
-    if kelvin is None:
-        raise Unsupported("a Blackbody of a temperature that varies")
-    return c.const(blackbody_rgb(kelvin), "color")
+    return blackbody_of(c, c.input(node, "Temperature", "float"))
 
 
 TRANSLATORS = {

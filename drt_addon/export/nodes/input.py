@@ -11,6 +11,7 @@ from .errors import Unsupported
 I = importlib.import_module(engine.__name__ + ".nodes.input_nodes")
 C = importlib.import_module(engine.__name__ + ".nodes.context")
 V = importlib.import_module(engine.__name__ + ".nodes.vector_nodes")
+X = importlib.import_module(engine.__name__ + ".nodes.texture_nodes")
 vis = importlib.import_module(engine.__name__ + ".visibility")
 
 
@@ -130,11 +131,31 @@ def _light_path(c, node, out):
     raise Unsupported(f"the Light Path output {name} is not evaluated")
 
 
+def grid_value(c, grid, kind, stochastic=False):
+    """A Volume object's grid (engine.volume_grid.VoxelGrid) at the point, in object
+    space: 'float' its channels' average (Cycles' Fac), else the triple (a scalar grid
+    repeated). stochastic: one voxel, picked with the trilinear weights (Cycles 5's
+    stochastic interpolation); else trilinear."""
+    co = hit3(c, C.H_OBJECT)
+    return c.emit(X.TEX_GRID, kind, [co, 0 if kind == "float" else 1, int(stochastic)],
+                  varying=True, grid=grid)
+
+
 def _color_attribute(c, node, out):
     """Color Attribute / Attribute (geometry): the mesh's colour attribute (the one the
-    material names, else its render colour attribute); Fac is the colour's average."""
+    material names, else its render colour attribute); Fac is the colour's average. On
+    a Volume object, an Attribute node naming one of its grids reads the grid (Alpha 1)."""
     if node.bl_idname == "ShaderNodeAttribute" and node.attribute_type != "GEOMETRY":
         raise Unsupported(f"{node.attribute_type.lower()} attributes are not evaluated")
+    grids = getattr(c.ctx, "volume_grids", None) or {}
+    if node.bl_idname == "ShaderNodeAttribute" and node.attribute_name in grids:
+        grid = grids[node.attribute_name]
+        name = out.identifier
+        if name == "Alpha":
+            return c.const(1.0)
+        if name == "Fac":
+            return grid_value(c, grid, "float")
+        return grid_value(c, grid, "color" if name == "Color" else "vector")
     color = c.convert(hit3(c, C.H_COLOR), "color")
     name = out.identifier
     if name == "Alpha":
