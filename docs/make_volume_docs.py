@@ -135,11 +135,14 @@ def main(argv=None):
              "material's node program runs at points inside the medium, the scattering "
              "distance is sampled by delta tracking (spectral tracking over the colour "
              "channels) against a majorant of the density, and shadow rays are attenuated "
-             "by ratio tracking. Both estimators are unbiased whatever the majorant; DRT "
-             "takes it as 1.5 times the largest of 4096 samples of the program over the "
-             "object's bounds, and at the centres of the largest voxels of the grids it "
-             "reads (engine/kernels/medium_density.py). Scenes without such a "
-             "volume run none of this.", "",
+             "by ratio tracking. Both estimators are unbiased whatever the majorant. DRT "
+             "keeps a grid of 16 x 16 x 16 majorants over the object's bounds, each 1.5 "
+             "times the largest of 8 samples of the program in its cell and of the "
+             "program at the centre of each grid's largest voxel that reaches into it, "
+             "and takes free flights cell by cell (engine/kernels/majorant_grid.py, "
+             "majorant_bounds.py), so that a smoke in its box is tracked at the rate "
+             "its density needs where it is (Cycles keeps an octree of majorants for "
+             "the same reason). Scenes without such a volume run none of this.", "",
              "Volume objects (an OpenVDB file: a smoke or fire cache, a cloud) render "
              "too. DRT reads the grids the object's materials use (Attribute nodes, and "
              "the Principled Volume's Density, Color and Temperature Attributes: "
@@ -215,9 +218,8 @@ def main(argv=None):
         "- A Volume object's grids are read from its file at the frame: modifiers on the "
         "Volume (Mesh to Volume, Volume Displace) and packed files are not read yet "
         "(warned). Velocity grids do not blur the smoke (Cycles' volume motion blur).",
-        "- A heterogeneous volume has one majorant per object (Cycles: an octree of "
-        "them): a volume whose density is high in a small part of a large object, such "
-        "as a smoke cache in its box, is slower to render than in Cycles, not less "
+        "- With motion blur a heterogeneous volume keeps one majorant everywhere "
+        "(its grid holds the media where they are at the frame): slower, not less "
         "accurate."]
     with open(os.path.join(DOCS, "volumes.md"), "w") as f:
         f.write("\n".join(lines) + "\n")

@@ -137,7 +137,7 @@ def test_scenes_without_grids_pack_no_voxels():
 
 
 def test_grid_peaks_find_the_one_hot_voxel():
-    from engine.kernels.medium_density import grid_peaks
+    from engine.kernels.majorant_bounds import grid_peaks
     from engine.nodes.context import O_TO_WORLD, N_OBJ
     from engine.nodes.pack import pack_programs
     values = np.zeros((40, 40, 40), np.float32)

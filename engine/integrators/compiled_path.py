@@ -30,7 +30,8 @@ from ..kernels.path_vertex import shade
 from ..kernels.path_weights import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
                                     add_unoccluded)
 from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
-from ..kernels.medium_density import bound_majorants, shadow_keys
+from ..kernels.majorant_bounds import bound_majorants
+from ..kernels.medium_density import shadow_keys
 from ..kernels.volume import STACK, V_HET, pack_volumes
 from ..nodes.pack import PROG
 from ..nodes.differentials import camera_cones
@@ -93,9 +94,12 @@ class CompiledPathIntegrator:
         # majorants; `het_runs` counts their program runs (0 in any other scene)
         self.heterogeneous = self.has_volumes and bool(self.vol[:, V_HET].any())
         if self.heterogeneous:
+            # majorant grids hold a still scene's media where they are; with motion
+            # blur each medium keeps one majorant everywhere
             bound_majorants(self.vol, self.textures, surf.material,
                             self.geometry[8], self.geometry[9],
-                            (surf.positions, surf.corners), self.camera)
+                            (surf.positions, surf.corners), self.camera,
+                            grids=not ctx.has_motion)
         self.het_runs = np.zeros(1, np.int64)
         # what shade is compiled with (None: without that code; see its docstring)
         programmed = bool((self.textures[PROG][:, 1] > 0).any())

@@ -26,11 +26,10 @@ extinction is mu everywhere, and sample tentative collisions at rate mu:
 
 Both are unbiased for any mu > 0: where the density exceeds mu, sigma_n is negative and
 so are the weights, which costs variance, never bias. The bound only decides the
-noise and the number of program runs (about mu times the length). `bound_majorants`
-takes it as 1.5 times the largest value of 4096 jittered samples of the program over
-the row's meshes' bounds (Cycles takes 16 samples per octree voxel, and scales on-the-fly
-estimates by 1.5), and at the centres of the largest voxels of the grids the program
-reads (`grid_peaks`); a program that is zero everywhere sampled gets MU_FLOOR.
+noise and the number of program runs (about mu times the length). The majorant is a
+row's V_MAJ, or where the row has one, its majorant grid's cell along the ray
+(engine.kernels.majorant_grid): free flights are sampled through the cells by their
+optical depth (`advance`). engine.kernels.majorant_bounds computes both.
 
 Paths through homogeneous media only never reach this module: `has_heterogeneous`
 is checked once per kernel call, and each evaluation of a program here counts in the
@@ -42,21 +41,17 @@ import math
 import numpy as np
 
 from .. import visibility
-from ..nodes.context import N_HIT, O_TO_WORLD, fill
+from ..nodes.context import fill
 from ..nodes.interpreter import run
-from ..nodes.pack import GRIDS, NREGS, OPS, OUTS, PROG, VOXELS
-from ..nodes.texture_nodes import TEX_GRID
-from ..volume_grid import G_AFFINE, G_C, G_NX, G_NY, G_NZ, G_OFFSET
+from ..nodes.pack import MAJORANTS, OUTS
 from ..nodes.shading import OUT_VOL_EM, OUT_VOL_SA, OUT_VOL_SS
 from ..sampling.hashing import chain, unit_float
 from .jit import kernel
+from .majorant_grid import RES, cell_majorant, has_grid
 from .volume import V_G, V_HET, V_MAJ, V_OBJ, medium
 
 MAX_STEPS = 1024           # collisions per segment (Cycles' VOLUME_MAX_STEPS)
-MU_FLOOR = 1e-2            # the majorant of a program found zero everywhere sampled
-MAJORANT_SCALE = 1.5
-BOUND_SAMPLES = 16         # per axis of the jittered grid over a row's bounds
-PEAK_VOXELS = 4096         # largest voxels of each grid a row reads, also sampled
+ADVANCE_LIMIT = 4 * RES + 8  # cells one free flight may cross
 HET_DIM = 1 << 26          # the tracking's own random numbers (hashed: any count)
 SHADOW = visibility.SHADOW
 
@@ -131,18 +126,45 @@ def point_medium(vol, stacks, p, T, objects, camera, px, py, pz, dx, dy, dz, ray
 
 
 @kernel(allocates=False)
-def majorant(vol, stacks, p):
-    """The majorant of p's medium: the heterogeneous rows' V_MAJ plus the homogeneous
-    rows' largest extinction or emission channel."""
+def majorant_parts(vol, stacks, p, maj):
+    """(mu_fixed, row): the part of p's majorant that is the same everywhere (the
+    homogeneous rows and the heterogeneous rows without a majorant grid), and the first
+    heterogeneous row with a grid (-1: none), whose cells add to it."""
     sar, sag, sab, ssr, ssg, ssb, _, er, eg, eb = medium(vol, stacks, p)
     mu = max(sar + ssr, sag + ssg, sab + ssb, er, eg, eb)
+    row = -1
     for k in range(stacks.shape[1]):
         m = stacks[p, k]
         if m < 0:
             break
         if vol[m, V_HET] != 0.0:
-            mu += vol[m, V_MAJ]
-    return mu
+            if row < 0 and has_grid(maj, m):
+                row = m
+            else:
+                mu += vol[m, V_MAJ]
+    return mu, row
+
+
+@kernel(allocates=False)
+def advance(maj, row, mu_fixed, ox, oy, oz, dx, dy, dz, s, t, tau):
+    """From distance s, the distance at which the ray has crossed optical depth tau of
+    the majorant (mu_fixed plus row's cells), with the majorant there; (t, mu, True)
+    when it reaches t first."""
+    mu = mu_fixed
+    for _ in range(ADVANCE_LIMIT):
+        end = math.inf
+        mu = mu_fixed
+        if row >= 0:
+            mc, end = cell_majorant(maj, row, ox, oy, oz, dx, dy, dz, s)
+            mu = mu_fixed + mc
+        lim = min(end, t)
+        if mu > 0.0 and tau < mu * (lim - s):
+            return s + tau / mu, mu, False
+        if lim >= t:
+            return t, mu, True
+        tau -= mu * (lim - s)
+        s = lim
+    return t, mu, True
 
 
 @kernel
@@ -175,19 +197,21 @@ def tracked_segment(vol, stacks, p, T, objects, camera, ox, oy, oz, dx, dy, dz, 
     Returns (scattered, t_end, throughput factor f RGB, f at distance t_mark RGB (0 when
     the path scattered before it), emitted radiance RGB (times b), g at the
     scattering)."""
-    mu = majorant(vol, stacks, p)
+    maj = T[MAJORANTS]
+    mu_fixed, row = majorant_parts(vol, stacks, p, maj)
     fr = fg = fb = 1.0
     mr = mg = mb = 0.0
     marked = False
     Er = Eg = Eb = 0.0
-    if not mu > 0.0:
+    if not (mu_fixed > 0.0 or row >= 0):
         return False, t, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0
     s = 0.0
     for step in range(MAX_STEPS):
-        s -= math.log(max(1.0 - _uniform(key, step, 0), 1e-300)) / mu
+        tau = -math.log(max(1.0 - _uniform(key, step, 0), 1e-300))
+        s, mu, passed = advance(maj, row, mu_fixed, ox, oy, oz, dx, dy, dz, s, t, tau)
         if not marked and s >= t_mark:
             mr, mg, mb, marked = fr, fg, fb, True
-        if s >= t:
+        if passed:
             return False, t, fr, fg, fb, mr, mg, mb, Er, Eg, Eb, 0.0
         sar, sag, sab, ssr, ssg, ssb, g, er, eg, eb = point_medium(
             vol, stacks, p, T, objects, camera, ox + dx * s, oy + dy * s, oz + dz * s,
@@ -218,14 +242,16 @@ def tracked_transmittance(vol, stacks, r, T, objects, camera, ox, oy, oz, dx, dy
     """Ratio tracking: an unbiased estimate of shadow ray r's transmittance (RGB) over
     distance t from o along d through its medium; Russian roulette once every channel
     is below 0.1."""
-    mu = majorant(vol, stacks, r)
+    maj = T[MAJORANTS]
+    mu_fixed, row = majorant_parts(vol, stacks, r, maj)
     tr = tg = tb = 1.0
-    if not mu > 0.0 or not math.isfinite(t):
+    if not (mu_fixed > 0.0 or row >= 0) or not math.isfinite(t):
         return tr, tg, tb
     s = 0.0
     for step in range(MAX_STEPS):
-        s -= math.log(max(1.0 - _uniform(key, step, 0), 1e-300)) / mu
-        if s >= t:
+        tau = -math.log(max(1.0 - _uniform(key, step, 0), 1e-300))
+        s, mu, passed = advance(maj, row, mu_fixed, ox, oy, oz, dx, dy, dz, s, t, tau)
+        if passed:
             return tr, tg, tb
         sar, sag, sab, ssr, ssg, ssb, _, _, _, _ = point_medium(
             vol, stacks, r, T, objects, camera, ox + dx * s, oy + dy * s, oz + dz * s,
@@ -250,93 +276,3 @@ def attenuate_tracked(vol, stacks, r, trans, T, objects, camera, ox, oy, oz, dx,
     trans[r, 0] *= tr
     trans[r, 1] *= tg
     trans[r, 2] *= tb
-
-
-@kernel
-def _sample_row(vol, m, T, objects, camera, lo, hi, n, seed):
-    """The largest extinction or emission channel of row m over n^3 jittered points of
-    the box [lo, hi]."""
-    hit = np.zeros(N_HIT)
-    regs = np.zeros(max(T[NREGS][0], 1))
-    count = np.zeros(1, np.int64)
-    top = 0.0
-    key = chain(seed, m)
-    i = 0
-    for a in range(n):
-        for b in range(n):
-            for c in range(n):
-                x = lo[0] + (hi[0] - lo[0]) * (a + _uniform(key, i, 0)) / n
-                y = lo[1] + (hi[1] - lo[1]) * (b + _uniform(key, i, 1)) / n
-                z = lo[2] + (hi[2] - lo[2]) * (c + _uniform(key, i, 2)) / n
-                i += 1
-                sar, sag, sab, ssr, ssg, ssb, er, eg, eb = row_coefficients(
-                    vol, m, T, objects, camera, x, y, z, 0.0, 0.0, -1.0, 1, 0, hit, regs,
-                    count)
-                top = max(top, sar + ssr, sag + ssg, sab + ssb, er, eg, eb)
-    return top
-
-
-def bound_majorants(vol, T, tri_material, tri_object, objects, triangles, camera):
-    """Fill V_OBJ and V_MAJ of the heterogeneous rows of `vol` (in place): the object of
-    the first triangle of the row's material (-1 without object rows) and the majorant
-    of the module's docstring, over the bounds of that material's triangles (triangles:
-    (positions (V, 3), each triangle's corners as rows of them (T, 3))). Returns vol."""
-    positions, corners = triangles
-    for m in np.nonzero(vol[:, V_HET] != 0.0)[0]:
-        tris = np.nonzero(tri_material == m)[0]
-        if tris.size == 0:
-            vol[m, V_MAJ] = MU_FLOOR
-            continue
-        vol[m, V_OBJ] = int(tri_object[tris[0]]) if len(tri_object) else -1
-        pts = positions[corners[tris].ravel()]
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        top = _sample_row(vol, int(m), T, objects, camera, np.ascontiguousarray(lo),
-                          np.ascontiguousarray(hi), BOUND_SAMPLES, np.uint64(0x5EED))
-        peaks = grid_peaks(T, int(m), objects, int(vol[m, V_OBJ]))
-        if len(peaks):
-            top = max(top, _sample_points(vol, int(m), T, objects, camera, peaks))
-        vol[m, V_MAJ] = max(MAJORANT_SCALE * top, MU_FLOOR)
-    return vol
-
-
-def grid_peaks(T, m, objects, obj) -> np.ndarray:
-    """World-space centres (k, 3) of the PEAK_VOXELS largest voxels of each grid material
-    m's program reads (a Volume object's density, temperature, ...): a trilinear grid
-    peaks at a voxel centre, so a program that grows with its grids peaks there too,
-    where the jittered samples of a sparse smoke would miss it."""
-    prog = T[PROG]
-    if not (0 <= m < prog.shape[0]) or prog[m, 1] == 0 or T[GRIDS].shape[0] == 0:
-        return np.zeros((0, 3))
-    ops = T[OPS][prog[m, 0]:prog[m, 0] + prog[m, 1]]
-    found = []
-    for g in np.unique(ops[ops[:, 0] == TEX_GRID, 7]):
-        row = T[GRIDS][g]
-        nx, ny, nz, nc = (int(row[G_NX]), int(row[G_NY]), int(row[G_NZ]), int(row[G_C]))
-        start = int(row[G_OFFSET])
-        block = T[VOXELS][start:start + nx * ny * nz * nc].reshape(nx * ny * nz, nc)
-        mag = np.abs(block).max(axis=1)
-        k = min(PEAK_VOXELS, mag.size)
-        idx = np.argpartition(mag, mag.size - k)[mag.size - k:]
-        ijk = np.stack(np.unravel_index(idx, (nx, ny, nz)), 1).astype(np.float64)
-        affine = row[G_AFFINE:G_AFFINE + 12].reshape(3, 4)
-        local = np.linalg.solve(affine[:, :3], (ijk - affine[:, 3]).T).T
-        if 0 <= obj < objects.shape[0]:
-            to_world = objects[obj, O_TO_WORLD:O_TO_WORLD + 12].reshape(3, 4)
-            local = local @ to_world[:, :3].T + to_world[:, 3]
-        found.append(local)
-    return np.ascontiguousarray(np.concatenate(found)) if found else np.zeros((0, 3))
-
-
-@kernel
-def _sample_points(vol, m, T, objects, camera, pts):
-    """The largest extinction or emission channel of row m at the points pts (k, 3)."""
-    hit = np.zeros(N_HIT)
-    regs = np.zeros(max(T[NREGS][0], 1))
-    count = np.zeros(1, np.int64)
-    top = 0.0
-    for i in range(pts.shape[0]):
-        sar, sag, sab, ssr, ssg, ssb, er, eg, eb = row_coefficients(
-            vol, m, T, objects, camera, pts[i, 0], pts[i, 1], pts[i, 2], 0.0, 0.0, -1.0,
-            1, 0, hit, regs, count)
-        top = max(top, sar + ssr, sag + ssg, sab + ssb, er, eg, eb)
-    return top

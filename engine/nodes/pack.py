@@ -18,11 +18,15 @@ types, so one compilation serves every scene):
   T[VOXELS] float32: the values of every voxel grid the programs read, concatenated
   T[GRIDS]  float64 (n_grids, volume_grid.N_GRID): each grid's offset, size and map
             (engine.volume_grid.pack_grids); grid operations name rows of it
+  T[MAJORANTS] float64: each material's majorant grid (engine.kernels.majorant_grid),
+            zeros until the integrator bounds its heterogeneous volume; (0, ...) when
+            no program computes a volume
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..kernels.majorant_grid import empty_table
 from ..kernels.textures import pack_textures
 from ..volume_grid import pack_grids
 from .bump import BUMP_ENTER, BUMP_NORMAL
@@ -37,6 +41,7 @@ PROG = 8
 OUTS = 9
 NREGS = 10
 MIX = 11
+MAJORANTS = 14
 assert (VOXELS, GRIDS) == (MIX + 1, MIX + 2)
 
 
@@ -77,13 +82,15 @@ def pack_programs(table) -> tuple:
         n_init += p.n_regs
         n_data += len(p.data)
     voxels, grid_rows = pack_grids(grids)
+    volumes = [j for j, name in enumerate(OUTPUTS) if name.startswith("volume_")]
+    maj = empty_table(n_mat if (outs[:, volumes] >= 0).any() else 0)
     return (np.concatenate(ops) if ops else np.zeros((0, WIDTH), np.int32),
             np.concatenate(init) if init else np.zeros(0),
             np.concatenate(data) if data else np.zeros(0),
             prog, outs, np.array([int(prog[:, 3].max()) if n_mat else 0], np.int64),
             np.ascontiguousarray(getattr(table, "mix_children",
                                          np.full((n_mat, 2), -1, np.int64)), np.int64),
-            voxels, grid_rows)
+            voxels, grid_rows, maj)
 
 
 def pack_shading(table) -> tuple:
