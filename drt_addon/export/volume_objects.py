@@ -101,8 +101,10 @@ def read_grid(grid, issue) -> "volume_grid.VoxelGrid | None":
 
 
 def grid_file(volume) -> str | None:
-    """The absolute path of the file a Volume datablock reads at the current frame."""
+    """The absolute path of the file a Volume datablock reads at the current frame (a
+    sequence's frame: Blender resolves it when it loads the grids' metadata)."""
     import bpy
+    volume.grids.load()
     path = volume.grids.frame_filepath or volume.filepath
     if not path:
         return None
