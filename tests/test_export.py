@@ -355,6 +355,15 @@ def test_hair_volumes_and_point_clouds_are_named_once_and_the_rest_renders(bpy_d
         assert part in said[0], said[0]
     smoke = [w for w in reporter.warnings if "Volume object 'Smoke'" in w]
     assert len(smoke) == 1 and "names no OpenVDB file" in smoke[0], reporter.warnings
+    # a smoke simulation's domain: its grids are named as left out, the mesh renders
+    domain = _mesh_object(bpy, "Domain", [(-1, -1, 3), (1, -1, 3), (1, 1, 3), (-1, 1, 3)],
+                          [(0, 1, 2, 3)])
+    fluid = domain.modifiers.new("Fluid", "FLUID")
+    fluid.fluid_type = "DOMAIN"
+    reporter = Reporter()
+    s = export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
+    said = [w for w in reporter.warnings if "not rendered yet" in w]
+    assert len(said) == 1 and "smoke simulation grids" in said[0] and "'Domain'" in said[0]
     assert _by_name(s, "Plain")                  # the emitter itself still renders
     last = _render_drt(bpy)
     assert last["ok"], last["error"]

@@ -155,6 +155,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 continue
             if not inst.is_instance:
                 left_out.note_hair(obj)           # a mesh's particle hair
+                left_out.note_smoke_domain(obj)
             local = cache.local(obj)
             if local is None:
                 continue

@@ -1,5 +1,6 @@
 """What the scene holds that DRT does not render yet, named once in Blender's report so
-that nothing is dropped silently: particle hair, hair Curves objects and point clouds.
+that nothing is dropped silently: particle hair, hair Curves objects, point clouds and
+the grids of a smoke simulation's domain.
 The rest of the scene renders. (Volume objects render: export.volume_objects.)"""
 from __future__ import annotations
 
@@ -31,6 +32,16 @@ class LeftOut:
             settings = mod.particle_system.settings
             if settings.type == "HAIR" and settings.render_type == "PATH":
                 self.note("particle hair", f"{obj.name} ({mod.particle_system.name})")
+
+    def note_smoke_domain(self, obj) -> None:
+        """A mesh that is a Fluid modifier's gas domain (a smoke or fire simulation):
+        Cycles renders its cached grids; DRT does not read them yet, so its volume
+        would be a uniform fog in the domain's box."""
+        for mod in getattr(obj, "modifiers", ()):
+            if (mod.type == "FLUID" and mod.show_render and mod.fluid_type == "DOMAIN"
+                    and getattr(mod.domain_settings, "domain_type", "") == "GAS"):
+                self.note("smoke simulation grids (the domain renders its material "
+                          "without them)", obj.name)
 
     def message(self) -> str | None:
         """One warning naming everything left out, or None."""
