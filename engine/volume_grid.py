@@ -68,19 +68,6 @@ class VoxelGrid:
         pts = corners @ to_object[:3, :3].T + to_object[:3, 3]
         return pts.min(axis=0), pts.max(axis=0)
 
-    def top_voxels(self, count: int) -> np.ndarray:
-        """The object-space centres (k, 3) of the `count` voxels of largest magnitude
-        (their channels' largest): where a program reading this grid peaks."""
-        mag = np.abs(self.values).max(axis=3).ravel()
-        k = min(int(count), mag.size)
-        if k <= 0:
-            return np.zeros((0, 3))
-        idx = np.argpartition(mag, mag.size - k)[mag.size - k:]
-        ijk = np.stack(np.unravel_index(idx, self.values.shape[:3]), 1).astype(np.float64)
-        ijk += np.asarray(self.origin, np.float64)
-        to_object = np.linalg.inv(self.to_index)
-        return ijk @ to_object[:3, :3].T + to_object[:3, 3]
-
     def lookup(self, points) -> np.ndarray:
         """Trilinear values (n, C) at object-space points (n, 3)."""
         p = np.asarray(points, np.float64).reshape(-1, 3)
