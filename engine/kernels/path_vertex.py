@@ -52,7 +52,7 @@ from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium, passed,
                      sample_method, segment, stack_cross, volume_dim)
-from .bsdf.params import P_FILTER_ALPHA
+from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .terminator import shadow_origin
 from .surface_hit import material_row, run_program, surface_emission
@@ -60,7 +60,8 @@ from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import bent_diffuse, bump_rejects, may_emit
+from ..nodes.shading import (bent_diffuse, bump_rejects, may_emit,
+                             valid_reflection_normal)
 
 @kernel
 def prepare_closures(cfg, row, min_pdf, ray_bit):
@@ -300,6 +301,16 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 programs, params, geometry, counts, path_info, p, m, prim, hit_inst[j],
                 hit_u[j], hit_v[j], uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front,
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
+        else:
+            correct = params[m, P_BUMP_CORRECTION] != 0.0
+        if not bent and correct and (nx != gx or ny != gy or nz != gz):
+            # a smooth mesh's normal, as Cycles' specular lobes (and the subsurface
+            # entry) use it: made a valid reflector for the view (a silhouette's normal
+            # may face away from it); the diffuse lobe keeps it as it is
+            sx, sy, sz = valid_reflection_normal(gx, gy, gz, -dx, -dy, -dz, nx, ny, nz)
+            if sx != nx or sy != ny or sz != nz:
+                rx, ry, rz = nx, ny, nz
+                nx, ny, nz, bent = sx, sy, sz, True
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
         er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
                                       programmed)
