@@ -22,9 +22,10 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # Sample scenes whose renders together reach the kernels DRT renders with: surfaces and
 # an area lamp; rigid and deforming motion; a homogeneous volume; node programs and
-# closures; a thin lens; an HDRI world; transparency and ray visibility.
+# closures; a thin lens; an HDRI world; transparency and ray visibility; subsurface
+# scattering (rays cast inside the kernel).
 SCENES = ("cornell_box", "fog_room", "motion_cube", "motion_torus", "node_closures",
-          "dof", "hdri_world", "ray_visibility")
+          "dof", "hdri_world", "ray_visibility", "subsurface")
 SIZE = 16          # pixels along the longer side of each compile render
 
 

@@ -258,6 +258,16 @@ class Accelerator:
         self._remaps = len(ids) > 1 or (len(ids) == 1 and ids[0][1:] != (0, -1))
         return scene.commit()
 
+    def kernel_rays(self) -> tuple:
+        """What a kernel needs to cast rays itself and name what they hit as the queries
+        here do (engine.kernels.subsurface.local_hit): (Embree scene handle, centre,
+        geometry id -> first global triangle, geometry id -> first object-table row, each
+        ordered mesh's first global triangle and the total)."""
+        counts = [len(m.triangles) for m in self.ordered_meshes]
+        starts = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        return (int(self._scene.handle), np.asarray(self.center, np.float64),
+                self._geom_base, self._geom_row, starts)
+
     def close(self):
         if self._pool is not None:
             self._pool.shutdown(wait=False)

@@ -64,6 +64,16 @@ class Material:
       translucent_color   a Translucent BSDF (diffuse transmission), its weight included;
       refraction_only     the glass lobe refracts without reflecting (Refraction BSDF).
 
+    Subsurface scattering (compiled path tracer; Cycles' random walk,
+    engine/kernels/subsurface.py): subsurface_weight of the diffuse base (a Principled
+    BSDF's Subsurface Weight, 1 for a Subsurface Scattering node) enters the surface with
+    the base colour as its albedo and walks inside it as a medium whose mean free path
+    per channel is subsurface_radius (Radius x Scale, scene units), with Henyey-Greenstein
+    subsurface_anisotropy. It enters by a GGX refraction of IOR subsurface_ior and alpha
+    subsurface_alpha (None: roughness^2 at the hit, Principled's rule) and leaves as a
+    diffuse surface. subsurface_method: 'RANDOM_WALK' or 'RANDOM_WALK_SKIN' (Cycles' two
+    random walks).
+
     bump_correction: Cycles' Material > Settings > Bump Map Correction (on by default),
     for a normal bent by the shader (Normal Map, Bump): its specular lobes on the bent
     normal made a valid reflector for the view, and its diffuse light faded towards the
@@ -101,6 +111,12 @@ class Material:
     translucent_color: tuple = (0.0, 0.0, 0.0)
     refraction_only: bool = False
     bump_correction: bool = True
+    subsurface_weight: float = 0.0
+    subsurface_radius: tuple = (1.0, 0.2, 0.1)
+    subsurface_anisotropy: float = 0.0
+    subsurface_ior: float = 1.4
+    subsurface_alpha: Optional[float] = None
+    subsurface_method: str = "RANDOM_WALK"
     base_color_texture: Optional[object] = None
     metallic_texture: Optional[object] = None
     roughness_texture: Optional[object] = None

@@ -51,12 +51,18 @@ def _world(scene, color, strength):
     scene.world = world
 
 
-def _volume_only(name, density, color=(0.8, 0.8, 0.8)):
+def empty_material(name):
+    """(a node material of only its Material Output, its node tree)."""
     mat = bpy.data.materials.new(name)
     if bpy.app.version < (5, 0, 0):
         mat.use_nodes = True
     nt = mat.node_tree
     nt.nodes.remove(nt.nodes["Principled BSDF"])
+    return mat, nt
+
+
+def _volume_only(name, density, color=(0.8, 0.8, 0.8)):
+    mat, nt = empty_material(name)
     vol = nt.nodes.new("ShaderNodeVolumePrincipled")
     vol.inputs["Density"].default_value = density
     vol.inputs["Color"].default_value = (*color, 1.0)

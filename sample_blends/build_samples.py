@@ -861,12 +861,13 @@ SCENES["sky_world"] = sky_world
 
 
 def _artist_scenes():
-    """sample_blends/artist_scenes.py's and volume_scenes.py's scenes (which use this
-    module's helpers)."""
+    """sample_blends/artist_scenes.py's, volume_scenes.py's and subsurface_scenes.py's
+    scenes (which use this module's helpers)."""
     sys.path.insert(0, HERE)
     import artist_scenes
+    import subsurface_scenes
     import volume_scenes
-    return {**artist_scenes.SCENES, **volume_scenes.SCENES}
+    return {**artist_scenes.SCENES, **volume_scenes.SCENES, **subsurface_scenes.SCENES}
 
 
 if __name__ == "__main__":

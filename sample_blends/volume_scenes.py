@@ -19,7 +19,7 @@ import sys
 import bpy
 import numpy as np
 
-from artist_scenes import _new_scene
+from artist_scenes import _new_scene, empty_material
 from build_samples import HERE, camera, cuboid, principled, quad
 
 sys.path.insert(0, os.path.dirname(HERE))
@@ -78,11 +78,7 @@ def write_plume(path: str) -> None:
 
 
 def _smoke_material():
-    mat = bpy.data.materials.new("Smoke")
-    if bpy.app.version < (5, 0, 0):
-        mat.use_nodes = True
-    nt = mat.node_tree
-    nt.nodes.remove(nt.nodes["Principled BSDF"])
+    mat, nt = empty_material("Smoke")
     vol = nt.nodes.new("ShaderNodeVolumePrincipled")
     vol.inputs["Density"].default_value = 10.0
     vol.inputs["Color"].default_value = (0.55, 0.55, 0.6, 1.0)

@@ -36,7 +36,9 @@ def test_reachable_follows_callees_and_only_them():
     assert "engine.kernels.bsdf.principled.setup" in found        # via a module attribute
     assert "engine.kernels.lights.light_set.sample" in found
     assert not any(name.startswith("engine.kernels.whitted_vertex") for name in found)
-    assert not any(name.startswith("engine.embree") for name in found)
+    # rays cast inside the kernel: the subsurface walk's
+    assert "engine.embree.rays.intersect1" in found
+    assert "engine.kernels.subsurface.walk" in found
     assert 50 < len(found) < 700
 
 
@@ -118,10 +120,12 @@ def test_cancel_during_a_compile_returns_without_waiting_for_it(monkeypatch):
 
 
 def test_shade_is_compiled_without_what_the_scene_lacks():
-    """Principle 3 for the compiler: a scene without node programs and volumes gets a
-    `shade` whose last three arguments are None, so Numba compiles none of that code
-    (nor the interpreter, the media's tracking and scattering, which only it calls); a
-    scene with a world volume gets the volume table in its place."""
+    """Principle 3 for the compiler: a scene without node programs, volumes and
+    subsurface scattering gets a `shade` whose last four arguments are None, so Numba
+    compiles none of that code (nor the interpreter, the media's tracking and scattering
+    and the random walk, which only it calls); a scene with a world volume gets the
+    volume table in its place, one with a subsurface material the scene for the walk's
+    rays."""
     from dataclasses import replace
 
     from numba.core import types
@@ -131,18 +135,25 @@ def test_shade_is_compiled_without_what_the_scene_lacks():
     plain = cornell_box(8, 8)
     ctx = render_module.RenderContext(plain, settings)
     render_module.render(plain, settings, context=ctx)
-    assert ctx.integrator.features == (None, None, None)
+    assert ctx.integrator.features == (None, None, None, None)
     ctx.close()
     foggy = cornell_box(8, 8)
     foggy.world = replace(foggy.world, volume=Volume(scattering=(0.1, 0.1, 0.1)))
     ctx = render_module.RenderContext(foggy, settings)
     render_module.render(foggy, settings, context=ctx)
-    programs, volumes, het = ctx.integrator.features
-    assert programs is None and het is None and volumes is ctx.integrator.vol
+    programs, volumes, het, sss = ctx.integrator.features
+    assert programs is None and het is None and sss is None
+    assert volumes is ctx.integrator.vol
     ctx.close()
-    last3 = [tuple(type(t) for t in sig[-3:]) for sig in shade.signatures]
-    assert (types.NoneType,) * 3 in last3
-    assert any(t[0] is types.NoneType and t[1] is not types.NoneType for t in last3)
+    waxy = cornell_box(8, 8)
+    waxy.materials[0] = replace(waxy.materials[0], subsurface_weight=1.0)
+    ctx = render_module.RenderContext(waxy, settings)
+    assert ctx.integrator.features[:3] == (None, None, None)
+    assert ctx.integrator.features[3] is not None
+    ctx.close()
+    last4 = [tuple(type(t) for t in sig[-4:]) for sig in shade.signatures]
+    assert (types.NoneType,) * 4 in last4
+    assert any(t[0] is types.NoneType and t[1] is not types.NoneType for t in last4)
 
 
 def test_the_batch_renderers_bar_says_compiling_then_counts_samples(capsys):

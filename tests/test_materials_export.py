@@ -115,9 +115,27 @@ def test_principled_values(bpy_drt):
     assert m.coat_ior == pytest.approx(1.5) and close(m.coat_tint, (0.9, 0.8, 0.7))
     assert m.sheen_weight == pytest.approx(0.25) and m.sheen_layered
     assert m.sheen_roughness == pytest.approx(0.3)
+    # subsurface scattering: Cycles' random walk of Radius x Scale, the node's IOR
+    assert m.subsurface_weight == 0.0
     p.inputs["Subsurface Weight"].default_value = 0.5
+    p.inputs["Subsurface Radius"].default_value = (1.0, 0.5, 0.25)
+    p.inputs["Subsurface Scale"].default_value = 0.2
+    p.inputs["Subsurface Anisotropy"].default_value = 0.3
     m, warnings = _export(mat)
-    assert len(warnings) == 1 and "'P'" in warnings[0] and "subsurface" in warnings[0]
+    assert warnings == [] and m.subsurface_weight == pytest.approx(0.5)
+    assert close(m.subsurface_radius, (0.2, 0.1, 0.05))
+    assert m.subsurface_anisotropy == pytest.approx(0.3) and m.subsurface_alpha is None
+    assert m.subsurface_ior == pytest.approx(m.ior) and m.subsurface_method == "RANDOM_WALK"
+    p.subsurface_method = "RANDOM_WALK_SKIN"
+    p.inputs["Subsurface IOR"].default_value = 1.33
+    m, warnings = _export(mat)
+    assert warnings == [] and m.subsurface_method == "RANDOM_WALK_SKIN"
+    assert m.subsurface_ior == pytest.approx(1.33)
+    p.subsurface_method = "BURLEY"             # Christensen-Burley: by the walk, reported
+    m, warnings = _export(mat)
+    assert len(warnings) == 1 and "'P'" in warnings[0] and "Random Walk" in warnings[0]
+    assert m.subsurface_method == "RANDOM_WALK" and m.subsurface_weight == pytest.approx(0.5)
+    p.subsurface_method = "RANDOM_WALK"
     p.inputs["Subsurface Weight"].default_value = 0.0
     # Specular Tint: the metal's F82 tint, the specular layer's and the glass's F0 tint
     assert close(m.specular_tint, (1, 1, 1))
@@ -176,6 +194,21 @@ def test_sheen_translucent_refraction(bpy_drt):
     m, w = _export(mat)
     assert close(m.base_color, (0.1, 0.3, 0.05)) and close(m.translucent_color, (0.2, 0.4, 0.1))
     assert w == []
+    # Subsurface Scattering node: all of it walks, Color the albedo, Roughness the
+    # entry's alpha as it is; no specular layer
+    m, w = _export(_single(bpy, "ShaderNodeSubsurfaceScattering", Color=(0.9, 0.5, 0.3, 1),
+                           Scale=0.5, Radius=(1.0, 0.4, 0.2), IOR=1.3, Roughness=0.6,
+                           Anisotropy=0.2)[0])
+    assert w == [] and m.subsurface_weight == 1.0 and close(m.base_color, (0.9, 0.5, 0.3))
+    assert close(m.subsurface_radius, (0.5, 0.2, 0.1)) and m.specular_ior_level == 0.0
+    assert m.subsurface_ior == pytest.approx(1.3) and m.subsurface_alpha == pytest.approx(0.6)
+    assert m.subsurface_anisotropy == pytest.approx(0.2)
+    # mixed half and half with a diffuse: half of the mixed base walks
+    mat, _, _ = _mix(bpy, "Skin", ("ShaderNodeBsdfDiffuse", {"Color": (0.5, 0.5, 0.5, 1)}),
+                     ("ShaderNodeSubsurfaceScattering", {"Color": (0.5, 0.5, 0.5, 1)}))
+    m, w = _export(mat)
+    assert w == [] and m.subsurface_weight == pytest.approx(0.5)
+    assert close(m.base_color, (0.5, 0.5, 0.5))
 
 
 def _mix(bpy, name, a, b, fac=0.5, add=False):
@@ -409,10 +442,10 @@ def test_unsupported_nodes_warn_once_per_material_and_render(bpy_drt):
     _camera_and_sun(bpy, scene, size=(8, 8))
     mat, nt = _material(bpy, "Weird")
     toon = nt.nodes.new("ShaderNodeBsdfToon")
-    sss = nt.nodes.new("ShaderNodeSubsurfaceScattering")
+    hair = nt.nodes.new("ShaderNodeBsdfHair")
     mix = nt.nodes.new("ShaderNodeMixShader")
     nt.links.new(toon.outputs[0], mix.inputs[1])
-    nt.links.new(sss.outputs[0], mix.inputs[2])
+    nt.links.new(hair.outputs[0], mix.inputs[2])
     nt.links.new(mix.outputs[0], _out(nt))
     ok_mat, _ = _material(bpy, "Fine", keep_principled=True)
     for i, m in enumerate([mat, mat, ok_mat]):             # two objects share "Weird"
@@ -422,7 +455,7 @@ def test_unsupported_nodes_warn_once_per_material_and_render(bpy_drt):
     assert last["ok"], last["error"]
     mine = [w for w in last["warnings"] if "'Weird'" in w]
     assert len(mine) == 1, last["warnings"]
-    assert "Toon" in mine[0] and "Subsurface" in mine[0] and "viewport colour" in mine[0]
+    assert "Toon" in mine[0] and "Hair" in mine[0] and "viewport colour" in mine[0]
     assert not any("'Fine'" in w for w in last["warnings"])
     assert np.isfinite(last["pixels"]).all() and last["pixels"].max() > 0
 

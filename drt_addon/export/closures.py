@@ -32,6 +32,7 @@ class _Comp:
     distribution: str = "MULTI_GGX"  # 'MULTI_GGX', 'GGX' or 'BECKMANN' (glossy_model)
     layers: object = None           # a _Layers: coat, sheen, translucency (None: none)
     refraction_only: bool = False   # the glass lobe does not reflect (Refraction BSDF)
+    subsurface: object = None       # nodes/subsurface.Subsurface (None: none)
 
     def glossy_weight(self):
         """Mean weight of the lobes the distribution shapes (metal, glass, specular)."""
@@ -199,6 +200,14 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
     if p["glass_color"] is not None:
         m.glass_color = tuple(_mean(p["glass_color"]))
     m.refraction_only = bool(p["refraction_only"])
+    sss = p["subsurface"]
+    if sss is not None and sss.weight > 0:
+        m.subsurface_weight = float(sss.weight)
+        m.subsurface_radius = tuple(float(x) for x in sss.radius)
+        m.subsurface_anisotropy = float(sss.anisotropy)
+        m.subsurface_ior = float(sss.ior)
+        m.subsurface_alpha = None if sss.alpha is None else float(sss.alpha)
+        m.subsurface_method = sss.method
     m.metal_fresnel = p["metal_fresnel"]
     m.specular_tint = tuple(p["specular_tint"])
     if p["layers"] is not None:
@@ -234,6 +243,22 @@ def _set(m, attr, value):
         setattr(m, attr, tuple(value) if isinstance(value, tuple) else float(value))
 
 
+def _blend_subsurface(lw, Wb, ctx):
+    """The subsurface scattering of a mixture [(c, comp, metal, glass, base weights)]:
+    its share of the mixed diffuse base is the closures' shares weighted by their base
+    weights; its parameters those of the closure that scatters most (reported when they
+    differ)."""
+    parts = [(c * b * comp.subsurface.weight, comp.subsurface) for c, comp, _, _, b in lw
+             if comp.subsurface is not None and c * b > 0]
+    if not parts or Wb <= 0:
+        return None
+    main = max(parts, key=lambda x: x[0])[1]
+    if len({(s.radius, s.anisotropy, s.ior, s.alpha, s.method) for _, s in parts}) > 1:
+        ctx.issue("mixed shaders scatter below the surface with different parameters; DRT "
+                  "uses those of the one that scatters most")
+    return replace(main, weight=float(min(sum(w for w, _ in parts) / Wb, 1.0)))
+
+
 def _blend(comps, ctx) -> dict:
     """Principled parameters of a convex combination [(c_i, _Comp)] of closures."""
     if len(comps) == 1:
@@ -244,7 +269,8 @@ def _blend(comps, ctx) -> dict:
                     else c.metal_color,
                     glass_color=c.glass_color, distribution=c.distribution,
                     layers=c.layers, refraction_only=c.refraction_only,
-                    metal_fresnel=c.metal_fresnel, specular_tint=c.specular_tint)
+                    metal_fresnel=c.metal_fresnel, specular_tint=c.specular_tint,
+                    subsurface=c.subsurface)
     lw = [(c, comp, *comp.weights()) for c, comp in comps]
     Wm = sum(c * m for c, _, m, _, _ in lw)
     Wg = sum(c * g for c, _, _, g, _ in lw)
@@ -313,4 +339,5 @@ def _blend(comps, ctx) -> dict:
                 roughness=roughness, ior=ior, spec=spec, metal_color=metal_color,
                 glass_color=glass_color, distribution=distribution,
                 layers=_blend_layers(comps, ctx), refraction_only=refr == {True},
-                metal_fresnel=metal_fresnel, specular_tint=specular_tint)
+                metal_fresnel=metal_fresnel, specular_tint=specular_tint,
+                subsurface=_blend_subsurface(lw, Wb, ctx))

@@ -15,10 +15,16 @@ Principled BSDF
     BSDF gets weight a and a Transparent BSDF the rest (so emission is a x emission on
     average), rendered as stochastic transparency. Coat and sheen are the compiled
     BSDF's layers; Specular Tint (`Material.specular_tint`) is the metal lobe's F82
-    tint and the specular layer's and the glass's F0 tint, as in Cycles. Subsurface,
-    anisotropy, thin film and diffuse roughness are not modelled: reported when used.
+    tint and the specular layer's and the glass's F0 tint, as in Cycles. Subsurface
+    Weight, Radius, Scale, IOR and Anisotropy are Cycles' random walk
+    (export/nodes/subsurface.py). Anisotropy, thin film and diffuse roughness are not
+    modelled: reported when used.
     The node's distribution is the material's `glossy_model`: 'MULTI_GGX' (Blender's
     default, Cycles' energy-compensated GGX) or 'GGX' (single scattering).
+Subsurface Scattering
+    Cycles' random walk of its Color, Radius x Scale, IOR, Roughness and Anisotropy
+    (Random Walk and Random Walk (Skin); Christensen-Burley is rendered by the random
+    walk, reported).
 Diffuse BSDF
     Lambert with its colour (no specular layer). Roughness > 0 (Oren-Nayar) is reported.
 Glossy BSDF

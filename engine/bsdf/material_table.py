@@ -86,6 +86,7 @@ class MaterialTable:
         self.glass_color = np.array([(c if c is not None else (1.0, 1.0, 1.0))[:3]
                                      for c in glass], np.float64).reshape(-1, 3)
         self._layer_params(materials)
+        self._subsurface_params(materials)
         self.transparent_color = np.array(
             [tuple(getattr(m, "transparent_color", (1.0, 1.0, 1.0)))[:3] for m in materials],
             np.float64).reshape(-1, 3)
@@ -176,6 +177,36 @@ class MaterialTable:
                 bad = [m.name for m, row in zip(materials, arr.reshape(len(materials), -1))
                        if not np.all(np.isfinite(row))]
                 raise ValueError(f"material {bad[0]!r} has a non-finite {name}")
+
+    def _subsurface_params(self, materials):
+        """Subsurface scattering (engine/kernels/subsurface.py): weight, radius (mean free
+        path per channel, scene units), anisotropy, the entry's IOR and GGX alpha (< 0:
+        the hit's roughness^2) and whether the method is Random Walk (Skin)."""
+        n = len(materials)
+        self.subsurface_weight = np.clip(np.array(
+            [float(getattr(m, "subsurface_weight", 0.0)) for m in materials], np.float64), 0, 1)
+        self.subsurface_radius = np.maximum(np.array(
+            [tuple(getattr(m, "subsurface_radius", (1.0, 0.2, 0.1)))[:3] for m in materials],
+            np.float64).reshape(n, 3), 0.0)
+        self.subsurface_anisotropy = np.array(
+            [float(getattr(m, "subsurface_anisotropy", 0.0)) for m in materials], np.float64)
+        self.subsurface_ior = np.array(
+            [float(getattr(m, "subsurface_ior", 1.4)) for m in materials], np.float64)
+        alpha = [getattr(m, "subsurface_alpha", None) for m in materials]
+        self.subsurface_alpha = np.array([-1.0 if a is None else float(a) for a in alpha])
+        self.subsurface_skin = np.array(
+            [getattr(m, "subsurface_method", "RANDOM_WALK") == "RANDOM_WALK_SKIN"
+             for m in materials], bool)
+        for name in ("subsurface_weight", "subsurface_radius", "subsurface_anisotropy",
+                     "subsurface_ior", "subsurface_alpha"):
+            arr = getattr(self, name)
+            if not np.all(np.isfinite(arr)):
+                bad = [m.name for m, row in zip(materials, arr.reshape(n, -1))
+                       if not np.all(np.isfinite(row))]
+                raise ValueError(f"material {bad[0]!r} has a non-finite {name}")
+        # whether any material scatters below its surface (the path tracer then compiles
+        # the random walk, engine.integrators.compiled_path)
+        self.any_subsurface = bool((self.subsurface_weight > 0.0).any())
 
     @property
     def any_textures(self) -> bool:

@@ -103,9 +103,13 @@ class CompiledPathIntegrator:
         self.het_runs = np.zeros(1, np.int64)
         # what shade is compiled with (None: without that code; see its docstring)
         programmed = bool((self.textures[PROG][:, 1] > 0).any())
+        # a material that scatters below its surface walks there with rays the kernel
+        # casts itself (engine.kernels.subsurface)
+        self.subsurface = mats.any_subsurface and ctx.accel._scene is not None
         self.features = (self.textures if programmed else None,
                          self.vol if self.has_volumes else None,
-                         self.vol if self.heterogeneous else None)
+                         self.vol if self.heterogeneous else None,
+                         ctx.accel.kernel_rays() if self.subsurface else None)
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
                             else np.full(STACK, -1, np.int32))
 
@@ -123,9 +127,10 @@ class CompiledPathIntegrator:
 
     @property
     def shadow_rays_per_path(self) -> int:
-        """The most shadow rays the vertex kernel queues per path and bounce: one, and
-        one more for the equiangular light sample of a segment in a medium."""
-        return 2 if self.has_volumes else 1
+        """The most shadow rays the vertex kernel queues per path and bounce: one, one
+        more for the equiangular light sample of a segment in a medium, and one more for
+        the exit of a subsurface walk."""
+        return 1 + int(self.has_volumes) + int(self.subsurface)
 
     @property
     def mis_mode(self) -> str:

@@ -13,6 +13,9 @@ class WhittedIntegrator(CompiledPathIntegrator):
     def __init__(self, ctx):
         super().__init__(ctx)
         self._lamp_rays = lamp_rays(self.lights)
+        # subsurface scattering is its diffuse lobe here: no walk, so no scene for rays
+        # cast in the kernel (and no second compile of it for that argument)
+        self.features = self.features[:3] + (None,)
 
     @property
     def shadow_rays_per_path(self) -> int:

@@ -45,7 +45,7 @@ from ..nodes.context import fill
 from ..nodes.interpreter import run
 from ..nodes.pack import MAJORANTS, OUTS
 from ..nodes.shading import OUT_VOL_EM, OUT_VOL_SA, OUT_VOL_SS
-from ..sampling.hashing import chain, unit_float
+from ..sampling.hashing import chain, stream_key, stream_uniform
 from .jit import kernel
 from .majorant_grid import RES, cell_majorant, has_grid
 from .volume import V_G, V_HET, V_MAJ, V_OBJ, medium
@@ -168,14 +168,9 @@ def advance(maj, row, mu_fixed, ox, oy, oz, dx, dy, dz, s, t, tau):
 
 
 @kernel
-def _uniform(key, step, j):
-    return unit_float(chain(chain(key, step), j))
-
-
-@kernel
 def path_key(pkey, index, depth):
     """The tracking's random stream of one path at one bounce."""
-    return chain(chain(chain(pkey, index), HET_DIM), depth)
+    return stream_key(pkey, index, HET_DIM, depth)
 
 
 @kernel
@@ -207,7 +202,7 @@ def tracked_segment(vol, stacks, p, T, objects, camera, ox, oy, oz, dx, dy, dz, 
         return False, t, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0
     s = 0.0
     for step in range(MAX_STEPS):
-        tau = -math.log(max(1.0 - _uniform(key, step, 0), 1e-300))
+        tau = -math.log(max(1.0 - stream_uniform(key, step, 0), 1e-300))
         s, mu, passed = advance(maj, row, mu_fixed, ox, oy, oz, dx, dy, dz, s, t, tau)
         if not marked and s >= t_mark:
             mr, mg, mb, marked = fr, fg, fb, True
@@ -226,7 +221,7 @@ def tracked_segment(vol, stacks, p, T, objects, camera, ox, oy, oz, dx, dy, dz, 
         if not den > 0.0:
             break                        # nothing left to carry: absorbed
         ps = num / den
-        if _uniform(key, step, 1) < ps:
+        if stream_uniform(key, step, 1) < ps:
             k = 1.0 / (mu * ps)
             return (True, s, fr * ssr * k, fg * ssg * k, fb * ssb * k, mr, mg, mb,
                     Er, Eg, Eb, g)
@@ -249,7 +244,7 @@ def tracked_transmittance(vol, stacks, r, T, objects, camera, ox, oy, oz, dx, dy
         return tr, tg, tb
     s = 0.0
     for step in range(MAX_STEPS):
-        tau = -math.log(max(1.0 - _uniform(key, step, 0), 1e-300))
+        tau = -math.log(max(1.0 - stream_uniform(key, step, 0), 1e-300))
         s, mu, passed = advance(maj, row, mu_fixed, ox, oy, oz, dx, dy, dz, s, t, tau)
         if passed:
             return tr, tg, tb
@@ -262,7 +257,7 @@ def tracked_transmittance(vol, stacks, r, T, objects, camera, ox, oy, oz, dx, dy
         big = max(abs(tr), abs(tg), abs(tb))
         if big < 0.1:
             q = max(big * 5.0, 0.05)     # survive with probability q
-            if _uniform(key, step, 1) >= q:
+            if stream_uniform(key, step, 1) >= q:
                 return 0.0, 0.0, 0.0
             tr, tg, tb = tr / q, tg / q, tb / q
     return 0.0, 0.0, 0.0

@@ -36,7 +36,8 @@ import math
 
 import numpy as np
 
-from .bsdf.principled import TRANSMISSION
+from .bsdf.principled import SUBSURFACE, TRANSMISSION
+from ..embree.rays import new_ray_record
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
@@ -56,6 +57,8 @@ from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .terminator import shadow_origin
 from .surface_hit import material_row, run_program, surface_emission
+from .subsurface import walk_key
+from .subsurface_vertex import scatter_below
 from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
 from ..nodes.interpreter import has_program
@@ -94,7 +97,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
           min_pdf, cont, path_time, live, ro, rd, rt, hits, stopped,
           geometry, params, emission, textures, tables, lights, world, media,
           sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir, path_info,
-          programs, volumes, het):
+          programs, volumes, het, sss):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`
     (engine.accel.HitArrays: t, prim, inst, u, v per ray; prim -1 where missed).
 
@@ -136,12 +139,15 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     point), emission along it is added, and what it reaches beyond is weighted by its
     transmittance. A hit on a volume's boundary surface is crossed without a bounce.
 
-    programs, volumes, het: what the scene uses, each None when it does not (Numba then
+    programs, volumes, het, sss: what the scene uses, each None when it does not (Numba then
     compiles this kernel without that code, and never compiles what only it calls: a
     scene without node programs and volumes compiles in about half the time, benchmarks
     section 10). programs: the
     shading tables when a material has a shader program; volumes: the volume table
-    when the scene has media; het: the same when one of them is heterogeneous."""
+    when the scene has media; het: the same when one of them is heterogeneous; sss: the
+    scene for rays cast inside a kernel (engine.kernels.subsurface.local_hit) when a
+    material scatters below its surface: a sampled subsurface lobe then walks there
+    (engine.kernels.subsurface_vertex), queueing one more shadow ray for its exit."""
     bounce, vbounce, vol, stacks, sh_stack, sh_bounce, het_count = media
     hit_t, hit_prim, hit_inst, hit_u, hit_v = hits.t, hits.prim, hits.inst, hits.u, hits.v
     het_scene = has_heterogeneous(vol)
@@ -160,6 +166,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     regs = np.zeros(max(textures[NREGS][0], 1))
     ns_out, nn_out = 0, 0
     base = D.FIRST_BOUNCE + depth * D.PER_BOUNCE
+    f_ray, w_ray = new_ray_record()           # for rays cast here (a subsurface walk)
     for j in range(live.shape[0]):
         p = live[j]
         ox, oy, oz = ro[j, 0], ro[j, 1], ro[j, 2]
@@ -398,6 +405,17 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         ix, iy, iz, wr, wg, wb, spdf, skind, sdelta, valid = bsdf.sample(
             state, wox, woy, woz, u_lobe, u1, u2, ad, ag, at)
         if not valid:
+            continue
+        if skind == SUBSURFACE:
+            if sss is not None:
+                cone_moves(path_info[1], p, t_geom)
+                ns_out, nn_out = scatter_below(
+                    cfg, walk_key(pkey[p], index[p], depth), p, path_time[p], sss, f_ray,
+                    w_ray, geometry, row, prim, hit_inst[j], px, py, pz, gx, gy, gz, nx, ny,
+                    nz, scale, dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, bounce, counts,
+                    beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, L, lights, stacks,
+                    sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack,
+                    ns_out, nx_path, nx_org, nx_dir, nn_out)
             continue
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
         if bent and ad and not sdelta and spdf > 0.0:

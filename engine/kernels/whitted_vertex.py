@@ -10,7 +10,8 @@ At each hit:
   sample at (1/2, 1/2): an area lamp's centre, the direction of a sphere lamp's or a
   sun's centre), so shadows are hard. The world and emissive surfaces light nothing
   directly; they are seen along the rays. The light is weighted by the lobes that are
-  not followed (diffuse, sheen, translucency: `bsdf.eval_seen` with diffuse rays only);
+  not followed (diffuse, sheen, translucency, and subsurface scattering as the diffuse
+  lobe it is a part of: `bsdf.eval_seen` with diffuse rays only);
 - one continuing ray, a perfect mirror reflection or a perfect refraction: the
   material's specular, metal, coat and glass lobes with their roughness set to zero
   (GGX at alpha = 1e-4 for reflection, the exact smooth interface for glass), chosen by
@@ -32,7 +33,8 @@ from ..sampling.dispatch import sample_1d
 from . import lights as lt
 from . import ray_queues
 from .bsdf import principled as bsdf
-from .bsdf.params import P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_ROUGHNESS, P_TRANSLUCENT
+from .bsdf.params import (P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_ROUGHNESS, P_SSS_WEIGHT,
+                          P_TRANSLUCENT)
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from .lights.light_set import sample_lamp_at
@@ -64,10 +66,11 @@ def lamp_rays(lights):
 @kernel
 def mirror_row(row):
     """The material row of the lobes Whitted follows: roughness zero (the coat's too),
-    no translucency (a diffuse lobe), no Filter Glossy."""
+    no translucency or subsurface scattering (diffuse lobes), no Filter Glossy."""
     row[P_ROUGHNESS] = 0.0
     row[P_COAT_ROUGHNESS] = 0.0
     row[P_FILTER_ALPHA] = 0.0
+    row[P_SSS_WEIGHT] = 0.0
     for c in range(3):
         row[P_TRANSLUCENT + c] = 0.0
 
@@ -77,11 +80,11 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
                   ray_bits, min_pdf, cont, path_time, live, ro, rd, rt, hits,
                   stopped, geometry, params, emission, textures, tables,
                   lights, world, media, sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path,
-                  nx_org, nx_dir, path_info, programs, volumes, het):
+                  nx_org, nx_dir, path_info, programs, volumes, het, sss):
     """Whitted's bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`.
     The arguments are `path_vertex.shade`'s (read its docstring); this kernel reads no
-    roulette verdict, MIS state or volume (min_pdf, cont, prev_pdf, prev_pos, volumes and
-    het are unused), and queues up to `lamp_rays(lights)` shadow rays per path, so sh_*
+    roulette verdict, MIS state or volume (min_pdf, cont, prev_pdf, prev_pos, volumes,
+    het and sss are unused: subsurface scattering is its diffuse lobe here), and queues up to `lamp_rays(lights)` shadow rays per path, so sh_*
     must hold that many times the live paths. Returns (shadow count, next count)."""
     bounce, sh_bounce, stacks, sh_stack = media[0], media[5], media[3], media[4]
     hit_t, hit_prim, hit_inst, hit_u, hit_v = hits.t, hits.prim, hits.inst, hits.u, hits.v
@@ -151,6 +154,7 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
         _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
         material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)
+        row[P_SSS_WEIGHT] = 0.0          # Whitted's model: subsurface light is diffuse
         # 2. direct light: one shadow ray to each lamp's fixed point, on the lobes that
         # are not followed (diffuse, sheen, translucency)
         bsdf.setup(row, front, wox, woy, woz, tables, state)

@@ -140,3 +140,17 @@ def permute_index(i, n, key) -> np.ndarray:
     shape = i.shape
     out = _permute_rows(np.array(i.ravel()), np.array(n.ravel()), np.array(key.ravel()))
     return out.reshape(shape)
+
+
+@kernel
+def stream_key(pkey, index, salt, depth):
+    """A hashed random stream of sample `index` of pixel key pkey at wavefront step
+    `depth`, apart from every other stream by `salt` (a volume's tracking, a subsurface
+    walk): numbers without count, for loops of unbounded length."""
+    return chain(chain(chain(pkey, index), salt), depth)
+
+
+@kernel
+def stream_uniform(key, step, j):
+    """Number j of step `step` of stream `key` (stream_key), in [0, 1)."""
+    return unit_float(chain(chain(key, step), j))

@@ -13,6 +13,7 @@ from ...engine_link import engine
 from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _Layers, _sum
 from ..material_params import TOL, NodeParam, _is_tex, _lin, _mean, _same, _scale
 from .links import _link
+from . import subsurface
 
 lobes = importlib.import_module(engine.__name__ + ".kernels.bsdf.lobe_batch")
 
@@ -66,8 +67,9 @@ def _principled(node, ctx) -> _Closure:
                  roughness=val("Roughness", 0.5), ior=const("IOR", 1.5),
                  spec=const("Specular IOR Level", 0.5),
                  distribution=_distribution(node, ctx), layers=_principled_layers(node, ctx))
+    comp.subsurface = subsurface.principled(node, ctx, _constant, comp.ior)
     ignored = []
-    for sock, what in (("Subsurface Weight", "subsurface"), ("Anisotropic", "anisotropy"),
+    for sock, what in (("Anisotropic", "anisotropy"),
                        ("Thin Film Thickness", "thin film"),
                        ("Diffuse Roughness", "diffuse roughness")):
         s = node_input(node, sock)
@@ -145,6 +147,16 @@ def _translucent(node, ctx) -> _Closure:
     color = _constant(node, "Color", ctx, (0.8,) * 3, color=True)
     return _Closure([(1.0, _Comp(base=BLACK, spec=0.0,
                                  layers=_Layers(translucent_color=tuple(color))))])
+
+
+def _scattering(node, ctx) -> _Closure:
+    """Subsurface Scattering node: all of its weight walks below the surface, its Color
+    the albedo (export/nodes/subsurface.py); no specular layer."""
+    _normal(node, ctx)
+    return _Closure([(1.0, _Comp(base=_input(node, "Color", ctx, True, (0.8,) * 3),
+                                 spec=0.0,
+                                 subsurface=subsurface.scattering_node(node, ctx,
+                                                                       _constant)))])
 
 
 def _normal(node, ctx):
@@ -323,6 +335,8 @@ def _closure(socket, ctx, depth=0) -> _Closure:
         return _sheen(node, ctx)
     if kind == "ShaderNodeBsdfTranslucent":
         return _translucent(node, ctx)
+    if kind == "ShaderNodeSubsurfaceScattering":
+        return _scattering(node, ctx)
     if kind == "ShaderNodeEmission":
         return _emission(node, ctx)
     if kind == "ShaderNodeBsdfTransparent":

@@ -96,17 +96,17 @@ def setup_batch(rows, front, wo, tables, walter=False):
 
 @kernel
 def selection_batch(rows, front, wo, allowed, tables, walter=False):
-    """Lobe probabilities (n, 7) of `principled.selection` (diffuse, specular, metal,
-    glass; coat, sheen, translucent)."""
+    """Lobe probabilities (n, 8) of `principled.selection` (diffuse, specular, metal,
+    glass; coat, sheen, translucent; subsurface)."""
     n = wo.shape[0]
-    out = np.zeros((n, 7))
+    out = np.zeros((n, 8))
     state = np.empty(P.NSTATE)
     for k in range(n):
         P.setup(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state)
         if walter:
             state[S_WALTER] = 1.0
         q = P.selection(state, allowed[k, 0], allowed[k, 1], allowed[k, 2])
-        for j in range(7):
+        for j in range(8):
             out[k, j] = q[j]
     return out
 
@@ -115,7 +115,7 @@ class Sample(NamedTuple):
     wi: np.ndarray        # (n, 3) local direction
     weight: np.ndarray    # (n, 3) f |cos| / pdf (zero where sampling failed)
     pdf: np.ndarray       # (n,) mixture pdf over the allowed lobes (inf for a delta)
-    kind: np.ndarray      # (n,) lobe kind: P.DIFFUSE, P.GLOSSY, P.TRANSMISSION
+    kind: np.ndarray      # (n,) lobe kind: P.DIFFUSE, P.GLOSSY, P.TRANSMISSION, P.SUBSURFACE
     delta: np.ndarray     # (n,) bool: a perfectly specular choice
     valid: np.ndarray     # (n,) bool
 
@@ -190,7 +190,7 @@ class Principled:
         return setup_batch(self.rows, self.front, self._dirs(wo), self.tables, self.walter)
 
     def selection(self, wo, allowed=None):
-        """The probabilities (n, 7) with which `sample` picks each lobe at wo."""
+        """The probabilities (n, 8) with which `sample` picks each lobe at wo."""
         return selection_batch(self.rows, self.front, self._dirs(wo),
                                self._allowed(allowed), self.tables, self.walter)
 

@@ -40,7 +40,14 @@ P_BUMP_CORRECTION = 35   # 0 / 1: Cycles' Bump Map Correction for a bent normal
 P_METAL_CONSTANT = 36    # 0 / 1: the metal lobe reflects its F0 at every angle (a
 #                          Glossy BSDF, Cycles' Fresnel-less closure), not Schlick's
 P_SPEC_TINT = 37         # 3 columns: Specular Tint, the metal lobe's F82 tint (1: none)
-NPARAM = 40
+# Subsurface scattering (subsurface_lobe.py; engine/kernels/subsurface.py walks it)
+P_SSS_WEIGHT = 40        # the share of the diffuse base that scatters below the surface
+P_SSS_RADIUS = 41        # 3 columns: mean free path per channel (Radius x Scale), scene units
+P_SSS_ANISOTROPY = 44    # Henyey-Greenstein g inside
+P_SSS_IOR = 45           # the entry's refraction IOR
+P_SSS_ALPHA = 46         # the entry's GGX alpha; < 0: the hit's roughness^2 (Principled)
+P_SSS_SKIN = 47          # 0 / 1: Random Walk (Skin), Cycles' other radius and entry
+NPARAM = 48
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -78,6 +85,12 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_SHEEN_LAYERED] = table.sheen_layered
     rows[:, P_BUMP_CORRECTION] = table.bump_correction
     rows[:, P_LAYERS] = table.layered
+    rows[:, P_SSS_WEIGHT] = table.subsurface_weight
+    rows[:, P_SSS_RADIUS:P_SSS_RADIUS + 3] = table.subsurface_radius
+    rows[:, P_SSS_ANISOTROPY] = table.subsurface_anisotropy
+    rows[:, P_SSS_IOR] = table.subsurface_ior
+    rows[:, P_SSS_ALPHA] = table.subsurface_alpha
+    rows[:, P_SSS_SKIN] = table.subsurface_skin
     rows[:, P_METAL_CONSTANT] = table.metal_constant
     rows[:, P_SPEC_TINT:P_SPEC_TINT + 3] = table.specular_tint
     return rows

@@ -58,7 +58,7 @@ from __future__ import annotations
 import math
 
 from ..jit import kernel
-from . import dielectric, fresnel, layers, specular_tint
+from . import dielectric, fresnel, layers, specular_tint, subsurface_lobe
 from . import microfacet as mf
 from . import multiscatter as ms
 from .albedo import specular_albedo
@@ -69,7 +69,8 @@ from .state import (NSTATE, S_ALPHA, S_BECKMANN, S_BLINN, S_DIFFUSE,  # noqa: F4
                     S_EST, S_ETA_GLASS, S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH,
                     S_GLASS_TINTED, S_LAYERED, S_METAL_CONST, S_METAL_F0, S_METAL_F82,
                     S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY,
-                    S_SPEC_TINTED, S_TINT, S_W_GLASS, S_W_METAL, S_W_SPEC, S_WALTER)
+                    S_SPEC_TINTED, S_EST_SSS, S_SSS, S_TINT, S_W_GLASS, S_W_METAL,
+                    S_W_SPEC, S_WALTER)
 from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX,  # noqa: F401
                      GLOSSY_MULTI_GGX, NPARAM, P_BASE, P_GLASS_COLOR, P_GLOSSY_MODEL,
                      P_HAS_GLASS_COLOR, P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR,
@@ -80,6 +81,7 @@ from .tables import kernel_tables  # noqa: F401  (re-exported)
 from ..warp import INV_PI, cosine_hemisphere
 
 DIFFUSE, GLOSSY, TRANSMISSION = 0, 1, 2    # lobe kinds
+SUBSURFACE = 3             # the subsurface lobe (subsurface_lobe.py): a walk, not a direction
 # Lower bound of a present lobe's selection estimate, relative to its weight, so a lobe
 # that reflects little at this wo (black metal at normal incidence) can still be sampled
 MIN_SELECTION = 0.02
@@ -139,7 +141,8 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
             state[S_TINT + c] = min(max(row[P_GLASS_COLOR + c], 0.0), 1.0)
         else:
             state[S_TINT + c] = math.sqrt(clamped)
-        state[S_DIFFUSE + c] = base * base_w
+        # (less the share that scatters below the surface: subsurface_lobe.py)
+        state[S_DIFFUSE + c] = subsurface_lobe.split(row, c, base, clamped, base_w, state)
         diffuse_max = max(diffuse_max, state[S_DIFFUSE + c])
     if m > 0.0 and state[S_METAL_CONST] == 0.0:
         f82_setup(row, state)
@@ -172,9 +175,12 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
                 e_spec = max(e_est, e_spec) * state[S_MS_SPEC]
         est_spec = w_spec * e_spec
     est_diff = 0.0
+    below = 1.0 - min(e_spec, 1.0)
     for c in range(3):
-        state[S_DIFFUSE + c] = state[S_DIFFUSE + c] * (1.0 - min(e_spec, 1.0))
+        state[S_DIFFUSE + c] = state[S_DIFFUSE + c] * below
         est_diff = max(est_diff, state[S_DIFFUSE + c])
+    subsurface_lobe.scale(state, below, below, below)
+    subsurface_lobe.estimate(state, MIN_SELECTION * base_w * subsurface_lobe.weight(row))
     est_metal = 0.0
     if m > 0.0:
         F = 0.0
@@ -205,6 +211,9 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
             state[S_DIFFUSE + c] = state[S_DIFFUSE + c] * state[layers.S_BASE_SCALE + c]
         for k in range(5):
             state[S_EST + k] = state[S_EST + k] * smax
+        s = layers.S_BASE_SCALE
+        subsurface_lobe.scale(state, state[s], state[s + 1], state[s + 2])
+        state[S_EST_SSS] = state[S_EST_SSS] * smax
 
 
 @kernel(allocates=False)
@@ -217,7 +226,9 @@ def transmits(state):
 @kernel(allocates=False)
 def selection(state, allow_d, allow_g, allow_t):
     """Lobe probabilities (diffuse, specular, metal, glass; coat, sheen, translucent of
-    layers.py) over the allowed kinds."""
+    layers.py; subsurface) over the allowed kinds. The subsurface lobe may be chosen
+    while any kind may continue: it leaves as a diffuse surface, which is then lit
+    directly even where no diffuse bounce is left (Cycles: the walk is no bounce)."""
     w0 = state[S_EST] if allow_d else 0.0
     w1 = state[S_EST + 1] if allow_g else 0.0
     w2 = state[S_EST + 2] if allow_g else 0.0
@@ -225,10 +236,12 @@ def selection(state, allow_d, allow_g, allow_t):
     wc = ws = wt = 0.0
     if state[S_LAYERED] != 0.0:
         wc, ws, wt = layers.selection(state, allow_d, allow_g, allow_t)
-    total = w0 + w1 + w2 + w3 + wc + ws + wt
+    wu = state[S_EST_SSS] if (allow_d or allow_g or allow_t) else 0.0
+    total = w0 + w1 + w2 + w3 + wc + ws + wt + wu
     if not total > 0.0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    return w0 / total, w1 / total, w2 / total, w3 / total, wc / total, ws / total, wt / total
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    return (w0 / total, w1 / total, w2 / total, w3 / total, wc / total, ws / total,
+            wt / total, wu / total)
 
 
 @kernel(allocates=False)
@@ -309,8 +322,9 @@ def eval_f(state, wox, woy, woz, wix, wiy, wiz):
 
 @kernel(allocates=False)
 def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
-    """sum_i q_i pdf_i over the lobes, for the selection probabilities q (`selection`)."""
-    q0, q1, q2, q3, qc, qs, qt = q
+    """sum_i q_i pdf_i over the lobes, for the selection probabilities q (`selection`;
+    the subsurface lobe's has no density here)."""
+    q0, q1, q2, q3, qc, qs, qt, qu = q
     p = 0.0
     if wiz > 0.0:
         p += q0 * (wiz * INV_PI)
@@ -339,15 +353,15 @@ def pdf_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t,
              see_d, see_g, see_t):
     """The part of `pdf` (same allow flags) due to the lobes of the kinds a light is seen
     by: the density with which BSDF sampling reaches that light through wi."""
-    q0, q1, q2, q3, qc, qs, qt = selection(state, allow_d, allow_g, allow_t)
+    q0, q1, q2, q3, qc, qs, qt, qu = selection(state, allow_d, allow_g, allow_t)
     if not see_d:
         q0 = qs = qt = 0.0
     if not see_g:
         q1 = q2 = qc = 0.0
     if not (see_g if wiz > 0.0 else see_t):
         q3 = 0.0
-    return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, (q0, q1, q2, q3, qc, qs, qt),
-                       allow_g, allow_t)
+    return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz,
+                       (q0, q1, q2, q3, qc, qs, qt, qu), allow_g, allow_t)
 
 
 @kernel(allocates=False)
@@ -361,7 +375,7 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     lobe = 0
     lo = 0.0
     total = 0.0
-    for k in range(7):
+    for k in range(8):
         if k > 0 and u_lobe >= total and q[k] > 0.0:
             lobe, lo = k, total
         total += q[k]
@@ -373,6 +387,9 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     ok = total > 0.0 and q_sel > 0.0
     if not ok:
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
+    if lobe == 7:                       # below the surface: the caller walks it
+        return (wix, wiy, wiz, state[S_SSS] / q_sel, state[S_SSS + 1] / q_sel,
+                state[S_SSS + 2] / q_sel, math.inf, SUBSURFACE, True, True)
     if lobe == 0:
         wix, wiy, wiz = cosine_hemisphere(u1, u2)
     elif lobe == 1 or lobe == 2:

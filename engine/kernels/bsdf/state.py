@@ -31,4 +31,6 @@ S_SPEC_F0 = layers.NSTATE + 8      # 3: ... its tinted F0 per channel
 S_SPEC_MS = layers.NSTATE + 11     # 3: ... its multiscatter factor per channel
 S_GLASS_TINTED = layers.NSTATE + 14  # 1: the glass lobe has a Specular Tint (specular_tint.py)
 S_GLASS_F0 = layers.NSTATE + 15      # 3: ... its tinted F0 per channel
-NSTATE = layers.NSTATE + 18
+S_SSS = layers.NSTATE + 18          # 3: the subsurface lobe's weight (subsurface_lobe.py)
+S_EST_SSS = layers.NSTATE + 21      # its selection estimate
+NSTATE = layers.NSTATE + 22

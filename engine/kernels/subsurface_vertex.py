@@ -1,0 +1,166 @@
+"""A path vertex that scatters below its surface: where `path_vertex.shade` sampled the
+Principled BSDF's subsurface lobe (bsdf/subsurface_lobe.py), this stage enters the
+surface, walks inside it (engine/kernels/subsurface.py) and shades the point where the
+walk leaves as Cycles does (integrator/subsurface.h):
+
+1. entry: the view direction refracted through a GGX microfacet normal about the
+   shading normal (made a valid reflector for the view, as path_vertex.shade makes it
+   for the specular lobes: Cycles' bssrdf N) (alpha: the
+   material's roughness^2 for the Principled BSDF, the node's Roughness for the
+   Subsurface Scattering node; IOR clamped to [1.01, 3.8]) with no Fresnel weight (only
+   the direction matters); Random Walk (Skin) enters half its paths by a cosine
+   direction about -N and the rest with alpha 1. A direction that does not go into the
+   surface ends the path;
+2. the walk, in the object it entered;
+3. exit: a Lambertian surface of weight 1 at the exit point (the throughput carries the
+   colour) with the exit's shading normal, no emission and no shader run: next-event
+   estimation (one light, one shadow ray, MIS against the diffuse bounce) and, while a
+   diffuse bounce is left, a cosine-distributed next ray. The walk is no bounce (Cycles
+   does not count it); the exit's bounce is a diffuse one.
+
+The entry direction uses the vertex's own BSDF sample numbers; the walk and the exit use
+the walk's hashed stream, independent of them.
+"""
+from __future__ import annotations
+
+import math
+
+from . import lights as lt
+from . import ray_queues
+from .bsdf import microfacet as mf
+from .bsdf.params import (P_BASE, P_ROUGHNESS, P_SSS_ALPHA, P_SSS_ANISOTROPY,
+                          P_SSS_IOR, P_SSS_RADIUS, P_SSS_SKIN)
+from .frame import dot, to_local, to_world
+from .jit import kernel
+from ..sampling.hashing import stream_uniform
+from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, nee_weight,
+                           roulette)
+from .subsurface import MAX_BOUNCES, object_of, walk, walk_radius
+from .surface import offset_origin, rebuild_at_time
+from .terminator import shadow_origin
+from .warp import INV_PI, cosine_hemisphere
+
+EXIT_STEP = MAX_BOUNCES + 1     # the walk stream's step whose numbers the exit uses
+
+
+@kernel
+def entry_direction(row, dx, dy, dz, nx, ny, nz, u1, u2):
+    """The direction into the surface for a ray along d hitting shading normal n (facing
+    the ray), or ok False."""
+    wix, wiy, wiz = -dx, -dy, -dz
+    skin = row[P_SSS_SKIN] != 0.0
+    if skin:
+        if u1 < 0.5:
+            lx, ly, lz = cosine_hemisphere(2.0 * u1, u2)
+            ox, oy, oz = to_world(lx, ly, lz, nx, ny, nz)
+            return -ox, -oy, -oz, True
+        u1 = 2.0 * (u1 - 0.5)
+        alpha = 1.0
+    elif row[P_SSS_ALPHA] >= 0.0:
+        alpha = min(row[P_SSS_ALPHA], 1.0)
+    else:
+        r = min(max(row[P_ROUGHNESS], 0.0), 1.0)
+        alpha = r * r
+    ior = min(max(row[P_SSS_IOR], 1.01), 3.8)
+    ix, iy, iz = to_local(wix, wiy, wiz, nx, ny, nz)
+    if not iz > 0.0:
+        return 0.0, 0.0, 0.0, False
+    hx, hy, hz = mf.sample_visible_normal(ix, iy, iz, alpha, u1, u2)
+    hx, hy, hz = to_world(hx, hy, hz, nx, ny, nz)
+    eta = 1.0 / ior
+    cos_hi = dot(hx, hy, hz, wix, wiy, wiz)
+    arg = 1.0 - eta * eta * (1.0 - cos_hi * cos_hi)
+    k = eta * cos_hi - max(math.sqrt(max(arg, 0.0)), 1e-7)
+    return -eta * wix + k * hx, -eta * wiy + k * hy, -eta * wiz + k * hz, True
+
+
+@kernel
+def walk_params(row):
+    """(albedo, walk radius) per channel, and the anisotropy, of material row `row`."""
+    skin = row[P_SSS_SKIN] != 0.0
+    ior = min(max(row[P_SSS_IOR], 1.01), 3.8)
+    a0 = min(max(row[P_BASE], 0.0), 1.0)
+    a1 = min(max(row[P_BASE + 1], 0.0), 1.0)
+    a2 = min(max(row[P_BASE + 2], 0.0), 1.0)
+    r0 = walk_radius(max(row[P_SSS_RADIUS], 0.0), a0, ior, skin)
+    r1 = walk_radius(max(row[P_SSS_RADIUS + 1], 0.0), a1, ior, skin)
+    r2 = walk_radius(max(row[P_SSS_RADIUS + 2], 0.0), a2, ior, skin)
+    return (a0, a1, a2), (r0, r1, r2), row[P_SSS_ANISOTROPY]
+
+
+@kernel
+def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, py, pz,
+                  gx, gy, gz, nx, ny, nz, scale, dx, dy, dz, u1, u2, br, bg, bb, bounce,
+                  counts, beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, L, lights,
+                  stacks, sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack,
+                  ns, nx_path, nx_org, nx_dir, nn):
+    """Path p (throughput b, the lobe's weight included) enters the surface it hit at p
+    (triangle prim of instance inst; geometric normal g and shading normal n facing the
+    ray along d), walks, and leaves: queues at most one shadow ray (count ns) and one
+    next ray (count nn), as path_vertex.shade does. key: the walk's stream
+    (subsurface.walk_key); rays: the scene for rays cast here (subsurface.local_hit);
+    f, w: a ray record (engine.embree.rays)."""
+    ex_dx, ex_dy, ex_dz, ok = entry_direction(row, dx, dy, dz, nx, ny, nz, u1, u2)
+    if not ok or dot(ex_dx, ex_dy, ex_dz, gx, gy, gz) >= 0.0:
+        return ns, nn
+    albedo, radius, g = walk_params(row)
+    sx, sy, sz = offset_origin(px, py, pz, gx, gy, gz, scale, ex_dx, ex_dy, ex_dz)
+    mesh = object_of(rays[4], prim)
+    left, prim2, inst2, u, v, wdx, wdy, wdz, tr, tg, tb = walk(
+        rays, f, w, key, time, mesh, inst, sx, sy, sz, ex_dx, ex_dy, ex_dz, nx, ny, nz,
+        albedo, radius, g, (br, bg, bb), True)
+    if not left or not max(tr, tg, tb) > 0.0:
+        return ns, nn
+    # the exit, seen from outside along the walk's last direction reversed
+    qx, qy, qz, hx, hy, hz, mx, my, mz, _, escale = rebuild_at_time(
+        geometry, prim2, inst2, u, v, -wdx, -wdy, -wdz, time)
+    b = bounce[p]
+    goes_on = b < int(cfg[2]) and counts[p, 0] < cfg[3]
+    mode = int(cfg[8])
+    # next-event estimation on the exit's Lambertian surface
+    if lt.n_entries(lights) > 0:
+        k, lx, ly, lz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
+            lights, qx, qy, qz, stream_uniform(key, EXIT_STEP, 0),
+            stream_uniform(key, EXIT_STEP, 1), stream_uniform(key, EXIT_STEP, 2), time)
+        seen = lt.entry_visibility(lights, k)
+        cosine = dot(lx, ly, lz, mx, my, mz)
+        if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and cosine > 0.0
+                and (seen & DIFFUSE_BIT) != 0):
+            bpdf = cosine * INV_PI if goes_on else 0.0
+            wt = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine * INV_PI
+            cr, cg, cb = tr * lr * wt, tg * lg * wt, tb * lb * wt
+            if not seen & SHADOW_BIT:
+                _add(L, p, cr, cg, cb, cfg[6] if b == 0 else cfg[7])
+            else:
+                sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[4],
+                                              geometry[13], geometry[9], prim2, inst2, u, v,
+                                              qx, qy, qz, hx, hy, hz, mx, my, mz, escale,
+                                              lx, ly, lz)
+                sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, qx, qy, qz, lx, ly,
+                                                         lz, dist, margin, cfg[9])
+                ns = ray_queues.push(ns, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr, cg,
+                                      cb, sh_path, sh_org, sh_dir, sh_far, sh_contrib,
+                                      sh_bounce, stacks, sh_stack)
+    if not goes_on:
+        return ns, nn
+    # the diffuse bounce from the exit (f cos / pdf = 1)
+    ix, iy, iz = cosine_hemisphere(stream_uniform(key, EXIT_STEP, 3),
+                                   stream_uniform(key, EXIT_STEP, 4))
+    ox, oy, oz = to_world(ix, iy, iz, mx, my, mz)
+    if dot(ox, oy, oz, hx, hy, hz) <= 0.0 or not iz > 0.0:
+        return ns, nn
+    if b + 1 >= ROULETTE_START:
+        cont[p] = roulette(stream_uniform(key, EXIT_STEP, 5), tr, tg, tb)
+    if not (tr < math.inf and tg < math.inf and tb < math.inf):
+        return ns, nn
+    pdf = iz * INV_PI
+    beta[p, 0], beta[p, 1], beta[p, 2] = tr, tg, tb
+    counts[p, 0] += 1
+    bounce[p] = b + 1
+    ray_bits[p] = DIFFUSE_BIT
+    min_pdf[p] = min(min_pdf[p], pdf)
+    prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2] = qx, qy, qz
+    prev_pdf[p] = pdf
+    nox, noy, noz = offset_origin(qx, qy, qz, hx, hy, hz, escale, ox, oy, oz)
+    return ns, ray_queues.push_next(nn, p, nox, noy, noz, ox, oy, oz, nx_path, nx_org,
+                                    nx_dir)

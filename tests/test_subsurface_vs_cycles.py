@@ -1,0 +1,64 @@
+"""Subsurface scattering against Cycles: sample_blends/subsurface.blend (a Principled
+skin Suzanne by Random Walk, a wax candle by Random Walk (Skin) under a flame lamp, a
+Subsurface Scattering node's marble mixed with a Glossy; sample_blends/
+subsurface_scenes.py) at Blender's defaults, DRT 512 against Cycles 1024 samples at
+64 x 48: image means within 1 % per channel (the artist scenes' tolerance,
+tests/test_artist_scenes_vs_cycles.py), the mean absolute difference of the 8 x 8 block
+means within 1 % of the image mean, and every block within 8 %.
+
+Measured (docs/subsurface.md has the numbers of its own run): means -0.3 % and -0.1 %,
+block MAD 0.55 % and 0.66 % (sampler seeds 0 and 7; Cycles against itself with another
+seed: 0.34 %). The worst block is the candle's top, lit by its flame lamp 6 cm above it:
+3.7 % and 6.3 % over the two seeds, noise. DRT picks a lamp in proportion to its power
+(the 4 W flame beside an 85 W key and a 50 W rim lamp), where Cycles' light tree picks
+the lamp that is near; issue 27's light tree is the fix, not this scene's lamps.
+The control, every subsurface weight rendered as the diffuse lobe it was before DRT
+walked it (DRT 128), fails: mean -1.9 % in red, block MAD 1.5 %."""
+from __future__ import annotations
+
+import os
+
+from conftest import SAMPLES_DIR, cached_render
+from test_artist_scenes_vs_cycles import _agrees
+
+CYCLES_SAMPLES = 1024
+DRT_SAMPLES = 512
+BLOCK_TOLERANCE = 0.08          # the flame-lit candle top's noise (above)
+BLOCK_MAD_TOLERANCE = 0.01
+
+_renders = {}
+BLEND = os.path.join(SAMPLES_DIR, "subsurface.blend")
+
+
+def _render(bpy, engine, samples, setup=None):
+    return cached_render(_renders, bpy, BLEND, engine, samples, setup,
+                         "" if setup is None else setup.__name__)
+
+
+def _diffuse_instead(scene):
+    """The control: no subsurface scattering, its weight left to the diffuse lobe (the
+    Subsurface Scattering node becomes a Diffuse BSDF of its colour)."""
+    import bpy
+    for mat in bpy.data.materials:
+        nt = mat.node_tree
+        if nt is None:
+            continue
+        for node in list(nt.nodes):
+            if node.bl_idname == "ShaderNodeBsdfPrincipled":
+                node.inputs["Subsurface Weight"].default_value = 0.0
+            elif node.bl_idname == "ShaderNodeSubsurfaceScattering":
+                diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
+                diffuse.inputs["Color"].default_value = node.inputs["Color"].default_value
+                for link in list(node.outputs[0].links):
+                    nt.links.new(diffuse.outputs[0], link.to_socket)
+                nt.nodes.remove(node)
+
+
+def test_subsurface_scene_matches_cycles(bpy_drt):
+    cycles = _render(bpy_drt, "CYCLES", CYCLES_SAMPLES)
+    assert cycles.shape == (48, 64, 3) and cycles.std() > 0.2 * cycles.mean()
+    def agrees(label, drt):
+        return _agrees(label, drt, cycles, BLOCK_TOLERANCE, BLOCK_MAD_TOLERANCE)
+    assert agrees("subsurface", _render(bpy_drt, "DRT", DRT_SAMPLES))
+    assert not agrees("subsurface rendered diffuse (control)",
+                      _render(bpy_drt, "DRT", 128, _diffuse_instead))
