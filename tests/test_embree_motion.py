@@ -89,21 +89,38 @@ def random_rays(rng, n, scale=1.0, offset=0.0):
 
 def _nearest(o, d, p0, p1, p2):
     """Every ray (n, 3) against every triangle (n or 1, T, 3) in float64
-    (Moller-Trumbore): (t, triangle) of the nearest hit, (inf, -1) where none."""
+    (Moller-Trumbore, written out per component): (t, triangle) of the nearest hit,
+    (inf, -1) where none."""
     e1, e2 = p1 - p0, p2 - p0
-    q = np.cross(d[:, None, :], e2)
-    det = (e1 * q).sum(-1)
+    e1x, e1y, e1z = e1[..., 0], e1[..., 1], e1[..., 2]
+    e2x, e2y, e2z = e2[..., 0], e2[..., 1], e2[..., 2]
+    dx, dy, dz = d[:, 0, None], d[:, 1, None], d[:, 2, None]
+    qx, qy, qz = dy * e2z - dz * e2y, dz * e2x - dx * e2z, dx * e2y - dy * e2x
+    det = e1x * qx + e1y * qy + e1z * qz
     ok = np.abs(det) > 1e-300
     inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    s = o[:, None, :] - p0
-    u = (s * q).sum(-1) * inv
-    r = np.cross(s, e1)
-    v = (d[:, None, :] * r).sum(-1) * inv
-    t = (e2 * r).sum(-1) * inv
+    sx = o[:, 0, None] - p0[..., 0]
+    sy = o[:, 1, None] - p0[..., 1]
+    sz = o[:, 2, None] - p0[..., 2]
+    u = (sx * qx + sy * qy + sz * qz) * inv
+    rx, ry, rz = sy * e1z - sz * e1y, sz * e1x - sx * e1z, sx * e1y - sy * e1x
+    v = (dx * rx + dy * ry + dz * rz) * inv
+    t = (e2x * rx + e2y * ry + e2z * rz) * inv
     t = np.where(ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0), t, np.inf)
     best = t.argmin(axis=1)
     tb = t[np.arange(len(o)), best]
     return tb, np.where(np.isfinite(tb), best, -1)
+
+
+def _deformed(motion, time):
+    """(n, V, 3): the deforming mesh at each ray's time, each vertex moving linearly from
+    step to step (DeformMotion's definition, written here for many times at once)."""
+    times, pos = motion.times, motion.positions
+    if len(times) == 1:
+        return np.broadcast_to(pos[0], (len(time),) + pos[0].shape)
+    i = np.clip(np.searchsorted(times, time, side="right") - 1, 0, len(times) - 2)
+    f = np.clip((time - times[i]) / (times[i + 1] - times[i]), 0.0, 1.0)[:, None, None]
+    return pos[i] * (1 - f) + pos[i + 1] * f
 
 
 def oracle(meshes, o, d, time, frozen=False):
@@ -129,7 +146,7 @@ def oracle(meshes, o, d, time, frozen=False):
             p = m.positions[tris][None]
             t, k = _nearest(lo, ld, p[:, :, 0], p[:, :, 1], p[:, :, 2])
         else:
-            world = np.stack([m.motion.positions_at(x) for x in at])     # (n, V, 3)
+            world = _deformed(m.motion, at)                              # (n, V, 3)
             p = world[:, tris]                                          # (n, T, 3, 3)
             t, k = _nearest(o, d, p[:, :, 0], p[:, :, 1], p[:, :, 2])
         closer = t < best_t
@@ -168,9 +185,10 @@ def test_hits_and_occlusion_equal_the_oracle(seed, scale, offset):
     blocked = accel.occluded(o, d, seg, time)
     assert 0.2 < blocked.mean() < 0.8
     assert (blocked != (t_ref < seg)).mean() <= 2e-3
-    # the control: every object frozen at mid-shutter
-    _, prim_frozen = oracle(meshes, o, d, time, frozen=True)
-    assert (prim_frozen != hits.prim).mean() > 0.05
+    # the control: every object frozen at mid-shutter (on a third of the rays)
+    k = len(o) // 3
+    _, prim_frozen = oracle(meshes, o[:k], d[:k], time[:k], frozen=True)
+    assert (prim_frozen != hits.prim[:k]).mean() > 0.05
 
 
 def test_steps_at_uneven_times_are_resampled_evenly():
