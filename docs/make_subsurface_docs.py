@@ -65,7 +65,8 @@ Christensen-Burley is rendered by the random walk, and the report says so.
 
 ![DRT and Cycles](images/subsurface.png)
 
-`sample_blends/subsurface.blend`: a Principled skin Suzanne (Random Walk, Scale 0.1), a
+`sample_blends/subsurface.blend`: a Principled skin Suzanne (Random Walk, Scale 0.1,
+bumped by a Noise Texture: the walk leaves on the bent normal, as in Cycles), a
 wax candle (Random Walk (Skin), Scale 0.05) lit by a flame lamp just above it, and a
 marble sphere (a Subsurface Scattering node mixed with a Glossy BSDF). The scene uses
 Blender's defaults. The images are {BIG}% of the file's 64 x 48 pixels, at
@@ -102,8 +103,6 @@ code (`tests/test_compile_progress.py`).
 ## Not modelled
 
 - Christensen-Burley's disk sampling (rendered by the random walk).
-- A bump or normal map at the exit point: the walk leaves on the surface's own normal.
-  Cycles evaluates the shader there again for the bent normal.
 - Textured subsurface parameters: the weight, radius, scale, IOR and anisotropy take
   their average, and the report says so. The base colour, which is the albedo, may be
   textured.

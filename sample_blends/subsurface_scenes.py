@@ -4,7 +4,8 @@ defaults: the scenes tests/test_subsurface_vs_cycles.py compares.
 subsurface
     Three translucent things on a checker floor in front of a wall: a smooth subdivided
     Suzanne of Principled skin (Subsurface Weight 1, the default Radius, Scale 0.1,
-    Random Walk), a wax candle (Principled, Subsurface Weight 1, Scale 0.05, Random Walk
+    Random Walk) with pores (a Noise Texture of scale 30 through a Bump of 4 mm into its
+    Normal), a wax candle (Principled, Subsurface Weight 1, Scale 0.05, Random Walk
     (Skin)) lit from just above its top by a warm point lamp for a flame, and a marble
     sphere (a Subsurface Scattering node, Scale 0.2, Roughness 0.3, mixed with a Glossy
     BSDF through a Fresnel-less Mix at 0.1). A key area lamp in front, a rim area lamp
@@ -17,8 +18,8 @@ import math
 import bmesh
 import bpy
 
-from artist_scenes import (_bmesh_object, _link, _new_scene, _smooth, _suzanne, _world,
-                           empty_material)
+from artist_scenes import (_bmesh_object, _bumped, _link, _new_scene, _smooth, _suzanne,
+                           _world, empty_material)
 from build_samples import _area_light, _checker, camera, principled, quad
 
 
@@ -74,7 +75,8 @@ def subsurface():
     _checker("Floor", -3.0, 3.0, -2.0, 4.0, 0.0, [(0.55, 0.55, 0.55), (0.2, 0.2, 0.2)], 12)
     quad("Wall", [(-3.0, 1.2, 0.0), (3.0, 1.2, 0.0), (3.0, 1.2, 3.0), (-3.0, 1.2, 3.0)],
          principled("Wall", (0.5, 0.45, 0.4)))
-    skin = _subsurface(principled("Skin", (0.85, 0.55, 0.45), roughness=0.4), 1.0, 0.1)
+    skin = _subsurface(_bumped("Skin", (0.85, 0.55, 0.45), 0.4, "ShaderNodeTexNoise", 30.0,
+                               0.004), 1.0, 0.1)
     suzanne = _suzanne(skin, 0.45)
     suzanne.scale = (0.4, 0.4, 0.4)
     wax = _subsurface(principled("Wax", (0.9, 0.8, 0.6), roughness=0.3), 1.0, 0.05,

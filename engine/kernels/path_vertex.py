@@ -415,7 +415,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                     nz, scale, dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, bounce, counts,
                     beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, L, lights, stacks,
                     sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack,
-                    ns_out, nx_path, nx_org, nx_dir, nn_out)
+                    ns_out, nx_path, nx_org, nx_dir, nn_out, programs, params, path_info,
+                    hit_row, regs)
             continue
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
         if bent and ad and not sdelta and spdf > 0.0:

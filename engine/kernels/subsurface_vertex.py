@@ -13,7 +13,8 @@ walk leaves as Cycles does (integrator/subsurface.h):
    surface ends the path;
 2. the walk, in the object it entered;
 3. exit: a Lambertian surface of weight 1 at the exit point (the throughput carries the
-   colour) with the exit's shading normal, no emission and no shader run: next-event
+   colour) with the exit's shading normal (bent by the material's program where it
+   bends it: a bump or normal map), no emission: next-event
    estimation (one light, one shadow ray, MIS against the diffuse bounce) and, while a
    diffuse bounce is left, a cosine-distributed next ray. The walk is no bounce (Cycles
    does not count it); the exit's bounce is a diffuse one.
@@ -36,9 +37,11 @@ from ..sampling.hashing import stream_uniform
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, nee_weight,
                            roulette)
 from .subsurface import MAX_BOUNCES, object_of, walk, walk_radius
-from .surface import offset_origin, rebuild_at_time
+from .surface import hit_uv, offset_origin, rebuild_at_time
+from .surface_hit import run_program
 from .terminator import shadow_origin
 from .warp import INV_PI, cosine_hemisphere
+from ..nodes.interpreter import has_program
 
 EXIT_STEP = MAX_BOUNCES + 1     # the walk stream's step whose numbers the exit uses
 
@@ -93,13 +96,16 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
                   gx, gy, gz, nx, ny, nz, scale, dx, dy, dz, u1, u2, br, bg, bb, bounce,
                   counts, beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, L, lights,
                   stacks, sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack,
-                  ns, nx_path, nx_org, nx_dir, nn):
+                  ns, nx_path, nx_org, nx_dir, nn, programs, params, path_info, hit_row,
+                  regs):
     """Path p (throughput b, the lobe's weight included) enters the surface it hit at p
     (triangle prim of instance inst; geometric normal g and shading normal n facing the
     ray along d), walks, and leaves: queues at most one shadow ray (count ns) and one
     next ray (count nn), as path_vertex.shade does. key: the walk's stream
     (subsurface.walk_key); rays: the scene for rays cast here (subsurface.local_hit);
-    f, w: a ray record (engine.embree.rays)."""
+    f, w: a ray record (engine.embree.rays). programs (None in a scene without shader
+    programs), params, path_info, hit_row, regs: what the exit's material program reads
+    and writes (path_vertex.shade's), run there for the normal it bends."""
     ex_dx, ex_dy, ex_dz, ok = entry_direction(row, dx, dy, dz, nx, ny, nz, u1, u2)
     if not ok or dot(ex_dx, ex_dy, ex_dz, gx, gy, gz) >= 0.0:
         return ns, nn
@@ -112,9 +118,21 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
     if not left or not max(tr, tg, tb) > 0.0:
         return ns, nn
     # the exit, seen from outside along the walk's last direction reversed
-    qx, qy, qz, hx, hy, hz, mx, my, mz, _, escale = rebuild_at_time(
+    qx, qy, qz, hx, hy, hz, mx, my, mz, front2, escale = rebuild_at_time(
         geometry, prim2, inst2, u, v, -wdx, -wdy, -wdz, time)
     b = bounce[p]
+    if programs is not None:
+        # a bump or normal map bends the exit's normal too: Cycles runs the shader there
+        # for it (SD_HAS_BSSRDF_BUMP), its lobes on that normal made a valid reflector
+        m2 = geometry[3][prim2]
+        if has_program(programs, m2):
+            uu, vv = hit_uv(geometry[6], prim2, u, v)
+            _, _, sx, sy, sz, _, _, _, bent, _ = run_program(
+                programs, params, geometry, counts, path_info, p, m2, prim2, inst2, u, v,
+                uu, vv, qx, qy, qz, hx, hy, hz, mx, my, mz, -wdx, -wdy, -wdz, front2,
+                ray_bits[p], b, 0.0, hit_row, regs, 0.5)
+            if bent:
+                mx, my, mz = sx, sy, sz
     goes_on = b < int(cfg[2]) and counts[p, 0] < cfg[3]
     mode = int(cfg[8])
     # next-event estimation on the exit's Lambertian surface
