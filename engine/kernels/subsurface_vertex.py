@@ -42,6 +42,7 @@ from .surface_hit import run_program
 from .terminator import shadow_origin
 from .warp import INV_PI, cosine_hemisphere
 from ..nodes.interpreter import has_program
+from ..nodes.shading import bump_shadowing
 
 EXIT_STEP = MAX_BOUNCES + 1     # the walk stream's step whose numbers the exit uses
 
@@ -121,18 +122,20 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
     qx, qy, qz, hx, hy, hz, mx, my, mz, front2, escale = rebuild_at_time(
         geometry, prim2, inst2, u, v, -wdx, -wdy, -wdz, time)
     b = bounce[p]
+    n0x, n0y, n0z = mx, my, mz          # the surface's own normal (shadow rays leave by it)
+    soften = True
     if programs is not None:
         # a bump or normal map bends the exit's normal too: Cycles runs the shader there
         # for it (SD_HAS_BSSRDF_BUMP), its lobes on that normal made a valid reflector
         m2 = geometry[3][prim2]
         if has_program(programs, m2):
             uu, vv = hit_uv(geometry[6], prim2, u, v)
-            _, _, sx, sy, sz, _, _, _, bent, _ = run_program(
+            _, _, bx, by, bz, _, _, _, bent, soften = run_program(
                 programs, params, geometry, counts, path_info, p, m2, prim2, inst2, u, v,
                 uu, vv, qx, qy, qz, hx, hy, hz, mx, my, mz, -wdx, -wdy, -wdz, front2,
                 ray_bits[p], b, 0.0, hit_row, regs, 0.5)
             if bent:
-                mx, my, mz = sx, sy, sz
+                mx, my, mz = bx, by, bz
     goes_on = b < int(cfg[2]) and counts[p, 0] < cfg[3]
     mode = int(cfg[8])
     # next-event estimation on the exit's Lambertian surface
@@ -141,7 +144,9 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
             lights, qx, qy, qz, stream_uniform(key, EXIT_STEP, 0),
             stream_uniform(key, EXIT_STEP, 1), stream_uniform(key, EXIT_STEP, 2), time)
         seen = lt.entry_visibility(lights, k)
-        cosine = dot(lx, ly, lz, mx, my, mz)
+        # (Cycles' bump shadowing where the normal is bent: path_vertex's bent_diffuse)
+        cosine = dot(lx, ly, lz, mx, my, mz) * bump_shadowing(n0x, n0y, n0z, mx, my, mz,
+                                                             lx, ly, lz, soften)
         if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and cosine > 0.0
                 and (seen & DIFFUSE_BIT) != 0):
             bpdf = cosine * INV_PI if goes_on else 0.0
@@ -152,8 +157,8 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
             else:
                 sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[4],
                                               geometry[13], geometry[9], prim2, inst2, u, v,
-                                              qx, qy, qz, hx, hy, hz, mx, my, mz, escale,
-                                              lx, ly, lz)
+                                              qx, qy, qz, hx, hy, hz, n0x, n0y, n0z,
+                                              escale, lx, ly, lz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, qx, qy, qz, lx, ly,
                                                          lz, dist, margin, cfg[9])
                 ns = ray_queues.push(ns, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr, cg,
@@ -166,6 +171,10 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
                                    stream_uniform(key, EXIT_STEP, 4))
     ox, oy, oz = to_world(ix, iy, iz, mx, my, mz)
     if dot(ox, oy, oz, hx, hy, hz) <= 0.0 or not iz > 0.0:
+        return ns, nn
+    shadowing = bump_shadowing(n0x, n0y, n0z, mx, my, mz, ox, oy, oz, soften)
+    tr, tg, tb = tr * shadowing, tg * shadowing, tb * shadowing
+    if not max(tr, tg, tb) > 0.0:
         return ns, nn
     if b + 1 >= ROULETTE_START:
         cont[p] = roulette(stream_uniform(key, EXIT_STEP, 5), tr, tg, tb)
