@@ -262,7 +262,9 @@ class Accelerator:
         """What a kernel needs to cast rays itself and name what they hit as the queries
         here do (engine.kernels.subsurface.local_hit): (Embree scene handle, centre,
         geometry id -> first global triangle, geometry id -> first object-table row, each
-        ordered mesh's first global triangle and the total)."""
+        ordered mesh's first global triangle and the total); None without triangles."""
+        if self._scene is None:
+            return None
         counts = [len(m.triangles) for m in self.ordered_meshes]
         starts = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
         return (int(self._scene.handle), np.asarray(self.center, np.float64),

@@ -127,10 +127,7 @@ class MaterialTable:
                           ("emission", emission), ("alpha", self.alpha),
                           ("metal_color", self.metal_color), ("glass_color", self.glass_color),
                           ("transparent_color", self.transparent_color)):
-            if not np.all(np.isfinite(arr)):
-                bad = [m.name for m, row in zip(materials, arr.reshape(len(materials), -1))
-                       if not np.all(np.isfinite(row))]
-                raise ValueError(f"material {bad[0]!r} has a non-finite {name}")
+            _require_finite(materials, name, arr)
         self.emission_textured = self.textured.get("emission", np.zeros(len(materials), bool))
         self.emission = np.where(self.emission_textured[:, None], 0.0, emission)
         self.any_emission = bool((self.emission > 0).any() or self.emission_textured.any())
@@ -172,11 +169,7 @@ class MaterialTable:
                         | (self.translucent_color.max(1) > 0.0) | self.refraction_only)
         for name in ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",
                      "sheen_roughness", "sheen_tint", "translucent_color"):
-            arr = getattr(self, name)
-            if not np.all(np.isfinite(arr)):
-                bad = [m.name for m, row in zip(materials, arr.reshape(len(materials), -1))
-                       if not np.all(np.isfinite(row))]
-                raise ValueError(f"material {bad[0]!r} has a non-finite {name}")
+            _require_finite(materials, name, getattr(self, name))
 
     def _subsurface_params(self, materials):
         """Subsurface scattering (engine/kernels/subsurface.py): weight, radius (mean free
@@ -199,11 +192,7 @@ class MaterialTable:
              for m in materials], bool)
         for name in ("subsurface_weight", "subsurface_radius", "subsurface_anisotropy",
                      "subsurface_ior", "subsurface_alpha"):
-            arr = getattr(self, name)
-            if not np.all(np.isfinite(arr)):
-                bad = [m.name for m, row in zip(materials, arr.reshape(n, -1))
-                       if not np.all(np.isfinite(row))]
-                raise ValueError(f"material {bad[0]!r} has a non-finite {name}")
+            _require_finite(materials, name, getattr(self, name))
         # whether any material scatters below its surface (the path tracer then compiles
         # the random walk, engine.integrators.compiled_path)
         self.any_subsurface = bool((self.subsurface_weight > 0.0).any())
@@ -326,3 +315,12 @@ class MaterialTable:
         index = np.asarray(index, dtype=np.int64)
         return np.where(self.has_metal_color[index][:, None], self.metal_color[index],
                         base_color)
+
+
+def _require_finite(materials, name, arr):
+    """Raise naming the first material whose parameter `name` (arr: one row per
+    material) is NaN or infinite."""
+    if not np.all(np.isfinite(arr)):
+        bad = [m.name for m, row in zip(materials, arr.reshape(len(materials), -1))
+               if not np.all(np.isfinite(row))]
+        raise ValueError(f"material {bad[0]!r} has a non-finite {name}")

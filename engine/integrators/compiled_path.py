@@ -105,11 +105,11 @@ class CompiledPathIntegrator:
         programmed = bool((self.textures[PROG][:, 1] > 0).any())
         # a material that scatters below its surface walks there with rays the kernel
         # casts itself (engine.kernels.subsurface)
-        self.subsurface = mats.any_subsurface and ctx.accel._scene is not None
+        rays = ctx.accel.kernel_rays() if mats.any_subsurface else None
+        self.subsurface = rays is not None
         self.features = (self.textures if programmed else None,
                          self.vol if self.has_volumes else None,
-                         self.vol if self.heterogeneous else None,
-                         ctx.accel.kernel_rays() if self.subsurface else None)
+                         self.vol if self.heterogeneous else None, rays)
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
                             else np.full(STACK, -1, np.int32))
 
