@@ -147,7 +147,8 @@ def _light(lights, lo, hi, part, n):
         py = lo[1] + (hi[1] - lo[1]) * v
         pz = lo[2] + (hi[2] - lo[2]) * w
         if part:
-            acc += lt.sample(lights, px, py, pz, w, u, v)[8]
+            acc += lt.sample(lights, lt.receiver(px, py, pz, 0.0, 0.0, 1.0, lt.ONE_SIDED), w,
+                             u, v, 0.0)[8]
         else:
             acc += px + py + pz
     return acc

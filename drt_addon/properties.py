@@ -32,6 +32,7 @@ CYCLES_SHARED = {
     "filter_glossy": ("blur_glossy", 1.0),
     "caustics_reflective": ("caustics_reflective", True),
     "caustics_refractive": ("caustics_refractive", True),
+    "light_tree": ("use_light_tree", True),
     "film_exposure": ("film_exposure", 1.0),
     "filter_type": ("pixel_filter_type", "BLACKMAN_HARRIS"),
     "filter_width": ("filter_width", 1.5),

@@ -38,6 +38,7 @@ class DRT_PT_sampling(DRTPanel, bpy.types.Panel):
             row = col.row(align=True)
             row.prop(cycles, "seed")
             row.prop(cycles, "use_animated_seed", text="", icon="TIME")
+            col.prop(cycles, "use_light_tree")   # Sampling > Lights > Light Tree, Cycles'
         col.prop(s, "integrator")
         col.prop(s, "threads")
 

@@ -27,6 +27,9 @@ class RenderSettings:
     filter_glossy: float = 1.0
     caustics_reflective: bool = True
     caustics_refractive: bool = True
+    # Cycles' Sampling > Lights > Light Tree: pick the light to sample for each shading
+    # point by its importance there (engine/kernels/lights/tree.py), else by power alone
+    light_tree: bool = True
     # Film
     filter_type: str = "BLACKMAN_HARRIS"
     filter_width: float = 1.5

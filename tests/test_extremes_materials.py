@@ -86,12 +86,14 @@ def test_material_at_its_limits_is_finite_and_energy_bounded(name):
 
 def test_emission_strength_1e6_is_finite_and_exact():
     """Emission radiance 1e6 (strength 1e6, white): seen directly it is 1e6 plus at most
-    the world's 1 reflected."""
+    the world's 1 reflected (an estimate: within four of its standard errors; the light
+    tree samples the world, not the sphere's own triangles below each point)."""
     film, stats = _furnace(Material("hot", base_color=WHITE, emission=(1e6,) * 3))
     assert not sane(film, stats)
     img = film.mean()[..., 0]
     centre = img[6:10, 6:10]                  # pixels wholly on the sphere
-    assert np.all(centre >= 1e6) and np.all(centre <= 1e6 + 1.0 + 1e-3), centre
+    se = np.sqrt(film.variance_of_mean()[6:10, 6:10, 0])
+    assert np.all(centre >= 1e6) and np.all(centre <= 1e6 + 1.0 + 4 * se + 1e-3), centre
 
 
 def _grazing_plane_scene(material, light=None, eye_height=1e-3, size=16):

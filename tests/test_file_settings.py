@@ -221,7 +221,6 @@ def test_fresh_scene_defaults_are_quiet(bpy_drt):
     (lambda s: (setattr(s.cycles, "use_adaptive_sampling", True),
                 setattr(s.cycles, "adaptive_threshold", 0.05)),
      "Noise Threshold is 0.05, not used: DRT renders with its own Noise Threshold"),
-    (lambda s: setattr(s.cycles, "use_light_tree", False), "Light Tree is off"),
     (lambda s: setattr(s.cycles, "time_limit", 30.0), "Time Limit is 30"),
     (lambda s: setattr(s.cycles, "use_fast_gi", True), "full global illumination"),
     (lambda s: setattr(s.render, "use_freestyle", True), "Freestyle"),
@@ -257,6 +256,16 @@ def test_light_paths_and_clamps_are_the_files_own(factory_scene):
             s.transparent_bounces, s.volume_bounces, s.clamp_direct, s.clamp_indirect) \
         == (8, 2, 3, 6, 5, 1, 2.0, 0.0)
     assert not hasattr(factory_scene.drt, "max_bounces")      # one vocabulary
+
+
+def test_light_tree_is_the_files_own(factory_scene):
+    """Sampling > Lights > Light Tree is read, not warned about: on (Cycles' default)
+    the engine picks lights with the tree, off by power."""
+    _quiet_defaults(factory_scene)
+    assert factory_scene.drt.to_engine_settings().light_tree
+    factory_scene.cycles.use_light_tree = False
+    assert _warnings(factory_scene) == []
+    assert not factory_scene.drt.to_engine_settings().light_tree
 
 
 def test_the_seed_is_the_files_own_and_animated_changes_it_per_frame(factory_scene):

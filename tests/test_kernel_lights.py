@@ -25,9 +25,10 @@ import zlib
 import numpy as np
 import pytest
 
-from engine.kernels.lights import (environment_pdf, environment_radiance, hit_lamps,
-                                   lamp_hit, lamp_pdf, n_entries, n_suns, pack_lights,
-                                   sample, sun_escaped)
+from engine.kernels.lights import (OMNI, ONE_SIDED, TWO_SIDED, environment_pdf,
+                                   environment_radiance, hit_lamps, lamp_hit, lamp_pdf,
+                                   n_entries, n_suns, pack_lights, sample, select_pdf,
+                                   sun_escaped)
 from engine.kernels.lights.batch import (hit_lamps_batch, lamp_pdf_batch, mesh_pdf_batch,
                                          sample_batch, sun_escaped_batch)
 from engine.kernels.lights.pack import LAMP_SLICES, LAMPS, SELECT_PDF, SLICE_OF, SUNS
@@ -224,17 +225,22 @@ def lamp_hits(L, k, p, wi):
     return t, rad
 
 
-def consistency(L, ls, p, up, u, shift=1.0):
-    """Sample every light entry from p, then find each sample again the way the path
-    tracer finds emission (a lamp's surface hit by the ray, a sun or the world seen by an
+def consistency(L, ls, p, up, u, shift=1.0, normals=None, mode=OMNI):
+    """Sample every light entry from p (receivers with these normals and mode: the
+    light tree picks for them), then find each sample again the way the path tracer
+    finds emission (a lamp's surface hit by the ray, a sun or the world seen by an
     escaped ray, an emissive triangle hit at the sampled point) and evaluate its pdf
     there; `shift` scales p for that second evaluation (the negative control). Returns
     a dict of (what, mismatched rows, rows checked, rows at a uniform's edge among the
     mismatched)."""
-    k, wi, dist, rad, pdf, delta, margin = sample_batch(L, p, up, u)
+    k, wi, dist, rad, pdf, delta, margin = sample_batch(L, p, up, u, None, normals, mode)
     n_lamps = ls.n_lamps
     edge = np.any((u == 0.0) | (u == ONE_MINUS), axis=1)
     q = p * shift
+    nq = np.zeros_like(q) if normals is None else normals
+
+    def recv(r):
+        return (*q[r], *nq[r], mode)
     ok = pdf > 0
     out = {}
     lamp = ok & (k >= 0) & (k < n_lamps) & ~delta
@@ -245,7 +251,7 @@ def consistency(L, ls, p, up, u, shift=1.0):
         found = np.isfinite(t)
         pdf_hit = np.zeros(len(rows))
         pdf_hit[found] = lamp_pdf_batch(L, k[rows][found], q[rows][found], wi[rows][found],
-                                         t[found])
+                                         t[found], None, nq[rows][found], mode)
         bad = ~found | ~np.isclose(t, dist[rows], rtol=1e-6) \
             | ~np.isclose(pdf_hit, pdf[rows], rtol=1e-6) \
             | ~np.all(np.isclose(rh, rad[rows], rtol=1e-9), axis=1)
@@ -263,7 +269,8 @@ def consistency(L, ls, p, up, u, shift=1.0):
                               and np.allclose(wi[r], to / d, rtol=0, atol=1e-9))
             else:
                 bad[i] = not (np.isinf(dist[r]) and np.allclose(wi[r], m.to_light, atol=1e-12))
-            bad[i] |= not np.isclose(pdf[r], ls.select_pdf[int(k[r])], rtol=1e-12)
+            bad[i] |= not np.isclose(pdf[r], select_pdf(L, int(k[r]), recv(r), 0.0),
+                                     rtol=1e-12)
         out["point lamps and delta suns"] = (int(bad.sum()), len(rows), 0)
     far = lamp & ~np.isfinite(dist)                # suns with a disc and the world
     if far.any():
@@ -272,9 +279,9 @@ def consistency(L, ls, p, up, u, shift=1.0):
         got = np.zeros(len(rows))
         for i, r in enumerate(rows):
             if int(k[r]) in suns:
-                got[i] = sun_escaped(L, suns[int(k[r])], *wi[r], 0.0)[3]
+                got[i] = sun_escaped(L, suns[int(k[r])], *wi[r], recv(r), 0.0)[3]
             else:
-                got[i] = environment_pdf(L, *wi[r])
+                got[i] = environment_pdf(L, *wi[r], recv(r), 0.0)
         bad = ~np.isclose(got, pdf[rows], rtol=1e-6)
         out["suns and world"] = (int(bad.sum()), len(rows), int((bad & edge[rows]).sum()))
     tri = ok & (k >= n_lamps)
@@ -282,14 +289,15 @@ def consistency(L, ls, p, up, u, shift=1.0):
         rows = np.nonzero(tri)[0]
         prim = ls.mesh.prim[k[rows] - n_lamps].astype(np.int64)
         point = p[rows] + wi[rows] * dist[rows, None]
-        got = mesh_pdf_batch(L, prim, np.ascontiguousarray(q[rows]), point)
+        got = mesh_pdf_batch(L, prim, np.ascontiguousarray(q[rows]), point, nq[rows], mode)
         bad = ~np.isclose(got, pdf[rows], rtol=1e-6)
         out["emissive triangles"] = (int(bad.sum()), len(rows), int((bad & edge[rows]).sum()))
     return out
 
 
+@pytest.mark.parametrize("tree", [True, False], ids=["tree", "power"])
 @pytest.mark.parametrize("name", SCENES)
-def test_every_sample_is_found_again_with_its_pdf(name):
+def test_every_sample_is_found_again_with_its_pdf(name, tree):
     """What multiple importance sampling relies on, on scenes of every light kind at
     hard shading points (a box about each light, 1e-8 .. 3 from it, near an area lamp's
     plane, inside sphere lights, at their centres, 1e4 away): a light sample's direction,
@@ -297,20 +305,23 @@ def test_every_sample_is_found_again_with_its_pdf(name):
     radiance, and the pdf found there (what a BSDF-sampled ray that hits the light uses)
     is the sample's pdf. Only a sample on a lamp's rim (a uniform of exactly 0 or 1,
     which `uniforms` mixes in) may miss: the ray then grazes the rim, a tie that rounding
-    decides."""
+    decides. With the light tree the pick depends on the receiver: the points are then
+    taken with random normals as opaque, transmitting and volume receivers."""
     ls, anchors = light_set(name)
-    L = pack_lights(ls)
+    L = pack_lights(ls, tree=tree)
     rng = np.random.default_rng(zlib.crc32(name.encode()))
     p = shading_points(ls, anchors, rng)
     up, u = pick_uniforms(ls, rng, len(p)), uniforms(rng, len(p))
-    found = consistency(L, ls, p, up, u)
-    print(name, found)
-    if name == "empty":
-        assert found == {}
-        return
-    assert found, "no sample to check"
-    for what, (bad, rows, at_edge) in found.items():
-        assert bad == at_edge, (what, bad, at_edge)      # only rim samples may miss
+    normals = unit(rng.normal(size=p.shape))
+    for mode in ((ONE_SIDED, TWO_SIDED, OMNI) if tree else (OMNI,)):
+        found = consistency(L, ls, p, up, u, normals=normals, mode=mode)
+        print(name, mode, found)
+        if name == "empty":
+            assert found == {}
+            continue
+        assert found, "no sample to check"
+        for what, (bad, rows, at_edge) in found.items():
+            assert bad == at_edge, (what, mode, bad, at_edge)   # only rim samples may miss
 
 
 def test_the_consistency_check_fails_for_a_wrong_pdf():
@@ -333,7 +344,7 @@ def test_entries_are_picked_in_proportion_to_their_power(name):
     """The pick (a CDF searched from its guide table) gives entry k to the share
     select_pdf[k] of the uniforms: exactly, to one step of a grid of them."""
     ls, _ = light_set(name)
-    L = pack_lights(ls)
+    L = pack_lights(ls, tree=False)
     n = 100_000
     up = (np.arange(n) + 0.5) / n
     k = sample_batch(L, np.zeros((n, 3)) + (0.1, 0.2, 0.3), up, np.full((n, 2), 0.5))[0]
@@ -349,7 +360,8 @@ def test_scalar_kernels_equal_batch_rows():
     up, u = pick_uniforms(ls, rng, len(p)), uniforms(rng, len(p))
     rows = sample_batch(L, p, up, u)
     for i in range(len(p)):
-        one = sample(L, *p[i], up[i], *u[i], 0.0)
+        recv = (*p[i], 0.0, 0.0, 0.0, OMNI)
+        one = sample(L, recv, up[i], *u[i], 0.0)
         assert one[0] == rows[0][i] and one[9] == rows[5][i]
         assert one[1:4] == tuple(rows[1][i]) and one[5:8] == tuple(rows[3][i])
         assert (one[4], one[8], one[10]) == (rows[2][i], rows[4][i], rows[6][i])
@@ -357,7 +369,7 @@ def test_scalar_kernels_equal_batch_rows():
         t, k, r, g, b = hit_lamps(L, *p[i], *d, np.inf, 31, 0.0)
         assert (t, k) == tuple(x[0] for x in hit_lamps_batch(L, p[i:i + 1], d[None],
                                                              np.array([np.inf]))[:2])
-        assert lamp_pdf(L, k, *p[i], *d, t, 0.0) == lamp_pdf_batch(
+        assert lamp_pdf(L, k, recv, *d, t, 0.0) == lamp_pdf_batch(
             L, np.array([k]), p[i:i + 1], d[None], np.array([t]))[0]
 
 
@@ -365,11 +377,11 @@ def test_empty_set():
     ls = LightSet([], 1.0)
     L = pack_lights(ls)
     assert n_entries(L) == 0 and n_suns(L) == 0
-    k, wx, wy, wz, dist, r, g, b, pdf, delta, margin = sample(L, 0.0, 0.0, 0.0, 0.3, 0.5, 0.5,
-                                                              0.0)
+    recv = (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, ONE_SIDED)
+    k, wx, wy, wz, dist, r, g, b, pdf, delta, margin = sample(L, recv, 0.3, 0.5, 0.5, 0.0)
     assert k == -1 and pdf == 0.0 and not delta and (r, g, b) == (0.0, 0.0, 0.0)
     assert hit_lamps(L, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 7.0, 31, 0.0) == (7.0, -1, 0.0, 0.0, 0.0)
-    assert environment_pdf(L, 0.0, 0.0, 1.0) == 0.0
+    assert environment_pdf(L, 0.0, 0.0, 1.0, recv, 0.0) == 0.0
     assert environment_radiance(L) == (0.0, 0.0, 0.0)
     black = pack_lights(LightSet([], 1.0, world=(0.0, 0.0, 0.0)))   # a black world: no light
     assert n_entries(black) == 0 and environment_radiance(black) == (0.0, 0.0, 0.0)
@@ -401,8 +413,9 @@ def test_a_moving_lamp_is_its_slice_at_the_rays_time():
     """A lamp that moves during the shutter (TimeSlicedLight: K slices) is, for a ray at
     shutter time t, exactly the still lamp of slice min(floor(t K), K - 1): sampling,
     hits, pdfs and an escaped ray's sun, against the still slice packed alone. Its pick
-    probability is the moving lamp's (the slices' mean power), so the comparison scales
-    by the ratio; a still lamp ignores the time."""
+    probability is the moving lamp's (the slices' mean power: picked by power here, as
+    the light tree's pick depends on where the lamp is), so the comparison scales by the
+    ratio; a still lamp ignores the time."""
     K = 4
     kinds = {
         "point": lambda x: PointLight((x, 0.2, 2.0), (40.0, 30.0, 20.0), radius=0.1),
@@ -418,9 +431,9 @@ def test_a_moving_lamp_is_its_slice_at_the_rays_time():
         xs = [-0.6 + 0.4 * j for j in range(K)]
         moving = at(0.0)
         moving.motion_slices = [at(x) for x in xs]
-        L = pack_lights(LightSet([moving, at(5.0)], 1.0))   # a still lamp beside it
+        L = pack_lights(LightSet([moving, at(5.0)], 1.0), tree=False)   # a still lamp beside
         for j, x in enumerate(xs):
-            still = pack_lights(LightSet([at(x), at(5.0)], 1.0))
+            still = pack_lights(LightSet([at(x), at(5.0)], 1.0), tree=False)
             ratio = L[SELECT_PDF][0] / still[SELECT_PDF][0]
             for t in (j / K, (j + 0.5) / K, (j + 1) / K - 1e-9):
                 time = np.full(64, t)

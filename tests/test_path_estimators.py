@@ -66,9 +66,10 @@ def _image_mean(scene, mode, samples, light_scale=1.0):
     direct light only (one bounce), estimated with `mode`."""
     # each pixel's camera ray through its centre: no edge of a lamp or an emitter seen
     # by the camera adds noise that all three estimators share
+    # (the control scales the power pick's probabilities: it picks lights by power)
     settings = RenderSettings(samples=samples, seed=11, max_bounces=1, clamp_direct=0.0,
                               clamp_indirect=0.0, filter_glossy=0.0, filter_type="BOX",
-                              filter_width=1e-3)
+                              filter_width=1e-3, light_tree=light_scale == 1.0)
     ctx = RenderContext(scene, settings)
     try:
         ctx.integrator.mis_mode = mode

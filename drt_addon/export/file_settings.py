@@ -262,9 +262,9 @@ SETTINGS: list[FileSetting] = [
              f"bounces; {NOISE_ONLY}", 0),
     _ignored("scene.cycles.light_sampling_threshold", "Sampling > Advanced > Light "
              "Threshold", f"DRT never skips a light sample; {NOISE_ONLY}", 0.01),
-    _ignored("scene.cycles.use_light_tree", "Sampling > Lights > Light Tree",
-             f"DRT picks lights in proportion to their power either way; {NOISE_ONLY}",
-             True),
+    _s("scene.cycles.use_light_tree", "Sampling > Lights > Light Tree", READ,
+       "DRT picks the light to sample for each shading point with Cycles' light tree, or "
+       "in proportion to the lights' power when it is off, as Cycles does"),
     _ignored("scene.cycles.direct_light_sampling_type", "Sampling > Advanced > Direct Light "
              "Sampling", f"DRT combines light and BSDF sampling with multiple importance "
              f"sampling; {NOISE_ONLY}", "MULTIPLE_IMPORTANCE_SAMPLING"),

@@ -83,7 +83,8 @@ class CompiledPathIntegrator:
         self.skips_shadows = bool(((vis & visibility.SHADOW) == 0).any())
         self.any_transparent = mats.any_transparent
         self.tables = kbsdf.kernel_tables()
-        self.lights = klights.pack_lights(ctx.lights, surf.visibility, ctx.has_motion)
+        self.lights = klights.pack_lights(ctx.lights, surf.visibility, ctx.has_motion,
+                                          tree=s.light_tree)
         self.world = np.ascontiguousarray(ctx.world_radiance, dtype=np.float64)
         # homogeneous volumes (engine.kernels.volume): the table, and the media the
         # camera is inside, where every path starts
@@ -213,7 +214,10 @@ class CompiledPathIntegrator:
         min_pdf = np.full(n, np.inf)               # smallest BSDF pdf so far per path
         cont = np.ones(n)                          # the roulette's verdict for the next vertex
         prev_pdf = np.full(n, np.inf)              # camera rays count as specular: weight 1
-        prev_pos = np.ascontiguousarray(origins, dtype=np.float64).copy()
+        # each path's last vertex, as its light sample's receiver (point, normal, mode:
+        # kernels/lights/tree.py); the camera's, with no normal
+        prev_pos = np.zeros((n, 7))
+        prev_pos[:, :3] = origins
         live = np.arange(n, dtype=np.int64)
         bounce = np.zeros(n, dtype=np.int64)       # bounces per path (not boundaries)
         vbounce = np.zeros(n, dtype=np.int64)      # volume scatterings per path

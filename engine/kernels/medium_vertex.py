@@ -12,10 +12,11 @@ multiple importance sampling over the distance (Cycles' "Multiple Importance" vo
 sampling): at the distance-sampled scattering (`scatter`, when the path scatters), and
 at a distance sampled equiangularly towards the picked light's position
 (`equiangular_light`, for every segment through a scattering medium, whether the path
-scatters or not: one more shadow ray). The light point is sampled alike at either
-distance, with the same pick probabilities, so the weights are the power heuristic of
-the two distance densities; a sun or the world, which has no position, is the distance
-strategy's alone. Heterogeneous segments use the distance strategy alone."""
+scatters or not: one more shadow ray). The scattering picks its light for its point
+(the light tree, lights/tree.py); the equiangular strategy picks one by power, before it
+knows its point. The weights are the power heuristic of the two strategies' densities
+of the pair (light, distance); a sun or the world, which has no position, is the
+distance strategy's alone. Heterogeneous segments use the distance strategy alone."""
 from __future__ import annotations
 
 import math
@@ -26,8 +27,8 @@ from . import equiangular as eq
 from . import lights as lt
 from . import ray_queues
 from .jit import kernel
-from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, nee_weight,
-                           power_heuristic, roulette)
+from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, keep_receiver,
+                           nee_weight, power_heuristic, roulette)
 from .volume import EQUIANGULAR, distance_pdf, hg_phase, hg_sample, medium, volume_dim
 
 C_VOLUME_BOUNCES = 14      # cfg entry: Cycles' max volume bounces
@@ -51,16 +52,17 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
     # whether the phase function samples a next ray; if not, light sampling alone finds
     # the light (its MIS weight is then 1, as a BSDF's at the last bounce)
     goes_on = bounce[p] < int(cfg[2]) and vbounce[p] < int(cfg[C_VOLUME_BOUNCES])
+    recv = lt.receiver(px, py, pz, 0.0, 0.0, 0.0, lt.OMNI)    # a point with no normal
     if lt.n_entries(lights) > 0:
         u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK)
         u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
         k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
-            lights, px, py, pz, u_pick, u1, u2, time)
+            lights, recv, u_pick, u1, u2, time)
         seen = lt.entry_visibility(lights, k)
         if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0:
             ph = hg_phase(g, dx * wx + dy * wy + dz * wz)
             w = nee_weight(mode, lpdf, ph if goes_on else 0.0, delta) / lpdf * ph
-            w *= distance_weight(lights, k, time, dx, dy, dz, segment)
+            w *= distance_weight(lights, k, recv, time, dx, dy, dz, segment)
             cr, cg, cb = br * lr * w, bg * lg * w, bb * lb * w
             if not w > 0.0:
                 pass                         # the equiangular sample's alone
@@ -85,16 +87,18 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
     bounce[p] += 1
     vbounce[p] += 1
     ray_bits[p] = DIFFUSE_BIT
-    prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2] = px, py, pz
+    keep_receiver(prev_pos, p, recv)
     prev_pdf[p] = pdf
     return ns, ray_queues.push_next(nn, p, px, py, pz, wx, wy, wz, nx_path, nx_org, nx_dir)
 
 
 @kernel(allocates=False)
-def distance_weight(lights, k, time, dx, dy, dz, segment):
-    """The weight of the distance-sampled scattering's light sample (entry k) against
-    equiangular sampling towards entry k on the same segment: 1 for a light without a
-    position, 0 where the medium samples such lights equiangularly only."""
+def distance_weight(lights, k, recv, time, dx, dy, dz, segment):
+    """The weight of the distance-sampled scattering's light sample (entry k, picked
+    for the scattering point recv) against equiangular sampling towards entry k on the
+    same segment: 1 for a light without a position, 0 where the medium samples such
+    lights equiangularly only. The densities compared are of the pair (light, distance):
+    the equiangular strategy picks its light by power (`equiangular_light`)."""
     ox, oy, oz, t_max, t, pd, method = segment
     if not pd > 0.0:
         return 1.0
@@ -103,7 +107,9 @@ def distance_weight(lights, k, time, dx, dy, dz, segment):
         return 1.0
     if int(method) == EQUIANGULAR:
         return 0.0
-    return power_heuristic(pd, eq.pdf(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_max, t))
+    return power_heuristic(pd * lt.select_pdf(lights, k, recv, time),
+                           eq.pdf(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_max, t)
+                           * lt.power_pdf(lights, k))
 
 
 @kernel
@@ -114,8 +120,10 @@ def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, 
     b before the segment, roulette applied) travels o + t d, t in [0, t_max], through its
     medium, whose distance sampling picked the channels with weights `channels` (RGB),
     with Volume Sampling Method `method` (EQUIANGULAR or MULTIPLE_IMPORTANCE). Picks a
-    light, samples a distance towards its position and a point on it from there, and
-    queues the shadow ray (returned count ns)."""
+    light by power (before any point on the segment is known), samples a distance
+    towards its position and a point on it from there, and queues the shadow ray
+    (returned count ns). Its weight against phase sampling takes the light's pick
+    probability for that point, as a scattering there would pick it."""
     kind, spp = int(cfg[0]), int(cfg[1])
     mode = int(cfg[8])
     if lt.n_entries(lights) == 0:
@@ -135,15 +143,20 @@ def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, 
     pd = distance_pdf(str_, stg, stb, wr, wg, wb, t)
     px, py, pz = ox + dx * t, oy + dy * t, oz + dz * t
     u1, u2 = sample_2d(kind, pkey[p], spp, index[p], volume_dim(depth, 4))
-    k2, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
-        lights, px, py, pz, u_pick, u1, u2, time)
-    seen = lt.entry_visibility(lights, k2)
-    if not (k2 == k and lpdf > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0):
+    wx, wy, wz, dist, lr, lg, lb, ppoint, delta, margin = lt.sample_entry(
+        lights, k, px, py, pz, u1, u2, time)
+    seen = lt.entry_visibility(lights, k)
+    if not (ppoint > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0):
         return ns
+    select = lt.select_pdf(lights, k, lt.receiver(px, py, pz, 0.0, 0.0, 0.0, lt.OMNI), time)
+    if not select > 0.0:
+        return ns                      # the light cannot reach this point (tree.py)
     goes_on = bounce[p] < int(cfg[2]) and vbounce[p] < int(cfg[C_VOLUME_BOUNCES])
     ph = hg_phase(g, dx * wx + dy * wy + dz * wz)
-    w_t = 1.0 if method == EQUIANGULAR else power_heuristic(pe, pd)
-    w = nee_weight(mode, lpdf, ph if goes_on else 0.0, delta) / lpdf * ph * w_t / pe
+    by_power = lt.power_pdf(lights, k)
+    w_t = 1.0 if method == EQUIANGULAR else power_heuristic(pe * by_power, pd * select)
+    w = (nee_weight(mode, ppoint * select, ph if goes_on else 0.0, delta)
+         / (ppoint * by_power) * ph * w_t / pe)
     cr = br * ssr * math.exp(-str_ * t) * lr * w
     cg = bg * ssg * math.exp(-stg * t) * lg * w
     cb = bb * ssb * math.exp(-stb * t) * lb * w

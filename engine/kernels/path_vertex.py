@@ -48,8 +48,8 @@ from .frame import dot, length, to_local, to_world
 from .jit import kernel
 from .medium_vertex import equiangular_light, scatter
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
-                           TRANSMISSION_BIT, _add, _INF, continues, hit_weight, nee_weight,
-                           roulette, uncovered)
+                           TRANSMISSION_BIT, _add, _INF, continues, hit_weight, keep_receiver,
+                           nee_weight, previous_receiver, roulette, uncovered)
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium, passed,
                      sample_method, segment, stack_cross, volume_dim)
@@ -239,8 +239,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 # the path's last vertex
                 t_l = length(ox + dx * t_l - prev_pos[p, 0], oy + dy * t_l - prev_pos[p, 1],
                              oz + dz * t_l - prev_pos[p, 2])
-            lpdf = lt.lamp_pdf(lights, k_l, prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2],
-                               dx, dy, dz, t_l, path_time[p])
+            lpdf = lt.lamp_pdf(lights, k_l, previous_receiver(prev_pos, p), dx, dy, dz, t_l,
+                               path_time[p])
             w = hit_weight(mode, prev_pdf[p], lpdf)
             _add(L, p, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w, clamp_hit)
         if volumes is not None and scattered:
@@ -262,11 +262,13 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             if b == 0 and film_transparent:
                 alpha[p] = uncovered(br, bg, bb)
                 continue
-            er, eg, eb, epdf = lt.world_escaped(lights, world, ray_bits[p], dx, dy, dz)
+            recv = previous_receiver(prev_pos, p)
+            er, eg, eb, epdf = lt.world_escaped(lights, world, ray_bits[p], dx, dy, dz, recv,
+                                                path_time[p])
             w = hit_weight(mode, prev_pdf[p], epdf)
             er, eg, eb = er * w, eg * w, eb * w
             for s in range(lt.n_suns(lights)):
-                sr, sg, sb, spdf = lt.sun_escaped(lights, s, dx, dy, dz, path_time[p])
+                sr, sg, sb, spdf = lt.sun_escaped(lights, s, dx, dy, dz, recv, path_time[p])
                 w = hit_weight(mode, prev_pdf[p], spdf)
                 er += sr * w
                 eg += sg * w
@@ -322,8 +324,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
                                       programmed)
         if er != 0.0 or eg != 0.0 or eb != 0.0:
-            lpdf = lt.mesh_pdf(lights, prim, prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2],
-                               px, py, pz)
+            lpdf = lt.mesh_pdf(lights, prim, previous_receiver(prev_pos, p), px, py, pz,
+                               path_time[p])
             w = hit_weight(mode, prev_pdf[p], lpdf)
             _add(L, p, br * er * w, bg * eg * w, bb * eb * w, clamp_hit)
         q = continues(cont, p)            # the roulette, after the emission found
@@ -334,6 +336,10 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
+        # the point lights are picked for (lights/tree.py): light from below the surface
+        # counts where it transmits, or where a bent normal makes "below" uncertain
+        recv = lt.receiver(px, py, pz, nx, ny, nz,
+                           lt.TWO_SIDED if bent or bsdf.transmits(state) else lt.ONE_SIDED)
         room = b < max_bounces
         ad = room and counts[p, 0] < cfg[3]
         ag = room and counts[p, 1] < cfg[4] and keep_g
@@ -345,7 +351,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 if n_lights > 1 else 0.0
             u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
             k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
-                lights, px, py, pz, u_pick, u1, u2, path_time[p])
+                lights, recv, u_pick, u1, u2, path_time[p])
             lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
             # a uniform world, which Cycles never samples (its escaping rays find it):
             # refraction towards it on Walter's pairs, as those rays see it
@@ -451,6 +457,6 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         cone_moves(path_info[1], p, t_geom)
         nn_out = ray_queues.push_next(nn_out, p, nox, noy, noz, wx, wy, wz, nx_path, nx_org,
                                       nx_dir)
-        prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2] = px, py, pz
+        keep_receiver(prev_pos, p, recv)
         prev_pdf[p] = _INF if sdelta else spdf
     return ns_out, nn_out

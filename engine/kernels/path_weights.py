@@ -124,3 +124,19 @@ def continues(cont, p):
     q = cont[p]
     cont[p] = 1.0
     return q
+
+
+@kernel(allocates=False)
+def previous_receiver(prev_pos, p):
+    """The receiver (lights/tree.py) of path p's last vertex, which its light sample was
+    picked for: prev_pos[p] holds its point, normal and mode."""
+    return (prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2], prev_pos[p, 3], prev_pos[p, 4],
+            prev_pos[p, 5], prev_pos[p, 6])
+
+
+@kernel(allocates=False)
+def keep_receiver(prev_pos, p, recv):
+    """Remember recv as path p's last vertex (see `previous_receiver`)."""
+    prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2] = recv[0], recv[1], recv[2]
+    prev_pos[p, 3], prev_pos[p, 4], prev_pos[p, 5] = recv[3], recv[4], recv[5]
+    prev_pos[p, 6] = recv[6]

@@ -34,8 +34,8 @@ from .bsdf.params import (P_BASE, P_ROUGHNESS, P_SSS_ALPHA, P_SSS_ANISOTROPY,
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from ..sampling.hashing import stream_uniform
-from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, nee_weight,
-                           roulette)
+from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, keep_receiver,
+                           nee_weight, roulette)
 from .subsurface import MAX_BOUNCES, object_of, walk, walk_radius
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .surface_hit import run_program
@@ -123,7 +123,7 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
         geometry, prim2, inst2, u, v, -wdx, -wdy, -wdz, time)
     b = bounce[p]
     n0x, n0y, n0z = mx, my, mz          # the surface's own normal (shadow rays leave by it)
-    soften = True
+    soften, bent = True, False
     if programs is not None:
         # a bump or normal map bends the exit's normal too: Cycles runs the shader there
         # for it (SD_HAS_BSSRDF_BUMP), its lobes on that normal made a valid reflector
@@ -138,10 +138,12 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
                 mx, my, mz = bx, by, bz
     goes_on = b < int(cfg[2]) and counts[p, 0] < cfg[3]
     mode = int(cfg[8])
-    # next-event estimation on the exit's Lambertian surface
+    # next-event estimation on the exit's Lambertian surface (lights picked for it:
+    # one-sided, unless a bump bends its normal)
+    recv = lt.receiver(qx, qy, qz, mx, my, mz, lt.TWO_SIDED if bent else lt.ONE_SIDED)
     if lt.n_entries(lights) > 0:
         k, lx, ly, lz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
-            lights, qx, qy, qz, stream_uniform(key, EXIT_STEP, 0),
+            lights, recv, stream_uniform(key, EXIT_STEP, 0),
             stream_uniform(key, EXIT_STEP, 1), stream_uniform(key, EXIT_STEP, 2), time)
         seen = lt.entry_visibility(lights, k)
         # (Cycles' bump shadowing where the normal is bent: path_vertex's bent_diffuse)
@@ -186,7 +188,7 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
     bounce[p] = b + 1
     ray_bits[p] = DIFFUSE_BIT
     min_pdf[p] = min(min_pdf[p], pdf)
-    prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2] = qx, qy, qz
+    keep_receiver(prev_pos, p, recv)
     prev_pdf[p] = pdf
     nox, noy, noz = offset_origin(qx, qy, qz, hx, hy, hz, escale, ox, oy, oz)
     return ns, ray_queues.push_next(nn, p, nox, noy, noz, ox, oy, oz, nx_path, nx_org,

@@ -120,9 +120,12 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
             if b == 0 and film_transparent:
                 alpha[p] = uncovered(br, bg, bb)
                 continue
-            er, eg, eb, _ = lt.world_escaped(lights, world, ray_bits[p], dx, dy, dz)
+            # (no light sampling to weigh against: the receiver's pdfs go unused)
+            recv = lt.receiver(ox, oy, oz, 0.0, 0.0, 0.0, lt.OMNI)
+            er, eg, eb, _ = lt.world_escaped(lights, world, ray_bits[p], dx, dy, dz, recv,
+                                             path_time[p])
             for s in range(lt.n_suns(lights)):
-                sr, sg, sb, _ = lt.sun_escaped(lights, s, dx, dy, dz, path_time[p])
+                sr, sg, sb, _ = lt.sun_escaped(lights, s, dx, dy, dz, recv, path_time[p])
                 er, eg, eb = er + sr, eg + sg, eb + sb
             _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)
             continue

@@ -30,29 +30,37 @@ Strategies (all pdfs in solid angle, omega = solid angle subtended, A = area):
 Use:
 
     L = pack_lights(light_set)                 # once per scene (NumPy arrays)
-    k, wix, wiy, wiz, dist, r, g, b, pdf, delta, margin = sample(L, px, py, pz, u_pick, u1,
-                                                                 u2, time)
+    recv = receiver(px, py, pz, nx, ny, nz, mode)   # the shading point (tree.py)
+    k, wix, wiy, wiz, dist, r, g, b, pdf, delta, margin = sample(L, recv, u_pick, u1, u2,
+                                                                 time)
     t, k, r, g, b = hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit, time)   # nearest
     n_lamps(L);  t, r, g, b = lamp_hit(L, k, ox, oy, oz, dx, dy, dz, ray_bit, time)
-    lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t, time)
-    mesh_pdf(L, prim, px, py, pz, qx, qy, qz)
-    environment_pdf(L, dx, dy, dz);  environment_radiance(L) -> (r, g, b)
-    world_escaped(L, world, ray_bit, dx, dy, dz) -> (r, g, b, pdf)   # escaped rays
-    n_suns(L);  sun_escaped(L, j, dx, dy, dz, time) -> (r, g, b, pdf)
-    n_entries(L);  entry_visibility(L, k);  pick(L, u_pick) -> k (as `sample` picks)
+    lamp_pdf(L, k, recv, wix, wiy, wiz, t, time)     # recv: the ray's origin's receiver
+    mesh_pdf(L, prim, recv, qx, qy, qz, time)
+    environment_pdf(L, dx, dy, dz, recv, time);  environment_radiance(L) -> (r, g, b)
+    world_escaped(L, world, ray_bit, dx, dy, dz, recv, time) -> (r, g, b, pdf)
+    n_suns(L);  sun_escaped(L, j, dx, dy, dz, recv, time) -> (r, g, b, pdf)
+    n_entries(L);  entry_visibility(L, k)
+    select_pdf(L, k, recv, time)                     # the probability `sample` picks k
+    pick(L, u_pick) -> k;  power_pdf(L, k)           # by power alone
+    sample_entry(L, k, px, py, pz, u1, u2, time)     # one entry, pick not included
     entry_center(L, k, time) -> (has_one, x, y, z)   # towards which distances are sampled
 
-Every pdf is in solid angle with the pick probability (LightSet.select_pdf) included. `time` is
+Every pdf is in solid angle with the pick probability included: the light tree's for the
+receiver (tree.py), as Cycles picks lights by default, or LightSet.select_pdf (by power)
+when the tree is off. `time` is
 the ray's shutter time in [0, 1]: a lamp that moves during the shutter is its slice at
 that time (pack.py, TimeSlicedLight). Array drivers for tests: `batch`.
 """
 from .light_set import (entry_center, environment_pdf, environment_radiance, hit_lamps,
                         is_uniform_world, lamp_hit, lamp_pdf, entry_visibility, mesh_pdf,
-                        n_entries, n_lamps, n_suns, pick, sample, sun_escaped,
-                        world_escaped)
+                        n_entries, n_lamps, n_suns, pick, power_pdf, sample, sample_entry,
+                        select_pdf, sun_escaped, world_escaped)
 from .pack import pack_lights
+from .tree import OMNI, ONE_SIDED, TWO_SIDED, receiver
 
 __all__ = ["pack_lights", "n_entries", "n_lamps", "sample", "hit_lamps", "lamp_hit",
-           "entry_visibility", "entry_center", "pick",
+           "entry_visibility", "entry_center", "pick", "power_pdf", "select_pdf",
+           "sample_entry", "receiver", "OMNI", "ONE_SIDED", "TWO_SIDED",
            "lamp_pdf", "mesh_pdf", "environment_pdf", "environment_radiance", "n_suns",
            "sun_escaped", "world_escaped", "is_uniform_world"]

@@ -1,7 +1,13 @@
 """The whole light set for one shading point or one ray (`engine.lights.LightSet`):
-pick an entry by its power (the CDF searched as np.searchsorted(side='right')), sample
-it, find lamps hit by rays, and every pdf multiple importance sampling needs. Entry k <
-n_lamps is lamp k (row k of L[LAMPS]); entry n_lamps + j is emissive triangle j.
+pick an entry, sample it, find lamps hit by rays, and every pdf multiple importance
+sampling needs. Entry k < n_lamps is lamp k (row k of L[LAMPS]); entry n_lamps + j is
+emissive triangle j.
+
+An entry is picked for a receiver (tree.py: the shading point, its normal and whether
+light from below counts) by the light tree, as Cycles does by default; with the tree
+off (L's tree fields empty) by its power alone (the CDF searched as
+np.searchsorted(side='right')). The pdfs of lights found by rays take the receiver of
+the path's previous vertex, so that they give the probability its light sample had.
 `time` is the ray's shutter time in [0, 1] (0 when nothing moves): a lamp that moves
 during the shutter is its slice at that time (`lamp_row`)."""
 from __future__ import annotations
@@ -21,6 +27,8 @@ from .pack import (C_CENTER, C_POS, C_TYPE, C_VISIBILITY, C_VISIBLE, CDF, CDF_GU
                    T_SUN, T_SUN_DELTA)
 from .point import intersect_point, pdf_point, sample_point
 from .sun import escaped_sun, pdf_sun, sample_sun
+from .tree import has_tree, pick_pdf
+from .tree import pick as tree_pick
 from .triangles import pdf_triangle, sample_triangle, triangle_entry
 
 _INF = math.inf
@@ -96,25 +104,54 @@ def sample_lamp_at(L, k, px, py, pz, u1, u2, time):
 
 
 @kernel(allocates=False)
-def sample(L, px, py, pz, u_pick, u1, u2, time):
-    """Light sampling for one shading point p at shutter time `time`: pick an entry with
-    u_pick, sample it with (u1, u2). Returns (k, wix, wiy, wiz, dist, r, g, b, pdf, delta,
-    margin): k the entry (-1 for an empty set), dist inf for suns and the world, pdf in
+def power_pdf(L, k):
+    """The probability that `pick` (by power) gives entry k."""
+    return L[SELECT_PDF][k]
+
+
+@kernel(allocates=False)
+def select_pdf(L, k, recv, time):
+    """The probability that `sample` picks entry k for the receiver `recv` (tree.py)."""
+    if k < 0:
+        return 0.0
+    if has_tree(L):
+        return pick_pdf(L, k, recv, time)
+    return L[SELECT_PDF][k]
+
+
+@kernel(allocates=False)
+def sample_entry(L, k, px, py, pz, u1, u2, time):
+    """Entry k sampled from p with (u1, u2), its pick probability not included: (wix,
+    wiy, wiz, dist, r, g, b, pdf, delta, margin) as `sample` returns them."""
+    n_lamps = L[LAMPS].shape[0]
+    if k < n_lamps:
+        wx, wy, wz, dist, r, g, b, pdf, delta = sample_lamp_at(L, k, px, py, pz, u1, u2,
+                                                               time)
+        return wx, wy, wz, dist, r, g, b, pdf, delta, 0.0
+    wx, wy, wz, dist, r, g, b, pdf, margin = sample_triangle(L, k - n_lamps, px, py, pz,
+                                                             u1, u2)
+    return wx, wy, wz, dist, r, g, b, pdf, False, margin
+
+
+@kernel(allocates=False)
+def sample(L, recv, u_pick, u1, u2, time):
+    """Light sampling for one receiver (tree.py: the shading point p, its normal and
+    mode) at shutter time `time`: pick an entry with u_pick, sample it with (u1, u2).
+    Returns (k, wix, wiy, wiz, dist, r, g, b, pdf, delta, margin): k the entry (-1 when
+    there is none, or none lights the receiver), dist inf for suns and the world, pdf in
     solid angle including the pick probability (0 = no sample), delta for points and
     zero-angle suns, margin the shadow-ray stop before dist for emissive triangles (0 for
     lamps)."""
-    k = pick(L, u_pick)
+    if has_tree(L):
+        k, select = tree_pick(L, recv, u_pick, time)
+    else:
+        k = pick(L, u_pick)
+        select = L[SELECT_PDF][k] if k >= 0 else 0.0
     if k < 0:
         return k, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, 0.0
-    select = L[SELECT_PDF][k]
-    lamps = L[LAMPS]
-    if k < lamps.shape[0]:
-        wx, wy, wz, dist, r, g, b, pdf, delta = sample_lamp_at(L, k, px, py, pz, u1, u2,
-                                                               time)
-        return k, wx, wy, wz, dist, r, g, b, pdf * select, delta, 0.0
-    wx, wy, wz, dist, r, g, b, pdf, margin = sample_triangle(L, k - lamps.shape[0],
-                                                             px, py, pz, u1, u2)
-    return k, wx, wy, wz, dist, r, g, b, pdf * select, False, margin
+    wx, wy, wz, dist, r, g, b, pdf, delta, margin = sample_entry(L, k, recv[0], recv[1],
+                                                                 recv[2], u1, u2, time)
+    return k, wx, wy, wz, dist, r, g, b, pdf * select, delta, margin
 
 
 @kernel(allocates=False)
@@ -186,13 +223,17 @@ def entry_visibility(L, k):
 
 
 @kernel(allocates=False)
-def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t, time):
+def lamp_pdf(L, k, recv, wix, wiy, wiz, t, time):
     """The pdf of one direction at shutter time `time`: solid-angle pdf, pick
-    probability included, of sampling wi from p towards lamp k hit at distance t (0 when
-    k is not a lamp)."""
+    probability for the receiver recv included, of sampling wi from recv's point towards
+    lamp k hit at distance t (0 when k is not a lamp)."""
     lamps = L[LAMPS]
     if k < 0 or k >= lamps.shape[0]:
         return 0.0
+    select = select_pdf(L, k, recv, time)
+    if select == 0.0:
+        return 0.0
+    px, py, pz = recv[0], recv[1], recv[2]
     kind = lamps[k, C_TYPE]
     sliced, row = lamp_row(L, k, time)
     table = L[LAMP_SLICES] if sliced else L[LAMPS]
@@ -206,32 +247,40 @@ def lamp_pdf(L, k, px, py, pz, wix, wiy, wiz, t, time):
         pdf = pdf_map(L, wix, wiy, wiz)
     else:
         pdf = pdf_environment(lamps, k)
-    return pdf * L[SELECT_PDF][k]
+    return pdf * select
 
 
 @kernel(allocates=False)
-def mesh_pdf(L, prim, px, py, pz, qx, qy, qz):
-    """The pdf of an emissive triangle's point for one hit: solid-angle pdf, pick probability included, of
-    next-event estimation from p sampling the point q of global triangle prim (0 when
-    that triangle is not a light)."""
+def mesh_pdf(L, prim, recv, qx, qy, qz, time):
+    """The pdf of an emissive triangle's point for one hit: solid-angle pdf, pick
+    probability for the receiver recv included, of next-event estimation from recv's
+    point sampling the point q of global triangle prim (0 when that triangle is not a
+    light)."""
     j = triangle_entry(L, prim)
     if j < 0:
         return 0.0
-    return pdf_triangle(L, j, px, py, pz, qx, qy, qz) * L[SELECT_PDF][L[LAMPS].shape[0] + j]
+    select = select_pdf(L, L[LAMPS].shape[0] + j, recv, time)
+    if select == 0.0:
+        return 0.0
+    return pdf_triangle(L, j, recv[0], recv[1], recv[2], qx, qy, qz) * select
 
 
 @kernel(allocates=False)
-def environment_pdf(L, dx, dy, dz):
-    """The world light's pdf for one escaped ray along d: pick probability x the world
-    light's solid-angle pdf, 0 when the world is not a light."""
+def environment_pdf(L, dx, dy, dz, recv, time):
+    """The world light's pdf for one escaped ray along d: pick probability for the
+    receiver recv x the world light's solid-angle pdf, 0 when the world is not a
+    light."""
     env = L[ENV]
     k = int(env[0])
     if k < 0:
         return 0.0
+    select = select_pdf(L, k, recv, time)
+    if select == 0.0:
+        return 0.0
     lamps = L[LAMPS]
     if lamps[k, C_TYPE] == T_ENV_MAP:
-        return pdf_map(L, dx, dy, dz) * L[SELECT_PDF][k]
-    return pdf_environment(lamps, k) * L[SELECT_PDF][k]
+        return pdf_map(L, dx, dy, dz) * select
+    return pdf_environment(lamps, k) * select
 
 
 @kernel(allocates=False)
@@ -242,9 +291,10 @@ def is_uniform_world(L, k):
 
 
 @kernel(allocates=False)
-def world_escaped(L, world, ray_bit, dx, dy, dz):
+def world_escaped(L, world, ray_bit, dx, dy, dz, recv, time):
     """What an escaped ray of kind ray_bit (engine.visibility) along d sees of the world,
-    and the MIS pdf of that: (r, g, b, environment_pdf(L, d)); the radiance is the
+    and the MIS pdf of that for the receiver recv of the ray's origin: (r, g, b,
+    environment_pdf(L, d, recv, time)); the radiance is the
     environment map's when there is one, else the uniform world's `world` (r, g, b),
     and black for the kinds of rays the world is hidden from."""
     if not int(L[ENV][5]) & ray_bit:
@@ -256,7 +306,7 @@ def world_escaped(L, world, ray_bit, dx, dy, dz):
             r, g, b = map_radiance(L, dx, dy, dz)
     else:
         r, g, b = world[0], world[1], world[2]
-    return r, g, b, environment_pdf(L, dx, dy, dz)
+    return r, g, b, environment_pdf(L, dx, dy, dz, recv, time)
 
 
 @kernel(allocates=False)
@@ -274,12 +324,14 @@ def n_suns(L):
 
 
 @kernel(allocates=False)
-def sun_escaped(L, j, dx, dy, dz, time):
+def sun_escaped(L, j, dx, dy, dz, recv, time):
     """The j-th non-delta sun seen by an escaped ray d at shutter time `time`: (r, g, b,
     pdf) with the radiance of sun.escaped(d) and pdf = sun.pdf(None, d, None) x its pick
-    probability."""
+    probability for the receiver recv of the ray's origin."""
     k = L[SUNS][j]
     sliced, row = lamp_row(L, k, time)
     table = L[LAMP_SLICES] if sliced else L[LAMPS]
     r, g, b = escaped_sun(table, row, dx, dy, dz)
-    return r, g, b, pdf_sun(table, row, dx, dy, dz) * L[SELECT_PDF][k]
+    if not (r > 0.0 or g > 0.0 or b > 0.0):
+        return r, g, b, 0.0
+    return r, g, b, pdf_sun(table, row, dx, dy, dz) * select_pdf(L, k, recv, time)

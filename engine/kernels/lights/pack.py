@@ -43,6 +43,10 @@ every scene):
                  count K (0 for a lamp that does not move). A moving lamp's own row in
                  L[LAMPS] is its middle slice (K // 2, as TimeSlicedLight without a time);
                  a ray at shutter time t in [0, 1] sees slice min(floor(t K), K - 1).
+  The light tree (tree_build.py; all three empty when lights are picked by power alone,
+  as with Cycles' Light Tree off or a single entry):
+  L[TREE_NODES]  float64 (n_nodes, tree_build.N_NODE), L[TREE_SLOTS] int64 (n_slots,),
+  L[TREE_EMIT]   float64 (n_entries, tree_build.N_EMIT).
 """
 from __future__ import annotations
 
@@ -78,6 +82,9 @@ ENV_CONDITIONAL_GUIDE = 20
 CDF_GUIDE = 21
 LAMP_SLICES = 22
 SLICE_OF = 23
+TREE_NODES = 24
+TREE_SLOTS = 25
+TREE_EMIT = 26
 
 # ---------------------------------------------------------------- L[ENV_MAP] fields
 M_HAS = 0           # 1: the world is an environment map
@@ -204,14 +211,15 @@ def _f64(a, shape):
     return np.array(np.asarray(a, dtype=np.float64).reshape(shape), order="C", copy=True)
 
 
-def pack_lights(light_set, tri_visibility=None, timed=True) -> tuple:
+def pack_lights(light_set, tri_visibility=None, timed=True, tree=True) -> tuple:
     """The LightSet as the kernels' tuple L (fields: this module's docstring).
     tri_visibility: the visibility mask of every global triangle (Surfaces.visibility),
     or None when every triangle is seen by every ray.
     A lamp that moves during the shutter (`TimeSlicedLight`) has a row per slice in
     L[LAMP_SLICES] (see the module docstring); with `timed` False (a render that samples
     no time: the shutter is closed) it is its middle slice alone, as TimeSlicedLight
-    without a time."""
+    without a time. `tree`: pick lights with the light tree (Cycles' default), else in
+    proportion to their power."""
     models = light_set.models
     lamps = np.zeros((len(models), N_COLUMNS))
     slice_of = np.zeros((len(models), 2), dtype=np.int64)
@@ -252,8 +260,13 @@ def pack_lights(light_set, tri_visibility=None, timed=True) -> tuple:
         entry = tri[7]
         prims = np.flatnonzero(entry >= 0)
         vis[entry[prims]] = np.asarray(tri_visibility)[prims]
-    return ((lamps, select_pdf, cdf, suns) + tri + (env, vis) + _pack_map(light_set.world)
-            + (guide_table(cdf, guide_cells(len(cdf))), slices, slice_of))
+    L = ((lamps, select_pdf, cdf, suns) + tri + (env, vis) + _pack_map(light_set.world)
+         + (guide_table(cdf, guide_cells(len(cdf))), slices, slice_of))
+    if tree and len(select_pdf) > 1:
+        from .tree_build import tree_arrays
+        return L + tree_arrays(L, models)
+    from .tree_build import N_EMIT, N_NODE
+    return L + (np.zeros((0, N_NODE)), np.zeros(0, np.int64), np.zeros((0, N_EMIT)))
 
 
 def _pack_map(world) -> tuple:

@@ -10,6 +10,12 @@ from .pack import (TRI_AREA, TRI_E1, TRI_E2, TRI_ENTRY, TRI_NORMAL, TRI_RADIANCE
                    TRI_SCALE, TRI_V0)
 
 
+# A point this close to a triangle's plane (|cos| at the triangle) gets none of its light:
+# its cosine is rounding there (a point on a coplanar emitter), and the light it would
+# carry, radiance x |cos|, is nothing; sampling and the pdf agree on it.
+GRAZING = 1e-9
+
+
 @kernel
 def square_to_triangle(u0, u1):
     """Heitz's square-to-triangle map: edge weights (b1, b2), uniform in area."""
@@ -34,7 +40,7 @@ def sample_triangle(L, j, px, py, pz, u0, u1):
     else:
         wx, wy, wz = 0.0, 0.0, 1.0
     cos_l = abs(wx * nrm[j, 0] + wy * nrm[j, 1] + wz * nrm[j, 2])
-    if not (dist > 0.0 and cos_l > 0.0):
+    if not (dist > 0.0 and cos_l > GRAZING):
         return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0, 0.0
     pdf = dist * dist / (L[TRI_AREA][j] * cos_l)
     rad = L[TRI_RADIANCE]
@@ -61,6 +67,6 @@ def pdf_triangle(L, j, px, py, pz, qx, qy, qz):
     d2 = tx * tx + ty * ty + tz * tz
     nrm = L[TRI_NORMAL]
     cos_abs_d = abs(tx * nrm[j, 0] + ty * nrm[j, 1] + tz * nrm[j, 2])
-    if cos_abs_d > 0.0 and d2 > 0.0:
+    if cos_abs_d > GRAZING * math.sqrt(d2) and d2 > 0.0:
         return d2 * math.sqrt(d2) / (L[TRI_AREA][j] * cos_abs_d)
     return 0.0
