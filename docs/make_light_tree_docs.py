@@ -154,10 +154,16 @@ costs more than a search of the power CDF, so per second of rendering the gain i
 variance of a street of 64 lamps at equal samples: the tree's is a fraction of picking
 by power's, and both converge to the same image.
 
-A scene with a single light builds no tree and picks nothing. Volumes: a scattering
-point picks its light with the tree (no normal); the equiangular strategy, which picks
-its light before it knows its point, picks by power, and the two are weighted by their
-densities of the pair (light, distance).
+A scene with a single light builds no tree and picks nothing.
+
+In volumes a scattering point picks its light with the tree (no normal). The
+equiangular strategy picks its light before it knows its point, for the whole ray
+segment through the medium, with the tree's volume form as Cycles does
+(`tree_segment.py`: a light's energy times the angle the segment subtends from it, over
+its distance to the segment's line; suns and the world, towards which no distance is
+sampled, are left to the scattering). The two strategies are weighted by their densities
+of the pair (light, distance). `tests/test_lit_fog.py` measures a row of 16 spot beams
+in fog: at equal samples the variance with the tree is a fraction of picking by power.
 
 Written by `docs/make_light_tree_docs.py`.
 """

@@ -218,7 +218,7 @@ def test_light_samples_carry_what_escaped_rays_see(interp, mapping, srgb):
     seen, pdf_seen = world_escaped_batch(L, np.zeros(3), np.ascontiguousarray(d[env_rows]))
     np.testing.assert_allclose(rad[env_rows], seen, rtol=1e-12, atol=1e-300)
     np.testing.assert_allclose(pdf[env_rows], pdf_seen, rtol=1e-12)
-    recv = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, OMNI)       # the origin, as map_sample's
+    recv = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, OMNI, 0.0)       # the origin, as map_sample's
     for x in d[env_rows][:50]:
         assert environment_pdf(L, *x, recv, 0.0) == world_escaped(L, np.zeros(3), 2, *x,
                                                                   recv, 0.0)[3]
@@ -230,7 +230,7 @@ def test_world_hidden_from_camera_rays_is_black_for_them():
     env = environment()
     world = World(texture=env.texture, visibility=31 & ~1)      # camera off
     L = pack_lights(LightSet([], 1.0, world=world_model(world)))
-    recv = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, OMNI)
+    recv = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, OMNI, 0.0)
     assert world_escaped(L, np.zeros(3), 1, 0.0, 0.0, 1.0, recv, 0.0) == (0.0, 0.0, 0.0, 0.0)
     assert world_escaped(L, np.zeros(3), 2, 0.0, 0.0, 1.0, recv, 0.0)[0] > 0.0   # diffuse
 

@@ -240,7 +240,7 @@ def consistency(L, ls, p, up, u, shift=1.0, normals=None, mode=OMNI):
     nq = np.zeros_like(q) if normals is None else normals
 
     def recv(r):
-        return (*q[r], *nq[r], mode)
+        return (*q[r], *nq[r], mode, 0.0)
     ok = pdf > 0
     out = {}
     lamp = ok & (k >= 0) & (k < n_lamps) & ~delta
@@ -360,7 +360,7 @@ def test_scalar_kernels_equal_batch_rows():
     up, u = pick_uniforms(ls, rng, len(p)), uniforms(rng, len(p))
     rows = sample_batch(L, p, up, u)
     for i in range(len(p)):
-        recv = (*p[i], 0.0, 0.0, 0.0, OMNI)
+        recv = (*p[i], 0.0, 0.0, 0.0, OMNI, 0.0)
         one = sample(L, recv, up[i], *u[i], 0.0)
         assert one[0] == rows[0][i] and one[9] == rows[5][i]
         assert one[1:4] == tuple(rows[1][i]) and one[5:8] == tuple(rows[3][i])
@@ -377,7 +377,7 @@ def test_empty_set():
     ls = LightSet([], 1.0)
     L = pack_lights(ls)
     assert n_entries(L) == 0 and n_suns(L) == 0
-    recv = (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, ONE_SIDED)
+    recv = (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, ONE_SIDED, 0.0)
     k, wx, wy, wz, dist, r, g, b, pdf, delta, margin = sample(L, recv, 0.3, 0.5, 0.5, 0.0)
     assert k == -1 and pdf == 0.0 and not delta and (r, g, b) == (0.0, 0.0, 0.0)
     assert hit_lamps(L, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 7.0, 31, 0.0) == (7.0, -1, 0.0, 0.0, 0.0)

@@ -136,3 +136,42 @@ def test_spot_beam_in_fog_is_the_same_image_with_each_method_and_less_noisy_with
     print("RMS error at 64 samples, relative to the image mean:", errors)
     assert errors["MULTIPLE_IMPORTANCE"] < 0.5 * errors["DISTANCE"]
     assert errors["EQUIANGULAR"] < 0.5 * errors["DISTANCE"]
+
+
+def _beams(tree, samples=64):
+    """16 spot lamps in a row 4 m above a black floor (100 to 800 W), in the thin fog,
+    seen from the side: many beams. (per-pixel mean, per-pixel variance of a sample)."""
+    floor = quad((0.0, 0.0, 0.0), (14.0, 0.0, 0.0), (0.0, 6.0, 0.0), material=0)
+    rng = np.random.default_rng(4)
+    spots = [PointLight((-11.25 + 1.5 * i, 0.0, 4.0), (p, p, p), spot_size=0.5,
+                        spot_blend=0.2, visibility=30)
+             for i, p in enumerate(rng.uniform(100.0, 800.0, 16))]
+    fog = Volume(scattering=(0.04, 0.04, 0.04), anisotropy=0.3,
+                 sampling="MULTIPLE_IMPORTANCE")
+    cam = Camera(look_at((0.0, -14.0, 2.0), (0.0, 0.0, 2.0)), lens=35.0)
+    scene = Scene(cam, 48, 24, [floor], [Material("floor", (0.0, 0.0, 0.0))], spots,
+                  World((0.0, 0.0, 0.0), volume=fog))
+    film, stats = render(scene, RenderSettings(samples=samples, seed=5, clamp_indirect=0.0,
+                                               light_tree=tree))
+    assert stats.nonfinite_samples == 0
+    n = film.count[:, None]
+    mean = film.sum / n
+    return mean, np.maximum(film.sum_sq / n - mean * mean, 0.0)
+
+
+def test_many_beams_in_fog_are_less_noisy_with_the_light_tree():
+    """The equiangular strategy picks its lamp for the whole segment with the light
+    tree's volume form (kernels/lights/tree_segment.py), the scattering for its point:
+    at equal samples the per-pixel variance is a fraction of picking both by power
+    (measured: 0.076), and the two converge to the same image (means within 4 standard
+    errors; measured 0.6 of one)."""
+    tree_mean, tree_var = _beams(True)
+    power_mean, power_var = _beams(False)
+    ratio = tree_var.mean() / power_var.mean()
+    n = 64 * len(tree_mean)
+    se = np.sqrt((tree_var.mean(0) + power_var.mean(0)) / n)
+    diff = tree_mean.mean(0) - power_mean.mean(0)
+    print(f"variance tree / power {ratio:.3f}; means {tree_mean.mean(0)} "
+          f"{power_mean.mean(0)} se {se}")
+    assert ratio < 0.25
+    assert np.all(np.abs(diff) < 4 * se)

@@ -13,7 +13,8 @@ sampling): at the distance-sampled scattering (`scatter`, when the path scatters
 at a distance sampled equiangularly towards the picked light's position
 (`equiangular_light`, for every segment through a scattering medium, whether the path
 scatters or not: one more shadow ray). The scattering picks its light for its point
-(the light tree, lights/tree.py); the equiangular strategy picks one by power, before it
+(the light tree, lights/tree.py); the equiangular strategy picks one for the whole
+segment (the tree's segment form, lights/tree_segment.py, as Cycles does), before it
 knows its point. The weights are the power heuristic of the two strategies' densities
 of the pair (light, distance); a sun or the world, which has no position, is the
 distance strategy's alone. Heterogeneous segments use the distance strategy alone."""
@@ -96,20 +97,25 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
 def distance_weight(lights, k, recv, time, dx, dy, dz, segment):
     """The weight of the distance-sampled scattering's light sample (entry k, picked
     for the scattering point recv) against equiangular sampling towards entry k on the
-    same segment: 1 for a light without a position, 0 where the medium samples such
-    lights equiangularly only. The densities compared are of the pair (light, distance):
-    the equiangular strategy picks its light by power (`equiangular_light`)."""
+    same segment: 1 for a light without a position or one the equiangular strategy
+    never picks, 0 where the medium samples the others equiangularly only. The
+    densities compared are of the pair (light, distance): the equiangular strategy
+    picks its light for the segment (`equiangular_light`)."""
     ox, oy, oz, t_max, t, pd, method = segment
     if not pd > 0.0:
         return 1.0
     has, cx, cy, cz = lt.entry_center(lights, k, time)
     if not has:
         return 1.0
+    by_segment = lt.select_pdf(lights, k, lt.segment_receiver(ox, oy, oz, dx, dy, dz,
+                                                              t_max), time)
+    if not by_segment > 0.0:
+        return 1.0
     if int(method) == EQUIANGULAR:
         return 0.0
     return power_heuristic(pd * lt.select_pdf(lights, k, recv, time),
                            eq.pdf(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_max, t)
-                           * lt.power_pdf(lights, k))
+                           * by_segment)
 
 
 @kernel
@@ -120,16 +126,19 @@ def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, 
     b before the segment, roulette applied) travels o + t d, t in [0, t_max], through its
     medium, whose distance sampling picked the channels with weights `channels` (RGB),
     with Volume Sampling Method `method` (EQUIANGULAR or MULTIPLE_IMPORTANCE). Picks a
-    light by power (before any point on the segment is known), samples a distance
-    towards its position and a point on it from there, and queues the shadow ray
-    (returned count ns). Its weight against phase sampling takes the light's pick
-    probability for that point, as a scattering there would pick it."""
+    light for the segment (before any point on it is known), samples a distance towards
+    its position and a point on it from there, and queues the shadow ray (returned count
+    ns). Its weight against phase sampling takes the light's pick probability for that
+    point, as a scattering there would pick it."""
     kind, spp = int(cfg[0]), int(cfg[1])
     mode = int(cfg[8])
     if lt.n_entries(lights) == 0:
         return ns
     u_pick = sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 2))
-    k = lt.pick(lights, u_pick)
+    k, by_segment = lt.pick_entry(lights, lt.segment_receiver(ox, oy, oz, dx, dy, dz,
+                                                              t_max), u_pick, time)
+    if k < 0:
+        return ns
     has, cx, cy, cz = lt.entry_center(lights, k, time)
     if not has:
         return ns
@@ -153,10 +162,9 @@ def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, 
         return ns                      # the light cannot reach this point (tree.py)
     goes_on = bounce[p] < int(cfg[2]) and vbounce[p] < int(cfg[C_VOLUME_BOUNCES])
     ph = hg_phase(g, dx * wx + dy * wy + dz * wz)
-    by_power = lt.power_pdf(lights, k)
-    w_t = 1.0 if method == EQUIANGULAR else power_heuristic(pe * by_power, pd * select)
+    w_t = 1.0 if method == EQUIANGULAR else power_heuristic(pe * by_segment, pd * select)
     w = (nee_weight(mode, ppoint * select, ph if goes_on else 0.0, delta)
-         / (ppoint * by_power) * ph * w_t / pe)
+         / (ppoint * by_segment) * ph * w_t / pe)
     cr = br * ssr * math.exp(-str_ * t) * lr * w
     cg = bg * ssg * math.exp(-stg * t) * lg * w
     cb = bb * ssb * math.exp(-stb * t) * lb * w

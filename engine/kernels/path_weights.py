@@ -129,9 +129,9 @@ def continues(cont, p):
 @kernel(allocates=False)
 def previous_receiver(prev_pos, p):
     """The receiver (lights/tree.py) of path p's last vertex, which its light sample was
-    picked for: prev_pos[p] holds its point, normal and mode."""
+    picked for: prev_pos[p] holds its point, normal and mode (a point: no segment)."""
     return (prev_pos[p, 0], prev_pos[p, 1], prev_pos[p, 2], prev_pos[p, 3], prev_pos[p, 4],
-            prev_pos[p, 5], prev_pos[p, 6])
+            prev_pos[p, 5], prev_pos[p, 6], 0.0)
 
 
 @kernel(allocates=False)

@@ -2,8 +2,9 @@
 chi-square harnesses call. Inputs are (n, 3) float64 points / directions, (n,) arrays of
 uniforms, distances and indices; outputs are freshly allocated arrays. `time`: the rows'
 shutter times (n,) in [0, 1], zeros when not given (only moving lamps read it).
-The receivers (tree.py) are the points p, with `normals` (n, 3) and `mode` (tree.OMNI,
-ONE_SIDED or TWO_SIDED); OMNI without normals."""
+The receivers (tree_importance.py) are the points p, with `normals` (n, 3) and `mode`
+(OMNI, ONE_SIDED or TWO_SIDED; OMNI without normals), or segments from p along the
+`normals` of lengths `t` (mode SEGMENT)."""
 from __future__ import annotations
 
 import numpy as np
@@ -18,14 +19,16 @@ def _times(time, n):
     return np.zeros(n) if time is None else np.ascontiguousarray(time, np.float64)
 
 
-def receivers(p, normals=None, mode=OMNI):
-    """(n, 7) receiver rows: p, the normals (zeros without them), the mode."""
+def receivers(p, normals=None, mode=OMNI, t=None):
+    """(n, 8) receiver rows: p, the normals (zeros without them), the mode, t."""
     p = np.asarray(p, np.float64).reshape(-1, 3)
-    r = np.zeros((len(p), 7))
+    r = np.zeros((len(p), 8))
     r[:, :3] = p
     if normals is not None:
         r[:, 3:6] = normals
     r[:, 6] = mode
+    if t is not None:
+        r[:, 7] = t
     return r
 
 
@@ -87,7 +90,7 @@ def lamp_pdf_batch(L, k, p, wi, t, time=None, normals=None, mode=OMNI):
 
 @kernel(allocates=False)
 def _recv(rc, i):
-    return (rc[i, 0], rc[i, 1], rc[i, 2], rc[i, 3], rc[i, 4], rc[i, 5], rc[i, 6])
+    return (rc[i, 0], rc[i, 1], rc[i, 2], rc[i, 3], rc[i, 4], rc[i, 5], rc[i, 6], rc[i, 7])
 
 
 @kernel
@@ -157,14 +160,14 @@ def _world_rows(L, world, d, ray_bit, rc):
     return rad, pdf
 
 
-def tree_pick_batch(L, u, p, normals=None, mode=OMNI, time=None):
+def tree_pick_batch(L, u, p, normals=None, mode=OMNI, time=None, t=None):
     """The light tree's pick (tree.pick) for one receiver per uniform u (n,) (p (n, 3) or
     one point for all): (entries (n,) int64, probabilities (n,))."""
     u = np.ascontiguousarray(u, np.float64)
     p = np.broadcast_to(np.asarray(p, np.float64), (len(u), 3))
     if normals is not None:
         normals = np.broadcast_to(np.asarray(normals, np.float64), (len(u), 3))
-    return _tree_rows(L, receivers(p, normals, mode), u, _times(time, len(u)))
+    return _tree_rows(L, receivers(p, normals, mode, t), u, _times(time, len(u)))
 
 
 @kernel

@@ -120,6 +120,16 @@ def select_pdf(L, k, recv, time):
 
 
 @kernel(allocates=False)
+def pick_entry(L, recv, u_pick, time):
+    """(k, probability): an entry picked for the receiver (by the tree, else by power),
+    k -1 when there is none."""
+    if has_tree(L):
+        return tree_pick(L, recv, u_pick, time)
+    k = pick(L, u_pick)
+    return k, (L[SELECT_PDF][k] if k >= 0 else 0.0)
+
+
+@kernel(allocates=False)
 def sample_entry(L, k, px, py, pz, u1, u2, time):
     """Entry k sampled from p with (u1, u2), its pick probability not included: (wix,
     wiy, wiz, dist, r, g, b, pdf, delta, margin) as `sample` returns them."""
@@ -142,11 +152,7 @@ def sample(L, recv, u_pick, u1, u2, time):
     solid angle including the pick probability (0 = no sample), delta for points and
     zero-angle suns, margin the shadow-ray stop before dist for emissive triangles (0 for
     lamps)."""
-    if has_tree(L):
-        k, select = tree_pick(L, recv, u_pick, time)
-    else:
-        k = pick(L, u_pick)
-        select = L[SELECT_PDF][k] if k >= 0 else 0.0
+    k, select = pick_entry(L, recv, u_pick, time)
     if k < 0:
         return k, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, 0.0
     wx, wy, wz, dist, r, g, b, pdf, delta, margin = sample_entry(L, k, recv[0], recv[1],
