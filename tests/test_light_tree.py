@@ -138,7 +138,7 @@ def test_pick_probabilities_are_a_distribution(name, mode):
     full = 0
     for recv in receivers(rng, anchors, 12, mode):
         pdf = np.array([T.pick_pdf(L, k, recv, 0.0) for k in range(n)])
-        important = np.array([T.emitter_importance(L, k, recv, 0.0)[0] > 0 for k in range(n)])
+        important = np.array([T.entry_importance(L, k, recv, 0.0)[0] > 0 for k in range(n)])
         assert np.array_equal(pdf > 0, important)
         assert pdf.sum() <= 1 + 1e-12
         if important.all():

@@ -13,15 +13,17 @@ finds a light. Entries the tree leaves out (no energy) have probability 0.
 from __future__ import annotations
 
 from ..jit import kernel
-from .pack import TREE_EMIT, TREE_NODES, TREE_SLOTS
+from .pack import (LAMP_SLICES, LAMPS, SLICE_OF, TREE_EMIT, TREE_NODES, TREE_SLOTS, TRI_E1,
+                   TRI_E2, TRI_V0)
 from .tree_build import E_LEAF, INNER, N_A, N_B, N_KIND, N_PARENT
-from .tree_importance import (OMNI, ONE_SIDED, SEGMENT, TWO_SIDED, cluster_importance,
-                              emitter_importance, receiver, segment_receiver)
+from .tree_importance import (OMNI, ONE_SIDED, SEGMENT, TWO_SIDED, V_EMIT, V_NODES,
+                              V_SLOTS, cluster_importance, emitter_importance, receiver,
+                              segment_receiver)
 
 ONE_MINUS_EPS = 1.0 - 2.0 ** -53
 
 __all__ = ["OMNI", "ONE_SIDED", "TWO_SIDED", "SEGMENT", "receiver", "segment_receiver",
-           "has_tree", "pick", "pick_pdf", "left_probability", "emitter_importance"]
+           "has_tree", "pick", "pick_pdf", "left_probability", "entry_importance"]
 
 
 @kernel(allocates=False)
@@ -31,20 +33,28 @@ def has_tree(L):
 
 
 @kernel(allocates=False)
-def _child_importance(L, node, recv, time):
-    nd = L[TREE_NODES]
-    if nd[node, N_KIND] != INNER and nd[node, N_B] == 1.0:
-        return emitter_importance(L, L[TREE_SLOTS][int(nd[node, N_A])], recv, time)
-    return cluster_importance(L, node, recv)
+def entry_importance(L, k, recv, time):
+    """(max, min) importance of light entry k for the receiver (tree_importance)."""
+    V = (L[TREE_NODES], L[TREE_SLOTS], L[TREE_EMIT], L[LAMPS], L[LAMP_SLICES],
+         L[SLICE_OF], L[TRI_V0], L[TRI_E1], L[TRI_E2])       # (a kernel cannot return it)
+    return emitter_importance(V, k, recv, time)
 
 
 @kernel(allocates=False)
-def left_probability(L, node, recv, time):
+def _child_importance(V, node, recv, time):
+    nd = V[V_NODES]
+    if nd[node, N_KIND] != INNER and nd[node, N_B] == 1.0:
+        return emitter_importance(V, V[V_SLOTS][int(nd[node, N_A])], recv, time)
+    return cluster_importance(V, node, recv)
+
+
+@kernel(allocates=False)
+def left_probability(V, node, recv, time):
     """(ok, p): the probability that inner node `node` goes to its left child; ok False
     when neither child matters to the receiver."""
-    nd = L[TREE_NODES]
-    l_max, l_min = _child_importance(L, int(nd[node, N_A]), recv, time)
-    r_max, r_min = _child_importance(L, int(nd[node, N_B]), recv, time)
+    nd = V[V_NODES]
+    l_max, l_min = _child_importance(V, int(nd[node, N_A]), recv, time)
+    r_max, r_min = _child_importance(V, int(nd[node, N_B]), recv, time)
     total_max = l_max + r_max
     if not total_max > 0.0:
         return False, 0.0
@@ -69,18 +79,18 @@ def _in_leaf(i_max, i_min, s_max, s_min, n_has):
 
 
 @kernel(allocates=False)
-def _leaf_pick(L, node, recv, time, u):
+def _leaf_pick(V, node, recv, time, u):
     """(entry, probability in the leaf) with u in [0, 1): half of u picks by the upper
     bounds, half by the lower ones, each by reservoir sampling in one pass over the
     leaf's lights (Cycles' `light_tree_cluster_select_emitter`)."""
-    nd, slots = L[TREE_NODES], L[TREE_SLOTS]
+    nd, slots = V[V_NODES], V[V_SLOTS]
     first, count = int(nd[node, N_A]), int(nd[node, N_B])
     by_max = u >= 0.5
     u = 2.0 * u - (1.0 if by_max else 0.0)
     s_max, s_min, n_has = 0.0, 0.0, 0
     chosen, c_max, c_min, total = -1, 0.0, 0.0, 0.0
     for i in range(first, first + count):
-        i_max, i_min = emitter_importance(L, slots[i], recv, time)
+        i_max, i_min = emitter_importance(V, slots[i], recv, time)
         if i_max > 0.0:
             n_has += 1
         s_max += i_max
@@ -101,7 +111,7 @@ def _leaf_pick(L, node, recv, time, u):
         target = int(u * n_has)
         seen = 0
         for i in range(first, first + count):
-            i_max, i_min = emitter_importance(L, slots[i], recv, time)
+            i_max, i_min = emitter_importance(V, slots[i], recv, time)
             if i_max > 0.0:
                 if seen == target or seen == n_has - 1:
                     chosen, c_max, c_min = slots[i], i_max, i_min
@@ -114,10 +124,12 @@ def _leaf_pick(L, node, recv, time, u):
 def pick(L, recv, u, time):
     """(entry, probability): a light entry for the receiver picked with u in [0, 1);
     (-1, 0) when no light matters to it."""
-    nd = L[TREE_NODES]
+    V = (L[TREE_NODES], L[TREE_SLOTS], L[TREE_EMIT], L[LAMPS], L[LAMP_SLICES],
+         L[SLICE_OF], L[TRI_V0], L[TRI_E1], L[TRI_E2])       # tree_importance.V_*
+    nd = V[V_NODES]
     node, prob = 0, 1.0
     while nd[node, N_KIND] == INNER:
-        ok, p_left = left_probability(L, node, recv, time)
+        ok, p_left = left_probability(V, node, recv, time)
         if not ok:
             return -1, 0.0
         if u < p_left:
@@ -126,21 +138,23 @@ def pick(L, recv, u, time):
             node, prob, u = int(nd[node, N_B]), prob * (1.0 - p_left), \
                 (u - p_left) / (1.0 - p_left)
         u = min(max(u, 0.0), ONE_MINUS_EPS)
-    k, p_leaf = _leaf_pick(L, node, recv, time, u)
+    k, p_leaf = _leaf_pick(V, node, recv, time, u)
     return k, prob * p_leaf
 
 
 @kernel(allocates=False)
 def pick_pdf(L, k, recv, time):
     """The probability that `pick` gives entry k for the receiver."""
-    nd, slots = L[TREE_NODES], L[TREE_SLOTS]
-    leaf = int(L[TREE_EMIT][k, E_LEAF])
+    V = (L[TREE_NODES], L[TREE_SLOTS], L[TREE_EMIT], L[LAMPS], L[LAMP_SLICES],
+         L[SLICE_OF], L[TRI_V0], L[TRI_E1], L[TRI_E2])       # tree_importance.V_*
+    nd, slots = V[V_NODES], V[V_SLOTS]
+    leaf = int(V[V_EMIT][k, E_LEAF])
     if leaf < 0:
         return 0.0
     first, count = int(nd[leaf, N_A]), int(nd[leaf, N_B])
     s_max, s_min, n_has, k_max, k_min = 0.0, 0.0, 0, 0.0, 0.0
     for i in range(first, first + count):
-        i_max, i_min = emitter_importance(L, slots[i], recv, time)
+        i_max, i_min = emitter_importance(V, slots[i], recv, time)
         if i_max > 0.0:
             n_has += 1
         s_max += i_max
@@ -153,7 +167,7 @@ def pick_pdf(L, k, recv, time):
         parent = int(nd[node, N_PARENT])
         if parent < 0:
             break
-        ok, p_left = left_probability(L, parent, recv, time)
+        ok, p_left = left_probability(V, parent, recv, time)
         if not ok:
             return 0.0
         prob *= p_left if int(nd[parent, N_A]) == node else 1.0 - p_left

@@ -22,12 +22,17 @@ import math
 from ..jit import kernel
 from ..warp import smoothstep01
 from .pack import (C_AX, C_AXIS, C_AY, C_CENTER, C_COS_HALF, C_IS_SPOT, C_NORMAL, C_POS,
-                   C_RADIUS, C_SMOOTH, C_TO_LIGHT, C_TYPE, LAMP_SLICES, LAMPS, SLICE_OF,
-                   T_AREA, T_ENV, T_ENV_MAP, T_SPHERE, T_SUN, T_SUN_DELTA, TREE_EMIT,
-                   TREE_NODES, TRI_E1, TRI_E2, TRI_V0)
+                   C_RADIUS, C_SMOOTH, C_TO_LIGHT, C_TYPE, T_AREA, T_ENV, T_ENV_MAP,
+                   T_SPHERE, T_SUN, T_SUN_DELTA)
 from .tree_build import (DISTANT, E_AXIS, E_CONE, E_ENERGY, N_AXIS, N_CONE, N_ENERGY,
                          N_KIND, N_MAX, N_MIN)
 from .tree_segment import closest, reaches_front, subtended, towards_segment
+
+# The arrays of L the tree reads, as the tuple V = (L[TREE_NODES], L[TREE_SLOTS],
+# L[TREE_EMIT], L[LAMPS], L[LAMP_SLICES], L[SLICE_OF], L[TRI_V0], L[TRI_E1], L[TRI_E2])
+# that tree.py makes once per pick: a kernel's arguments are passed by value, and the
+# 27 arrays of L would be copied (about 1.7 kB) into every call of the walk.
+V_NODES, V_SLOTS, V_EMIT, V_LAMPS, V_SLICES, V_SLICE_OF, V_V0, V_E1, V_E2 = range(9)
 
 PI = math.pi
 OMNI = 0.0
@@ -144,8 +149,8 @@ def _corner(recv, rx, ry, rz, tx, ty, tz, cx, cy, cz):
 
 
 @kernel(allocates=False)
-def _triangle_importance(L, j, recv, em, k):
-    v0, e1, e2 = L[TRI_V0], L[TRI_E1], L[TRI_E2]
+def _triangle_importance(V, j, recv, em, k):
+    v0, e1, e2 = V[V_V0], V[V_E1], V[V_E2]
     cx = v0[j, 0] + (e1[j, 0] + e2[j, 0]) / 3.0
     cy = v0[j, 1] + (e1[j, 1] + e2[j, 1]) / 3.0
     cz = v0[j, 2] + (e1[j, 2] + e2[j, 2]) / 3.0
@@ -170,12 +175,12 @@ def _triangle_importance(L, j, recv, em, k):
 
 
 @kernel(allocates=False)
-def _slice(L, k, time):
+def _slice(V, k, time):
     """(sliced, row): lamp k's row at shutter time `time` (light_set.lamp_row)."""
-    count = L[SLICE_OF][k, 1]
+    count = V[V_SLICE_OF][k, 1]
     if count == 0:
         return False, k
-    return True, L[SLICE_OF][k, 0] + min(max(int(time * count), 0), count - 1)
+    return True, V[V_SLICE_OF][k, 0] + min(max(int(time * count), 0), count - 1)
 
 
 @kernel(allocates=False)
@@ -253,20 +258,21 @@ def _area_importance(lamps, row, recv, em, k):
 
 
 @kernel(allocates=False)
-def emitter_importance(L, k, recv, time):
-    """(max, min) importance of light entry k for the receiver at shutter time `time`."""
-    em = L[TREE_EMIT]
-    n_lamps = L[LAMPS].shape[0]
+def emitter_importance(V, k, recv, time):
+    """(max, min) importance of light entry k for the receiver at shutter time `time`
+    (V: the tree's view of L, above)."""
+    em = V[V_EMIT]
+    n_lamps = V[V_LAMPS].shape[0]
     if k >= n_lamps:
-        return _triangle_importance(L, k - n_lamps, recv, em, k)
-    kind = L[LAMPS][k, C_TYPE]
+        return _triangle_importance(V, k - n_lamps, recv, em, k)
+    kind = V[V_LAMPS][k, C_TYPE]
     distant = kind == T_ENV or kind == T_ENV_MAP or kind == T_SUN or kind == T_SUN_DELTA
     if distant and recv[6] == SEGMENT:
         return 0.0, 0.0                # no distance to sample towards
     if kind == T_ENV or kind == T_ENV_MAP:
         return em[k, E_ENERGY], 0.0    # the whole sphere: no cosine bounds it
-    sliced, row = _slice(L, k, time)
-    table = L[LAMP_SLICES] if sliced else L[LAMPS]
+    sliced, row = _slice(V, k, time)
+    table = V[V_SLICES] if sliced else V[V_LAMPS]
     if kind == T_SUN or kind == T_SUN_DELTA:
         # a disc one unit away (Cycles' distant light): theta_u = theta_e
         tx, ty, tz = table[row, C_TO_LIGHT], table[row, C_TO_LIGHT + 1], \
@@ -281,9 +287,9 @@ def emitter_importance(L, k, recv, time):
 
 
 @kernel(allocates=False)
-def cluster_importance(L, node, recv):
+def cluster_importance(V, node, recv):
     """(max, min) importance of a node holding several lights (Cycles' node form)."""
-    nd = L[TREE_NODES]
+    nd = V[V_NODES]
     ax, ay, az = nd[node, N_AXIS], nd[node, N_AXIS + 1], nd[node, N_AXIS + 2]
     cos_o, sin_o = nd[node, N_CONE], nd[node, N_CONE + 1]
     cos_oe, cos_eo, energy = nd[node, N_CONE + 2], nd[node, N_CONE + 3], nd[node, N_ENERGY]
