@@ -30,8 +30,8 @@ from ..jit import kernel
 from .pack import (C_AREA, C_AX, C_AXIS, C_AY, C_CENTER, C_COS_HALF, C_INTENSITY,
                    C_IS_SPOT, C_IRRADIANCE, C_NORMAL, C_ONE_MINUS, C_POS, C_RAD, C_RADIUS,
                    C_TO_LIGHT, C_TYPE, LAMP_SLICES, LAMPS, SLICE_OF, T_AREA, T_DISC,
-                   T_ENV, T_ENV_MAP, T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA, TRI_AREA,
-                   TRI_E1, TRI_E2, TRI_RADIANCE, TRI_V0)
+                   T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA, TRI_AREA, TRI_E1, TRI_E2,
+                   TRI_RADIANCE, TRI_V0)
 from .tree_cone import EMPTY, box_measure, measure, merge
 
 PI = math.pi
