@@ -43,7 +43,7 @@ Use:
     n_entries(L);  entry_visibility(L, k)
     select_pdf(L, k, recv, time)                     # the probability `sample` picks k
     pick_entry(L, recv, u_pick, time) -> (k, probability)   # as `sample` picks
-    pick(L, u_pick) -> k;  power_pdf(L, k)           # by power alone
+    pick(L, u_pick) -> k                             # by power alone
     sample_entry(L, k, px, py, pz, u1, u2, time)     # one entry, pick not included
     entry_center(L, k, time) -> (has_one, x, y, z)   # towards which distances are sampled
 
@@ -55,13 +55,13 @@ that time (pack.py, TimeSlicedLight). Array drivers for tests: `batch`.
 """
 from .light_set import (entry_center, environment_pdf, environment_radiance, hit_lamps,
                         is_uniform_world, lamp_hit, lamp_pdf, entry_visibility, mesh_pdf,
-                        n_entries, n_lamps, n_suns, pick, pick_entry, power_pdf, sample,
+                        n_entries, n_lamps, n_suns, pick, pick_entry, sample,
                         sample_entry, select_pdf, sun_escaped, world_escaped)
 from .pack import pack_lights
 from .tree import OMNI, ONE_SIDED, SEGMENT, TWO_SIDED, receiver, segment_receiver
 
 __all__ = ["pack_lights", "n_entries", "n_lamps", "sample", "hit_lamps", "lamp_hit",
-           "entry_visibility", "entry_center", "pick", "power_pdf", "select_pdf",
+           "entry_visibility", "entry_center", "pick", "select_pdf",
            "sample_entry", "pick_entry", "receiver", "segment_receiver", "OMNI",
            "ONE_SIDED", "TWO_SIDED", "SEGMENT",
            "lamp_pdf", "mesh_pdf", "environment_pdf", "environment_radiance", "n_suns",

@@ -104,12 +104,6 @@ def sample_lamp_at(L, k, px, py, pz, u1, u2, time):
 
 
 @kernel(allocates=False)
-def power_pdf(L, k):
-    """The probability that `pick` (by power) gives entry k."""
-    return L[SELECT_PDF][k]
-
-
-@kernel(allocates=False)
 def select_pdf(L, k, recv, time):
     """The probability that `sample` picks entry k for the receiver `recv` (tree.py)."""
     if k < 0:
