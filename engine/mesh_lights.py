@@ -27,6 +27,15 @@ A BSDF-sampled ray that hits an emissive triangle (global primitive id g, as Emb
 reports it) is weighted by multiple importance sampling against that same pdf times the
 triangle's pick probability: `entry_of(g)` maps g to its light entry.
 
+Coincident copies are one light. A mesh duplicated in place (a Solidify of thickness 0, a
+copy never moved, a text curve extruded twice) holds emissive triangles with the same
+three corners and the same radiance. A shadow ray towards a point on one copy passes the
+other (both lie at its far end), so sampling each copy as its own light would add the
+light of every copy, while a BSDF ray sees one surface and one radiance. So copies share
+one entry: the first copy is sampled, and a BSDF ray that hits any copy is weighted with
+that entry's pdf. (Copies of different radiance stay apart: which one a ray sees is then
+the tracer's choice, as in Cycles.)
+
 Only static triangles are light entries. Emissive triangles of objects that move during
 the shutter (engine.accel traces them apart, after the static ones) are not sampled:
 BSDF-sampled rays still find them, with MIS weight 1 (their light pdf is 0), which is
@@ -38,6 +47,26 @@ import numpy as np
 
 from .luminance import luminance
 from .surface import RELATIVE_OFFSET, triangle_scale
+
+
+def _coincident_copies(v0, v1, v2, radiance):
+    """(first, copy_of): the indices of the first of each set of triangles with the same
+    corners (in any order) and radiance, ascending, and for every triangle the position
+    of its set's first one in `first`."""
+    if not len(v0):
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    c = [v0 + 0.0, v1 + 0.0, v2 + 0.0]                        # + 0.0: -0.0 is 0.0
+    for i, j in ((0, 1), (1, 2), (0, 1)):                     # a sorting network of 3
+        a, b = c[i], c[j]
+        swap = ((b[:, 0] < a[:, 0]) | ((b[:, 0] == a[:, 0]) & (
+            (b[:, 1] < a[:, 1]) | ((b[:, 1] == a[:, 1]) & (b[:, 2] < a[:, 2])))))[:, None]
+        c[i], c[j] = np.where(swap, b, a), np.where(swap, a, b)
+    key = np.concatenate(c + [radiance], axis=1)
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    rank = np.argsort(first, kind="stable")           # sets in the order of their first
+    position = np.empty_like(rank)
+    position[rank] = np.arange(len(rank))
+    return first[rank], position[inverse.reshape(-1)]
 
 
 class EmissiveTriangles:
@@ -60,8 +89,13 @@ class EmissiveTriangles:
         # the offset scale relative to the static scene's centre (engine.accel, surface)
         c = np.zeros(3) if center is None else np.asarray(center, np.float64)
         self.tri_scale = triangle_scale(v0, v1, v2, c)[keep]
+        first, copy_of = _coincident_copies(v0[keep], v1[keep], v2[keep],
+                                              self.radiance)
         self.entry = np.full(max(int(n_prims_total), 1), -1, dtype=np.int64)
-        self.entry[self.prim] = np.arange(len(self.prim))
+        self.entry[self.prim] = copy_of
+        for name in ("v0", "e1", "e2", "normal", "area", "radiance", "power", "tri_scale",
+                     "prim"):
+            setattr(self, name, getattr(self, name)[first])
 
     @classmethod
     def from_scene(cls, scene, accel, emission=None) -> "EmissiveTriangles":

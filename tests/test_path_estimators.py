@@ -61,15 +61,18 @@ def _materials_image_mean(mode, light_scale=1.0):
     return _image_mean(_materials_scene(), mode, SAMPLES, light_scale)
 
 
-def _image_mean(scene, mode, samples, light_scale=1.0):
+def _image_mean(scene, mode, samples, light_scale=1.0, light_tree=None):
     """(mean radiance (3,), its standard error (3,)) over every sample of the image,
-    direct light only (one bounce), estimated with `mode`."""
+    direct light only (one bounce), estimated with `mode`; lights picked with the light
+    tree unless `light_tree` is False or `light_scale` is not 1."""
     # each pixel's camera ray through its centre: no edge of a lamp or an emitter seen
     # by the camera adds noise that all three estimators share
     # (the control scales the power pick's probabilities: it picks lights by power)
     settings = RenderSettings(samples=samples, seed=11, max_bounces=1, clamp_direct=0.0,
                               clamp_indirect=0.0, filter_glossy=0.0, filter_type="BOX",
-                              filter_width=1e-3, light_tree=light_scale == 1.0)
+                              filter_width=1e-3,
+                              light_tree=light_scale == 1.0 if light_tree is None
+                              else light_tree)
     ctx = RenderContext(scene, settings)
     try:
         ctx.integrator.mis_mode = mode
