@@ -193,11 +193,30 @@ def _gradient(kind):
     return build
 
 
+def _missing_image(extension, interpolation="Linear", output="Color"):
+    """An Image Texture whose file is not there: Cycles samples it as a 1 x 1 pink image
+    with the node's extension and interpolation (constant when repeated, a tent of
+    pink fading to black at the UV square's edges when clipped)."""
+    def build(nt, p):
+        import bpy
+        image = bpy.data.images.new("gone.png", 4, 4)  # load() refuses a missing file
+        image.source, image.filepath = "FILE", "//no/such/texture.png"
+        t = p.node(nt, "ShaderNodeTexImage", extension=extension,
+                   interpolation=interpolation)
+        t.image = image
+        return t.outputs[output]
+    return build
+
+
 TEXTURE = [("checker", _checker()), ("checker_uv", _checker("UV", 3.0)),
            ("checker_fac", lambda nt, p: _checker()(nt, p).node.outputs["Fac"])] + [
     (f"gradient_{k.lower()}", _gradient(k)) for k in
     ("LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "SPHERICAL", "QUADRATIC_SPHERE",
-     "RADIAL")]
+     "RADIAL")] + [
+    ("missing_image_repeat", _missing_image("REPEAT")),
+    ("missing_image_clip", _missing_image("CLIP")),
+    ("missing_image_clip_alpha", _missing_image("CLIP", output="Alpha")),
+    ("missing_image_clip_closest", _missing_image("CLIP", "Closest"))]
 
 
 # ---------------------------------------------------------------- colour

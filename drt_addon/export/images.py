@@ -67,11 +67,15 @@ def image_texture(image, interpolation, extension, ctx, premultiply):
     if key in ctx.cache:
         return ctx.cache[key]
     px = read_pixels(image, ctx)
-    tex = None
-    if px is not None:
-        if premultiply and px.shape[2] == 4 and (px[:, :, 3] < 1.0).any():
-            px = px.copy()
-            px[:, :, :3] *= px[:, :, 3:4]
-        tex = textures.Texture(px, interp, extension, srgb=srgb, name=image.name)
+    if px is None:
+        # What Cycles samples for an image it cannot load (scene/image.cpp): one texel of
+        # its missing colour, in the image's own storage (a byte sRGB image is decoded
+        # after the blend), read with the node's interpolation and extension: pink
+        # everywhere when repeated, a tent of pink over the UV square when clipped.
+        px = np.array(textures.MISSING_RGBA, np.float32).reshape(1, 1, 4)
+    elif premultiply and px.shape[2] == 4 and (px[:, :, 3] < 1.0).any():
+        px = px.copy()
+        px[:, :, :3] *= px[:, :, 3:4]
+    tex = textures.Texture(px, interp, extension, srgb=srgb, name=image.name)
     ctx.cache[key] = tex
     return tex

@@ -33,7 +33,7 @@ import numpy as np
 
 from ..engine_link import engine
 from .errors import Reporter
-from .images import image_cache, image_texture, textures
+from .images import image_cache, image_texture, read_pixels, textures
 from .nodes.links import _link, uses_nodes
 from .world_nodes import bake_background
 from .world_sky import sky_world
@@ -133,11 +133,11 @@ def _environment(node, strength, vis, ctx):
     rgb = (strength,) * 3
     if node.image is None:
         return engine.World(tuple(c * strength for c in MISSING), visibility=vis)
+    if read_pixels(node.image, ctx) is None:   # no pixels (reported): Cycles' pink
+        return engine.World(tuple(c * strength for c in MISSING), visibility=vis)
     alpha_linked = any(o.is_linked for o in node.outputs if o.identifier == "Alpha")
     tex = image_texture(node.image, node.interpolation, "REPEAT", ctx,
                         premultiply=not alpha_linked)
-    if tex is None:                       # no pixels (reported): Cycles' pink
-        return engine.World(tuple(c * strength for c in MISSING), visibility=vis)
     mapping = _mapping(node, ctx)
     mean = tuple(float(c) * strength for c in tex.mean_rgba()[:3])
     return engine.World(mean, texture=tex, strength=rgb, mapping=mapping, visibility=vis)

@@ -32,10 +32,10 @@ def _image(c, node, out):
         c.ctx.issue(f"{node.name!r} uses {node.interpolation} interpolation; DRT uses Linear")
     image = node.image
     alpha_linked = any(o.is_linked for o in node.outputs if o.identifier == "Alpha")
-    tex = image_texture(image, node.interpolation, node.extension, c.ctx,
-                        premultiply=not alpha_linked) if image is not None else None
-    if tex is None:                       # Cycles' colour for a missing image
+    if image is None:                     # no image: Cycles' colour, unfiltered
         return c.const(1.0) if alpha_out else c.const(MISSING, "color")
+    tex = image_texture(image, node.interpolation, node.extension, c.ctx,
+                        premultiply=not alpha_linked)
     uv = coordinates(c, node, C.H_UV)
     op = X.TEX_IMAGE_ALPHA if alpha_out else X.TEX_IMAGE_COLOR
     return c.emit(op, "float" if alpha_out else "color", [uv], varying=True, image=tex)
