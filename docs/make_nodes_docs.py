@@ -129,7 +129,8 @@ def supported_nodes(bpy):
 # each is compared with Cycles in tests/test_closures_vs_cycles.py and the *_vs_cycles
 # tests of its feature
 SHADERS_ROW = ("| Shader | Principled BSDF, Diffuse BSDF, Glossy BSDF, Glass BSDF, "
-               "Refraction BSDF (GGX, Multiscatter GGX, Beckmann), Sheen BSDF, "
+               "Refraction BSDF (GGX, Multiscatter GGX, Beckmann), Metallic BSDF (F82 Tint; a "
+               "Physical Conductor as its F82-tint fit), Sheen BSDF, "
                "Translucent BSDF, Emission, Transparent BSDF, Holdout (as the whole "
                "Surface; mixed with other shaders it renders black, without its hole), "
                "Mix Shader, Add Shader; "

@@ -1,5 +1,5 @@
-"""Coat, sheen, translucency, the Refraction BSDF, Beckmann, the Glossy BSDF and the
-Principled Specular Tint against Cycles: eight small scenes
+"""Coat, sheen, translucency, the Refraction BSDF, Beckmann, the Glossy BSDF, the
+Principled Specular Tint and the Metallic BSDF against Cycles: nine small scenes
 (64 x 48 pixels) built here with bpy at Blender's defaults (bounces, Filter Glossy,
 Principled inputs not named), rendered by Cycles (512 samples per pixel) and DRT (512),
 each compared with `compare` of tests/test_multiscatter_vs_cycles.py: image means within
@@ -32,6 +32,10 @@ a control, DRT rendering it without the feature (as it did before), which must f
     tints (what DRT rendered before).
   * glass_tint: a smooth and a rough Principled glass (IOR 2.2) with strong Specular
     Tints (the reflection's F0 tinted, 1 - F_c let through); control: white tints.
+  * metallic: four Metallic BSDF spheres (Blender 4.3+), F82 Tint and Physical Conductor
+    (DRT: the F82-tint fit, tests/test_metallic_node.py), each at its defaults and with
+    a metal's colours, over the three distributions; control: grey diffuse spheres
+    (what DRT rendered the node as before: a warning and the viewport colour).
 
 Measured (DRT vs Cycles: mean per channel, worst block; control the same), at 512
 samples (at 1024 the worst blocks were 0.06 % to 1.62 %, the means the same within
@@ -44,6 +48,7 @@ samples (at 1024 the worst blocks were 0.06 % to 1.62 %, the means the same with
   glossy       -0.04 %, 0.31 %;  control +0.89 / +1.1 / +1.2 %, 6.8 %
   specular_tint 0.00 %, 0.59 %;  control +1.27 / +1.66 / +0.33 %, 4.2 %
   glass_tint   -0.31 / -0.18 / -0.28 %, 1.72 %;  control -0.36 / +0.42 / -0.99 %, 7.8 %
+  metallic     +0.08 / +0.06 / -0.06 %, 0.50 %;  control +3.9 / +8.1 / +16.9 %, 37 %
 """
 from __future__ import annotations
 
@@ -290,9 +295,35 @@ def glass_tint_scene(bpy, control=False):
     return scene
 
 
+def metallic_scene(bpy, control=False):
+    """Four Metallic BSDF spheres (Blender 4.3+): F82 Tint at the node's defaults and
+    with a gold colour and a red edge (GGX), Physical Conductor at its defaults (Multiscatter
+    GGX) and with gold's IOR and Extinction (Beckmann); control: grey diffuse spheres,
+    what DRT rendered the unsupported node as before (the viewport colour)."""
+    scene = _striped_room(bpy)
+    for k, (fresnel, dist, rough, inputs) in enumerate((
+            ("F82", "MULTI_GGX", 0.25, {}),
+            ("F82", "GGX", 0.45, {"Base Color": (0.95, 0.75, 0.3, 1.0),
+                                  "Edge Tint": (1.0, 0.35, 0.2, 1.0)}),
+            ("PHYSICAL_CONDUCTOR", "MULTI_GGX", 0.3, {}),
+            ("PHYSICAL_CONDUCTOR", "BECKMANN", 0.35, {"IOR": (0.18, 0.42, 1.37),
+                                                      "Extinction": (3.42, 2.35, 1.77)}))):
+        if control:
+            mat, _ = _bsdf(bpy, f"Metallic{k}", "ShaderNodeBsdfDiffuse")
+        else:
+            mat, node = _bsdf(bpy, f"Metallic{k}", "ShaderNodeBsdfMetallic", distribution=dist,
+                              Roughness=rough)
+            node.fresnel_type = fresnel             # before its inputs: it shows them
+            for key, value in inputs.items():
+                node.inputs[key].default_value = value
+        _sphere(bpy, (-1.35 + 0.9 * k, 0.0, 0.42), 0.42, mat)
+    return scene
+
+
 SCENES = {"coat": coat_scene, "sheen": sheen_scene, "translucent": translucent_scene,
           "refraction": refraction_scene, "beckmann": beckmann_scene, "glossy": glossy_scene,
-          "specular_tint": tint_scene, "glass_tint": glass_tint_scene}
+          "specular_tint": tint_scene, "glass_tint": glass_tint_scene,
+          "metallic": metallic_scene}
 
 
 def render(bpy, name, engine, control=False):

@@ -13,7 +13,7 @@ from ...engine_link import engine
 from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _Layers, _sum
 from ..material_params import TOL, NodeParam, _is_tex, _lin, _mean, _same, _scale
 from .links import _link
-from . import subsurface
+from . import metallic, subsurface
 
 lobes = importlib.import_module(engine.__name__ + ".kernels.bsdf.lobe_batch")
 
@@ -208,6 +208,22 @@ def _glossy(node, ctx) -> _Closure:
                                  distribution=distribution, metal_fresnel="CONSTANT"))])
 
 
+def _metallic(node, ctx) -> _Closure:
+    """Metallic BSDF: the Principled metal lobe (export/nodes/metallic.py)."""
+    _normal(node, ctx)
+    distribution = _distribution(node, ctx)
+    for sock, what in (("Anisotropy", "anisotropy"), ("Thin Film Thickness", "thin film")):
+        s = node_input(node, sock)
+        if s is not None and (s.is_linked or float(s.default_value) > 0.0):
+            ctx.issue(f"{node.name!r} uses {what}, which DRT does not render (left out)")
+    base, tint = metallic.metal_inputs(
+        node, ctx, lambda name, default: _input(node, name, ctx, True, default),
+        lambda name, default: _constant(node, name, ctx, default, color=True))
+    return _Closure([(1.0, _Comp(base=base, metallic=1.0, specular_tint=tint,
+                                 roughness=_input(node, "Roughness", ctx, False, 0.5),
+                                 distribution=distribution))])
+
+
 def _glass(node, ctx, refraction=False) -> _Closure:
     """Glass BSDF, or with `refraction` the Refraction BSDF (its refraction alone)."""
     _normal(node, ctx)
@@ -327,6 +343,8 @@ def _closure(socket, ctx, depth=0) -> _Closure:
         return _diffuse(node, ctx)
     if kind == "ShaderNodeBsdfGlossy" or kind == "ShaderNodeBsdfAnisotropic":
         return _glossy(node, ctx)
+    if kind == "ShaderNodeBsdfMetallic":
+        return _metallic(node, ctx)
     if kind == "ShaderNodeBsdfGlass":
         return _glass(node, ctx)
     if kind == "ShaderNodeBsdfRefraction":
