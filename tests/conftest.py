@@ -25,7 +25,39 @@ def bpy_drt():
 
     import drt_addon
     drt_addon.register()
+    if os.environ.get("DRT_TEST_RENDER_LOG"):
+        _log_renders(bpy, os.environ["DRT_TEST_RENDER_LOG"])
     return bpy
+
+
+def _log_renders(bpy, path):
+    """With DRT_TEST_RENDER_LOG=FILE, each render the suite starts through Blender appends
+    a line to FILE: the test, the engine, samples, resolution and seconds (where the
+    suite's time goes: `python tests/render_log.py FILE` sums it up)."""
+    import json
+    import time
+
+    started = {}
+
+    @bpy.app.handlers.persistent              # kept when a test opens another file
+    def pre(scene, *_):
+        started["t"] = time.perf_counter()
+
+    @bpy.app.handlers.persistent
+    def post(scene, *_):
+        r = scene.render
+        row = {"test": os.environ.get("PYTEST_CURRENT_TEST", "").split(" ")[0],
+               "engine": r.engine, "samples": int(scene.drt.samples if r.engine == "DRT"
+                                                  else scene.cycles.samples),
+               "size": [r.resolution_x * r.resolution_percentage // 100,
+                        r.resolution_y * r.resolution_percentage // 100],
+               "seconds": time.perf_counter() - started.pop("t", time.perf_counter())}
+        with open(path, "a") as f:
+            f.write(json.dumps(row) + "\n")
+
+    bpy.app.handlers.render_pre.append(pre)
+    bpy.app.handlers.render_post.append(post)
+    bpy.app.handlers.render_cancel.append(post)
 
 
 def read_image_linear(bpy, path) -> np.ndarray:
