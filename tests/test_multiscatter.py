@@ -139,7 +139,7 @@ def test_compensation_formula():
 
 def albedo(model, front=True, tables=None, **p):
     """Directional albedo (len(ANGLES), 3) of the compiled Principled BSDF (colour 1 unless given),
-    in flux terms (refraction's 1/eta^2 undone), by quadrature: the sample weights
+    in flux terms (the kernels' own: no radiance scaling), by quadrature: the sample weights
     f |cos| / pdf integrated over the sampler's unit square with the visible-normal rule
     of energy_tables, for each lobe choice. Reflecting lobes: each lobe's samples (u_lobe
     in the middle of its segment) weighted by its selection probability q (the one-sample
@@ -156,14 +156,12 @@ def albedo(model, front=True, tables=None, **p):
                                kb.GLOSSY_MULTI_GGX if model == "MULTI_GGX" else kb.GLOSSY_GGX)
     if tables is not None:
         b.tables = tables
-    eta_rel = p.get("ior", 1.5) if front else 1.0 / p.get("ior", 1.5)
     parts = []
     if p.get("transmission", 0.0) > 0:
         for kind in (GLOSSY, TRANSMISSION):
             allowed = np.zeros((n, 3), bool)
             allowed[:, kind] = True
-            parts.append((allowed, np.full(n, 0.5), np.ones(n),
-                          eta_rel ** 2 if kind == TRANSMISSION else 1.0))
+            parts.append((allowed, np.full(n, 0.5), np.ones(n), 1.0))
     else:
         q = b.selection(wo)[:, :4]
         lo = np.concatenate([np.zeros((n, 1)), np.cumsum(q, 1)], 1)

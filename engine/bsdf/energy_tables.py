@@ -19,8 +19,8 @@ and, for a relative IOR eta, z = sqrt(|e - 1| / (e + 1)) where e = eta on side 0
                           scattering: integral of D G2 / (4 cos_o) over the hemisphere;
   ggx_E_avg[r]            its cosine-weighted average 2 int_0^1 E(mu) mu dmu;
   glass_E[s, z, r, t]     directional albedo of the rough dielectric interface (reflection
-                          plus refraction) in flux terms, i.e. with refraction's radiance
-                          factor 1/eta^2 removed, so that a lossless interface gives 1;
+                          plus refraction) in flux terms (the kernels' own: no radiance
+                          scaling), so that a lossless interface gives 1;
   glass_E_avg[s, z, r]    its cosine-weighted average;
   fresnel_avg[s, z]       2 int_0^1 F(mu) mu dmu of the exact dielectric Fresnel reflectance
                           (the "Fss" of a dielectric specular layer);
@@ -119,8 +119,8 @@ def reflection_albedo(mu, alpha, quad=QUAD_GGX) -> np.ndarray:
 
 def glass_albedo(mu, alpha, eta, quad=QUAD_GLASS) -> np.ndarray:
     """Flux albedo (m,) of the rough dielectric of relative IOR eta seen from wo above
-    the surface: reflection F G2/G1 plus refraction (1 - F) G2/G1 (the refraction weight
-    of `lobe_batch.rough_dielectric_sample` times eta^2, undoing the radiance factor).
+    the surface: reflection F G2/G1 plus refraction (1 - F) G2/G1 (the weights of
+    `lobe_batch.rough_dielectric_sample`, which carry no radiance scaling).
     Index-matched (|eta - 1| < INDEX_MATCHED), the quadrature is degenerate (every normal
     refracts wo into -wo); the entry is the limit eta -> 1 of the rough interface: F = 0
     and every sample refracts along -wo with weight G2(wo, -wo) / G1(wo), so that the
@@ -137,7 +137,7 @@ def glass_albedo(mu, alpha, eta, quad=QUAD_GLASS) -> np.ndarray:
     zero = np.zeros(len(wo))
     _, w_r, _, ok_r, _ = lb.rough_dielectric_sample(wo, e, a, zero, uu, True, False)
     _, w_t, _, ok_t, _ = lb.rough_dielectric_sample(wo, e, a, zero, uu, False, True)
-    g = np.where(ok_r, w_r, 0.0) + np.where(ok_t, w_t * e * e, 0.0)
+    g = np.where(ok_r, w_r, 0.0) + np.where(ok_t, w_t, 0.0)
     out = (g.reshape(-1, k) * w).sum(1).reshape(mu.shape)
     wo = _directions(mu.ravel(), 1)
     limit = lb.ggx_G2_over_G1(wo, -wo, alpha.ravel()).reshape(mu.shape)

@@ -8,7 +8,7 @@ Rough Surfaces" (EGSR), eqs. 16, 17, 20-21 (generalised half vector, transmissio
 its Jacobian), with GGX D and height-correlated Smith G2 from `microfacet` (Heitz 2014)
 and visible-normal sampling (Heitz 2018): a normal h ~ D_wo, then reflection with
 probability F(wo.h) or refraction with 1 - F(wo.h). Sampled reflection weighs
-F G2/G1 / P(reflect), refraction (1 - F) G2/G1 / eta^2 / P(refract).
+F G2/G1 / P(reflect), refraction (1 - F) G2/G1 / P(refract).
 
 Sides: `eta` is the material IOR relative to the outside (interior over exterior, as
 Blender's IOR). wo_z > 0: wo is outside, light refracts into a medium of relative index
@@ -17,16 +17,16 @@ are mirrored through the tangent plane so that wo_z > 0 ("canonical"), and the r
 mirrored back. Total internal reflection (eta_rel < 1 past the critical angle) reflects
 everything.
 
-Radiance scaling (a choice, documented): the BSDF transports *radiance*, so refraction
-carries the factor 1/eta_rel^2 with eta_rel = n(wi side) / n(wo side) (Veach 1997,
-sec. 5.2; pbrt's TransportMode::Radiance). A camera path entering glass is weighted by
-(1 - F)/eta^2, leaving it by (1 - F) eta^2, so the factors cancel for closed objects seen
-from outside (Cycles, which leaves them out, renders the same image then); they matter
-only when a light or the camera is inside a medium. Consequences: the BSDF obeys the
-generalised reciprocity f(wo, wi) / n(wo)^2 = f(wi, wo) / n(wi)^2, and its directional
-albedo from the optically denser side may exceed 1 (radiance is concentrated by
-refraction); the flux-conserving quantity is the albedo with the 1/eta_rel^2 removed,
-which is <= 1.
+No radiance scaling, as Cycles: refraction carries no factor 1/eta_rel^2 (Veach 1997,
+sec. 5.2, and pbrt's TransportMode::Radiance carry it; Cycles' bsdf_microfacet_eval has
+ior^2 in its refraction value and its delta refraction weighs 1 - F). So the BTDF is the
+adjoint form: f(wo, wi) / n(wi)^2 = f(wi, wo) / n(wo)^2, and the directional albedo is at
+most 1 from either side. For closed objects seen from outside the two conventions give
+the same image (a path entering glass and leaving it gains and loses eta^2); they differ
+where a path ends inside a denser medium: emission on or inside glass and lamps inside
+glass are seen eta^2 brighter than under radiance scaling, as Cycles renders them
+(tests/test_glass_emission.py; a public file, glowing_energy_capsule.blend, was 25 %
+darker than Cycles before).
 
 Pairs the sampler never produces (a choice, to match Cycles): Cycles evaluates the
 refraction lobe at every pair of directions on opposite sides from the generalised half
@@ -99,7 +99,7 @@ def smooth_sample(ox, oy, oz, eta, u, allow_reflect, allow_refract):
         ix, iy, iz = -ox / eta_t, -oy / eta_t, -cos_t
         p = pt
         ok = p > 0.0 and cz > 0.0 and F < 1.0
-        w = (1.0 - F) / (eta_t * eta_t)
+        w = 1.0 - F
     else:
         ix, iy, iz = -ox, -oy, cz
         p = pr
@@ -112,13 +112,13 @@ def smooth_sample(ox, oy, oz, eta, u, allow_reflect, allow_refract):
 @kernel
 def smooth_refract(ox, oy, oz, eta):
     """The delta refraction alone (Refraction BSDF): (wi_x, wi_y, wi_z, weight, valid),
-    weight 1 / eta^2 (radiance scaling, no Fresnel factor), invalid under total internal
+    weight 1 (no Fresnel factor, no radiance scaling), invalid under total internal
     reflection."""
     sign, eta_rel = canonical(oz, eta)
     cz = oz * sign
     F, cos_t, eta_t = fresnel.dielectric_full(cz, eta_rel)
     ok = cz > 0.0 and F < 1.0
-    return -ox / eta_t, -oy / eta_t, -cos_t * sign, 1.0 / (eta_t * eta_t) if ok else 0.0, ok
+    return -ox / eta_t, -oy / eta_t, -cos_t * sign, 1.0 if ok else 0.0, ok
 
 
 # --- rough interface -------------------------------------------------------------------
@@ -186,7 +186,7 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter, b
     F_t = fresnel.dielectric(cos_oh, eta_rel)
     if refract_only:
         F_t = 1.0 if F_t >= 1.0 else 0.0
-    den = s * s
+    den = s * s / (eta_rel * eta_rel)          # Cycles' ior^2: no radiance scaling
     if beckmann:
         g2c = bk.G2_over_cos2(ox, oy, oz, ix, iy, iz, a)
         if not (g2c > 0.0 and den > 0.0):

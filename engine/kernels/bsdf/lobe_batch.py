@@ -272,7 +272,7 @@ def rough_dielectric_pdf(wo, wi, eta, alpha, allow_reflect=True, allow_refract=T
 def rough_dielectric_sample(wo, eta, alpha, u_choice, u, allow_reflect=True,
                             allow_refract=True):
     """(wi (n, 3), weight (n,), refracted (n,), valid (n,), pdf (n,)); the weight is
-    f |cos| / pdf in radiance terms (a refraction into the denser side carries 1/eta^2)."""
+    f |cos| / pdf (no radiance scaling: dielectric.py)."""
     wo, u = _dirs(wo, u)
     n = len(wo)
     return _rough_sample(wo, _vec(eta, n), _vec(alpha, n), _vec(u_choice, n), u,

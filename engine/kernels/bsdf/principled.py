@@ -193,11 +193,10 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
         F = fresnel.dielectric(woz, eta_glass)
         if state[S_REFRACT_ONLY] != 0.0:          # no reflection, refraction unless TIR
             F = 1.0 if F >= 1.0 else 0.0
-        eta_rel = 1.0 / eta_glass if woz < 0.0 else eta_glass
         tint_max = max(state[S_TINT], max(state[S_TINT + 1], state[S_TINT + 2]))
         c_max = max(state[S_MS_GLASS], max(state[S_MS_GLASS + 1], state[S_MS_GLASS + 2]))
         est_gr = w_glass * F * c_max if state[S_REFRACT_ONLY] == 0.0 else 0.0
-        est_gt = w_glass * (1.0 - F) * tint_max / (eta_rel * eta_rel) * c_max
+        est_gt = w_glass * (1.0 - F) * tint_max * c_max
     # floors so that every present lobe can be sampled
     state[S_EST] = max(est_diff, MIN_SELECTION * w_diff) if w_diff > 0.0 else 0.0
     state[S_EST + 1] = max(est_spec, MIN_SELECTION * w_spec) if w_spec > 0.0 else 0.0
