@@ -193,10 +193,12 @@ def _gradient(kind):
     return build
 
 
-def _missing_image(extension, interpolation="Linear", output="Color"):
+def _missing_image(extension, interpolation="Linear", output="Color", mix_alpha=False):
     """An Image Texture whose file is not there: Cycles samples it as a 1 x 1 pink image
     with the node's extension and interpolation (constant when repeated, a tent of
-    pink fading to black at the UV square's edges when clipped)."""
+    pink fading to black at the UV square's edges when clipped); with its Alpha used too
+    (`mix_alpha`: the colour times the alpha), Cycles divides the colour by the alpha,
+    so the colour is pink again and only the alpha is a tent."""
     def build(nt, p):
         import bpy
         image = bpy.data.images.new("gone.png", 4, 4)  # load() refuses a missing file
@@ -204,7 +206,13 @@ def _missing_image(extension, interpolation="Linear", output="Color"):
         t = p.node(nt, "ShaderNodeTexImage", extension=extension,
                    interpolation=interpolation)
         t.image = image
-        return t.outputs[output]
+        if not mix_alpha:
+            return t.outputs[output]
+        mix = p.node(nt, "ShaderNodeMix", data_type="RGBA", blend_type="MULTIPLY")
+        ident(mix.inputs, "Factor_Float").default_value = 1.0
+        nt.links.new(t.outputs["Color"], ident(mix.inputs, "A_Color"))
+        nt.links.new(t.outputs["Alpha"], ident(mix.inputs, "B_Color"))
+        return ident(mix.outputs, "Result_Color")
     return build
 
 
@@ -216,7 +224,8 @@ TEXTURE = [("checker", _checker()), ("checker_uv", _checker("UV", 3.0)),
     ("missing_image_repeat", _missing_image("REPEAT")),
     ("missing_image_clip", _missing_image("CLIP")),
     ("missing_image_clip_alpha", _missing_image("CLIP", output="Alpha")),
-    ("missing_image_clip_closest", _missing_image("CLIP", "Closest"))]
+    ("missing_image_clip_closest", _missing_image("CLIP", "Closest")),
+    ("missing_image_clip_times_alpha", _missing_image("CLIP", mix_alpha=True))]
 
 
 # ---------------------------------------------------------------- colour

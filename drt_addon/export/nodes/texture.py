@@ -6,7 +6,7 @@ from __future__ import annotations
 import importlib
 
 from ...engine_link import engine
-from ..images import image_texture
+from ..images import image_texture, read_pixels
 from .errors import Unsupported
 from .input import hit3
 
@@ -36,6 +36,12 @@ def _image(c, node, out):
         return c.const(1.0) if alpha_out else c.const(MISSING, "color")
     tex = image_texture(image, node.interpolation, node.extension, c.ctx,
                         premultiply=not alpha_linked)
+    if alpha_linked and not alpha_out and read_pixels(image, c.ctx) is None:
+        # Cycles divides the colour of an image whose Alpha is used by its alpha
+        # (svm/image.h, NODE_IMAGE_ALPHA_UNASSOCIATE): a missing image's pink over its
+        # clipped tent of alpha is pink again (0 only where the tent is, outside the
+        # UV square's half-texel border)
+        return c.const(MISSING, "color")
     uv = coordinates(c, node, C.H_UV)
     op = X.TEX_IMAGE_ALPHA if alpha_out else X.TEX_IMAGE_COLOR
     return c.emit(op, "float" if alpha_out else "color", [uv], varying=True, image=tex)
