@@ -38,9 +38,9 @@ def _image(c, node, out):
                         premultiply=not alpha_linked)
     if alpha_linked and not alpha_out and read_pixels(image, c.ctx) is None:
         # Cycles divides the colour of an image whose Alpha is used by its alpha
-        # (svm/image.h, NODE_IMAGE_ALPHA_UNASSOCIATE): a missing image's pink over its
-        # clipped tent of alpha is pink again (0 only where the tent is, outside the
-        # UV square's half-texel border)
+        # (svm/image.h, NODE_IMAGE_ALPHA_UNASSOCIATE): a missing image's clipped tent
+        # of pink over the same tent of alpha is pink again. (Where the tent is 0,
+        # half a texel and more outside the UV square, Cycles' colour is 0; DRT's pink.)
         return c.const(MISSING, "color")
     uv = coordinates(c, node, C.H_UV)
     op = X.TEX_IMAGE_ALPHA if alpha_out else X.TEX_IMAGE_COLOR
