@@ -69,7 +69,8 @@ def expand(mesh: TriangleMesh) -> list[TriangleMesh]:
         out.append(replace(mesh, name=f"{mesh.name}#{k}", positions=mesh.positions @ a.T + t,
                            triangles=mesh.triangles[:, order], corner_normals=corner(normals),
                            uvs=corner(mesh.uvs), tangents=corner(tangents),
-                           colors=corner(mesh.colors), object_info=placed_info,
+                           colors=corner(mesh.colors), undisplaced=corner(mesh.undisplaced),
+                           object_info=placed_info,
                            instances=None, **names))
     return out
 

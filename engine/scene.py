@@ -111,6 +111,10 @@ class Material:
     translucent_color: tuple = (0.0, 0.0, 0.0)
     refraction_only: bool = False
     bump_correction: bool = True
+    sets_normal: bool = False            # the program's normal becomes the surface's own
+    #                                      (Cycles' Set Normal, which the Displacement
+    #                                      socket's bump uses): lobes are not shadowed
+    #                                      against the smooth normal it bent
     subsurface_weight: float = 0.0
     subsurface_radius: tuple = (1.0, 0.2, 0.1)
     subsurface_anisotropy: float = 0.0
@@ -129,6 +133,8 @@ class Material:
     pass_index: int = 0                  # Blender's material Pass Index (IndexMA pass)
     holdout: bool = False                # a Holdout shader: a hole in the alpha where the
     #                                      camera sees it, black to every other ray
+    displacement: Optional[object] = None    # engine.displacement.Displacement: moves the
+    #                                      vertices of its meshes at export (true displacement)
 
     TEXTURED = ("base_color", "metallic", "roughness", "emission", "alpha")
 
@@ -275,6 +281,9 @@ class TriangleMesh:
     object_info: Optional[object] = None   # ObjectInfo, what shader nodes read of it
     tangents: Optional[np.ndarray] = None  # (T, 3, 4) float32: tangent, bitangent sign
     colors: Optional[np.ndarray] = None    # (T, 3, 4) float32: a color attribute, RGBA
+    # (T, 3, 3) float32: a displaced mesh's corners before displacement, in object space
+    # (engine.displacement): its hits read Generated coordinates there, as in Cycles
+    undisplaced: Optional[np.ndarray] = None
     # Shadow Terminator > Geometry Offset (Cycles' per-object setting; 0 = off): how far
     # shadow rays start from the curved surface of a smooth mesh (engine.kernels.terminator)
     terminator_offset: float = 0.1
@@ -298,18 +307,24 @@ class TriangleMesh:
         if len(self.material_indices) != len(self.triangles):
             raise ValueError(f"mesh {self.name!r}: {len(self.material_indices)} material indices "
                              f"for {len(self.triangles)} triangles")
-        if self.uvs is not None:
-            uvs = np.asarray(self.uvs, dtype=np.float32)
-            if uvs.size != len(self.triangles) * 6:
-                raise ValueError(f"mesh {self.name!r}: {uvs.size // 6} UV triangles for "
-                                 f"{len(self.triangles)} triangles")
-            self.uvs = np.ascontiguousarray(uvs.reshape(-1, 3, 2))
+        self.uvs = self._per_corner(self.uvs, 2, "UV")
+        self.undisplaced = self._per_corner(self.undisplaced, 3, "undisplaced")
         if len(self.triangles) and (self.triangles.min() < 0
                                     or self.triangles.max() >= len(self.positions)):
             raise ValueError(f"mesh {self.name!r}: triangle index out of range")
         if self.instances is not None and self.motion is not None:
             raise ValueError(f"mesh {self.name!r}: instances cannot move (export moving "
                              f"places as meshes of their own)")
+
+    def _per_corner(self, values, width: int, what: str):
+        """A per-corner attribute as (T, 3, width) float32 (None stays None)."""
+        if values is None:
+            return None
+        a = np.asarray(values, dtype=np.float32)
+        if a.size != len(self.triangles) * 3 * width:
+            raise ValueError(f"mesh {self.name!r}: {a.size // (3 * width)} {what} triangles "
+                             f"for {len(self.triangles)} triangles")
+        return np.ascontiguousarray(a.reshape(-1, 3, width))
 
 
 @dataclass

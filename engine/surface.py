@@ -87,6 +87,14 @@ class SurfaceBuilder:
         # a color attribute per corner (0 where a mesh has none, as in Cycles)
         self.corner_tangents = _corner_attribute(ordered, "tangents")
         self.corner_colors = _corner_attribute(ordered, "colors")
+        # the undisplaced object-space point of each corner of displaced meshes (NaN
+        # elsewhere), where their hits read Generated coordinates (engine.displacement)
+        self.corner_undisplaced = None
+        if any(getattr(m, "undisplaced", None) is not None for m in ordered):
+            self.corner_undisplaced = np.concatenate([
+                np.asarray(m.undisplaced, np.float32).reshape(-1, 3, 3)
+                if getattr(m, "undisplaced", None) is not None
+                else np.full((len(m.triangles), 3, 3), np.nan, np.float32) for m in ordered])
         self.corner_normals = None
         if any(m.corner_normals is not None for m in ordered):
             parts, offset = [], 0
@@ -150,7 +158,8 @@ class SurfaceBuilder:
         """The triangles as the compiled kernels read them (engine.kernels.surface,
         engine.nodes.shading): (positions, corners, centre, material, corner normals,
         holdout, corner UVs, moving objects, triangle objects, object table, corner
-        tangents, corner colours, camera, terminator cutoffs); empty arrays for what the
+        tangents, corner colours, camera, terminator cutoffs, corners' undisplaced
+        points); empty arrays for what the
         scene has not. camera: the packed render camera (engine.kernels.camera_rays),
         which shader nodes read; None: none."""
         from .nodes.context import N_OBJ
@@ -165,7 +174,8 @@ class SurfaceBuilder:
                 or_empty(self.corner_tangents, (0, 3, 4), np.float32),
                 or_empty(self.corner_colors, (0, 3, 4), np.float32),
                 np.zeros(0) if camera is None else camera,
-                or_empty(self.terminator_cutoff, 0, np.float64))
+                or_empty(self.terminator_cutoff, 0, np.float64),
+                or_empty(self.corner_undisplaced, (0, 3, 3), np.float32))
 
     def build(self, hits: Hits, index: np.ndarray, ray_dirs: np.ndarray,
               time: np.ndarray | None = None) -> SurfaceHit:

@@ -861,15 +861,17 @@ SCENES["sky_world"] = sky_world
 
 
 def _artist_scenes():
-    """sample_blends/artist_scenes.py's, volume_scenes.py's, subsurface_scenes.py's and
-    light_tree_scenes.py's scenes (which use this module's helpers)."""
+    """sample_blends/artist_scenes.py's, volume_scenes.py's, subsurface_scenes.py's,
+    light_tree_scenes.py's and displacement_scenes.py's scenes (which use this module's
+    helpers)."""
     sys.path.insert(0, HERE)
     import artist_scenes
+    import displacement_scenes
     import light_tree_scenes
     import subsurface_scenes
     import volume_scenes
     return {**artist_scenes.SCENES, **volume_scenes.SCENES, **subsurface_scenes.SCENES,
-            **light_tree_scenes.SCENES}
+            **light_tree_scenes.SCENES, **displacement_scenes.SCENES}
 
 
 if __name__ == "__main__":

@@ -5,6 +5,7 @@ import copy
 import time
 
 from ..engine_link import engine
+from .displaced_mesh import DisplacedMeshes, adaptive_message, adaptive_subdivision
 from .camera import RenderRegion, export_camera, render_region, window_camera
 from .errors import ExportError, Reporter
 from .instances import InstanceGroups, Source, regroup_still, source_key
@@ -128,6 +129,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                                                      False)))
     meshes, lights = [], []
     groups = InstanceGroups()
+    displaced = DisplacedMeshes()
+    adaptive = set()                 # objects asking for adaptive subdivision
     held = []
     left_out = LeftOut()
     holdouts = 0
@@ -159,8 +162,12 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             local = cache.local(obj)
             if local is None:
                 continue
+            if adaptive_subdivision(obj):
+                adaptive.add(obj.name)
             slots = ([material_id(s.material, k) for s in obj.material_slots]
                      or [material_id(None)])
+            # true displacement moves the mesh once, with its first user (as Cycles)
+            local = displaced.get(local, obj, inst.matrix_world, slots, materials)
             name = f"{obj.name}#{k}" if inst.is_instance else obj.name
             # Object > Shadow Terminator > Geometry Offset (engine.kernels.terminator)
             offset = float(getattr(obj, "shadow_terminator_geometry_offset", 0.1))
@@ -203,6 +210,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     meshes.extend(groups.meshes())
     if left_out.message():
         reporter.warn(left_out.message(), key="left out")
+    if adaptive:
+        reporter.warn(adaptive_message(adaptive), key="adaptive subdivision")
     if not materials:
         materials.append(engine.Material())
     world = export_world(scene.world, reporter)
@@ -217,6 +226,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         reporter.warn(dark, key=BLACK_IMAGE)
     if stats is not None:
         stats.update(mesh_evaluations=cache.evaluations, mesh_reuses=cache.reuses,
+                     displaced_meshes=displaced.displaced,
                      meshes=len(meshes), lights=len(lights), holdouts=holdouts,
                      triangles=int(sum(len(m.triangles) for m in meshes)),
                      instances=groups.instanced(),

@@ -77,10 +77,10 @@ Linked inputs (any node graph, engine/nodes and export/nodes)
     are; straight-alpha images have their colour premultiplied when the Alpha output is
     not used (Cycles associates alpha on load).
 Displacement (the Material Output's socket)
-    Rendered as Cycles' Bump Only (Blender's default method): the normal bends as a Bump
-    of the displacement's height would bend it (export/nodes/displacement.py). True
-    displacement (Displacement Only, Displacement and Bump) is rendered the same way and
-    reported.
+    As Material > Settings > Displacement asks (export/nodes/displacement.py): Bump Only
+    (Blender's default) bends the normal as a Bump of the displacement's height would
+    bend it; Displacement Only moves the mesh's vertices (engine.displacement, at
+    export); Displacement and Bump does both.
 
 Anything else falls back to a diffuse surface of the material's viewport colour. Every
 approximation is reported once per material, in one warning naming the material.
@@ -95,7 +95,7 @@ from .closures import _Comp, _reduce, program_outputs
 from .errors import Reporter
 from .images import image_cache
 from .nodes import NodeCompiler
-from .nodes.displacement import displacement_normal
+from .nodes.displacement import displacement_normal, true_displacement
 from .nodes.errors import Unsupported
 from .nodes.links import _all_nodes, _link, _output_node, tree_problems, uses_nodes
 from .nodes.shader import _closure
@@ -114,6 +114,7 @@ class _Ctx:
         self.cache = image_cache(reporter)
         self.nodes = NodeCompiler(self)
         self.normal = None          # the per-hit shading normal (a program Value), if any
+        self.sets_normal = False    # ... set as the surface's own (the Displacement's bump)
         self.volume_programs = True     # a volume varying in space joins the program
         self.volume_outputs = {}        # ... as these outputs (export/volumes.py)
 
@@ -172,7 +173,7 @@ def _displace(mat, socket, ctx):
         ctx.issue("its displacement is not rendered where a shader has a Normal of its "
                   "own (DRT uses the shader's)")
         return
-    ctx.normal = bent
+    ctx.normal, ctx.sets_normal = bent, True      # Cycles' Set Normal
 
 
 def _attach_programs(m, ctx, program):
@@ -181,6 +182,7 @@ def _attach_programs(m, ctx, program):
     outputs = dict(program_outputs(m))
     if ctx.normal is not None:
         outputs["normal"] = ctx.normal
+        m.sets_normal = ctx.sets_normal
     if outputs:
         m.shader = dataclasses.replace(program, outputs=outputs)
     for side in (m.mix or ()):
@@ -266,6 +268,10 @@ def _from_nodes(mat, ctx, fallback) -> "engine.Material":
         disp = out.inputs.get("Displacement")
         if disp is not None and _link(disp) is not None:
             _displace(mat, disp, ctx)
+            try:
+                result.displacement = true_displacement(mat, disp, ctx)
+            except Unsupported as e:
+                ctx.issue(f"its displacement does not move the surface ({e})")
         # a volume inside its meshes (its program outputs, when it varies in space, join
         # the surface's); with no surface shader, the surface is its boundary
         result.volume = export_volume(out.inputs.get("Volume"), ctx)

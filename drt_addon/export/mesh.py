@@ -19,6 +19,7 @@ from ..blender_compat import prepare_corner_normals
 from .matrices import to_numpy
 from .tangents import mesh_tangents, uv_layer, wants_tangents
 from .vertex_colors import color_request, mesh_colors
+from .nodes.displacement import moves_surface
 
 GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT", "CURVES"}
 _BLOCK = 1 << 16          # triangles per block of the degenerate-triangle test
@@ -36,6 +37,12 @@ class LocalMesh:
     kept: Optional[np.ndarray] = None      # indices of the mesh's triangles kept (None: all)
     tangents: Optional[np.ndarray] = None  # (T, 3, 4) float32 tangent + sign, if wanted
     colors: Optional[np.ndarray] = None    # (T, 3, 4) float32 color attribute, if wanted
+    # for true displacement (export.displacement), read only for objects whose materials
+    # move their surface: the vertices' smooth normals, each triangle's smooth shading,
+    # and, once displaced, each vertex's object-space offset
+    vertex_normals: Optional[np.ndarray] = None   # (V, 3) float64
+    smooth: Optional[np.ndarray] = None           # (T,) bool
+    offset: Optional[np.ndarray] = None           # (V, 3) float64
 
 
 def _attribute(mesh, name: str, field: str, dtype, domain: str, components: int = 1):
@@ -165,15 +172,18 @@ class MeshCache:
             want_uv = ""
         want_tangents = wants_tangents(obj)
         want_colors = color_request(obj)
+        want_normals = moves_surface(obj)
         if key is not None and key in self._local:
             cached = self._local[key]
             # a shared mesh whose other user needed no UVs (object-linked materials)
             if cached is None or ((want_uv is None or cached.uv_request == want_uv)
                                   and (not want_tangents or cached.tangents is not None)
-                                  and (want_colors is None or cached.colors is not None)):
+                                  and (want_colors is None or cached.colors is not None)
+                                  and (not want_normals or cached.vertex_normals is not None)):
                 self.reuses += 1
                 return cached
-        local = _evaluate(obj, want_uv, self.reporter, want_tangents, want_colors)
+        local = _evaluate(obj, want_uv, self.reporter, want_tangents, want_colors,
+                          want_normals)
         self.evaluations += 1
         if key is not None:
             self._local[key] = local
@@ -223,8 +233,31 @@ def _drop_degenerate(obj, pos, tris, mat, normals, uvs, reporter):
     return pos, tris, mat, normals, uvs, kept
 
 
+def vertex_normals(mesh) -> np.ndarray:
+    """The vertices' smooth normals (V, 3) float64, object space (Blender's, which Cycles
+    reads)."""
+    out = np.empty(len(mesh.vertices) * 3, np.float32)
+    if hasattr(mesh, "vertex_normals"):                  # Blender 3.5+
+        mesh.vertex_normals.foreach_get("vector", out)
+    else:
+        mesh.vertices.foreach_get("normal", out)
+    return out.reshape(-1, 3).astype(np.float64)
+
+
+def smooth_triangles(mesh) -> np.ndarray:
+    """Whether each loop triangle's face is smooth shaded (T,) bool."""
+    nt = len(mesh.loop_triangles)
+    sharp = _attribute(mesh, "sharp_face", "value", bool, "FACE")
+    if sharp is None:
+        return np.ones(nt, bool)
+    tri_face = np.empty(nt, dtype=np.int32)
+    mesh.loop_triangle_polygons.foreach_get("value", tri_face)
+    return ~sharp[tri_face]
+
+
 def _evaluate(obj, want_uv: Optional[str] = None, reporter=None,
-              want_tangents=False, want_colors: Optional[str] = None) -> Optional[LocalMesh]:
+              want_tangents=False, want_colors: Optional[str] = None,
+              want_normals=False) -> Optional[LocalMesh]:
     try:
         mesh = obj.to_mesh()
     except RuntimeError as e:     # one object Blender cannot turn into a mesh: the rest renders
@@ -232,19 +265,23 @@ def _evaluate(obj, want_uv: Optional[str] = None, reporter=None,
             reporter.warn(f"DRT: object {obj.name!r} is left out: Blender cannot evaluate "
                           f"its mesh ({str(e).strip()})", key=(obj.name, "to_mesh"))
         return None
-    uvs = tangents = colors = None
+    uvs = tangents = colors = vnormals = smooth = None
     try:
         if mesh is None:
             return None
         pos, tris, mat, normals = mesh_arrays(mesh)
+        if want_normals and len(tris):
+            vnormals, smooth = vertex_normals(mesh), smooth_triangles(mesh)
         if want_uv is not None and len(tris):
             uvs = mesh_uvs(mesh, want_uv)
         if want_tangents and len(tris):
             tangents = mesh_tangents(mesh, want_uv or "")
             if tangents is None and reporter is not None:
-                reporter.warn(f"DRT: object {obj.name!r}: no tangents for its Normal Map (no "
-                              "UV map, or faces of more than four corners); the map is not "
-                              "applied", key=(obj.name, "tangents"))
+                reporter.warn(f"DRT: object {obj.name!r}: no tangents for its tangent-space "
+                              "Normal Map or Vector Displacement (no UV map, or faces of "
+                              "more than four corners); the map is not applied, the "
+                              "displacement only along the normal",
+                              key=(obj.name, "tangents"))
         if want_colors is not None and len(tris):
             colors = mesh_colors(mesh, want_colors)
     finally:
@@ -265,7 +302,11 @@ def _evaluate(obj, want_uv: Optional[str] = None, reporter=None,
     if colors is not None:
         colors = colors[kept] if kept is not None else colors
         colors = np.where(np.isfinite(colors), colors, 0.0).astype(np.float32)
-    return LocalMesh(pos, tris, mat, normals, uvs, want_uv, kept, tangents, colors)
+    if vnormals is not None:
+        vnormals = np.where(np.isfinite(vnormals), vnormals, 0.0)
+        smooth = smooth[kept] if kept is not None else smooth
+    return LocalMesh(pos, tris, mat, normals, uvs, want_uv, kept, tangents, colors,
+                     vnormals, smooth)
 
 
 def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engine.TriangleMesh":
@@ -282,6 +323,7 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
     uvs = local.uvs
     tangents = tangent_space.to_world(local.tangents, m3)
     colors = local.colors
+    undisplaced = undisplaced_corners(local)
     det = float(np.linalg.det(m3))
     if normals is not None:
         normal_matrix = np.linalg.inv(m3).T if abs(det) > 1e-300 else m3
@@ -300,10 +342,20 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
             tangents = tangents[:, [0, 2, 1]]
         if colors is not None:
             colors = colors[:, [0, 2, 1]]
+        if undisplaced is not None:
+            undisplaced = undisplaced[:, [0, 2, 1]]
     slots = np.asarray(material_slots if len(material_slots) else [0], dtype=np.int32)
     global_mat = slots[np.clip(local.material, 0, len(slots) - 1)]
     return engine.TriangleMesh(name, world, tris, global_mat, corner_normals=normals, uvs=uvs,
-                               tangents=tangents, colors=colors)
+                               tangents=tangents, colors=colors, undisplaced=undisplaced)
+
+
+def undisplaced_corners(local: LocalMesh) -> Optional[np.ndarray]:
+    """A displaced mesh's corners (T, 3, 3) float32 before displacement, object space
+    (engine.TriangleMesh.undisplaced); None for a mesh that was not displaced."""
+    if local.offset is None:
+        return None
+    return (local.positions - local.offset)[local.triangles].astype(np.float32)
 
 
 def export_mesh_instance(obj, matrix_world, material_slots, name,

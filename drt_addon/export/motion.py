@@ -388,8 +388,9 @@ class MotionExport:
                         or not np.array_equal(got[1] if kept is None else got[1][kept],
                                               tr.local.triangles)):
                     tr.topology_changed = True
-                else:
-                    tr.positions[i] = got[0]
+                else:        # a displaced mesh moves by its offset at every step (Cycles)
+                    off = tr.local.offset
+                    tr.positions[i] = got[0] if off is None else got[0] + off
         cam = self.scene.camera
         if self.camera_steps and cam is not None:
             i = t * (self.camera_steps - 1)

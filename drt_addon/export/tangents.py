@@ -1,6 +1,6 @@
-"""Tangent space for Normal Map nodes: Blender's MikkTSpace tangents and bitangent signs
-per triangle corner (`Mesh.calc_tangents`, the tangents Cycles reads), exported only
-for objects whose materials have a tangent-space Normal Map."""
+"""Tangent space for Normal Map and Vector Displacement nodes: Blender's MikkTSpace
+tangents and bitangent signs per triangle corner (`Mesh.calc_tangents`, the tangents
+Cycles reads), exported only for objects whose materials read tangent space."""
 from __future__ import annotations
 
 from typing import Optional
@@ -9,12 +9,15 @@ import numpy as np
 
 
 def wants_tangents(obj) -> bool:
+    """Whether the object's materials read tangent space: a Normal Map or a Vector
+    Displacement node in Tangent space."""
     from .nodes.links import _all_nodes, uses_nodes
+    readers = ("ShaderNodeNormalMap", "ShaderNodeVectorDisplacement")
     for slot in getattr(obj, "material_slots", ()):
         mat = slot.material
         if mat is None or not uses_nodes(mat):
             continue
-        if any(n.bl_idname == "ShaderNodeNormalMap" and n.space == "TANGENT"
+        if any(n.bl_idname in readers and n.space == "TANGENT"
                for n in _all_nodes(mat.node_tree)):
             return True
     return False

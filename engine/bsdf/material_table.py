@@ -165,6 +165,8 @@ class MaterialTable:
                                        for m in materials], bool)
         self.bump_correction = np.array([bool(getattr(m, "bump_correction", True))
                                          for m in materials], bool)
+        self.sets_normal = np.array([bool(getattr(m, "sets_normal", False))
+                                     for m in materials], bool)
         self.layered = ((self.coat_weight > 1e-5) | (self.sheen_weight > 1e-5)
                         | (self.translucent_color.max(1) > 0.0) | self.refraction_only)
         for name in ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",

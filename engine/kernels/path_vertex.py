@@ -53,7 +53,7 @@ from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium, passed,
                      sample_method, segment, stack_cross, volume_dim)
-from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA
+from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA, P_SETS_NORMAL
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .terminator import shadow_origin
 from .surface_hit import material_row, run_program, surface_emission
@@ -312,6 +312,12 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
         else:
             correct = params[m, P_BUMP_CORRECTION] != 0.0
+        # Cycles' sd->N, which bent lobes are shadowed against and shadow rays are lifted
+        # by: the surface's own normal, or the bent one where the program sets it (the
+        # Displacement socket's bump)
+        s0x, s0y, s0z = n0x, n0y, n0z
+        if params[ms, P_SETS_NORMAL] != 0.0:
+            s0x, s0y, s0z = rx, ry, rz
         if not bent and correct and (nx != gx or ny != gy or nz != gz):
             # a smooth mesh's normal, as Cycles' specular lobes (and the subsurface
             # entry) use it: made a valid reflector for the view (a silhouette's normal
@@ -366,11 +372,11 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 # the diffuse lobe on the raw normal with bump shadowing (Cycles)
                 fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, False, see_g,
                                             see_t)
-                if bump_rejects(n0x, n0y, n0z, nx, ny, nz, wx, wy, wz):
+                if bump_rejects(s0x, s0y, s0z, nx, ny, nz, wx, wy, wz):
                     cosine = 0.0
                 fr, fg, fb = fr * cosine, fg * cosine, fb * cosine
                 if see_d:
-                    dr, dg, db = bent_diffuse(state, wox, woy, woz, n0x, n0y, n0z, rx, ry,
+                    dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry,
                                               rz, wx, wy, wz, correct)
                     fr, fg, fb = fr + dr, fg + dg, fb + db
                 cosine = 1.0
@@ -384,7 +390,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[4],
                                               geometry[13], geometry[9], prim, hit_inst[j],
                                               hit_u[j], hit_v[j], px, py, pz, gx, gy, gz,
-                                              n0x, n0y, n0z, scale, wx, wy, wz)
+                                              s0x, s0y, s0z, scale, wx, wy, wz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy,
                                                          wz, dist, margin, scene_radius)
                 bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
@@ -430,7 +436,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             # cosine to the raw normal's (with bump shadowing)
             fd_r, fd_g, fd_b = bsdf.eval_seen(state, wox, woy, woz, 0.0, 0.0, 1.0, True,
                                               False, False)
-            dr, dg, db = bent_diffuse(state, wox, woy, woz, n0x, n0y, n0z, rx, ry, rz, wx, wy,
+            dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry, rz, wx, wy,
                                       wz, correct)
             c = abs(iz)
             wr = max(wr + (dr - fd_r * c) / spdf, 0.0)

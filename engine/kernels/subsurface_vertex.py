@@ -29,8 +29,8 @@ import math
 from . import lights as lt
 from . import ray_queues
 from .bsdf import microfacet as mf
-from .bsdf.params import (P_BASE, P_ROUGHNESS, P_SSS_ALPHA, P_SSS_ANISOTROPY,
-                          P_SSS_IOR, P_SSS_RADIUS, P_SSS_SKIN)
+from .bsdf.params import (P_BASE, P_ROUGHNESS, P_SETS_NORMAL, P_SSS_ALPHA,
+                          P_SSS_ANISOTROPY, P_SSS_IOR, P_SSS_RADIUS, P_SSS_SKIN)
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from ..sampling.hashing import stream_uniform
@@ -136,6 +136,8 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
                 ray_bits[p], b, 0.0, hit_row, regs, 0.5)
             if bent:
                 mx, my, mz = bx, by, bz
+                if params[m2, P_SETS_NORMAL] != 0.0:     # a Set Normal: the surface's own
+                    n0x, n0y, n0z = bx, by, bz
     goes_on = b < int(cfg[2]) and counts[p, 0] < cfg[3]
     mode = int(cfg[8])
     # next-event estimation on the exit's Lambertian surface (lights picked for it:

@@ -33,8 +33,8 @@ from ..sampling.dispatch import sample_1d
 from . import lights as lt
 from . import ray_queues
 from .bsdf import principled as bsdf
-from .bsdf.params import (P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_ROUGHNESS, P_SSS_WEIGHT,
-                          P_TRANSLUCENT)
+from .bsdf.params import (P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_ROUGHNESS, P_SETS_NORMAL,
+                          P_SSS_WEIGHT, P_TRANSLUCENT)
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from .lights.light_set import sample_lamp_at
@@ -152,6 +152,8 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
                 programs, params, geometry, counts, path_info, p, m, prim, hit_inst[j],
                 hit_u[j], hit_v[j], uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front,
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
+            if params[ms, P_SETS_NORMAL] != 0.0:      # a Set Normal: the surface's own
+                n0x, n0y, n0z = rx, ry, rz
         er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
                                       programmed)
         _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)

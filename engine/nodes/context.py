@@ -54,7 +54,17 @@ H_FOOTPRINT = 54     # the ray's footprint at the hit (Cycles' compact sd->dP); 
 N_BASE = 55
 H_DX = N_BASE        # d(column)/dx of the first N_DIFF columns
 H_DY = N_BASE + N_DIFF
-N_HIT = N_BASE + 2 * N_DIFF
+# A displaced surface's point before displacement (engine.displacement): its position
+# (3) and object-space position (3), then the position's changes over the pixel steps
+# in x and in y (3 each); the hit's own where the surface is not displaced. A
+# Displacement and Bump material's bump reads them (bump.DISP_ENTER), as Cycles' bump
+# evaluation does.
+H_UNDISPLACED = N_BASE + 2 * N_DIFF
+N_UNDISPLACED = 12
+# the object's linear part M (3 x 3, row-major, object -> world; the identity without an
+# object), for the nodes that work in object space (engine.nodes.bump)
+H_OBJ_MATRIX = H_UNDISPLACED + N_UNDISPLACED
+N_HIT = H_OBJ_MATRIX + 9
 
 # ---------------------------------------------------------------- object table columns
 O_TO_OBJECT = 0      # 3 x 4 world -> object, row-major (12)
@@ -163,6 +173,9 @@ def fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, u, v, front, ray, 
             hit[H_OBJ_COLOR + k] = o[O_COLOR + k]
         hit[H_OBJ_RANDOM] = o[O_RANDOM]
         hit[H_OBJ_INDEX] = o[O_INDEX]
+        for r in range(3):
+            for c in range(3):
+                hit[H_OBJ_MATRIX + 3 * r + c] = o[O_TO_WORLD + 4 * r + c]
         ln = math.sqrt(hit[H_OBJ_NORMAL] ** 2 + hit[H_OBJ_NORMAL + 1] ** 2
                        + hit[H_OBJ_NORMAL + 2] ** 2)
         if ln > 0.0:
@@ -177,6 +190,30 @@ def fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, u, v, front, ray, 
         hit[H_OBJ_NORMAL], hit[H_OBJ_NORMAL + 1], hit[H_OBJ_NORMAL + 2] = nx, ny, nz
         hit[H_OBJ_RANDOM] = 0.0
         hit[H_OBJ_INDEX] = 0.0
+        for r in range(3):
+            for c in range(3):
+                hit[H_OBJ_MATRIX + 3 * r + c] = 1.0 if r == c else 0.0
+    for k in range(3):
+        hit[H_UNDISPLACED + k] = hit[H_P + k]
+        hit[H_UNDISPLACED + 3 + k] = hit[H_OBJECT + k]
+
+
+@kernel(allocates=False)
+def set_undisplaced(hit, objects, obj, x, y, z):
+    """A displaced surface's hit at its undisplaced object-space point (x, y, z): its
+    Generated coordinates from there (as Cycles reads its generated attribute) and the
+    undisplaced fields (H_UNDISPLACED; engine.displacement)."""
+    if obj >= 0 and obj < objects.shape[0]:
+        o = objects[obj]
+        for k, c in enumerate((x, y, z)):
+            hit[H_GENERATED + k] = (c - o[O_TEX_LOCATION + k]) / (2.0 * o[O_TEX_SIZE + k]) + 0.5
+            hit[H_UNDISPLACED + k] = (o[O_TO_WORLD + 4 * k] * x + o[O_TO_WORLD + 4 * k + 1] * y
+                                      + o[O_TO_WORLD + 4 * k + 2] * z + o[O_TO_WORLD + 4 * k + 3])
+    else:
+        for k, c in enumerate((x, y, z)):
+            hit[H_GENERATED + k] = 0.5 * c + 0.5
+            hit[H_UNDISPLACED + k] = c
+    hit[H_UNDISPLACED + 3], hit[H_UNDISPLACED + 4], hit[H_UNDISPLACED + 5] = x, y, z
 
 
 @kernel

@@ -26,8 +26,8 @@ from ..kernels.camera_rays import C_CLIP_START, C_H, C_HALF_X, C_HALF_Y, C_PERSP
 from ..kernels.jit import kernel
 from .camera_coords import window
 from .context import (H_CAMERA, H_COLOR, H_DX, H_DY, H_FOOTPRINT, H_GENERATED, H_NG,
-                      H_OBJECT, H_P, H_UV, H_WINDOW, N_DIFF, O_TEX_SIZE, O_TO_OBJECT,
-                      to_world_direction)
+                      H_OBJECT, H_P, H_UNDISPLACED, H_UV, H_WINDOW, N_DIFF, N_UNDISPLACED,
+                      O_TEX_SIZE, O_TO_OBJECT, to_world_direction)
 
 
 @kernel
@@ -127,7 +127,8 @@ def _fill_step(hit, block, geometry, prim, obj, placed, camera, sx, sy, sz):
     if colors.shape[0] > 0:
         for k in range(4):
             hit[block + H_COLOR + k] = _corner_step(colors, prim, k, b1, b2)
-    if obj >= 0 and obj < objects.shape[0]:
+    has_object = obj >= 0 and obj < objects.shape[0]
+    if has_object:
         o = objects[obj]
         for k in range(3):
             d = (o[O_TO_OBJECT + 4 * k] * sx + o[O_TO_OBJECT + 4 * k + 1] * sy
@@ -138,6 +139,25 @@ def _fill_step(hit, block, geometry, prim, obj, placed, camera, sx, sy, sz):
         for k, d in enumerate((sx, sy, sz)):
             hit[block + H_OBJECT + k] = d
             hit[block + H_GENERATED + k] = 0.5 * d
+    # the undisplaced surface's steps (H_UNDISPLACED): the same barycentric steps on the
+    # corners before displacement (Cycles' attribute differentials); the hit's own steps
+    # where the triangle is not displaced
+    step = H_UNDISPLACED + (6 if block == H_DX else 9)
+    undisplaced = geometry[14]
+    if undisplaced.shape[0] > 0 and not math.isnan(undisplaced[prim, 0, 0]):
+        ox = _corner_step(undisplaced, prim, 0, b1, b2)
+        oy = _corner_step(undisplaced, prim, 1, b1, b2)
+        oz = _corner_step(undisplaced, prim, 2, b1, b2)
+        wx, wy, wz = ox, oy, oz
+        if has_object:
+            wx, wy, wz = to_world_direction(objects[obj], ox, oy, oz)
+        for k, (w, d) in enumerate(((wx, ox), (wy, oy), (wz, oz))):
+            hit[step + k] = w
+            hit[block + H_GENERATED + k] = (d / (2.0 * objects[obj][O_TEX_SIZE + k])
+                                            if has_object else 0.5 * d)
+    else:
+        for k in range(3):
+            hit[step + k] = hit[block + H_P + k]
     if camera.shape[0] >= N_CAM:
         r = camera[C_ROT:C_ROT + 9]
         hit[block + H_CAMERA] = r[0] * sx + r[3] * sy + r[6] * sz
@@ -173,6 +193,8 @@ def fill_differentials(hit, geometry, prim, obj, placed, camera):
     for k in range(N_DIFF):
         hit[H_DX + k] = 0.0
         hit[H_DY + k] = 0.0
+    for k in range(6, N_UNDISPLACED):
+        hit[H_UNDISPLACED + k] = 0.0
     f = hit[H_FOOTPRINT]
     if not f > 0.0:
         return

@@ -15,7 +15,7 @@ import numpy as np
 from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
 from ..kernels.textures import I_TEXTURE, INPUTS, TEX_EMISSION
-from .context import fill, mirrors, to_world_direction
+from .context import fill, mirrors, set_undisplaced, to_world_direction
 from .differentials import fill_differentials
 from .interpreter import reads_differentials, run
 from .pack import MIX, OUTS
@@ -29,7 +29,8 @@ def program_hit(T, geometry, m, prim, inst, bu, bv, uu, vv, px, py, pz, gx, gy, 
                 nz, dx, dy, dz, front, ray, depth, length, hit, regs):
     """Fill the hit row of a hit on triangle prim (material m) at barycentrics (bu, bv)
     and run m's program. inst: the instance's object row (engine.instancing), -1 for a
-    mesh that is not instanced. The caller has written the row's path fields
+    mesh that is not instanced. A displaced triangle (geometry[14], its corners'
+    undisplaced object-space points; NaN: not displaced) reads Generated coordinates there. The caller has written the row's path fields
     (context.path_fields; zeros: a path of no bounces and a ray without footprint); the
     differentials are filled only for a program that reads them (a Bump's)."""
     tri_object, objects, corner_tangents = geometry[8], geometry[9], geometry[10]
@@ -61,6 +62,14 @@ def program_hit(T, geometry, m, prim, inst, bu, bv, uu, vv, px, py, pz, gx, gy, 
     camera = geometry[12]
     fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, uu, vv, front, ray, depth,
          length, objects, obj, camera, tx, ty, tz, ts, cr, cg, cb, ca)
+    undisplaced = geometry[14]
+    if undisplaced.shape[0] > 0 and not math.isnan(undisplaced[prim, 0, 0]):
+        b0 = 1.0 - bu - bv
+        u = undisplaced
+        set_undisplaced(hit, objects, obj,
+                        b0 * u[prim, 0, 0] + bu * u[prim, 1, 0] + bv * u[prim, 2, 0],
+                        b0 * u[prim, 0, 1] + bu * u[prim, 1, 1] + bv * u[prim, 2, 1],
+                        b0 * u[prim, 0, 2] + bu * u[prim, 1, 2] + bv * u[prim, 2, 2])
     if reads_differentials(T, m):
         fill_differentials(hit, geometry, prim, obj, inst >= 0, camera)
     run(T, m, hit, regs)

@@ -209,6 +209,24 @@ class NodeCompiler:
         self.emit(bump.BUMP_LEAVE, "float", [save], varying=True)
         return value
 
+    def undisplaced(self, compute):
+        """What `compute(steps)` compiles, evaluated on a displaced surface's undisplaced
+        point (bump.DISP_ENTER): a Displacement and Bump material's bump, as Cycles
+        evaluates it. compute calls steps() before its Bump normal, which takes the
+        undisplaced surface's steps. Its nodes are compiled anew there (a region of
+        their own)."""
+        save = self.b.block(context.N_UNDISPLACED)
+        self.emit(bump.DISP_ENTER, "float", [save, 0], varying=True)
+        self._regions += 1
+        outer, self._region = self._region, self._regions
+        try:
+            value = compute(lambda: self.emit(bump.DISP_ENTER, "float", [save, 1],
+                                              varying=True))
+        finally:
+            self._region = outer
+        self.emit(bump.DISP_LEAVE, "float", [save], varying=True)
+        return value
+
     # -- results -------------------------------------------------------------------
     def fold(self, value):
         """A non-varying value computed now (float or tuple); None if it varies."""

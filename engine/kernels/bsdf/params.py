@@ -47,7 +47,10 @@ P_SSS_ANISOTROPY = 44    # Henyey-Greenstein g inside
 P_SSS_IOR = 45           # the entry's refraction IOR
 P_SSS_ALPHA = 46         # the entry's GGX alpha; < 0: the hit's roughness^2 (Principled)
 P_SSS_SKIN = 47          # 0 / 1: Random Walk (Skin), Cycles' other radius and entry
-NPARAM = 48
+P_SETS_NORMAL = 48       # 0 / 1: the program's normal becomes the surface's (Cycles' Set
+#                          Normal: the Displacement socket's bump), so lobes are not
+#                          shadowed against the smooth normal it bends
+NPARAM = 49
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -84,6 +87,7 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_REFRACT_ONLY] = table.refraction_only
     rows[:, P_SHEEN_LAYERED] = table.sheen_layered
     rows[:, P_BUMP_CORRECTION] = table.bump_correction
+    rows[:, P_SETS_NORMAL] = table.sets_normal
     rows[:, P_LAYERS] = table.layered
     rows[:, P_SSS_WEIGHT] = table.subsurface_weight
     rows[:, P_SSS_RADIUS:P_SSS_RADIUS + 3] = table.subsurface_radius

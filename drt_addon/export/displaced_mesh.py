@@ -1,0 +1,82 @@
+"""True displacement at export: an evaluated mesh whose materials move their surface
+(Material > Settings > Displacement: Displacement Only, Displacement and Bump) is moved
+once, in object space, before it is placed (engine.displacement does the work, as Cycles'
+GeometryManager::displace does), and every place of it shares the moved mesh. Like
+Cycles, the shader is evaluated with the first object that uses the mesh."""
+from __future__ import annotations
+
+import dataclasses
+import importlib
+
+import numpy as np
+
+from ..engine_link import engine
+from .matrices import to_numpy
+from .object_info import object_values
+
+D = importlib.import_module(engine.__name__ + ".displacement")
+C = importlib.import_module(engine.__name__ + ".nodes.context")
+
+
+class DisplacedMeshes:
+    """The moved meshes of one export, one per (evaluated mesh, materials)."""
+
+    def __init__(self):
+        self._done = {}
+        self.displaced = 0            # meshes moved
+
+    def get(self, local, obj, matrix_world, slots, materials):
+        """`local` moved by the displacements of its material slots (indices into
+        `materials`), or `local` itself when none moves it."""
+        displacements = [materials[i].displacement for i in slots]
+        if local is None or all(d is None for d in displacements):
+            return local
+        key = (id(local), tuple(slots))
+        if key not in self._done:
+            self._done[key] = displace_local(local, obj, matrix_world, displacements)
+            self.displaced += 1
+        return self._done[key]
+
+
+def displace_local(local, obj, matrix_world, displacements):
+    """A LocalMesh (export.mesh) moved by `displacements` (one engine Displacement or
+    None per material slot), evaluated for object `obj` at `matrix_world`."""
+    m = np.asarray(to_numpy(matrix_world), np.float64)
+    color, pass_index, (loc, size) = object_values(obj)
+    row = C.object_row(m, color, 0.0, pass_index, loc, size)
+    normals = local.vertex_normals
+    if normals is None:        # every face flat and no normals read: the faces' own
+        normals = _area_normals(local.positions, local.triangles)
+    positions, moved = D.displace(local.positions, local.triangles, local.material, normals,
+                                  displacements, m, row, local.uvs, local.tangents,
+                                  local.colors)
+    keep = np.array([d is not None and d.keep_normals for d in displacements] + [False])
+    recompute = moved & ~keep[np.clip(local.material, 0, len(keep) - 1)]
+    corner_normals = D.displaced_normals(positions, local.triangles, recompute, local.normals,
+                                         local.smooth)
+    return dataclasses.replace(local, positions=positions, normals=corner_normals,
+                               offset=positions - local.positions)
+
+
+def adaptive_subdivision(obj) -> bool:
+    """Whether the object's Subdivision modifier asks for adaptive subdivision (Cycles'
+    dicing), which DRT renders at the modifier's render levels."""
+    return any(m.type == "SUBSURF" and m.show_render
+               and getattr(m, "use_adaptive_subdivision", False)
+               for m in getattr(obj, "modifiers", ()))
+
+
+def adaptive_message(names) -> str:
+    shown = ", ".join(repr(n) for n in sorted(names)[:5])
+    more = f" and {len(names) - 5} more" if len(names) > 5 else ""
+    return (f"DRT: adaptive subdivision (Cycles' dicing) is not modelled; {shown}{more} "
+            "render at their Subdivision modifier's render levels")
+
+
+def _area_normals(positions, triangles):
+    n = np.zeros_like(positions)
+    a, b, c = (positions[triangles[:, k]] for k in range(3))
+    f = np.cross(b - a, c - a)
+    for k in range(3):
+        np.add.at(n, triangles[:, k], f)
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)

@@ -1,0 +1,205 @@
+"""True displacement (Material > Settings > Displacement: Displacement Only, Displacement
+and Bump) against Cycles at its defaults, and what it costs scenes without it. The engine
+side alone: test_displacement.py.
+
+The plane: a 6 m plane, Subdivision (Simple, 7 levels), scaled and turned (the
+Displacement node's default Object space then differs from World), displaced by a Noise
+Texture at its default (Generated) coordinates through a Displacement node (Scale 0.5),
+coloured by the same noise through a Color Ramp, under a low sun. The surface must move
+(its silhouette and shadows), read its colour at the undisplaced point (Generated
+coordinates, as Cycles' generated attribute) and, for Displacement and Bump, bend its
+normal as Cycles' bump evaluation does on the undisplaced surface. The control, the same
+material as Bump Only (what DRT rendered before), fails.
+
+The sample scene: sample_blends/displacement.blend, a cobbled path (Voronoi -> Color Ramp
+-> Displacement, Displacement Only) and a rock (Noise, Displacement and Bump) at sunset;
+docs/displacement.md shows it."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+import node_probe
+from conftest import render_blend
+from node_probe import image_errors, new_material, new_scene
+from test_artist_scenes_vs_cycles import _agrees
+
+SAMPLES = 64
+SAMPLES_DIR = os.path.join(os.path.dirname(os.path.dirname(__file__)), "sample_blends")
+SCENE_CYCLES_SAMPLES = 1024
+SCENE_DRT_SAMPLES = 512
+
+
+def _plane_scene(bpy, method, coordinates=None, vector=False):
+    """The plane (the module's docstring); coordinates: a Texture Coordinate output for
+    the noise (None: its default); vector: a Vector Displacement node (Tangent space) of
+    the noise's Color instead of a Displacement node."""
+    scene = new_scene(bpy, 96)
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.1
+    bpy.ops.mesh.primitive_plane_add(size=6.0)
+    plane = bpy.context.object
+    plane.scale = (1.0, 0.8, 1.2)
+    plane.rotation_euler = (0.0, 0.0, 0.3)
+    mod = plane.modifiers.new("Subdivision", "SUBSURF")
+    mod.subdivision_type = "SIMPLE"
+    mod.levels = mod.render_levels = 7
+    bpy.ops.object.shade_smooth()
+    mat, nt = new_material(bpy, "Displaced")
+    mat.displacement_method = method
+    bsdf = nt.nodes["Principled BSDF"]
+    bsdf.inputs["Roughness"].default_value = 0.4
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = 2.0
+    if coordinates is not None:
+        coords = nt.nodes.new("ShaderNodeTexCoord")
+        nt.links.new(coords.outputs[coordinates], noise.inputs["Vector"])
+    if vector:
+        disp = nt.nodes.new("ShaderNodeVectorDisplacement")
+        disp.inputs["Scale"].default_value = 0.4
+        nt.links.new(noise.outputs["Color"], disp.inputs["Vector"])
+    else:
+        disp = nt.nodes.new("ShaderNodeDisplacement")
+        disp.inputs["Scale"].default_value = 0.5
+        nt.links.new(noise.outputs["Fac"], disp.inputs["Height"])
+    nt.links.new(disp.outputs["Displacement"], nt.nodes["Material Output"].inputs["Displacement"])
+    ramp = nt.nodes.new("ShaderNodeValToRGB")
+    nt.links.new(noise.outputs["Fac"], ramp.inputs["Fac"])
+    nt.links.new(ramp.outputs["Color"], bsdf.inputs["Base Color"])
+    plane.data.materials.append(mat)
+    node_probe.sun_and_camera(bpy, scene, 3.0, 0.05, (1.1, 0.3, 0.5), (0.0, -5.0, 3.5),
+                              (0.98, 0.0, 0.0))
+    return scene, mat
+
+
+# (method, texture coordinates (None: the noise's default), Vector Displacement, mean
+# tolerance, block tolerance)
+PLANE_CASES = [
+    ("DISPLACEMENT", None, False, 0.01, 0.03),
+    ("BOTH", None, False, 0.01, 0.03),
+    ("BOTH", "Object", False, 0.01, 0.03),
+    ("DISPLACEMENT", None, True, 0.01, 0.03),
+]
+
+
+@pytest.mark.parametrize("method, coordinates, vector, mean_tol, block_tol", PLANE_CASES)
+def test_displacement_matches_cycles(bpy_drt, method, coordinates, vector, mean_tol,
+                                     block_tol):
+    """Measured (DRT and Cycles at 64 samples, of the image mean): see the module's
+    numbers in docs/displacement.md. The control, the material in Bump Only mode, has
+    blocks off by more than 10 %."""
+    bpy = bpy_drt
+    scene, mat = _plane_scene(bpy, method, coordinates, vector)
+    cycles = node_probe.render(bpy, scene, "CYCLES", SAMPLES)
+    drt = node_probe.render(bpy, scene, "DRT", SAMPLES)
+    mean, block = image_errors(drt, cycles)
+    mat.displacement_method = "BUMP"
+    control = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles)
+    print(f"{method} {coordinates or 'Generated'}{' vector' if vector else ''}: mean "
+          f"{mean:.2%}, largest block {block:.2%}; as Bump Only: mean {control[0]:.2%}, "
+          f"largest block {control[1]:.2%}")
+    assert mean < mean_tol and block < block_tol, (mean, block)
+    assert control[1] > 0.1, control
+
+
+def test_only_scenes_with_true_displacement_pay_for_it(bpy_drt):
+    """Bump Only (Blender's default): no mesh is moved, no vertex normals or undisplaced
+    corners are read. Displacement Only: the plane moves, and a grid with two users
+    (linked duplicates, instanced) moves once, in object space, for both of its places,
+    as Cycles displaces a mesh once."""
+    bpy = bpy_drt
+    from drt_addon.export import export_scene
+    scene, mat = _plane_scene(bpy, "BUMP")
+    bpy.ops.mesh.primitive_grid_add(x_subdivisions=60, y_subdivisions=60, size=2.0,
+                                    location=(0.0, 5.0, 0.0))
+    grid = bpy.context.object
+    grid.data.materials.append(mat)
+    twin = bpy.data.objects.new("Twin", grid.data)
+    twin.location = (3.0, 5.0, 0.0)
+    scene.collection.objects.link(twin)
+    stats = {}
+    bump = export_scene(bpy.context.evaluated_depsgraph_get(), stats=stats)
+    assert stats["displaced_meshes"] == 0
+    assert all(m.undisplaced is None for m in bump.meshes)
+    assert all(m.displacement is None for m in bump.materials)
+    mat.displacement_method = "DISPLACEMENT"
+    stats = {}
+    moved = export_scene(bpy.context.evaluated_depsgraph_get(), stats=stats)
+    assert stats["displaced_meshes"] == 2, stats          # the plane, and the grid once
+    placed = [m for m in moved.meshes if m.instances is not None]
+    assert len(placed) == 1 and len(placed[0].instances) == 2
+    for m in moved.meshes:
+        assert m.undisplaced is not None
+        assert np.ptp(m.positions[:, 2]) > 0.1, np.ptp(m.positions[:, 2])   # no longer flat
+
+
+def test_displacement_scene_matches_cycles(bpy_drt):
+    """sample_blends/displacement.blend (64 x 48, DRT 512 against Cycles 1024 samples):
+    means within 1 % per channel, every 8 x 8 block within 3 % of the image mean. The
+    control, both materials as Bump Only, fails."""
+    bpy = bpy_drt
+    path = os.path.join(SAMPLES_DIR, "displacement.blend")
+    cycles = render_blend(bpy, path, "CYCLES", SCENE_CYCLES_SAMPLES, percentage=100)
+    drt = render_blend(bpy, path, "DRT", SCENE_DRT_SAMPLES, percentage=100)
+    assert _agrees("displacement", drt, cycles)
+
+    def bump_only(scene):
+        for m in bpy.data.materials:
+            m.displacement_method = "BUMP"
+    control = render_blend(bpy, path, "DRT", 128, percentage=100, setup=bump_only)
+    assert not _agrees("displacement as Bump Only (control)", control, cycles)
+
+
+def test_adaptive_subdivision_is_named_and_renders_at_the_render_levels(bpy_drt):
+    """Adaptive subdivision (Cycles' dicing) is not modelled: one warning names the
+    object, which renders at its Subdivision modifier's render levels."""
+    bpy = bpy_drt
+    from drt_addon.export import Reporter, export_scene
+    scene, _ = _plane_scene(bpy, "DISPLACEMENT")
+    plane = bpy.data.objects["Plane"]
+    reporter = Reporter()
+    flat = export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
+    assert not any("adaptive" in w for w in reporter.warnings)
+    plane.modifiers["Subdivision"].use_adaptive_subdivision = True
+    reporter = Reporter()
+    diced = export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
+    named = [w for w in reporter.warnings if "adaptive subdivision" in w]
+    assert len(named) == 1 and "'Plane'" in named[0], reporter.warnings
+    assert diced.triangle_count() == flat.triangle_count() == 2 * 4 ** 7
+
+
+def test_a_deforming_displaced_mesh_moves_its_displacement_along(bpy_drt):
+    """Motion blur of a mesh that deforms (a shape key) and is displaced: every time step
+    carries the same offsets, as Cycles adds them to its motion steps, so the steps differ
+    by the deformation alone (1 m along x over the shutter)."""
+    from engine.motion import DeformMotion
+    from test_motion_blender import CUBE, _mesh, _shape_key_motion
+    bpy = bpy_drt
+    from drt_addon.export import export_scene
+    bpy.ops.wm.open_mainfile(filepath=CUBE, load_ui=False)
+    _shape_key_motion(bpy.context.scene)
+    cube = bpy.data.objects["Cube"]
+    sub = cube.modifiers.new("Subdivision", "SUBSURF")
+    sub.subdivision_type = "SIMPLE"
+    sub.levels = sub.render_levels = 3
+    mat, nt = new_material(bpy, "Displaced")
+    mat.displacement_method = "DISPLACEMENT"
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    noise.inputs["Scale"].default_value = 4.0
+    disp = nt.nodes.new("ShaderNodeDisplacement")
+    disp.inputs["Scale"].default_value = 0.2
+    nt.links.new(noise.outputs["Fac"], disp.inputs["Height"])
+    nt.links.new(disp.outputs["Displacement"], nt.nodes["Material Output"].inputs["Displacement"])
+    cube.data.materials.clear()
+    cube.data.materials.append(mat)
+    mesh = _mesh(export_scene(bpy.context.evaluated_depsgraph_get()), "Cube")
+    assert isinstance(mesh.motion, DeformMotion) and mesh.undisplaced is not None
+    steps = mesh.motion.positions
+    np.testing.assert_allclose(steps[1], mesh.positions, atol=1e-6)
+    for k, dx in ((0, -0.5), (2, 0.5)):
+        np.testing.assert_allclose(steps[k] - steps[1],
+                                   np.tile([dx, 0.0, 0.0], (len(steps[1]), 1)),
+                                   atol=1e-5)
+    # the displacement itself is there: the cube's faces are no longer flat
+    assert np.ptp(np.abs(steps[1] - steps[1].mean(axis=0)).max(axis=1)) > 0.02
