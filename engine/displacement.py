@@ -192,3 +192,22 @@ def displaced_normals(positions: np.ndarray, triangles: np.ndarray, recompute: n
     out[s] = vn[triangles[s]]
     out[f] = np.repeat(fn[f][:, None, :], 3, axis=1)
     return out
+
+
+def bumped_from_vertex_normals(positions: np.ndarray, triangles: np.ndarray,
+                               kept: np.ndarray, corner_normals: Optional[np.ndarray],
+                               smooth: Optional[np.ndarray], vertex_normals: np.ndarray):
+    """Corner normals (T, 3, 3) float32 where Displacement and Bump moved flat faces
+    (`kept`, (T,) bool): Cycles bumps those from the undisplaced vertex normals (its
+    undisplaced-normal attribute, smooth whatever the face's shading), not from the
+    moved face's own normal, so they take the vertex normals; every other flat face keeps
+    its own (moved) face normal. Unchanged when no flat face was so moved."""
+    smooth_here = np.ones(len(triangles), bool) if smooth is None else np.asarray(smooth, bool)
+    flat = np.asarray(kept, bool) & ~smooth_here
+    if not flat.any():
+        return corner_normals
+    if corner_normals is None:
+        corner_normals = np.repeat(face_normals(positions, triangles)[:, None, :], 3, axis=1)
+    out = np.array(corner_normals, np.float32, copy=True)
+    out[flat] = _unit(np.asarray(vertex_normals, np.float64))[triangles[flat]]
+    return out

@@ -291,3 +291,19 @@ def test_undisplaced_region_swaps_and_restores_the_hit():
     np.testing.assert_array_equal(got(steps[1]), und[9:12])
     for v, col in zip(after, (C.H_P, C.H_OBJECT, C.H_DX + C.H_P, C.H_DY + C.H_P)):
         np.testing.assert_array_equal(got(v), hit[0, col:col + 3])
+
+
+def test_flat_faces_bumped_after_displacement_take_the_vertex_normals():
+    """Displacement and Bump on flat faces: those faces' corners take the undisplaced
+    vertex normals (Cycles bumps from them); other flat faces keep their moved face
+    normal; nothing changes where no flat face was so moved."""
+    pos, tris, _, normals = grid(n=2)
+    moved = pos + np.column_stack([np.zeros((len(pos), 2)), 0.3 * pos[:, 0] ** 2])
+    kept = np.array([True, True, False, False, True, False, False, False])
+    smooth = np.zeros(len(tris), bool)
+    out = D.bumped_from_vertex_normals(moved, tris, kept, None, smooth, normals * 2.0)
+    face = D.face_normals(moved, tris)
+    for t in range(len(tris)):
+        want = np.tile([0.0, 0.0, 1.0], (3, 1)) if kept[t] else np.tile(face[t], (3, 1))
+        np.testing.assert_allclose(out[t], want, atol=1e-6)
+    assert D.bumped_from_vertex_normals(moved, tris, kept, None, ~smooth, normals) is None

@@ -32,10 +32,11 @@ SCENE_CYCLES_SAMPLES = 1024
 SCENE_DRT_SAMPLES = 512
 
 
-def _plane_scene(bpy, method, coordinates=None, vector=False):
+def _plane_scene(bpy, method, coordinates=None, vector=False, flat=False):
     """The plane (the module's docstring); coordinates: a Texture Coordinate output for
     the noise (None: its default); vector: a Vector Displacement node (Tangent space) of
-    the noise's Color instead of a Displacement node."""
+    the noise's Color instead of a Displacement node; flat: flat shaded (Displacement and
+    Bump then bumps from the undisplaced vertex normals, and no shadow ray is lifted)."""
     scene = new_scene(bpy, 96)
     scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.1
     bpy.ops.mesh.primitive_plane_add(size=6.0)
@@ -45,7 +46,8 @@ def _plane_scene(bpy, method, coordinates=None, vector=False):
     mod = plane.modifiers.new("Subdivision", "SUBSURF")
     mod.subdivision_type = "SIMPLE"
     mod.levels = mod.render_levels = 7
-    bpy.ops.object.shade_smooth()
+    if not flat:
+        bpy.ops.object.shade_smooth()
     mat, nt = new_material(bpy, "Displaced")
     mat.displacement_method = method
     bsdf = nt.nodes["Principled BSDF"]
@@ -73,30 +75,33 @@ def _plane_scene(bpy, method, coordinates=None, vector=False):
     return scene, mat
 
 
-# (method, texture coordinates (None: the noise's default), Vector Displacement, mean
-# tolerance, block tolerance)
+# (method, texture coordinates (None: the noise's default), Vector Displacement, flat
+# shading, mean tolerance, block tolerance)
 PLANE_CASES = [
-    ("DISPLACEMENT", None, False, 0.01, 0.03),
-    ("BOTH", None, False, 0.01, 0.03),
-    ("BOTH", "Object", False, 0.01, 0.03),
-    ("DISPLACEMENT", None, True, 0.01, 0.03),
+    ("DISPLACEMENT", None, False, False, 0.01, 0.03),
+    ("BOTH", None, False, False, 0.01, 0.03),
+    ("BOTH", "Object", False, False, 0.01, 0.03),
+    ("DISPLACEMENT", None, True, False, 0.01, 0.03),
+    ("BOTH", None, False, True, 0.01, 0.03),
 ]
 
 
-@pytest.mark.parametrize("method, coordinates, vector, mean_tol, block_tol", PLANE_CASES)
-def test_displacement_matches_cycles(bpy_drt, method, coordinates, vector, mean_tol,
+@pytest.mark.parametrize("method, coordinates, vector, flat, mean_tol, block_tol",
+                         PLANE_CASES)
+def test_displacement_matches_cycles(bpy_drt, method, coordinates, vector, flat, mean_tol,
                                      block_tol):
     """Measured (DRT and Cycles at 64 samples, of the image mean): see the module's
     numbers in docs/displacement.md. The control, the material in Bump Only mode, has
     blocks off by more than 10 %."""
     bpy = bpy_drt
-    scene, mat = _plane_scene(bpy, method, coordinates, vector)
+    scene, mat = _plane_scene(bpy, method, coordinates, vector, flat)
     cycles = node_probe.render(bpy, scene, "CYCLES", SAMPLES)
     drt = node_probe.render(bpy, scene, "DRT", SAMPLES)
     mean, block = image_errors(drt, cycles)
     mat.displacement_method = "BUMP"
     control = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles)
-    print(f"{method} {coordinates or 'Generated'}{' vector' if vector else ''}: mean "
+    print(f"{method} {coordinates or 'Generated'}{' vector' if vector else ''}"
+          f"{' flat' if flat else ''}: mean "
           f"{mean:.2%}, largest block {block:.2%}; as Bump Only: mean {control[0]:.2%}, "
           f"largest block {control[1]:.2%}")
     assert mean < mean_tol and block < block_tol, (mean, block)

@@ -171,6 +171,9 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             name = f"{obj.name}#{k}" if inst.is_instance else obj.name
             # Object > Shadow Terminator > Geometry Offset (engine.kernels.terminator)
             offset = float(getattr(obj, "shadow_terminator_geometry_offset", 0.1))
+            if local.smooth is not None and not local.smooth.any():
+                offset = 0.0          # Cycles lifts smooth faces only (a flat mesh's normals
+                #                       may come from its displacement's bump: displaced_mesh)
             # an instance is seen by the rays that see both it and its instancer (Cycles)
             seen = object_visibility(obj) & (
                 object_visibility(inst.parent) if inst.is_instance and inst.parent is not None

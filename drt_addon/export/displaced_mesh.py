@@ -51,9 +51,11 @@ def displace_local(local, obj, matrix_world, displacements):
                                   displacements, m, row, local.uvs, local.tangents,
                                   local.colors)
     keep = np.array([d is not None and d.keep_normals for d in displacements] + [False])
-    recompute = moved & ~keep[np.clip(local.material, 0, len(keep) - 1)]
-    corner_normals = D.displaced_normals(positions, local.triangles, recompute, local.normals,
-                                         local.smooth)
+    kept = moved & keep[np.clip(local.material, 0, len(keep) - 1)]
+    corner_normals = D.displaced_normals(positions, local.triangles, moved & ~kept,
+                                         local.normals, local.smooth)
+    corner_normals = D.bumped_from_vertex_normals(positions, local.triangles, kept,
+                                                  corner_normals, local.smooth, normals)
     return dataclasses.replace(local, positions=positions, normals=corner_normals,
                                offset=positions - local.positions)
 
