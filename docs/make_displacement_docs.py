@@ -41,13 +41,14 @@ def _plane_rows(bpy):
     import node_probe
     from node_probe import image_errors
     rows = []
-    for method, coordinates, vector, _, _ in PLANE_CASES:
-        scene, mat = _plane_scene(bpy, method, coordinates, vector)
+    for method, coordinates, vector, flat, _, _ in PLANE_CASES:
+        scene, mat = _plane_scene(bpy, method, coordinates, vector, flat)
         cycles = node_probe.render(bpy, scene, "CYCLES", SAMPLES)
         mean, block = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles)
         mat.displacement_method = "BUMP"
         c_mean, c_block = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles)
         node = "Vector Displacement (Tangent)" if vector else "Displacement (Object)"
+        node += ", flat shaded" if flat else ""
         rows.append(f"| {METHODS[method]} | {node} | "
                     f"{coordinates or 'Generated'} | {mean:.2%} | {block:.2%} | "
                     f"{c_mean:.2%} | {c_block:.2%} |")
@@ -118,7 +119,8 @@ DRT renders Material > Settings > Displacement as Cycles does:
   it moved, as Cycles reads its generated attribute.
 - **Displacement and Bump** moves the vertices and keeps their undisplaced normals. The
   bump is then worked out on the undisplaced surface and in the object's space, as in
-  Cycles.
+  Cycles. On flat-shaded faces it starts from the undisplaced vertex normals, as
+  Cycles' does.
 
 The Displacement node (Object and World space) and the Vector Displacement node
 (Tangent, Object and World space) are evaluated. Any other vector linked to the socket
