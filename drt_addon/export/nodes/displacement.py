@@ -116,7 +116,10 @@ def displacement_normal(mat, socket, ctx):
     if method == "DISPLACEMENT":
         return None
     c = ctx.nodes
-    if not _height(c, socket).varying:
+    # whether the height varies, asked of a scratch compiler: the material's program then
+    # holds the height only where the bump uses it (inside the undisplaced region for
+    # Displacement and Bump)
+    if not _height(NodeCompiler(ctx), socket).varying:
         return None
 
     def bent(steps=lambda: None):
