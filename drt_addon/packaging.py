@@ -46,6 +46,8 @@ REQUIREMENTS = "requirements.txt"
 DEFAULT_OUTPUT_DIR = os.path.join(REPO_ROOT, "build")
 # Blender bundles numpy; a second copy in the extension would shadow it.
 NEVER_BUNDLED = {"numpy"}
+# The Python of Blender 4.2 to 5.x, for wheels tagged for any Python 3 ("py3")
+BLENDER_PYTHON = "3.11"
 # The tool's exclusions when a manifest has no [build] table (blender_ext.py build).
 TOOL_DEFAULT_EXCLUDES = ["__pycache__/", ".*", "/*.zip", "*.blend[1-9]"]
 
@@ -212,7 +214,8 @@ def fetch_wheels(root: str = REPO_ROOT, python: str = sys.executable,
         paths.append(dest)
         if os.path.exists(dest) and _wheel_is_complete(dest, dist, version):
             continue
-        m = re.fullmatch(r"cp(\d)(\d+)", py_tag)
+        m = re.fullmatch(r"cp(\d)(\d+)", py_tag) or \
+            (py_tag == "py3" and re.fullmatch(r"(\d)\.(\d+)", BLENDER_PYTHON))
         if not m:
             raise PackagingError(f"cannot tell the Python version of {filename}")
         _log(f"downloading {filename}")

@@ -45,6 +45,9 @@ def _tiny(scene) -> None:
     r.resolution_percentage = max(1, round(100 * SIZE / max(r.resolution_x, r.resolution_y)))
     scene.render.engine = "DRT"
     scene.drt.samples = 1
+    if hasattr(scene, "cycles"):
+        # Render > Denoise, on in new files: the first-hit passes it reads compile too
+        scene.cycles.use_denoising = True
 
 
 def run(args) -> int:

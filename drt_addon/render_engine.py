@@ -24,6 +24,8 @@ layer (Properties > View Layer > Passes):
   coverage) pairs of the names each pixel shows, with the manifest in the render
   result's metadata, so that Blender's Cryptomatte node picks mattes by name
   (engine.cryptomatte).
+- Noisy Image (when Render > Denoise and the view layer's Denoising are on, Cycles'
+  settings): the render before denoising; Combined is then denoised (drt_addon.denoise).
 Depth, Normal, Mist, Position, UV, the index passes, Cryptomatte and the denoising passes
 come from engine.aov (a first-hit query on the same camera samples), not from the path
 tracer.
@@ -44,8 +46,11 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
+from . import denoise
 from .blender_compat import (ENVIRONMENT_PASS, MATERIAL_INDEX_PASS, OBJECT_INDEX_PASS,
                              set_pass_pixels)
+from .render_passes import (CRYPTOMATTE, FIRST_HIT, PASSES, FirstHit, cryptomatte_passes,
+                            enabled_passes)
 
 # The tracer (engine: kernels compiled by Numba, Embree through its C API) and the export
 # are imported by the first DRT render, not when Blender registers the add-on: a Blender
@@ -84,54 +89,6 @@ class DRTViewLayerSettings(bpy.types.PropertyGroup):
         name="Noise Estimate", default=False,
         description="Write the 'DRT Noise' pass: per pixel, the standard error of the mean "
                     "radiance (how far the pixel may be from the converged value)")
-
-
-# (name, channels, channel ids, type) of each pass DRT can write, and when it is enabled.
-PASSES = {
-    "Depth": (1, "Z", "VALUE", lambda vl: vl.use_pass_z),
-    "Normal": (3, "XYZ", "VECTOR", lambda vl: vl.use_pass_normal),
-    "Denoising Normal": (3, "XYZ", "VECTOR", lambda vl: _drt_layer(vl, "use_pass_denoising_data")),
-    "Denoising Albedo": (3, "RGB", "COLOR", lambda vl: _drt_layer(vl, "use_pass_denoising_data")),
-    "DRT Noise": (3, "RGB", "COLOR", lambda vl: _drt_layer(vl, "use_pass_noise")),
-    "Mist": (1, "Z", "VALUE", lambda vl: vl.use_pass_mist),
-    "Position": (3, "XYZ", "VECTOR", lambda vl: vl.use_pass_position),
-    "UV": (3, "UVA", "VECTOR", lambda vl: vl.use_pass_uv),
-    OBJECT_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_object_index),
-    MATERIAL_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_material_index),
-    ENVIRONMENT_PASS: (3, "RGB", "COLOR", lambda vl: vl.use_pass_environment),
-}
-FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position",
-             "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, ENVIRONMENT_PASS)
-
-
-CRYPTOMATTE = {"object": "Object", "material": "Material", "asset": "Asset"}
-
-
-def cryptomatte_passes(view_layer) -> dict:
-    """{kind: its pass names} of the Cryptomatte layers the view layer asks for: Levels
-    names, two to a pass (CryptoObject00, CryptoObject01, ...), as Cycles names them."""
-    depth = int(getattr(view_layer, "pass_cryptomatte_depth", 6))
-    return {kind: [f"Crypto{label}{i:02d}" for i in range((depth + 1) // 2)]
-            for kind, label in CRYPTOMATTE.items()
-            if getattr(view_layer, f"use_pass_cryptomatte_{kind}", False)}
-
-
-def _mist(aov, world):
-    """World > Mist Pass (Blender's defaults without a world) as engine.aov.Mist."""
-    m = getattr(world, "mist_settings", None)
-    if m is None:
-        return aov.Mist()
-    exponent = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}.get(m.falloff, 2.0)
-    return aov.Mist(float(m.start), float(m.depth), exponent)
-
-
-def _drt_layer(view_layer, name) -> bool:
-    settings = getattr(view_layer, "drt", None)
-    return bool(getattr(settings, name, False))
-
-
-def enabled_passes(view_layer) -> list:
-    return [name for name, (*_, enabled) in PASSES.items() if enabled(view_layer)]
 
 
 def _clock(seconds: float) -> str:
@@ -199,6 +156,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         for name in enabled_passes(renderlayer):
             channels, chan_id, kind, _ = PASSES[name]
             self.register_pass(scene, renderlayer, name, channels, chan_id, kind)
+        if denoise.wanted(scene, renderlayer):
+            self.register_pass(scene, renderlayer, denoise.NOISY_PASS, 4, "RGBA", "COLOR")
         for names in cryptomatte_passes(renderlayer).values():
             for name in names:
                 self.register_pass(scene, renderlayer, name, 4, "RGBA", "COLOR")
@@ -325,6 +284,16 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                                         cancelled=lambda: self._polled("tracing"),
                                         compiling=compiling)
             image, alpha = film.mean(), film.mean_alpha()
+            first_hit = FirstHit(ctx, scene.world, description)
+            if not stats.cancelled and denoise.wanted(scene, view_layer):
+                self.update_stats("", "DRT: denoising")
+                clean = denoise.denoised(scene, image, first_hit, reporter)
+                if clean is not None:
+                    noisy, image = image, clean.astype(np.float64)
+                    if layer.passes.get(denoise.NOISY_PASS) is not None:
+                        set_pass_pixels(layer.passes[denoise.NOISY_PASS],
+                                        _rgba_bottom_up(noisy, alpha))
+                    last_render["passes"][denoise.NOISY_PASS] = noisy
             set_pass_pixels(combined, _rgba_bottom_up(image, alpha))
             extra = enabled_passes(view_layer) or cryptomatte_passes(view_layer)
             if not stats.cancelled and extra and self._polled("passes"):
@@ -333,7 +302,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             elif stats.cancelled:
                 last_render["cancelled_in"] = "tracing"
             if not stats.cancelled:
-                self._write_passes(layer, ctx, film, view_layer, description, scene.world)
+                self._write_passes(layer, ctx, film, view_layer, description, first_hit)
                 self._write_cryptomatte(result, layer, ctx, view_layer)
         finally:
             ctx.close()
@@ -378,7 +347,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 result.stamp_data_add_field(key, value)
             last_render["metadata"].update(fields)
 
-    def _write_passes(self, layer, ctx, film, view_layer, description, world=None):
+    def _write_passes(self, layer, ctx, film, view_layer, description, first_hit):
         wanted = [name for name in enabled_passes(view_layer)
                   if layer.passes.get(name) is not None]
         if not wanted:
@@ -386,9 +355,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         images = {}
         if any(n in wanted for n in FIRST_HIT):
             self.update_stats("", "DRT: first-hit passes")
-            from .engine_link import engine
-            aov = import_module(engine.__name__ + ".aov")   # in either package layout
-            first = aov.first_hit_passes(ctx, mist=_mist(aov, world))
+            first, _ = first_hit()
             images.update({"Depth": first.depth, "Normal": first.normal,
                            "Denoising Albedo": first.albedo,
                            "Denoising Normal": first.camera_normal(description.camera.matrix),

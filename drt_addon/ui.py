@@ -43,6 +43,32 @@ class DRT_PT_sampling(DRTPanel, bpy.types.Panel):
         col.prop(s, "threads")
 
 
+class DRT_PT_denoise(DRTPanel, bpy.types.Panel):
+    """Render > Denoise: Cycles' own settings (scene.cycles), which DRT renders with
+    (drt_addon.denoise)."""
+    bl_label = "Denoise"
+    bl_parent_id = "DRT_PT_sampling"
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and hasattr(context.scene, "cycles")
+
+    def draw_header(self, context):
+        self.layout.prop(context.scene.cycles, "use_denoising", text="")
+
+    def draw(self, context):
+        cycles = context.scene.cycles
+        col = self.layout.column()
+        col.use_property_split = True
+        col.active = cycles.use_denoising
+        col.prop(cycles, "denoiser")
+        col.prop(cycles, "denoising_input_passes", text="Passes")
+        sub = col.column()
+        sub.active = cycles.denoising_input_passes != "RGB"
+        sub.prop(cycles, "denoising_prefilter", text="Prefilter")
+        col.prop(cycles, "denoising_quality", text="Quality")
+
+
 class DRT_PT_light_paths(DRTPanel, bpy.types.Panel):
     bl_label = "Light Paths"
 
@@ -103,7 +129,7 @@ class DRT_PT_passes(DRTPanel, bpy.types.Panel):
             col.prop(drt, "use_pass_noise")
 
 
-CLASSES = (DRT_PT_sampling, DRT_PT_light_paths, DRT_PT_film, DRT_PT_passes)
+CLASSES = (DRT_PT_sampling, DRT_PT_denoise, DRT_PT_light_paths, DRT_PT_film, DRT_PT_passes)
 
 # Blender's generic panels for what Cycles draws in panels of its own add-on: depth of
 # field, light type/colour/power, spot shape, the material slots and node surfaces.

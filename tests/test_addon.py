@@ -129,6 +129,34 @@ def test_light_paths_panel_edits_the_files_cycles_settings(bpy_drt):
         "sample_clamp_indirect"]
 
 
+def test_denoise_panel_shows_the_files_cycles_denoise_settings(bpy_drt):
+    """Sampling > Denoise in DRT's panels draws Cycles' own Denoise settings, which DRT
+    denoises with (drt_addon.denoise), its switch in the header."""
+    import types
+    from drt_addon import ui
+    scene = bpy_drt.context.scene
+    drawn = []
+
+    class Layout:
+        use_property_split = False
+        active = True
+
+        def column(self, **kw):
+            return self
+
+        def prop(self, data, name, **kw):
+            drawn.append((data, name))
+    context = types.SimpleNamespace(scene=scene, engine="DRT")
+    panel = types.SimpleNamespace(layout=Layout())
+    assert ui.DRT_PT_denoise.poll(context)
+    assert ui.DRT_PT_denoise.bl_parent_id == "DRT_PT_sampling"
+    ui.DRT_PT_denoise.draw_header(panel, context)
+    ui.DRT_PT_denoise.draw(panel, context)
+    assert drawn == [(scene.cycles, n) for n in (
+        "use_denoising", "denoiser", "denoising_input_passes", "denoising_prefilter",
+        "denoising_quality")]
+
+
 def test_manifest_is_a_valid_extension_manifest():
     import tomllib
     with open(os.path.join(ROOT, "blender_manifest.toml"), "rb") as f:

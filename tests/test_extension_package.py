@@ -3,7 +3,7 @@
 `python -m drt_addon package --platform linux-x64` builds and validates this machine's zip
 (one zip per platform; only this one is built, so a run downloads only its wheels); the zip
 holds the add-on, the tracer, its kernels compiled for CPU tiers (engine/kernels/prebuilt)
-and the embreex, numba and llvmlite wheels for linux-x64, and nothing of the development
+and the embreex, numba, llvmlite, pyoidn, cffi and pycparser wheels for linux-x64, and nothing of the development
 tree; installed with Blender's own operator into a throwaway user extension repository it
 is enabled as `bl_ext.user_default.drt` and renders the Cornell box with the DRT engine
 without compiling: the kernels built under the module name `engine` load in the installed
@@ -65,7 +65,10 @@ PLATFORM = "linux-x64"  # this machine's; the only zip the tests build
 # instructions loads (the default build adds x86-64-v3 and more scenes).
 KERNEL_OPTIONS = ("--kernel-tier", "generic", "--kernel-scene", "cornell_box")
 PREBUILT = "engine/kernels/prebuilt/"
-BUNDLED = {"embreex", "numba", "llvmlite"}
+BUNDLED = {"embreex", "numba", "llvmlite", "pyoidn", "cffi", "pycparser"}
+# a wheel is for CPython 3.11 alone, or for any Python 3 without compiled extensions
+# (pyoidn loads its library with cffi; pycparser is pure Python)
+TAGS = {("cp311", "cp311"), ("py3", "none")}
 
 
 def _platform_wheels(platform: str = PLATFORM) -> list[str]:
@@ -158,7 +161,8 @@ def test_zip_holds_the_addon_tracer_and_wheels_only(built):
         assert required in names, required
     zipped_wheels = sorted(n for n in names if n.endswith(".whl"))
     assert zipped_wheels == sorted(os.path.normpath(w).replace(os.sep, "/") for w in wheels)
-    assert all("manylinux" in w and w.endswith("x86_64.whl") for w in wheels)
+    assert all(("manylinux" in w and w.endswith("x86_64.whl")) or w.endswith("-none-any.whl")
+               for w in wheels)
     forbidden_tops = {"tests", "docs", "sample_blends", ".venv", ".git", ".ci", "build",
                       "renders", "requirements.txt", "pytest.ini", ".gitignore",
                       ".pytest_cache"}
@@ -179,7 +183,7 @@ def test_zip_holds_the_addon_tracer_and_wheels_only(built):
                for x in extras), sorted(extras)
 
 
-def test_zip_bundles_the_pinned_embreex_numba_and_llvmlite_for_linux(built):
+def test_zip_bundles_the_pinned_wheels_for_linux(built):
     zip_path, _ = built
     pins = packaging.read_pins(ROOT)
     blender_ext = _blender_ext_module()
@@ -189,8 +193,9 @@ def test_zip_bundles_the_pinned_embreex_numba_and_llvmlite_for_linux(built):
         for member in sorted(members):
             dist, version, py_tag, abi_tag, plat = packaging.parse_wheel_filename(member)
             found.add(dist)
-            assert (version, py_tag, abi_tag) == (pins[dist], "cp311", "cp311"), member
-            assert blender_ext.blender_platforms_from_wheel_platform(plat) == [PLATFORM]
+            assert version == pins[dist] and (py_tag, abi_tag) in TAGS, member
+            assert plat == "any" or \
+                blender_ext.blender_platforms_from_wheel_platform(plat) == [PLATFORM]
             # Byte for byte the wheel that was downloaded (and checked intact) in wheels/.
             with open(os.path.join(ROOT, member), "rb") as f:
                 on_disk = hashlib.sha256(f.read()).hexdigest()
@@ -212,9 +217,12 @@ def test_manifest_has_one_pinned_wheel_of_each_package_for_every_platform():
         parsed = [packaging.parse_wheel_filename(w) for w in wheels]
         assert sorted(p[0] for p in parsed) == sorted(BUNDLED), platform
         for dist, version, py_tag, abi_tag, plat in parsed:
-            assert (version, py_tag, abi_tag) == (pins[dist], "cp311", "cp311")
-            assert platform in blender_ext.blender_platforms_from_wheel_platform(plat)
-    assert sorted(w for ws in per_platform.values() for w in ws) == sorted(_manifest()["wheels"])
+            assert version == pins[dist] and (py_tag, abi_tag) in TAGS
+            assert plat == "any" or \
+                platform in blender_ext.blender_platforms_from_wheel_platform(plat)
+    # every wheel serves some platform (a pure-Python one, tagged "any", serves them all)
+    assert sorted({w for ws in per_platform.values() for w in ws}) == \
+        sorted(_manifest()["wheels"])
 
 
 def test_packaging_refuses_a_platform_without_all_its_wheels(tmp_path):
@@ -325,12 +333,15 @@ scene = bpy.context.scene
 scene.render.engine = "DRT"
 scene.render.resolution_percentage = 12
 scene.drt.samples = 2
+scene.cycles.use_denoising = True      # Render > Denoise, through the bundled pyoidn
 facts["expected_size"] = [scene.render.resolution_x * 12 // 100,
                           scene.render.resolution_y * 12 // 100]
 t0 = time.perf_counter()
 bpy.ops.render.render(write_still=False)
 facts["render_seconds"] = time.perf_counter() - t0
 facts["last_render"] = {k: mod.last_render.get(k) for k in ("ok", "error")} if mod else None
+facts["denoised"] = bool(mod and "Noisy Image" in mod.last_render.get("passes", {}))
+facts["warnings"] = list(mod.last_render.get("warnings", [])) if mod else None
 tracer = sys.modules.get(args["pkg"] + ".engine")
 facts["tracer_file"] = getattr(tracer, "__file__", None)
 
@@ -350,7 +361,7 @@ facts["std"] = float(rgb.std())
 facts["distinct"] = int(np.unique(rgb).size)
 
 facts["module_files"] = {name: getattr(sys.modules.get(name), "__file__", None)
-                         for name in ("numba", "llvmlite")}
+                         for name in ("numba", "llvmlite", "pyoidn", "cffi", "pycparser")}
 # Embree: the library DRT loaded (the embreex wheel's; its Python binding is not used)
 embree = sys.modules.get(args["pkg"] + ".engine.embree.library")
 facts["module_files"]["embreex"] = getattr(getattr(embree, "_LIB", None), "drt_path", None)
@@ -525,11 +536,13 @@ def _check_session(facts, user_dir):
     assert facts["source_modules"] == [] and facts["repo_on_path"] == []
     # The render.
     assert facts["last_render"] == {"ok": True, "error": None}
+    assert facts["denoised"], facts["warnings"]     # OIDN from the bundled pyoidn
     assert facts["size"] == facts["expected_size"]
     assert min(facts["size"]) >= 8
     assert facts["finite"]
     assert facts["max"] > 0.01 and facts["std"] > 1e-3 and facts["distinct"] > 10
-    # numba, llvmlite and the Embree library of the embreex wheel from the bundled wheels,
+    # numba, llvmlite, the denoiser's pyoidn, cffi and pycparser, and the Embree library
+    # of the embreex wheel from the bundled wheels,
     # which Blender unpacked into extensions/.local, never from the Python environment
     # running this test; embreex's own Python binding is never imported.
     site_packages = os.path.realpath(_site_packages(user_dir)) + os.sep

@@ -191,13 +191,11 @@ def _quiet_defaults(scene):
     scene.cycles.use_adaptive_sampling = False
 
 
-def test_factory_defaults_warn_only_about_denoise(factory_scene):
-    """Blender turns Denoise on by default and DRT does not denoise; Cycles' adaptive
-    sampling at its defaults is not warned (DRT has its own Noise Threshold, off by
-    default); nothing else warns."""
-    warnings = _warnings(factory_scene)
-    assert len(warnings) == 1, warnings
-    assert "Denoise" in warnings[0] and "does not denoise" in warnings[0]
+def test_factory_defaults_warn_about_nothing(factory_scene):
+    """Blender turns Denoise on by default and DRT denoises as Cycles does (read since
+    2026-11-29: it warned before); Cycles' adaptive sampling at its defaults is not warned
+    (DRT has its own Noise Threshold, off by default); nothing warns."""
+    assert _warnings(factory_scene) == []
 
 
 def test_no_warning_at_defaults(factory_scene):
@@ -217,7 +215,6 @@ def test_fresh_scene_defaults_are_quiet(bpy_drt):
 
 
 @pytest.mark.parametrize("change, expected", [
-    (lambda s: setattr(s.cycles, "use_denoising", True), "does not denoise"),
     (lambda s: (setattr(s.cycles, "use_adaptive_sampling", True),
                 setattr(s.cycles, "adaptive_threshold", 0.05)),
      "Noise Threshold is 0.05, not used: DRT renders with its own Noise Threshold"),
@@ -360,17 +357,21 @@ def test_unwritten_passes_warn_together(factory_scene):
 
 
 def test_a_render_warns_once_per_setting(factory_scene):
-    """Through the render engine's Reporter: one warning for the file's Denoise."""
+    """Through the render engine's Reporter: one warning for a setting DRT ignores
+    (Freestyle), none for the file's Denoise, which the render honours."""
     bpy = __import__("bpy")
     from drt_addon import render_engine
     factory_scene.render.engine = "DRT"
     factory_scene.render.resolution_percentage = 1            # 19 x 10
     factory_scene.drt.samples = 1
     factory_scene.cycles.use_adaptive_sampling = False
+    factory_scene.render.use_freestyle = True
     bpy.ops.render.render()
     last = render_engine.last_render
     assert last["ok"], last["error"]
-    assert sum("does not denoise" in w for w in last["warnings"]) == 1, last["warnings"]
+    assert sum("Freestyle" in w for w in last["warnings"]) == 1, last["warnings"]
+    assert not any("enois" in w for w in last["warnings"]), last["warnings"]
+    assert "Noisy Image" in last["passes"]                    # denoised, as Cycles would
 
 
 # ------------------------------------------------------------------------ the table
@@ -395,8 +396,8 @@ def test_the_table_covers_every_cycles_setting_and_pass(bpy_drt):
 
 
 def test_quiet_values_are_blenders_defaults(bpy_drt):
-    """Every row's path exists in this Blender and, but for Denoise, its quiet value is
-    the default of a new scene."""
+    """Every row's path exists in this Blender and its quiet value is the default of a
+    new scene."""
     from drt_addon.export.file_settings import IGNORED, OWN, SETTINGS
     from drt_addon.export.settings_check import _MISSING, is_quiet, read
     scene = bpy_drt.data.scenes.new("defaults")
@@ -409,7 +410,7 @@ def test_quiet_values_are_blenders_defaults(bpy_drt):
             assert value is not _MISSING, s.path
             if s.kind in (IGNORED, OWN) and s.warns and not is_quiet(s, value):
                 loud.append(s.path)
-        assert loud == ["scene.cycles.use_denoising"]
+        assert loud == []           # Denoise, on in a new scene, is read since 2026-11-29
     finally:
         bpy_drt.data.scenes.remove(scene)
 

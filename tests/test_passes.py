@@ -30,6 +30,7 @@ def build_scene(bpy, light="SUN"):
     scene.render.resolution_x, scene.render.resolution_y = W, H
     scene.render.resolution_percentage = 100
     scene.drt.samples = 8
+    scene.cycles.use_denoising = False       # these tests read the render's own samples
     mat = bpy.data.materials.new("Base")
     if bpy.app.version < (5, 0, 0):
         mat.use_nodes = True

@@ -7,8 +7,8 @@ and docs/make_settings_docs.py writes docs/settings.md from it. Each row is a se
 its path from the scene (`scene.cycles.film_exposure`) or from the view layer being
 rendered (`view_layer.samples`), its place in Blender's interface, what DRT does with it
 (`kind`, `how`) and, for the settings DRT does not honour, the value at which ignoring it
-changes nothing (`quiet`). That value is Blender's default except for Denoise and
-Adaptive Sampling, which Blender turns on by default and DRT does not do.
+changes nothing (`quiet`). That value is Blender's default except for Adaptive
+Sampling, which Blender turns on by default and DRT's own switch leaves off.
 """
 from __future__ import annotations
 
@@ -217,9 +217,18 @@ SETTINGS: list[FileSetting] = [
     _s("scene.render.use_simplify", "Simplify", BLENDER, "Blender applies its render "
        "limits (subdivision, child particles); Cycles' own Simplify settings are warned"),
     # -- ignored: a warning when the file changes them
-    _ignored("scene.cycles.use_denoising", "Sampling > Render > Denoise",
-             "DRT does not denoise; it renders without (the compositor's Denoise node "
-             "can use DRT's Denoising Data passes)", False),
+    _s("scene.cycles.use_denoising", "Sampling > Render > Denoise", READ,
+       "DRT denoises its final render with OpenImageDenoise, as Cycles does, and keeps "
+       "the noisy one as the Noisy Image pass (DRT's Sampling > Denoise panel shows it)"),
+    *[_s(f"scene.cycles.{name}", f"Sampling > Render > Denoise > {label}", READ,
+         "read, as Cycles reads it") for name, label in [
+        ("denoising_input_passes", "Passes"), ("denoising_prefilter", "Prefilter"),
+        ("denoising_quality", "Quality")]],
+    _s("scene.cycles.denoiser", "Sampling > Render > Denoise > Denoiser", READ,
+       "OpenImageDenoise; OptiX (NVIDIA GPUs only) is denoised with OpenImageDenoise, "
+       "with a warning, as Cycles does without such a GPU"),
+    _s("scene.cycles.denoising_use_gpu", "Sampling > Render > Denoise > Use GPU", NO_EFFECT,
+       "DRT denoises on the CPU"),
     _own("use_adaptive_sampling", "Sampling > Render > Noise Threshold (adaptive "
          "sampling)", "use_adaptive_sampling", "Noise Threshold switch (DRT's Sampling "
          "panel)", True),
@@ -229,8 +238,6 @@ SETTINGS: list[FileSetting] = [
          "Min Samples (DRT's Sampling panel)", 0, when=_ADAPTIVE),
     _own("time_limit", "Sampling > Render > Time Limit", "time_limit",
          "Time Limit (DRT's Sampling panel)", 0.0),
-    *_part_of("Sampling > Render > Denoise", ["denoiser", "denoising_prefilter",
-              "denoising_quality", "denoising_input_passes", "denoising_use_gpu"]),
     _ignored("scene.cycles.use_sample_subset", "Sampling > Advanced > Sample Subset",
              "DRT renders all its samples (the engine can render a sample range, "
              "engine.render(sample_start, sample_end), but the add-on does not)", False),
@@ -349,8 +356,8 @@ SETTINGS: list[FileSetting] = [
     _ignored("view_layer.pass_alpha_threshold", "View Layer > Filter > Alpha Threshold",
              "DRT's Depth and Normal passes take the first surface hit, whatever its alpha",
              0.5, when=("view_layer.use_pass_z", (True,))),
-    _ignored("view_layer.cycles.use_denoising", "View Layer > Denoising",
-             "part of Denoise (warned there)", True, warns=False),
+    _s("view_layer.cycles.use_denoising", "View Layer > Denoising", READ,
+       "off: this view layer is not denoised, as in Cycles"),
     _ignored("view_layer.aovs", "View Layer > Shader AOV",
              "DRT writes no shader AOVs (count shown)", 0),
     _ignored("view_layer.lightgroups", "View Layer > Light Groups",

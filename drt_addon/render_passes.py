@@ -1,0 +1,71 @@
+"""The render passes DRT writes besides Combined: which the view layer asks for, their
+channels, and the first-hit passes (engine.aov) computed once per render for the passes
+and the denoiser. drt_addon.render_engine writes them into Blender's render result."""
+from __future__ import annotations
+
+from importlib import import_module
+
+from .blender_compat import ENVIRONMENT_PASS, MATERIAL_INDEX_PASS, OBJECT_INDEX_PASS
+
+
+# (name, channels, channel ids, type) of each pass DRT can write, and when it is enabled.
+PASSES = {
+    "Depth": (1, "Z", "VALUE", lambda vl: vl.use_pass_z),
+    "Normal": (3, "XYZ", "VECTOR", lambda vl: vl.use_pass_normal),
+    "Denoising Normal": (3, "XYZ", "VECTOR", lambda vl: _drt_layer(vl, "use_pass_denoising_data")),
+    "Denoising Albedo": (3, "RGB", "COLOR", lambda vl: _drt_layer(vl, "use_pass_denoising_data")),
+    "DRT Noise": (3, "RGB", "COLOR", lambda vl: _drt_layer(vl, "use_pass_noise")),
+    "Mist": (1, "Z", "VALUE", lambda vl: vl.use_pass_mist),
+    "Position": (3, "XYZ", "VECTOR", lambda vl: vl.use_pass_position),
+    "UV": (3, "UVA", "VECTOR", lambda vl: vl.use_pass_uv),
+    OBJECT_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_object_index),
+    MATERIAL_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_material_index),
+    ENVIRONMENT_PASS: (3, "RGB", "COLOR", lambda vl: vl.use_pass_environment),
+}
+FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position",
+             "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, ENVIRONMENT_PASS)
+
+
+CRYPTOMATTE = {"object": "Object", "material": "Material", "asset": "Asset"}
+
+
+def cryptomatte_passes(view_layer) -> dict:
+    """{kind: its pass names} of the Cryptomatte layers the view layer asks for: Levels
+    names, two to a pass (CryptoObject00, CryptoObject01, ...), as Cycles names them."""
+    depth = int(getattr(view_layer, "pass_cryptomatte_depth", 6))
+    return {kind: [f"Crypto{label}{i:02d}" for i in range((depth + 1) // 2)]
+            for kind, label in CRYPTOMATTE.items()
+            if getattr(view_layer, f"use_pass_cryptomatte_{kind}", False)}
+
+
+def _mist(aov, world):
+    """World > Mist Pass (Blender's defaults without a world) as engine.aov.Mist."""
+    m = getattr(world, "mist_settings", None)
+    if m is None:
+        return aov.Mist()
+    exponent = {"QUADRATIC": 2.0, "LINEAR": 1.0, "INVERSE_QUADRATIC": 0.5}.get(m.falloff, 2.0)
+    return aov.Mist(float(m.start), float(m.depth), exponent)
+
+
+class FirstHit:
+    """engine.aov's first-hit passes of a render, computed on the first call (for the
+    passes, or for the denoiser's albedo and normal) and kept: (passes, camera matrix)."""
+
+    def __init__(self, ctx, world, description):
+        self.ctx, self.world, self.description, self.passes = ctx, world, description, None
+
+    def __call__(self):
+        if self.passes is None:
+            from .engine_link import engine
+            aov = import_module(engine.__name__ + ".aov")   # in either package layout
+            self.passes = aov.first_hit_passes(self.ctx, mist=_mist(aov, self.world))
+        return self.passes, self.description.camera.matrix
+
+
+def _drt_layer(view_layer, name) -> bool:
+    settings = getattr(view_layer, "drt", None)
+    return bool(getattr(settings, name, False))
+
+
+def enabled_passes(view_layer) -> list:
+    return [name for name, (*_, enabled) in PASSES.items() if enabled(view_layer)]
