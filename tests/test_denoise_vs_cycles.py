@@ -160,3 +160,24 @@ def test_optix_is_denoised_with_oidn_and_a_missing_binding_keeps_the_render_nois
     assert "Noisy Image" not in render_engine.last_render["passes"] and len(calls) == 1
     np.testing.assert_allclose(image, render_engine.last_render["pixels"], rtol=1e-5,
                                atol=1e-6)
+
+
+def test_an_oidn_failure_keeps_the_render_noisy_and_says_so(bpy_drt, monkeypatch):
+    bpy = bpy_drt
+    import importlib
+    from drt_addon import render_engine
+    from drt_addon.engine_link import engine
+    denoiser = importlib.import_module(engine.__name__ + ".denoiser")
+
+    def fails(*args, **kwargs):
+        raise RuntimeError("OpenImageDenoise failed: out of memory (test)")
+    monkeypatch.setattr(denoiser, "denoise", fails)
+    scene = _open(bpy, "DRT", 4)
+    scene.render.resolution_percentage = 10
+    image = render_current(bpy, scene)
+    last = render_engine.last_render
+    assert last["ok"], last["error"]
+    assert any("not denoised: OpenImageDenoise failed: out of memory (test)" in w
+               for w in last["warnings"]), last["warnings"]
+    assert "Noisy Image" not in last["passes"]
+    np.testing.assert_allclose(image, last["pixels"], rtol=1e-5, atol=1e-6)
