@@ -1,7 +1,8 @@
-"""The compiled-kernel cache (engine/kernels/jit.py): a change to any engine source
-recompiles every kernel that could have inlined it (Numba alone would keep a caller's
-stale machine code when only a callee in another module changed), a user-chosen cache
-folder is honoured, and with no writable cache the kernels compile in memory.
+"""The compiled-kernel cache (engine/kernels/jit.py): a change to any engine source a
+kernel can see recompiles every kernel that could have inlined it (Numba alone would keep
+a caller's stale machine code when only a callee in another module changed), a change no
+kernel can see recompiles nothing, a user-chosen cache folder is honoured, and with no
+writable cache the kernels compile in memory.
 
 Each case runs in a fresh process on a private copy of the engine package, so this
 process's own kernels and cache are never touched."""
@@ -57,6 +58,38 @@ def test_a_change_in_a_callee_module_recompiles_its_callers(tmp_path):
                                     "GOLDEN = np.uint64(0x9E3779B97F4A7C17)"))
     changed = _run(src)
     assert changed != first, "a stale cached kernel ignored the changed callee"
+
+
+def _stamps(folder):
+    return {os.path.join(d, f): os.stat(os.path.join(d, f)).st_mtime_ns
+            for d, _, files in os.walk(folder) for f in files if f.endswith((".nbi", ".nbc"))}
+
+
+def test_a_change_no_kernel_can_see_recompiles_nothing(tmp_path):
+    """The fingerprint covers the modules that define kernels and what they import
+    (jit.kernel_sources): a change to the denoiser, which no kernel imports, keeps every
+    cached kernel (no cache file is rewritten); the callee case above shows the reverse."""
+    src = _copy_engine(tmp_path)
+    first = _run(src)
+    cache = src / "engine" / "kernels" / "__pycache__" / "numba"
+    before = _stamps(cache)
+    assert before
+    denoiser = src / "engine" / "denoiser.py"
+    denoiser.write_text(denoiser.read_text() + "\n# changed\n")
+    assert _run(src) == first
+    assert _stamps(cache) == before
+
+
+def test_kernel_sources_follow_the_kernels_imports():
+    from engine.kernels import jit
+    names = {os.path.relpath(p, jit.ENGINE_DIR).replace(os.sep, "/")
+             for p in jit.kernel_sources()}
+    # kernels, their callees' modules, and plain modules they read constants from
+    assert {"kernels/jit.py", "kernels/path_vertex.py", "sampling/hashing.py",
+            "sampling/dispatch.py", "visibility.py", "kernels/lights/light_set.py",
+            "embree/rays.py", "embree/library.py"} <= names
+    # Python-side modules no kernel imports
+    assert not names & {"denoiser.py", "render.py", "aov.py", "integrators/compiled_path.py"}
 
 
 def test_user_cache_folder_is_used(tmp_path):

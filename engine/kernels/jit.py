@@ -3,11 +3,13 @@
 `kernel` is Numba's `njit` with the GIL released (`nogil=True`), so work units on
 threads run in parallel, and with an on-disk cache so a second render starts at once.
 
-The cache is keyed by ALL of the engine's sources, not by each function's own file as
-Numba does by default: a kernel inlines the kernels it calls, so a change to a callee in
-another module (or an upgraded add-on) must recompile its callers. `EngineCacheLocator`
-stamps every cached kernel of the `engine` package with one fingerprint (the SHA-256 of
-every engine source file and the Numba version).
+The cache is keyed by all the engine sources compiled code can depend on, not by each
+function's own file as Numba does by default: a kernel inlines the kernels it calls, so a
+change to a callee in another module (or an upgraded add-on) must recompile its callers.
+`EngineCacheLocator` stamps every cached kernel of the `engine` package with one
+fingerprint: the SHA-256 of the Numba version and of `kernel_sources()`, every module
+that defines kernels and every engine module they import, transitively. A module no
+kernel reaches (engine/denoiser.py, say) changes nothing compiled.
 
 Cache folder, the first writable of:
   1. `NUMBA_CACHE_DIR` when set (the Blender add-on points it at the extension's user
@@ -30,6 +32,7 @@ import glob
 import hashlib
 import inspect
 import os
+import re
 import tempfile
 import threading
 
@@ -75,11 +78,65 @@ def _cache_root() -> str | None:
 BORROWING = os.environ.get("DRT_BORROWING", "1") != "0"
 
 
+def _module_name(path: str) -> str:
+    rel = os.path.relpath(path, ENGINE_DIR)[:-len(".py")].split(os.sep)
+    return ".".join(["engine", *(rel[:-1] if rel[-1] == "__init__" else rel)])
+
+
+_FROM_IMPORT = re.compile(r"^[ \t]*from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+"
+                          r"(\([^)]*\)|[^\n]*)", re.MULTILINE)
+_KERNEL = re.compile(r"^[ \t]*@kernel\b", re.MULTILINE)
+
+
+def _imported(text: str, path: str, name: str, modules: dict) -> set:
+    """The engine modules (names in `modules`) that module `name` (its source `text`, at
+    `path`) imports. The engine imports its own modules relatively, `from .x import y`."""
+    package = name if path.endswith("__init__.py") else name.rsplit(".", 1)[0]
+    found = set()
+    for dots, module, names in _FROM_IMPORT.findall(text):
+        if dots:
+            base = package.rsplit(".", len(dots) - 1)[0] if len(dots) > 1 else package
+            module = ".".join(p for p in (base, module) if p)
+        names = [n.split()[0] for n in names.strip("()").replace("\\", " ").split(",")
+                 if n.split() and not n.strip().startswith("#")]
+        # `from .pkg import mod` reads the submodule; any other name comes from the
+        # module (or the package's __init__) itself
+        subs = {f"{module}.{n}" for n in names} & modules.keys()
+        found.update(subs)
+        if len(subs) < len(names) and module in modules:
+            found.add(module)
+    return found
+
+
+def kernel_sources() -> list:
+    """The engine's source files compiled code can depend on: every module that defines
+    kernels (a function decorated with `@kernel`), this one, and transitively every
+    engine module they import. A module no kernel reaches (the denoiser, the
+    integrators' Python loops, the scene description) can change without recompiling
+    anything."""
+    paths = glob.glob(os.path.join(ENGINE_DIR, "**", "*.py"), recursive=True)
+    modules = {_module_name(p): p for p in paths}
+    texts = {}
+    for n, p in modules.items():
+        with open(p, encoding="utf-8") as f:
+            texts[n] = f.read()
+    imports = {n: _imported(texts[n], modules[n], n, modules) for n in modules}
+    todo = [n for n in modules if _KERNEL.search(texts[n])] + ["engine.kernels.jit"]
+    seen = set()
+    while todo:
+        n = todo.pop()
+        if n not in seen:
+            seen.add(n)
+            todo.extend(imports[n])
+    return sorted(modules[n] for n in seen)
+
+
 def _fingerprint() -> bytes:
+    """SHA-256 of Numba's version and the sources compiled code can depend on."""
     h = hashlib.sha256(numba.__version__.encode())
     if not BORROWING:
         h.update(b"reference counting everywhere")
-    for path in sorted(glob.glob(os.path.join(ENGINE_DIR, "**", "*.py"), recursive=True)):
+    for path in kernel_sources():
         h.update(os.path.relpath(path, ENGINE_DIR).encode())
         with open(path, "rb") as f:
             h.update(f.read())
