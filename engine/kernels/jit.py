@@ -97,8 +97,8 @@ def _imported(text: str, path: str, name: str, modules: dict) -> set:
         if dots:
             base = package.rsplit(".", len(dots) - 1)[0] if len(dots) > 1 else package
             module = ".".join(p for p in (base, module) if p)
-        names = [n.split()[0] for n in names.strip("()").replace("\\", " ").split(",")
-                 if n.split() and not n.strip().startswith("#")]
+        names = re.sub(r"#[^\n]*", "", names).strip().strip("()").replace("\\", " ")
+        names = [n.split()[0] for n in names.split(",") if n.split()]
         # `from .pkg import mod` reads the submodule; any other name comes from the
         # module (or the package's __init__) itself
         subs = {f"{module}.{n}" for n in names} & modules.keys()
