@@ -377,14 +377,15 @@ facts["jit_cache"] = getattr(jit, "CACHE", None)
 facts["shipped_root"] = getattr(jit, "SHIPPED_ROOT", None)
 kernels = {}
 if jit is not None:
-    # the engine's kernels (jit.Kernel); a kernel's Numba dispatcher exists once it was
-    # used (called, or typed by a caller being compiled)
+    # the engine's kernels (jit.Kernel); a kernel's Numba dispatchers exist once it was
+    # used: the one for Python once called, the callee one once typed by a caller
     for name, m in list(sys.modules.items()):
         if name == args["pkg"] + ".engine" or name.startswith(args["pkg"] + ".engine."):
             for v in list(vars(m).values()):
                 if isinstance(v, jit.Kernel):
                     kernels[id(v)] = v
-used = [k.dispatcher for k in kernels.values() if k.realized and k.signatures]
+used = [d for k in kernels.values() for d in (k._dispatcher, k._callee)
+        if d is not None and d.signatures]
 facts["kernels"], facts["kernels_used"] = len(kernels), len(used)
 facts["cache_hits"] = sum(sum(k.stats.cache_hits.values()) for k in used)
 facts["cache_misses"] = sum(sum(k.stats.cache_misses.values()) for k in used)

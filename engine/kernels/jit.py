@@ -204,9 +204,10 @@ class EngineFunctionCache(caching.FunctionCache):
     the runtime its allocations call (`rtsys`). A kernel that does compile goes through
     Numba's pipeline, which refreshes them then."""
 
-    def __init__(self, py_func):
+    def __init__(self, py_func, variant: str = ""):
         super().__init__(py_func)
         stamp, base = self._impl.locator.get_source_stamp(), self._impl.filename_base
+        base += variant        # a kernel's two dispatchers keep their code apart (Kernel)
         # the cache's files read by whatever name this engine package has (none when
         # nothing can be written: the shipped kernels are then the only ones on disk)
         self._cache_file = (cache_files.RelocatableCacheFile(self._cache_path, base, stamp)
@@ -257,58 +258,87 @@ if LOADS and EngineCacheLocator not in caching.CacheImpl._locator_classes:
 
 
 class Kernel:
-    """A compiled kernel, made on first use: its Numba dispatcher (`njit(...)(py_func)`
-    with the engine's cache) is created when the kernel is first called, compiled or
+    """A compiled kernel, made on first use: its Numba dispatchers (`njit(...)(py_func)`
+    with the engine's cache) are created when the kernel is first called, compiled or
     typed, not when its module is imported. The engine defines about 700 kernels; a
     render loads six of them from the cache, and the rest are never used as dispatchers
     (the six hold their callees' machine code). Creating them all cost about 0.1 s of
     every process's first render (each dispatcher inspects its function's signature
-    twice and sets up its cache). Numba sees a Kernel as its dispatcher: `_numba_type_`
-    (typing of a global, a closure variable or an argument), and `targetoptions` and
-    `py_func` (inlining) are the dispatcher's. Calls from Python go through the
-    dispatcher."""
+    twice and sets up its cache).
+
+    Two dispatchers, one per kind of caller:
+    - `dispatcher`, for calls from Python: Numba's usual function, with the wrappers
+      that convert Python objects to native arguments and back;
+    - `callee`, for calls from other kernels (Numba sees a Kernel as it: `_numba_type_`,
+      the typing of a global, a closure variable or an argument). It is compiled without
+      those wrappers (`no_cpython_wrapper`, `no_cfunc_wrapper`), which a function only
+      kernels call never runs: for a small kernel taking the light table, the wrapper that
+      unboxes its twenty arrays is larger than the kernel itself, and Numba optimises
+      and generates machine code for it all the same: with them, nearly a quarter of
+      a first render's compile went to wrappers no kernel calls (docs/benchmarks.md,
+      section 10, times the first run). A kernel called both ways (a test calling a callee from
+      Python) compiles once for each.
+    `targetoptions` and `py_func` (inlining) are the dispatcher's."""
 
     _lock = threading.Lock()
+    CALLEE_OPTIONS = dict(no_cpython_wrapper=True, no_cfunc_wrapper=True)
 
     def __init__(self, py_func, options: dict):
         self.py_func = py_func
         self._options = options
         self._dispatcher = None
+        self._callee = None
         self.__name__ = py_func.__name__
         self.__qualname__ = py_func.__qualname__
         self.__module__ = py_func.__module__
         self.__doc__ = py_func.__doc__
 
+    def _make(self, options: dict, variant: str):
+        made = njit(**options)(self.py_func)
+        if LOADS and self._options.get("cache", True) and hasattr(made, "_cache"):
+            # Numba's `cache=True`, with the engine's cache class
+            made._cache = EngineFunctionCache(self.py_func, variant)
+        return made
+
     @property
     def dispatcher(self):
-        """The Numba dispatcher, created once (threads may ask at the same time)."""
+        """The dispatcher for calls from Python, created once (threads may ask at the
+        same time)."""
         dispatcher = self._dispatcher
         if dispatcher is None:
             with Kernel._lock:
                 if self._dispatcher is None:
-                    made = njit(**self._options)(self.py_func)
-                    if LOADS and self._options.get("cache", True):
-                        # Numba's `cache=True`, with the engine's cache class
-                        made._cache = EngineFunctionCache(self.py_func)
-                    self._dispatcher = made
+                    self._dispatcher = self._make(self._options, "")
                 dispatcher = self._dispatcher
         return dispatcher
 
     @property
+    def callee(self):
+        """The dispatcher for calls from kernels, without Python's wrappers."""
+        callee = self._callee
+        if callee is None:
+            with Kernel._lock:
+                if self._callee is None:
+                    self._callee = self._make({**self._options, **Kernel.CALLEE_OPTIONS},
+                                              ".callee")
+                callee = self._callee
+        return callee
+
+    @property
     def realized(self) -> bool:
-        """Whether the dispatcher exists (the kernel was called, compiled or typed)."""
-        return self._dispatcher is not None
+        """Whether a dispatcher exists (the kernel was called, compiled or typed)."""
+        return self._dispatcher is not None or self._callee is not None
 
     @property
     def _numba_type_(self):
-        return self.dispatcher._numba_type_
+        return self.callee._numba_type_
 
     def __call__(self, *args, **kwargs):
         return self.dispatcher(*args, **kwargs)
 
     def __getattr__(self, name):
         # targetoptions, compile, signatures, stats, overloads, ...: the dispatcher's
-        if name in ("py_func", "_options", "_dispatcher"):    # not set yet (a copy)
+        if name in ("py_func", "_options", "_dispatcher", "_callee"):   # not set yet (a copy)
             raise AttributeError(name)
         return getattr(self.dispatcher, name)
 
