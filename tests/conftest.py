@@ -141,3 +141,25 @@ def render_current(bpy, scene) -> np.ndarray:
         from drt_addon import render_engine
         assert render_engine.last_render["ok"], render_engine.last_render["error"]
     return read_render_result(bpy, scene)
+
+
+def grey_room(bpy, size, grey, world=0.02):
+    """A new empty scene at `size` pixels (100 %) with a grey floor and back wall (8 m
+    planes, Principled at base colour `grey`) under a uniform world of `world`: the
+    stage of small comparison scenes built in a test."""
+    import math
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    scene.render.resolution_x, scene.render.resolution_y = size
+    scene.render.resolution_percentage = 100
+    scene.world = bpy.data.worlds.new("dim")
+    scene.world.color = (world, world, world)
+    mat = bpy.data.materials.new("grey")
+    mat.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (
+        grey, grey, grey, 1.0)
+    bpy.ops.mesh.primitive_plane_add(size=8.0)
+    bpy.context.object.data.materials.append(mat)
+    bpy.ops.mesh.primitive_plane_add(size=8.0, location=(0.0, 2.0, 2.0),
+                                     rotation=(math.pi / 2, 0.0, 0.0))
+    bpy.context.object.data.materials.append(mat)
+    return scene

@@ -142,6 +142,16 @@ def compare(image, reference):
     return (m_img - m_ref) / m_ref, float(block)
 
 
+def assert_matches(drt, cycles, mean_tolerance, block_tolerance):
+    """A DRT render against Cycles': finite, and within the tolerances of `compare`
+    (printed first)."""
+    assert np.isfinite(drt).all() and cycles.mean() > 0.02
+    rel, block = compare(drt, cycles)
+    print(f"DRT vs Cycles: mean {np.round(100 * rel, 2)} %, worst block {100 * block:.2f} %")
+    assert (np.abs(rel) <= mean_tolerance).all(), rel
+    assert block <= block_tolerance, block
+
+
 def within(image, reference):
     rel, block = compare(image, reference)
     return bool((np.abs(rel) <= MEAN_TOLERANCE).all() and block <= BLOCK_TOLERANCE)

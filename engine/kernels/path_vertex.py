@@ -175,10 +175,11 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         hit = hit_prim[j] >= 0
         t_geom = hit_t[j] if hit else rt[j]
         b = bounce[p]
-        # Emission found by this bounce's rays is lit by bounce b - 1 (Cycles' count): a
-        # lamp hit from the first surface is direct light, as its next-event estimate is;
-        # what the camera sees directly is never clamped.
-        clamp_hit = 0.0 if b == 0 else (clamp_direct if b == 1 else clamp_indirect)
+        # Emission found by this bounce's rays is clamped by bounce b - 1 (Cycles'
+        # film_clamp_light): what the camera sees and what the first surface's ray finds
+        # (a lamp hit from there is direct light, as its next-event estimate is) by the
+        # Direct clamp, the rest by the Indirect one.
+        clamp_hit = clamp_direct if b <= 1 else clamp_indirect
         # 0. the medium along the ray: emission, transmittance, maybe a scattering
         b0r, b0g, b0b = br, bg, bb
         vmode, scattered, t_end = 0, False, t_geom

@@ -109,7 +109,7 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
         hit = hit_prim[j] >= 0
         t_geom = hit_t[j] if hit else rt[j]
         b = bounce[p]
-        clamp_hit = 0.0 if b == 0 else (clamp_direct if b == 1 else clamp_indirect)
+        clamp_hit = clamp_direct if b <= 1 else clamp_indirect     # as path_vertex.shade
         # 1. emission found: every lamp in front of the geometry (rays pass through lamps)
         for k in range(lamps.shape[0]):
             t_l, lr, lg, lb = lt.lamp_hit(lights, k, ox, oy, oz, dx, dy, dz, ray_bits[p],
