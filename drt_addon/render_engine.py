@@ -208,6 +208,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         t0 = time.perf_counter()
         from .engine_link import engine           # the first render of a process loads them
         from .export import BLACK_IMAGE, ExportError, Reporter, export_scene, render_region
+        from .export.layer_overrides import render_world
         last_render["import_seconds"] = time.perf_counter() - t0
         scene = depsgraph.scene
         view_layer = depsgraph.view_layer
@@ -284,7 +285,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                                         cancelled=lambda: self._polled("tracing"),
                                         compiling=compiling)
             image, alpha = film.mean(), film.mean_alpha()
-            first_hit = FirstHit(ctx, scene.world, description)
+            first_hit = FirstHit(ctx, render_world(scene, view_layer), description)
             if not stats.cancelled and denoise.wanted(scene, view_layer):
                 self.update_stats("", "DRT: denoising")
                 clean = denoise.denoised(scene, image, first_hit, reporter)

@@ -13,6 +13,7 @@ from .left_out import LEFT_OUT_TYPES, LeftOut
 from .libraries import missing_library_messages
 from .settings_check import check as check_file_settings
 from .lights import export_light, object_visibility
+from .layer_overrides import material_override, render_world, slot_materials
 from .materials import export_default_volume, export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
 from .motion import MotionExport, read_settings
@@ -125,8 +126,9 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     het_owner = {}
 
     # the UV pass reads every mesh's UVs (its active map, where no material names one)
-    cache = MeshCache(reporter, uv_pass=bool(getattr(depsgraph.view_layer, "use_pass_uv",
-                                                     False)))
+    override = material_override(view_layer)
+    cache = MeshCache(reporter, uv_pass=bool(getattr(view_layer, "use_pass_uv", False)),
+                      override=override)
     meshes, lights = [], []
     groups = InstanceGroups()
     displaced = DisplacedMeshes()
@@ -140,7 +142,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         obj = inst.object
         if obj.type == "VOLUME":
             if inst.is_instance or inst.show_self:
-                _place_volume(inst, obj, k, groups, material_id, reporter, view_layer)
+                _place_volume(inst, obj, k, groups, material_id, reporter, view_layer,
+                              slot_materials(obj, override))
             continue
         if obj.type in GEOMETRY_TYPES:
             if not inst.is_instance and not inst.show_self:
@@ -164,7 +167,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 continue
             if adaptive_subdivision(obj):
                 adaptive.add(obj.name)
-            slots = ([material_id(s.material, k) for s in obj.material_slots]
+            slots = ([material_id(m, k) for m in slot_materials(obj, override)]
                      or [material_id(None)])
             # true displacement moves the mesh once, with its first user (as Cycles)
             local = displaced.get(local, obj, inst.matrix_world, slots, materials)
@@ -217,9 +220,10 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         reporter.warn(adaptive_message(adaptive), key="adaptive subdivision")
     if not materials:
         materials.append(engine.Material())
-    world = export_world(scene.world, reporter)
-    if scene.world is not None:
-        world.volume = world_volume(scene.world, reporter)
+    world_id = render_world(scene, view_layer)
+    world = export_world(world_id, reporter)
+    if world_id is not None:
+        world.volume = world_volume(world_id, reporter)
     shutter = None
     if tracker is not None:
         shutter = tracker.finish(meshes, camera, lights)
@@ -241,14 +245,16 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                         film_transparent=bool(scene.render.film_transparent))
 
 
-def _place_volume(inst, obj, k, groups, material_id, reporter, view_layer) -> None:
+def _place_volume(inst, obj, k, groups, material_id, reporter, view_layer,
+                  materials) -> None:
     """A Volume object: its grids, read from its OpenVDB file, in the box around them,
-    with its materials exported for those grids (export.volume_objects)."""
-    grids = read_volume(obj, reporter)
+    with its materials (layer_overrides.slot_materials) exported for those grids
+    (export.volume_objects)."""
+    grids = read_volume(obj, reporter, materials)
     if grids is None:
         return
     scale = density_scale(obj, inst.matrix_world)
-    slots = ([material_id(s.material, k, grids, scale) for s in obj.material_slots]
+    slots = ([material_id(m, k, grids, scale) for m in materials]
              or [material_id(None, k, grids, scale)])
     name = f"{obj.name}#{k}" if inst.is_instance else obj.name
     holdout = _is_holdout(inst, obj, view_layer)

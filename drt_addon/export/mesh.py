@@ -17,6 +17,7 @@ from .errors import ExportError
 from . import tangents as tangent_space
 from ..blender_compat import prepare_corner_normals
 from .matrices import to_numpy
+from .layer_overrides import slot_materials
 from .tangents import mesh_tangents, uv_layer, wants_tangents
 from .vertex_colors import color_request, mesh_colors
 from .nodes.displacement import moves_surface
@@ -111,14 +112,14 @@ def mesh_uvs(mesh, name: str = "") -> Optional[np.ndarray]:
     return uv.reshape(-1, 2)[loops].reshape(nt, 3, 2)
 
 
-def uv_request(obj) -> Optional[str]:
-    """Which UV map the object's materials read through image textures: None (no
-    textures, no UVs exported), '' (the default map) or a UV map's name (the first one a
-    UV Map node names)."""
+def uv_request(materials) -> Optional[str]:
+    """Which UV map an object's materials (layer_overrides.slot_materials) read through
+    image textures: None (no textures, no UVs exported), '' (the default map) or a UV
+    map's name (the first one a UV Map node names)."""
     from .materials import material_uv_maps
     names = set()
-    for slot in getattr(obj, "material_slots", ()):
-        found = material_uv_maps(slot.material)
+    for mat in materials:
+        found = material_uv_maps(mat)
         if found:
             names |= found
     if not names:
@@ -158,21 +159,23 @@ def _cache_key(obj):
 class MeshCache:
     """Object-space arrays per evaluated geometry, for the length of one export."""
 
-    def __init__(self, reporter=None, uv_pass=False):
+    def __init__(self, reporter=None, uv_pass=False, override=None):
         self._local = {}
         self.reporter = reporter
         self.uv_pass = uv_pass    # every mesh's UVs: the UV pass reads them
+        self.override = override  # View Layer > Override > Material (layer_overrides)
         self.evaluations = 0      # to_mesh calls
         self.reuses = 0           # instances served from the cache
 
     def local(self, obj) -> Optional[LocalMesh]:
         key = _cache_key(obj)
-        want_uv = uv_request(obj)
+        materials = slot_materials(obj, self.override)
+        want_uv = uv_request(materials)
         if want_uv is None and self.uv_pass:
             want_uv = ""
-        want_tangents = wants_tangents(obj)
-        want_colors = color_request(obj)
-        want_normals = moves_surface(obj)
+        want_tangents = wants_tangents(materials)
+        want_colors = color_request(materials)
+        want_normals = moves_surface(materials)
         if key is not None and key in self._local:
             cached = self._local[key]
             # a shared mesh whose other user needed no UVs (object-linked materials)

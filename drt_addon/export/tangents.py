@@ -8,13 +8,12 @@ from typing import Optional
 import numpy as np
 
 
-def wants_tangents(obj) -> bool:
-    """Whether the object's materials read tangent space: a Normal Map or a Vector
-    Displacement node in Tangent space."""
+def wants_tangents(materials) -> bool:
+    """Whether an object's materials (layer_overrides.slot_materials) read tangent space:
+    a Normal Map or a Vector Displacement node in Tangent space."""
     from .nodes.links import _all_nodes, uses_nodes
     readers = ("ShaderNodeNormalMap", "ShaderNodeVectorDisplacement")
-    for slot in getattr(obj, "material_slots", ()):
-        mat = slot.material
+    for mat in materials:
         if mat is None or not uses_nodes(mat):
             continue
         if any(n.bl_idname in readers and n.space == "TANGENT"

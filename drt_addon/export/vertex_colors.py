@@ -10,13 +10,12 @@ import numpy as np
 READERS = {"ShaderNodeVertexColor": "layer_name", "ShaderNodeAttribute": "attribute_name"}
 
 
-def color_request(obj) -> Optional[str]:
-    """The color attribute the object's materials read: None (none), '' (the mesh's
-    render colour attribute) or a name."""
+def color_request(materials) -> Optional[str]:
+    """The color attribute an object's materials (layer_overrides.slot_materials) read:
+    None (none), '' (the mesh's render colour attribute) or a name."""
     from .nodes.links import _all_nodes, uses_nodes
     names = []
-    for slot in getattr(obj, "material_slots", ()):
-        mat = slot.material
+    for mat in materials:
         if mat is None or not uses_nodes(mat):
             continue
         for n in _all_nodes(mat.node_tree):

@@ -22,6 +22,7 @@ import sys
 
 import numpy as np
 
+from .layer_overrides import slot_materials
 from ..engine_link import engine
 from .matrices import to_numpy
 from .mesh import LocalMesh
@@ -134,12 +135,12 @@ def _nodes(tree, seen=None):
             yield from _nodes(node.node_tree, seen)
 
 
-def wanted_grids(obj) -> set:
-    """The grid names the object's materials read (Attribute nodes, the Principled
-    Volume's attributes); Cycles' default volume's for an empty slot or none."""
+def wanted_grids(materials) -> set:
+    """The grid names a Volume object's materials (layer_overrides.slot_materials) read
+    (Attribute nodes, the Principled Volume's attributes); Cycles' default volume's for
+    an empty slot or none."""
     names = set()
-    mats = [s.material for s in obj.material_slots] or [None]
-    for mat in mats:
+    for mat in materials or [None]:
         if mat is None:
             names |= DEFAULT_GRIDS
             continue
@@ -151,9 +152,10 @@ def wanted_grids(obj) -> set:
     return {n for n in names if n}
 
 
-def read_volume(obj, reporter) -> dict | None:
-    """{grid name: VoxelGrid} of the grids a Volume object's materials read, from its
-    OpenVDB file at the current frame; None (reported) when none can be read."""
+def read_volume(obj, reporter, materials=None) -> dict | None:
+    """{grid name: VoxelGrid} of the grids a Volume object's materials read (`materials`,
+    by default its slots' own), from its OpenVDB file at the current frame; None
+    (reported) when none can be read."""
     volume = obj.data
     issues = []
     if getattr(volume, "packed_file", None) is not None:
@@ -171,7 +173,7 @@ def read_volume(obj, reporter) -> dict | None:
         issues.append("its modifiers are not applied (the grids are read from the file)")
     grids = {}
     if vdb is not None:
-        wanted = wanted_grids(obj)
+        wanted = wanted_grids(slot_materials(obj) if materials is None else materials)
         try:
             names = [g.name for g in vdb.readAllGridMetadata(path)]
             found = [vdb.read(path, n) for n in names if n in wanted]

@@ -41,12 +41,12 @@ def displacement_method(mat) -> str:
             or getattr(getattr(mat, "cycles", None), "displacement_method", None) or "BUMP")
 
 
-def moves_surface(obj) -> bool:
-    """Whether any of the object's materials moves its surface: a linked Displacement
-    socket and a method other than Bump Only (its meshes then need vertex normals)."""
+def moves_surface(materials) -> bool:
+    """Whether any of an object's materials (layer_overrides.slot_materials) moves its
+    surface: a linked Displacement socket and a method other than Bump Only (its meshes
+    then need vertex normals)."""
     from .links import _link, _output_node, uses_nodes
-    for slot in getattr(obj, "material_slots", ()):
-        mat = slot.material
+    for mat in materials:
         if mat is None or not uses_nodes(mat) or displacement_method(mat) == "BUMP":
             continue
         out = _output_node(mat.node_tree)
