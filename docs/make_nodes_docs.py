@@ -132,7 +132,7 @@ SHADERS_ROW = ("| Shader | Principled BSDF, Diffuse BSDF, Glossy BSDF, Glass BSD
                "Refraction BSDF (GGX, Multiscatter GGX, Beckmann), Metallic BSDF (F82 Tint; a "
                "Physical Conductor as its F82-tint fit), Sheen BSDF, "
                "Translucent BSDF, Emission, Transparent BSDF, Holdout (as the whole "
-               "Surface; mixed with other shaders it renders black, without its hole), "
+               "Surface, or mixed: a hole of its weight in the camera's alpha), "
                "Mix Shader, Add Shader; "
                "Principled Volume, Volume Scatter, Volume Absorption, Volume "
                "Coefficients; Background |")

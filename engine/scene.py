@@ -133,6 +133,9 @@ class Material:
     pass_index: int = 0                  # Blender's material Pass Index (IndexMA pass)
     holdout: bool = False                # a Holdout shader: a hole in the alpha where the
     #                                      camera sees it, black to every other ray
+    holdout_weight: float = 0.0          # a Holdout shader's share of the opaque part (a
+    #                                      Mix Shader with a Holdout): that share of the
+    #                                      hits is a hole for the camera, black to others
     displacement: Optional[object] = None    # engine.displacement.Displacement: moves the
     #                                      vertices of its meshes at export (true displacement)
 
@@ -484,9 +487,12 @@ class Scene:
             or self.world.volume is not None
 
     def has_holdouts(self) -> bool:
-        """Whether an object is a holdout, or a material is a Holdout shader."""
-        return (any(m.holdout for m in self.meshes)
-                or any(getattr(m, "holdout", False) for m in self.materials))
+        """Whether an object is a holdout, or a material is or holds a Holdout shader (also
+        as a side of a Mix Shader)."""
+        def holds(m):
+            return (getattr(m, "holdout", False) or getattr(m, "holdout_weight", 0.0) > 0
+                    or any(holds(side) for side in (getattr(m, "mix", None) or ())))
+        return any(m.holdout for m in self.meshes) or any(holds(m) for m in self.materials)
 
     def needs_alpha(self) -> bool:
         """Whether samples carry a coverage (alpha) below one anywhere."""

@@ -119,6 +119,7 @@ class _Closure:
     alpha_texture: object = None                     # a lone Principled's textured Alpha
     mix: object = None     # (A, B, Fac Value): a Mix Shader whose Fac varies per hit; the
     #                        fields above are then its mixture at the Fac's average
+    h_weight: float = 0.0                            # Holdout closure weight
 
     def scaled(self, f, ctx):
         if self.alpha_texture is not None and f != 1.0:
@@ -127,12 +128,13 @@ class _Closure:
             return c.scaled(f, ctx)
         return _Closure([(w * f, c) for w, c in self.comps], self.t_weight * f,
                         _plain(np.asarray(self.t_color) * f), _scale(self.emission, f),
-                        self.alpha_texture)
+                        self.alpha_texture, h_weight=self.h_weight * f)
 
     def _alpha_to_constant(self):
         a = float(np.clip(self.alpha_texture.mean(), 0.0, 1.0))
         return _Closure([(w * a, c) for w, c in self.comps], self.t_weight + (1.0 - a),
-                        _plain(np.asarray(self.t_color) + (1.0 - a)), self.emission)
+                        _plain(np.asarray(self.t_color) + (1.0 - a)), self.emission,
+                        h_weight=self.h_weight * a)
 
     def is_emission_only(self):
         return (all(c is NULL_COMP for _, c in self.comps) and self.t_weight == 0
@@ -147,20 +149,32 @@ def _sum(a: _Closure, b: _Closure, ctx) -> _Closure:
     b = b._alpha_to_constant() if b.alpha_texture is not None else b
     return _Closure(a.comps + b.comps, a.t_weight + b.t_weight,
                     _plain(np.asarray(a.t_color) + np.asarray(b.t_color)),
-                    _lin([(1.0, a.emission), (1.0, b.emission)], ctx, "emission"))
+                    _lin([(1.0, a.emission), (1.0, b.emission)], ctx, "emission"),
+                    h_weight=a.h_weight + b.h_weight)
 
 
 def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
     """One Material from a closure set (see the module docstring)."""
     W = float(sum(w for w, _ in cl.comps))
     T = float(cl.t_weight)
-    total = W + T
+    H = float(cl.h_weight)
+    total = W + T + H
     if total <= 0.0:
         # Nothing but emission can come out (e.g. every weight mixed to zero).
         return engine.Material(name, BLACK, specular_ior_level=0.0,
                                emission=tuple(_mean(cl.emission)))
-    alpha = W / total
+    # A Holdout's weight H (Cycles: a hole of H in the camera's alpha, no light): the
+    # opaque part (alpha) holds it, and a hit there is a Holdout with probability
+    # holdout_weight, else shades the BSDFs (their weights over W); so a hit is
+    # transparent, a hole and shaded with probabilities T, H and W over the total.
+    alpha = (W + H) / total
+    holdout = H / (W + H) if W + H > 0.0 else 0.0
     t_color = _plain(np.asarray(cl.t_color) * (total / T)) if T > 0 else WHITE
+    if W <= 0.0 and H > 0.0:
+        if max(_mean(cl.emission)) > 0:
+            ctx.issue("emission on a Holdout mixed with no BSDF is not rendered")
+        return engine.Material(name, BLACK, specular_ior_level=0.0, alpha=alpha,
+                               transparent_color=t_color, holdout_weight=1.0)
     if W <= 0.0:
         if max(_mean(cl.emission)) > 0:
             ctx.issue("emission on a fully transparent shader is not rendered")
@@ -177,7 +191,8 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
             L = p["layers"] = replace(p["layers"])
             L.coat_weight, L.sheen_weight = L.coat_weight * total, L.sheen_weight * total
             L.translucent_color = _scale(L.translucent_color, total)
-    emission = _scale(cl.emission, 1.0 / alpha)        # emitted by the opaque part
+    # emitted by the shaded part (probability W / total)
+    emission = _scale(cl.emission, total / W)
     alpha_tex = cl.alpha_texture
     if alpha_tex is not None:
         alpha = 1.0
@@ -216,6 +231,7 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
             setattr(m, k, tuple(float(x) for x in v) if isinstance(v, tuple) else v)
     m.alpha = float(alpha)
     m.transparent_color = tuple(t_color)
+    m.holdout_weight = float(holdout)
     if alpha_tex is not None:
         # a per-hit Alpha is an output of the material's program (the tracer clips it
         # to [0, 1] per hit); its plain value is the clipped average

@@ -167,6 +167,11 @@ class MaterialTable:
                                          for m in materials], bool)
         self.sets_normal = np.array([bool(getattr(m, "sets_normal", False))
                                      for m in materials], bool)
+        # the share of hits that are a Holdout (1 for a Holdout shader alone)
+        self.holdout_weight = np.array(
+            [1.0 if getattr(m, "holdout", False)
+             else float(np.clip(getattr(m, "holdout_weight", 0.0), 0.0, 1.0))
+             for m in materials], np.float64)
         self.layered = ((self.coat_weight > 1e-5) | (self.sheen_weight > 1e-5)
                         | (self.translucent_color.max(1) > 0.0) | self.refraction_only)
         for name in ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",

@@ -53,7 +53,7 @@ from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium, passed,
                      sample_method, segment, stack_cross, volume_dim)
-from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA, P_SETS_NORMAL
+from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA, P_HOLDOUT, P_SETS_NORMAL
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .terminator import shadow_origin
 from .surface_hit import material_row, run_program, surface_emission
@@ -313,6 +313,16 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
         else:
             correct = params[m, P_BUMP_CORRECTION] != 0.0
+        h = params[ms, P_HOLDOUT]
+        if h > 0.0:
+            # a Holdout shader's share of the hits (a Mix Shader with a Holdout): a hole
+            # in the alpha for camera rays (through transparent surfaces too), nothing for
+            # other rays, as Cycles' holdout closure; the rest shade the other shaders
+            if u_lobe < h:
+                if b == 0 and alpha.shape[0] > 0:
+                    alpha[p] = uncovered(br, bg, bb)
+                continue
+            u_lobe = min((u_lobe - h) / (1.0 - h), 1.0 - 1e-16)
         # Cycles' sd->N, which bent lobes are shadowed against and shadow rays are lifted
         # by: the surface's own normal, or the bent one where the program sets it (the
         # Displacement socket's bump)

@@ -33,8 +33,8 @@ from ..sampling.dispatch import sample_1d
 from . import lights as lt
 from . import ray_queues
 from .bsdf import principled as bsdf
-from .bsdf.params import (P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_ROUGHNESS, P_SETS_NORMAL,
-                          P_SSS_WEIGHT, P_TRANSLUCENT)
+from .bsdf.params import (P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_HOLDOUT, P_ROUGHNESS,
+                          P_SETS_NORMAL, P_SSS_WEIGHT, P_TRANSLUCENT)
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from .lights.light_set import sample_lamp_at
@@ -154,6 +154,13 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
             if params[ms, P_SETS_NORMAL] != 0.0:      # a Set Normal: the surface's own
                 n0x, n0y, n0z = rx, ry, rz
+        h = params[ms, P_HOLDOUT]
+        if h > 0.0:                        # a Holdout's share, as in path_vertex.shade
+            if u_lobe < h:
+                if b == 0 and alpha.shape[0] > 0:
+                    alpha[p] = uncovered(br, bg, bb)
+                continue
+            u_lobe = min((u_lobe - h) / (1.0 - h), 1.0 - 1e-16)
         er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
                                       programmed)
         _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)

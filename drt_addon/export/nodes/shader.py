@@ -360,10 +360,8 @@ def _closure(socket, ctx, depth=0) -> _Closure:
     if kind == "ShaderNodeBsdfTransparent":
         return _transparent(node, ctx)
     if kind == "ShaderNodeHoldout":
-        ctx.issue(f"the Holdout {node.name!r} is mixed with other shaders: it renders "
-                  "black where it weighs, without its hole in the alpha (a Holdout alone "
-                  "as the Surface is a hole)")
-        return _Closure([(1.0, NULL_COMP)])
+        # a hole in the camera's alpha where it weighs (engine Material.holdout_weight)
+        return _Closure([], h_weight=1.0)
     if kind == "ShaderNodeMixShader":
         fac, ior, varying = _mix_factor(node, ctx)
         a = _closure(node.inputs[1], ctx, depth + 1)

@@ -50,7 +50,9 @@ P_SSS_SKIN = 47          # 0 / 1: Random Walk (Skin), Cycles' other radius and e
 P_SETS_NORMAL = 48       # 0 / 1: the program's normal becomes the surface's (Cycles' Set
 #                          Normal: the Displacement socket's bump), so lobes are not
 #                          shadowed against the smooth normal it bends
-NPARAM = 49
+P_HOLDOUT = 49           # the share of hits that are a Holdout shader (a hole for the
+#                          camera, black to other rays); 1 for a Holdout alone
+NPARAM = 50
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -88,6 +90,7 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_SHEEN_LAYERED] = table.sheen_layered
     rows[:, P_BUMP_CORRECTION] = table.bump_correction
     rows[:, P_SETS_NORMAL] = table.sets_normal
+    rows[:, P_HOLDOUT] = table.holdout_weight
     rows[:, P_LAYERS] = table.layered
     rows[:, P_SSS_WEIGHT] = table.subsurface_weight
     rows[:, P_SSS_RADIUS:P_SSS_RADIUS + 3] = table.subsurface_radius
