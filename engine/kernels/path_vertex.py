@@ -48,8 +48,8 @@ from .frame import dot, length, to_local, to_world
 from .jit import kernel
 from .medium_vertex import equiangular_light, scatter
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
-                           TRANSMISSION_BIT, _add, _INF, continues, hit_weight, keep_receiver,
-                           nee_weight, previous_receiver, roulette, uncovered)
+                           TRANSMISSION_BIT, _add, _INF, continues, hit_weight, holdout_share,
+                           keep_receiver, nee_weight, previous_receiver, roulette, uncovered)
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium, passed,
                      sample_method, segment, stack_cross, volume_dim)
@@ -313,16 +313,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
         else:
             correct = params[m, P_BUMP_CORRECTION] != 0.0
-        h = params[ms, P_HOLDOUT]
-        if h > 0.0:
-            # a Holdout shader's share of the hits (a Mix Shader with a Holdout): a hole
-            # in the alpha for camera rays (through transparent surfaces too), nothing for
-            # other rays, as Cycles' holdout closure; the rest shade the other shaders
-            if u_lobe < h:
-                if b == 0 and alpha.shape[0] > 0:
-                    alpha[p] = uncovered(br, bg, bb)
-                continue
-            u_lobe = min((u_lobe - h) / (1.0 - h), 1.0 - 1e-16)
+        holed, u_lobe = holdout_share(params[ms, P_HOLDOUT], u_lobe, b, alpha, p, br, bg, bb)
+        if holed:
+            continue                      # a Holdout's share: a hole, or no light
         # Cycles' sd->N, which bent lobes are shadowed against and shadow rays are lifted
         # by: the surface's own normal, or the bent one where the program sets it (the
         # Displacement socket's bump)

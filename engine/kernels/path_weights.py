@@ -88,6 +88,22 @@ def uncovered(br, bg, bb):
     return 1.0 - min(max((br + bg + bb) / 3.0, 0.0), 1.0)
 
 
+@kernel(allocates=False)
+def holdout_share(h, u_lobe, b, alpha, p, br, bg, bb):
+    """A Holdout shader's share h of a material's hits (a Mix Shader with a Holdout,
+    Material.holdout_weight): with probability h (u_lobe < h) the hit is a hole in the
+    alpha for camera rays (through transparent surfaces too) and its path ends, no light
+    for other rays, as Cycles' holdout closure; else the other shaders shade it. Returns
+    (a hole, u_lobe remapped to [0, 1) for the shaders' own choice)."""
+    if h > 0.0:
+        if u_lobe < h:
+            if b == 0 and alpha.shape[0] > 0:
+                alpha[p] = uncovered(br, bg, bb)
+            return True, u_lobe
+        return False, min((u_lobe - h) / (1.0 - h), 1.0 - 1e-16)
+    return False, u_lobe
+
+
 @kernel
 def add_unoccluded(L, sh_path, sh_contrib, blocked, sh_bounce, clamp_direct, clamp_indirect):
     """Add the contributions of the shadow rays that reached their light, clamped (the

@@ -39,7 +39,7 @@ from .frame import dot, to_local, to_world
 from .jit import kernel
 from .lights.light_set import sample_lamp_at
 from .lights.pack import C_TYPE, LAMPS, T_ENV, T_ENV_MAP
-from .path_weights import DIFFUSE_BIT, SHADOW_BIT, _add, uncovered
+from .path_weights import DIFFUSE_BIT, SHADOW_BIT, _add, holdout_share, uncovered
 from .surface import hit_uv, offset_origin, rebuild_at_time
 from .surface_hit import material_row, run_program, surface_emission
 from ..nodes.context import N_HIT
@@ -154,13 +154,9 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
             if params[ms, P_SETS_NORMAL] != 0.0:      # a Set Normal: the surface's own
                 n0x, n0y, n0z = rx, ry, rz
-        h = params[ms, P_HOLDOUT]
-        if h > 0.0:                        # a Holdout's share, as in path_vertex.shade
-            if u_lobe < h:
-                if b == 0 and alpha.shape[0] > 0:
-                    alpha[p] = uncovered(br, bg, bb)
-                continue
-            u_lobe = min((u_lobe - h) / (1.0 - h), 1.0 - 1e-16)
+        holed, u_lobe = holdout_share(params[ms, P_HOLDOUT], u_lobe, b, alpha, p, br, bg, bb)
+        if holed:
+            continue                      # a Holdout's share: a hole, or no light
         er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
                                       programmed)
         _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)
