@@ -2,6 +2,7 @@
 
 Never imports bpy. The input is an `engine.scene.Scene`, the output an `engine.film.Film`.
 """
+from .curves import HairCurves
 from .film import Film
 from .render import RenderContext, RenderStats, render
 from .scene import (AreaLight, Camera, Instances, Material, ObjectInfo, PointLight, Scene,
@@ -10,7 +11,6 @@ from .settings import RenderSettings
 from . import visibility  # noqa: E402  (the Ray Visibility bits, for exporters)
 from . import sky_texture  # noqa: E402  (Blender's Sky Texture node, for exporters)
 
-__all__ = ["AreaLight", "Camera", "Film", "Instances", "Material", "ObjectInfo", "PointLight",
-           "RenderContext",
-           "RenderSettings", "RenderStats", "Scene", "SunLight", "TriangleMesh", "Volume", "World",
-           "render"]
+__all__ = ["AreaLight", "Camera", "Film", "HairCurves", "Instances", "Material", "ObjectInfo",
+           "PointLight", "RenderContext", "RenderSettings", "RenderStats", "Scene", "SunLight",
+           "TriangleMesh", "Volume", "World", "render"]

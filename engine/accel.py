@@ -14,12 +14,14 @@ space relative to `center`:
   at each ray's time as engine.motion.RigidMotion.at does (translation and scale
   linearly, rotation spherically);
 - each deforming object: a triangle geometry with one vertex buffer per motion step,
-  which Embree interpolates linearly at each ray's time.
+  which Embree interpolates linearly at each ray's time;
+- hair (engine.curves): one round Catmull-Rom curve geometry of every strand, its
+  segments' global ids right after the static triangles'.
 Embree builds its motion hierarchies over the moving geometry itself (Cycles likewise
 hands motion to Embree). Motion steps are evenly spaced over the shutter, as Embree
 takes them (`evenly_spaced()` resamples others).
 
-Triangles get global ids in the order static, instanced, moving; a hit's Embree ids
+Primitives get global ids in the order static, hair, instanced, moving; a hit's Embree ids
 (geometry, instance, element) map to its global triangle id and to `Hits.inst`, the
 place's row in the object table (engine.surface; -1 for a triangle that is not an
 instanced mesh's). Memory grows with the places, not with places x triangles.
@@ -47,6 +49,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .curves import pack_curves
+from .embree.library import GEOMETRY_ROUND_CATMULL_ROM_CURVE
 from .embree.rays import intersect_batch, occluded_batch
 from .embree.scene import Scene as EmbreeScene
 from .instancing import is_instanced
@@ -164,14 +168,18 @@ class Accelerator:
     """All triangles of a scene in one Embree scene: static ones, instanced meshes'
     places and moving objects (see the module docstring)."""
 
-    def __init__(self, meshes: list[TriangleMesh], threads: int = 0, time_enabled: bool = False):
+    def __init__(self, meshes: list[TriangleMesh], threads: int = 0, time_enabled: bool = False,
+                 curves: list = ()):
         for m in meshes:
             if not np.all(np.isfinite(m.positions)):
                 raise ValueError(f"mesh {m.name!r} has non-finite (NaN or Inf) vertex positions")
         static = [m for m in meshes if not _is_moving(m, time_enabled) and not is_instanced(m)]
         instanced = [m for m in meshes if is_instanced(m)]
         moving = [m for m in meshes if _is_moving(m, time_enabled) and not is_instanced(m)]
-        self.ordered_meshes = static + instanced + moving    # the global triangle order
+        # hair (engine.curves): its segments' ids follow the static triangles'
+        self.curves = [c for c in curves if c.segment_count]
+        # the global primitive order
+        self.ordered_meshes = static + self.curves + instanced + moving
         self.static_meshes = len(static)
         # Every static vertex in world space, and every static triangle's corners as
         # int32 rows of them (Embree's index format); a single static mesh's own arrays
@@ -189,14 +197,17 @@ class Accelerator:
         # with a vertex at 3.4e38, tests/test_degenerate_input.py) do not move it off
         # the bulk of the geometry
         self.center = np.median(self.positions, axis=0) if len(self.positions) else \
-            _places_center(instanced, moving)
+            np.median(np.concatenate([c.keys for c in self.curves]), axis=0) \
+            if self.curves else _places_center(instanced, moving)
         self.threads = threads or min(os.cpu_count() or 1, 8)
         self._pool = ThreadPoolExecutor(self.threads) if self.threads > 1 else None
         # Embree builds the hierarchy when the scene is committed: here, as part of
         # building the accelerator (and before a cancel can come), not of the first sample
         self.prototypes: list[Prototype] = []
         self.instance_count = 0
-        offset = self.static_count
+        self.curve_start = self.static_count
+        offset = self.static_count + sum(c.segment_count for c in self.curves)
+        self.packed_curves = pack_curves(self.curves, self.curve_start)
         for m in instanced:
             self.prototypes.append(Prototype(m, offset, _embree_scene(m.positions, m.triangles),
                                              self.instance_count))
@@ -237,6 +248,11 @@ class Accelerator:
         if len(self.triangles):
             ids.append((scene.add_triangles(self.positions, self.triangles, self.center),
                         0, -1))
+        if self.curves:
+            C = self.packed_curves
+            ids.append((scene.add_curves(C.points, C.first, GEOMETRY_ROUND_CATMULL_ROM_CURVE,
+                                         self.center, cull_back_faces=True),
+                        self.curve_start, -1))
         for proto in self.prototypes:
             places = proto.mesh.instances.matrices[:, :3, :].copy()
             places[:, :, 3] -= self.center

@@ -89,10 +89,8 @@ def _intersect(ctx, o, d, tmax, time):
     return ctx.accel.intersect(o, d, tmax, time=time)
 
 
-def _build(ctx, hits, index, d, time):
-    if time is None:
-        return ctx.surfaces.build(hits, index, d)
-    return ctx.surfaces.build(hits, index, d, time=time)
+def _build(ctx, hits, index, o, d, time):
+    return ctx.surfaces.build(hits, index, d, time=time, origins=o)
 
 
 def _world_seen(ctx, directions) -> np.ndarray:
@@ -117,7 +115,7 @@ def sample_hits(ctx, k: int, chunk: int = 1 << 16):
         rays, time = camera_rays(ctx, pixel, index)
         hits = _intersect(ctx, rays.origins, rays.directions, rays.tmax, time)
         hit = np.nonzero(hits.hit)[0]
-        si = _build(ctx, hits, hit, rays.directions, time) if hit.size else None
+        si = _build(ctx, hits, hit, rays.origins, rays.directions, time) if hit.size else None
         yield pixel, index, hit, si, rays.directions
 
 

@@ -102,7 +102,8 @@ class RenderContext:
         # instanced meshes stay instanced unless they emit or bound a volume
         meshes = instancing.resolve(scene.meshes,
                                     _instanceable(scene.materials, self.materials.emission))
-        self.accel = Accelerator(meshes, threads=1, time_enabled=self.has_motion)
+        self.accel = Accelerator(meshes, threads=1, time_enabled=self.has_motion,
+                                 curves=scene.curves)
         self.surfaces = SurfaceBuilder(self.accel, [getattr(m, "holdout", False)
                                                     for m in scene.materials])
         self.scene_radius = _scene_radius(scene, self.accel)
@@ -161,6 +162,7 @@ def _instanceable(materials, emission):
 def _scene_radius(scene: Scene, accel: Accelerator) -> float:
     pts = [accel.positions] if len(accel.positions) else []
     pts += [np.stack(instancing.world_bounds(p.mesh)) for p in accel.prototypes]
+    pts += [c.keys for c in accel.curves]
     for l in scene.lights:
         if hasattr(l, "position"):
             pts.append(np.asarray(l.position, dtype=np.float64)[None])

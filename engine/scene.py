@@ -458,13 +458,14 @@ class Scene:
     pixel_aspect: float = 1.0
     shutter: Optional[object] = None     # engine.motion.Shutter; None = motion blur off
     film_transparent: bool = False       # Blender's Film > Transparent: background alpha 0
+    curves: list = field(default_factory=list)   # hair: engine.curves.HairCurves
 
     def __post_init__(self):
         if self.width < 1 or self.height < 1:
             raise ValueError(f"resolution must be positive, got {self.width}x{self.height}")
         if not self.materials:
             self.materials = [Material()]
-        for m in self.meshes:
+        for m in self.meshes + self.curves:
             if len(m.material_indices) and m.material_indices.max() >= len(self.materials):
                 raise ValueError(f"mesh {m.name!r} uses a material index beyond the "
                                  f"{len(self.materials)} materials")
@@ -492,7 +493,8 @@ class Scene:
         def holds(m):
             return (getattr(m, "holdout", False) or getattr(m, "holdout_weight", 0.0) > 0
                     or any(holds(side) for side in (getattr(m, "mix", None) or ())))
-        return any(m.holdout for m in self.meshes) or any(holds(m) for m in self.materials)
+        return any(m.holdout for m in self.meshes + self.curves) or \
+            any(holds(m) for m in self.materials)
 
     def needs_alpha(self) -> bool:
         """Whether samples carry a coverage (alpha) below one anywhere."""

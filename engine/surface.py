@@ -53,6 +53,10 @@ class SurfaceBuilder:
         self.accel = accel
         ordered = accel.ordered_meshes
         positions, corners, base = [accel.positions], [accel.triangles], len(accel.positions)
+        for c in accel.curves:            # hair: each segment as the triangle of its keys
+            positions.append(c.positions)
+            corners.append(c.triangles.astype(accel.triangles.dtype) + base)
+            base += len(c.positions)
         for proto in accel.prototypes:          # instanced meshes, in object space
             m = proto.mesh
             positions.append(m.positions)
@@ -155,12 +159,12 @@ class SurfaceBuilder:
         return out
 
     def geometry(self, camera=None) -> tuple:
-        """The triangles as the compiled kernels read them (engine.kernels.surface,
+        """The primitives as the compiled kernels read them (engine.kernels.surface,
         engine.nodes.shading): (positions, corners, centre, material, corner normals,
         holdout, corner UVs, moving objects, triangle objects, object table, corner
         tangents, corner colours, camera, terminator cutoffs, corners' undisplaced
-        points); empty arrays for what the
-        scene has not. camera: the packed render camera (engine.kernels.camera_rays),
+        points, hair strands (engine.kernels.curve_hit.PackedCurves)); empty arrays for
+        what the scene has not. camera: the packed render camera (engine.kernels.camera_rays),
         which shader nodes read; None: none."""
         from .nodes.context import N_OBJ
         return (self.positions, self.corners,
@@ -175,13 +179,16 @@ class SurfaceBuilder:
                 or_empty(self.corner_colors, (0, 3, 4), np.float32),
                 np.zeros(0) if camera is None else camera,
                 or_empty(self.terminator_cutoff, 0, np.float64),
-                or_empty(self.corner_undisplaced, (0, 3, 3), np.float32))
+                or_empty(self.corner_undisplaced, (0, 3, 3), np.float32),
+                self.accel.packed_curves)
 
     def build(self, hits: Hits, index: np.ndarray, ray_dirs: np.ndarray,
-              time: np.ndarray | None = None) -> SurfaceHit:
+              time: np.ndarray | None = None, origins: np.ndarray | None = None
+              ) -> SurfaceHit:
         """Interactions for the rays `index` (which must all have hit), rebuilt by the
-        kernels' own `rebuild_at_time`; `time` is the per-ray shutter time of all rays
-        (needed when the scene has moving objects)."""
+        kernels' own `surface_at`; `time` is the per-ray shutter time of all rays
+        (needed when the scene has moving objects); `origins` the rays' origins (needed
+        where they hit hair: engine.kernels.curve_hit)."""
         from .kernels.surface import rebuild_batch
         if self._geometry is None:
             self._geometry = self.geometry()
@@ -191,6 +198,11 @@ class SurfaceBuilder:
         u = np.ascontiguousarray(hits.u[index], np.float64)
         v = np.ascontiguousarray(hits.v[index], np.float64)
         d = np.ascontiguousarray(np.asarray(ray_dirs)[index], np.float64)
+        if origins is None and self.accel.curves:
+            raise ValueError("a scene with hair needs the rays' origins")
+        o = np.zeros((len(index), 3)) if origins is None else \
+            np.ascontiguousarray(np.asarray(origins)[index], np.float64)
+        t = np.ascontiguousarray(hits.t[index], np.float64)
         if self.accel.moving and time is None:
             raise ValueError("a scene with moving objects needs a time per ray")
         tm = np.zeros(0) if time is None else np.ascontiguousarray(
@@ -198,7 +210,8 @@ class SurfaceBuilder:
         n = len(prim)
         pos, ng, ns = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
         front, scale = np.empty(n, bool), np.empty(n)
-        rebuild_batch(self._geometry, prim, inst, u, v, d, tm, pos, ng, ns, front, scale)
+        rebuild_batch(self._geometry, prim, inst, u, v, o, t, d, tm, pos, ng, ns, front,
+                      scale)
         uv = None
         if self.corner_uvs is not None:
             # the same barycentric weights as the position: w vertex 0, u vertex 1, v vertex 2

@@ -330,9 +330,9 @@ def test_nan_vertex_drops_its_triangles_with_a_warning_naming_the_object(bpy_drt
 
 
 def test_hair_volumes_and_point_clouds_are_named_once_and_the_rest_renders(bpy_drt):
-    """What DRT cannot draw yet is never dropped silently: particle hair on a mesh and a
-    hair Curves object are named in one warning, a Volume object without a file in its
-    own, and the render works."""
+    """Nothing is dropped silently: particle hair on a mesh and a hair Curves object are
+    exported as strands (export.hair), a point cloud DRT cannot draw yet is named in one
+    warning, a Volume object without a file in its own, and the render works."""
     bpy = bpy_drt
     build_scene(bpy)
     from drt_addon.export import Reporter, export_scene
@@ -345,14 +345,19 @@ def test_hair_volumes_and_point_clouds_are_named_once_and_the_rest_renders(bpy_d
     mod.particle_system.settings.count = 10
     smoke = bpy.data.objects.new("Smoke", bpy.data.volumes.new("Smoke"))
     bpy.context.scene.collection.objects.link(smoke)
-    strands = bpy.data.objects.new("Strands", bpy.data.hair_curves.new("Strands"))
+    curves = bpy.data.hair_curves.new("Strands")
+    curves.add_curves([3, 4])
+    strands = bpy.data.objects.new("Strands", curves)
     bpy.context.scene.collection.objects.link(strands)
+    dots = bpy.data.objects.new("Dots", bpy.data.pointclouds.new("Dots"))
+    bpy.context.scene.collection.objects.link(dots)
     reporter = Reporter()
     s = export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
+    assert sorted((c.name, c.curve_count) for c in s.curves) == [("Plain (Fur)", 10),
+                                                                 ("Strands", 2)]
     said = [w for w in reporter.warnings if "not rendered yet" in w]
-    assert len(said) == 1, reporter.warnings
-    for part in ("particle hair ('Plain (Fur)')", "hair curves ('Strands')"):
-        assert part in said[0], said[0]
+    assert len(said) == 1 and "point clouds ('Dots')" in said[0], reporter.warnings
+    assert "hair" not in said[0]
     smoke = [w for w in reporter.warnings if "Volume object 'Smoke'" in w]
     assert len(smoke) == 1 and "names no OpenVDB file" in smoke[0], reporter.warnings
     # a smoke simulation's domain: its grids are named as left out, the mesh renders

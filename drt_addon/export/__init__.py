@@ -8,6 +8,7 @@ from ..engine_link import engine
 from .displaced_mesh import DisplacedMeshes, adaptive_message, adaptive_subdivision
 from .camera import RenderRegion, export_camera, render_region, window_camera
 from .errors import ExportError, Reporter
+from .hair import curves_object, hair_systems, particle_hair
 from .instances import InstanceGroups, Source, regroup_still, source_key
 from .left_out import LEFT_OUT_TYPES, LeftOut
 from .libraries import missing_library_messages
@@ -15,7 +16,7 @@ from .settings_check import check as check_file_settings
 from .lights import export_light, object_visibility
 from .layer_overrides import material_override, render_world, slot_materials
 from .materials import export_default_volume, export_material
-from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh
+from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh, uv_request
 from .motion import MotionExport, read_settings
 from .object_info import object_info, object_values
 from .volume_objects import density_scale, domain, read_volume
@@ -136,6 +137,10 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     held = []
     left_out = LeftOut()
     holdouts = 0
+    curves = []
+    # View Layer > Filter > Curves: hair drawn or not (Cycles' use_hair)
+    use_hair = bool(getattr(view_layer, "use_strand", True))
+    rendering = getattr(depsgraph, "mode", "RENDER") == "RENDER"
     for k, inst in enumerate(depsgraph.object_instances):
         if check_cancel is not None:
             check_cancel()
@@ -145,6 +150,12 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 _place_volume(inst, obj, k, groups, material_id, reporter, view_layer,
                               slot_materials(obj, override))
             continue
+        if obj.type == "CURVES" or (obj.type == "MESH" and inst.show_particles):
+            if use_hair and (obj.type == "MESH" or inst.is_instance or inst.show_self):
+                curves += _hair(inst, obj, k, material_id, materials, override, view_layer,
+                                rendering)
+            if obj.type == "CURVES":
+                continue
         if obj.type in GEOMETRY_TYPES:
             if not inst.is_instance and not inst.show_self:
                 continue
@@ -156,11 +167,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 continue
             holdout = _is_holdout(inst, obj, view_layer)
             holdouts += holdout
-            if obj.type in LEFT_OUT_TYPES:      # hair curves (to_mesh fails on them)
-                left_out.note_object(obj)
-                continue
             if not inst.is_instance:
-                left_out.note_hair(obj)           # a mesh's particle hair
                 left_out.note_smoke_domain(obj)
             local = cache.local(obj)
             if local is None:
@@ -240,9 +247,37 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                      seconds=time.perf_counter() - t0)
         if tracker is not None:
             stats["motion"] = tracker.stats
+    if stats is not None:
+        stats.update(hair_strands=int(sum(c.curve_count for c in curves)))
     return engine.Scene(camera, region.width, region.height, meshes, materials, lights, world,
                         pixel_aspect=aspect, shutter=shutter,
-                        film_transparent=bool(scene.render.film_transparent))
+                        film_transparent=bool(scene.render.film_transparent), curves=curves)
+
+
+def _hair(inst, obj, k, material_id, materials, override, view_layer, rendering) -> list:
+    """The strands of one instance (export.hair): a Curves object's, or a mesh's
+    particle hair, with the object's materials, holdout, ray visibility and names."""
+    if obj.type == "MESH" and not any(True for _ in hair_systems(obj, rendering)):
+        return []
+    mats = slot_materials(obj, override)
+    slots = [material_id(m, k) for m in mats] or [material_id(None)]
+    name = f"{obj.name}#{k}" if inst.is_instance else obj.name
+    if obj.type == "CURVES":
+        found = [c for c in [curves_object(obj, inst.matrix_world, slots, name)] if c]
+    else:
+        found = particle_hair(obj, inst.matrix_world, slots, rendering, uv_request(mats),
+                              name)
+    seen = object_visibility(obj) & (
+        object_visibility(inst.parent) if inst.is_instance and inst.parent is not None
+        else 31)
+    for c in found:
+        c.holdout = _is_holdout(inst, obj, view_layer)
+        c.visibility = seen
+        c.pass_index = int(getattr(obj, "pass_index", 0))
+        c.object_name, c.asset_name = crypto_names(inst, obj)
+        if any(materials[i].shader is not None for i in slots):
+            c.object_info = object_info(inst, obj, inst.matrix_world)
+    return found
 
 
 def _place_volume(inst, obj, k, groups, material_id, reporter, view_layer,

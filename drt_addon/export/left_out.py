@@ -1,11 +1,11 @@
 """What the scene holds that DRT does not render yet, named once in Blender's report so
-that nothing is dropped silently: particle hair, hair Curves objects, point clouds and
-the grids of a smoke simulation's domain.
-The rest of the scene renders. (Volume objects render: export.volume_objects.)"""
+that nothing is dropped silently: point clouds and the grids of a smoke simulation's
+domain. The rest of the scene renders. (Volume objects render: export.volume_objects;
+hair: export.hair.)"""
 from __future__ import annotations
 
 # object types DRT cannot draw yet, as their kind in the warning
-LEFT_OUT_TYPES = {"POINTCLOUD": "point clouds", "CURVES": "hair curves"}
+LEFT_OUT_TYPES = {"POINTCLOUD": "point clouds"}
 
 
 class LeftOut:
@@ -22,16 +22,6 @@ class LeftOut:
     def note_object(self, obj) -> None:
         """An object of one of LEFT_OUT_TYPES."""
         self.note(LEFT_OUT_TYPES[obj.type], obj.name)
-
-    def note_hair(self, obj) -> None:
-        """The hair particle systems of a mesh (drawn as strands, Render As Path, with
-        their modifier enabled for renders)."""
-        for mod in getattr(obj, "modifiers", ()):
-            if mod.type != "PARTICLE_SYSTEM" or not mod.show_render:
-                continue
-            settings = mod.particle_system.settings
-            if settings.type == "HAIR" and settings.render_type == "PATH":
-                self.note("particle hair", f"{obj.name} ({mod.particle_system.name})")
 
     def note_smoke_domain(self, obj) -> None:
         """A mesh that is a Fluid modifier's gas domain (a smoke or fire simulation):

@@ -115,6 +115,8 @@ def _prototypes(lib) -> None:
         "rtcIntersect1": (None, [c_void_p, c_void_p, c_void_p]),
         "rtcOccluded1": (None, [c_void_p, c_void_p, c_void_p]),
         "rtcSetGeometryEnableFilterFunctionFromArguments": (None, [c_void_p, c_bool]),
+        "rtcSetGeometryIntersectFilterFunction": (None, [c_void_p, c_void_p]),
+        "rtcSetGeometryOccludedFilterFunction": (None, [c_void_p, c_void_p]),
     }
     for name, (restype, argtypes) in sig.items():
         fn = getattr(lib, name)

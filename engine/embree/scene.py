@@ -144,14 +144,21 @@ class Scene:
         return self._attach(geom, "triangles", len(index))
 
     def add_curves(self, control_points, first_point: np.ndarray,
-                   kind: int = L.GEOMETRY_ROUND_BSPLINE_CURVE, offset=None) -> int:
+                   kind: int = L.GEOMETRY_ROUND_BSPLINE_CURVE, offset=None,
+                   cull_back_faces: bool = False) -> int:
         """Curves: control_points (n, 4) x, y, z, radius (or a list of K time steps);
         first_point (m,) the first control point of each segment (cubic curves read 4
-        points from it, linear ones 2)."""
+        points from it, linear ones 2). cull_back_faces: rays meet the curves only where
+        they enter them (engine.embree.curve_culling), as in Cycles."""
         steps = control_points if isinstance(control_points, (list, tuple)) \
             else [control_points]
         index = np.ascontiguousarray(first_point, dtype=np.int32)
         geom = self._new(kind)
+        if cull_back_faces:
+            from .curve_culling import filter_address
+            address = filter_address()
+            self._lib.rtcSetGeometryIntersectFilterFunction(geom, address)
+            self._lib.rtcSetGeometryOccludedFilterFunction(geom, address)
         self._steps(geom, steps)
         for k, pts in enumerate(steps):
             buf = padded_float32(pts, 4, _xyz_offset(offset))

@@ -159,15 +159,17 @@ class CompiledPathIntegrator:
         out_rows, out_org, out_far = np.empty(m, np.int64), np.empty((m, 3)), np.empty(m)
         cfg = self.cfg
         layer = 0
+        seg_org = np.ascontiguousarray(o, np.float64)    # where the hits cur are measured from
         while rows.size:
             k = alpha_pass(depth, layer, self.transparent_limit, int(cfg[0]), int(cfg[1]),
-                           paths[0], paths[1], live, used, ray_bits, path_time, rows, d, tm,
-                           cur, travelled, factor, stopped,
+                           paths[0], paths[1], live, used, ray_bits, path_time, rows, seg_org,
+                           d, tm, cur, travelled, factor, stopped,
                            self.geometry, self.materials, out_rows, out_org, out_far)
             if k == 0:
                 break
             rows = out_rows[:k].copy()
-            cur = self.ctx.accel.intersect(out_org[:k], d[rows], out_far[:k],
+            seg_org = out_org[:k].copy()
+            cur = self.ctx.accel.intersect(seg_org, d[rows], out_far[:k],
                                            None if time is None else time[rows]).arrays()
             merge_layer(rows, travelled, cur, found)
             layer += 1

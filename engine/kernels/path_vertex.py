@@ -54,7 +54,7 @@ from .medium_density import has_heterogeneous, heterogeneous_in, path_key, track
 from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium, passed,
                      sample_method, segment, stack_cross, volume_dim)
 from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA, P_HOLDOUT, P_SETS_NORMAL
-from .surface import hit_uv, offset_origin, rebuild_at_time
+from .surface import hit_uv, offset_origin, surface_at
 from .terminator import shadow_origin
 from .surface_hit import material_row, run_program, surface_emission
 from .subsurface import walk_key
@@ -109,7 +109,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     triangle objects, object table, corner tangents, corner colours, camera, terminator
     cutoffs) of every triangle (corner normals, holdout, UVs, objects, tangents, colours
     and cutoffs may be empty; see
-    `surface.rebuild_at_time` and engine.nodes.shading). textures: the packed textures
+    `surface.surface_at` and engine.nodes.shading). textures: the packed textures
     and shader programs (engine.nodes.pack.pack_shading); a material with a program
     runs it at each hit, and its outputs replace the parameters they drive. path_time: each path's shutter time (its
     moving triangles are placed at that time). alpha: each path's film coverage, or
@@ -283,9 +283,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             if alpha.shape[0] > 0:        # Cycles' holdout: a hole, for camera rays only
                 alpha[p] = uncovered(br, bg, bb)
             continue
-        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
-            geometry, prim, hit_inst[j], hit_u[j], hit_v[j], dx, dy, dz,
-            path_time[p])
+        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = surface_at(
+            geometry, prim, hit_inst[j], hit_u[j], hit_v[j], ox, oy, oz, hit_t[j], dx, dy,
+            dz, path_time[p])
         m = tri_material[prim]
         if vol.shape[0] > 0 and vol[m, V_BOUNDARY] != 0.0:
             # a volume's boundary: no surface; the ray goes on inside or outside it

@@ -10,6 +10,7 @@ import math
 import numpy as np
 
 from ..surface import RELATIVE_OFFSET
+from .curve_hit import curve_surface, is_curve
 from .frame import cross, dot
 from .jit import kernel
 from .motion import I_KIND, I_NVERTS, I_STEPS, I_VERT0, RIGID, adjugate_columns, object_of, \
@@ -133,6 +134,18 @@ def rebuild_at_time(geometry, prim, inst, u, v, dx, dy, dz, time):
     return px, py, pz, fx, fy, fz, sx, sy, sz, front, scale
 
 
+@kernel(allocates=False)
+def surface_at(geometry, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz, time):
+    """The hit of the ray o + t d on primitive `prim` at (u, v): a triangle's
+    (`rebuild_at_time`, which needs only d) or a hair strand's (engine.kernels.curve_hit,
+    geometry[15], whose point comes from the ray). Returns (position, geometric normal
+    facing the ray, shading normal, front_facing, offset scale)."""
+    C = geometry[15]
+    if is_curve(C, prim):
+        return curve_surface(C, geometry[2], prim, u, ox, oy, oz, t, dx, dy, dz)
+    return rebuild_at_time(geometry, prim, inst, u, v, dx, dy, dz, time)
+
+
 @kernel(inline="always")
 def _between(verts, a, b, f):
     """Vertex row a moved the fraction f of the way to row b (one deformation step to the
@@ -230,16 +243,16 @@ def _placed_hit(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z, corner_normals, pri
 
 
 @kernel
-def rebuild_batch(geometry, prim, inst, u, v, d, time, position, geometric, shading,
+def rebuild_batch(geometry, prim, inst, u, v, o, t, d, time, position, geometric, shading,
                   front, scale):
-    """`rebuild_at_time` for n hits (time may be empty: 0): writes the hit points, the
-    geometric and shading normals facing the rays (n, 3), front (n,) and the offset
-    scales (n,). What engine.surface.SurfaceBuilder.build returns, compiled once."""
+    """`surface_at` for n hits of the rays o + t d (time may be empty: 0): writes the hit
+    points, the geometric and shading normals facing the rays (n, 3), front (n,) and the
+    offset scales (n,). What engine.surface.SurfaceBuilder.build returns, compiled once."""
     timed = time.shape[0] > 0
     for i in range(prim.shape[0]):
-        px, py, pz, gx, gy, gz, sx, sy, sz, fr, sc = rebuild_at_time(
-            geometry, prim[i], inst[i], u[i], v[i], d[i, 0], d[i, 1], d[i, 2],
-            time[i] if timed else 0.0)
+        px, py, pz, gx, gy, gz, sx, sy, sz, fr, sc = surface_at(
+            geometry, prim[i], inst[i], u[i], v[i], o[i, 0], o[i, 1], o[i, 2], t[i],
+            d[i, 0], d[i, 1], d[i, 2], time[i] if timed else 0.0)
         position[i, 0], position[i, 1], position[i, 2] = px, py, pz
         geometric[i, 0], geometric[i, 1], geometric[i, 2] = gx, gy, gz
         shading[i, 0], shading[i, 1], shading[i, 2] = sx, sy, sz

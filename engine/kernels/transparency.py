@@ -29,7 +29,7 @@ import numpy as np
 from .. import visibility
 from ..sampling.dispatch import sample_1d
 from .jit import kernel
-from .surface import hit_uv, offset_origin, rebuild_at_time
+from .surface import hit_uv, offset_origin, surface_at
 from .textures import alpha_at
 from .medium_density import attenuate_tracked, has_heterogeneous, heterogeneous_in
 from .volume import V_BOUNDARY, attenuate, stack_cross
@@ -49,13 +49,15 @@ def alpha_dim(depth, layer):
 
 
 @kernel
-def _hit_alpha(geometry, materials, prim, inst, u, v, dx, dy, dz, time, ray, depth, length):
-    """Alpha of the hit (a material program's, run for a ray of kind `ray`, the path's
-    bounce depth and the hit's distance), its material and its surface point."""
+def _hit_alpha(geometry, materials, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz, time, ray,
+               depth, length):
+    """Alpha of the hit of the ray o + t d (a material program's, run for a ray of kind
+    `ray`, the path's bounce depth and the hit's distance `length` from the path's last
+    vertex), its material and its surface point."""
     tri_material, corner_uvs = geometry[3], geometry[6]
     _, _, alpha_table, _, T, _ = materials
-    px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
-        geometry, prim, inst, u, v, dx, dy, dz, time)
+    px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = surface_at(
+        geometry, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz, time)
     uu, vv = hit_uv(corner_uvs, prim, u, v)
     m = tri_material[prim]
     a = alpha_at(T, alpha_table, m, uu, vv)
@@ -80,13 +82,13 @@ def _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, d
 
 
 @kernel
-def _pass_through(geometry, prim, inst, u, v, d, r, time, far, out_rows, out_org, out_far,
-                  n_out):
-    """Ray r (direction d[r]) goes on, unchanged, beyond the triangle it hit; returns
-    whether it hit the triangle's front."""
+def _pass_through(geometry, prim, inst, u, v, ox, oy, oz, t, d, r, time, far, out_rows,
+                  out_org, out_far, n_out):
+    """Ray r (origin o, direction d[r]) goes on, unchanged, beyond the surface it hit at
+    t; returns whether it hit the surface's front."""
     dx, dy, dz = d[r, 0], d[r, 1], d[r, 2]
-    px, py, pz, gx, gy, gz, _, _, _, front, scale = rebuild_at_time(geometry, prim, inst, u,
-                                                                    v, dx, dy, dz, time)
+    px, py, pz, gx, gy, gz, _, _, _, front, scale = surface_at(
+        geometry, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz, time)
     _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, dx, dy, dz,
           far)
     return front
@@ -94,14 +96,15 @@ def _pass_through(geometry, prim, inst, u, v, d, r, time, far, out_rows, out_org
 
 @kernel
 def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits, path_time,
-               rows, rd, tmax, cur, travelled, factor, stopped,
+               rows, ro, rd, tmax, cur, travelled, factor, stopped,
                geometry, materials, out_rows, out_org, out_far):
     """One transparent layer for the camera or bounce rays `rows` (indices into the
     wavefront `live`) whose current closest hits are cur_*: each ray whose hit surface
     lets it through (a sampler number >= alpha) goes on beyond it, tinted, counting one
     transparent bounce of its path (`used`, per path); past `limit` such bounces the
     path stops. A ray whose kind (ray_bits, per path) does not see the hit triangle goes
-    on beyond it as it is. Writes the rays that go on (row, origin, remaining distance);
+    on beyond it as it is. ro: the origins the hits cur_* are measured from (row i's at
+    ro[i]). Writes the rays that go on (row, origin, remaining distance);
     returns their count."""
     tri_material, maybe_transparent, _, tcolor, _, tri_vis = materials
     cur_t, cur_prim, cur_inst, cur_u, cur_v = cur.t, cur.prim, cur.inst, cur.u, cur.v
@@ -113,8 +116,8 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
             continue
         if tri_vis.shape[0] > 0 and not tri_vis[prim] & ray_bits[live[r]]:
             travelled[r] += cur_t[i]
-            _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], rd, r,
-                          path_time[live[r]],
+            _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], ro[i, 0],
+                          ro[i, 1], ro[i, 2], cur_t[i], rd, r, path_time[live[r]],
                           tmax[r] - travelled[r], out_rows, out_org, out_far, n_out)
             n_out += 1
             continue
@@ -123,8 +126,8 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
         dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
         p = live[r]
         a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(
-            geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], dx, dy, dz,
-            path_time[p],
+            geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], ro[i, 0], ro[i, 1],
+            ro[i, 2], cur_t[i], dx, dy, dz, path_time[p],
             ray_bits[p], depth, travelled[r] + cur_t[i])
         if not sample_1d(kind, pkey[p], spp, index[p], alpha_dim(depth, layer)) >= a:
             continue
@@ -175,15 +178,16 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
         if reached:
             continue
         if vol.shape[0] > 0 and vol[tri_material[prim], V_BOUNDARY] != 0.0:
-            front = _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], sd, r,
-                                  ray_time[r],
+            front = _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], so[i, 0],
+                                  so[i, 1], so[i, 2], cur_t[i], sd, r, ray_time[r],
                                   remaining[i] - cur_t[i], out_rows, out_org, out_far, n_out)
             n_out += 1
             if stacks.shape[0] > 0:
                 stack_cross(stacks, r, tri_material[prim], front)
             continue
         if tri_vis.shape[0] > 0 and not tri_vis[prim] & SHADOW_BIT:
-            _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], sd, r, ray_time[r],
+            _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], so[i, 0], so[i, 1],
+                          so[i, 2], cur_t[i], sd, r, ray_time[r],
                           remaining[i] - cur_t[i], out_rows, out_org, out_far, n_out)
             n_out += 1
             continue
@@ -192,8 +196,8 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
             continue
         dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
         a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(
-            geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], dx, dy, dz,
-            ray_time[r],
+            geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], so[i, 0], so[i, 1],
+            so[i, 2], cur_t[i], dx, dy, dz, ray_time[r],
             SHADOW_BIT, 0, cur_t[i])
         trans[r, 0] *= (1.0 - a) * tcolor[m, 0]
         trans[r, 1] *= (1.0 - a) * tcolor[m, 1]

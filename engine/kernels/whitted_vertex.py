@@ -40,7 +40,7 @@ from .jit import kernel
 from .lights.light_set import sample_lamp_at
 from .lights.pack import C_TYPE, LAMPS, T_ENV, T_ENV_MAP
 from .path_weights import DIFFUSE_BIT, SHADOW_BIT, _add, holdout_share, uncovered
-from .surface import hit_uv, offset_origin, rebuild_at_time
+from .surface import hit_uv, offset_origin, surface_at
 from .surface_hit import material_row, run_program, surface_emission
 from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
@@ -136,9 +136,9 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
             if alpha.shape[0] > 0:        # Cycles' holdout: a hole, for camera rays only
                 alpha[p] = uncovered(br, bg, bb)
             continue
-        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = rebuild_at_time(
-            geometry, prim, hit_inst[j], hit_u[j], hit_v[j], dx, dy, dz,
-            path_time[p])
+        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = surface_at(
+            geometry, prim, hit_inst[j], hit_u[j], hit_v[j], ox, oy, oz, hit_t[j], dx, dy,
+            dz, path_time[p])
         m = tri_material[prim]
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         programmed = programs is not None and has_program(programs, m)
