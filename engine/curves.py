@@ -31,7 +31,11 @@ class HairCurves:
     curve_keys: (C + 1,) offsets, strand c's keys being rows curve_keys[c]:curve_keys[c+1]
     (at least 2 each); materials: (C,) or one index into Scene.materials;
     uvs: optional (C, 2) each strand's texture coordinate (its root's on the emitter);
-    colors: optional (C, 4) a colour attribute per strand."""
+    colors: optional (C, 4) a colour attribute per strand.
+    What the Hair Info node reads (as Cycles has them, in the object's own space):
+    intercepts: optional (K,) each key's fraction of its strand's length, lengths:
+    optional (C,) each strand's length (both measured along the keys in world space when
+    not given); first_index: the strands' first index in the object, for Random."""
 
     # what a triangle mesh may have and strands have not
     corner_normals = None
@@ -44,7 +48,8 @@ class HairCurves:
     def __init__(self, name: str, keys, radii, curve_keys, materials=0, uvs=None,
                  colors=None, holdout: bool = False, visibility: int = 31,
                  object_info: Optional[object] = None, pass_index: int = 0,
-                 object_name: str = "", asset_name: str = ""):
+                 object_name: str = "", asset_name: str = "", intercepts=None,
+                 lengths=None, first_index: int = 0):
         self.name = name
         self.keys = np.ascontiguousarray(keys, np.float64).reshape(-1, 3)
         self.radii = np.ascontiguousarray(radii, np.float64).reshape(-1)
@@ -74,6 +79,12 @@ class HairCurves:
         self.holdout, self.visibility = holdout, visibility
         self.object_info, self.pass_index = object_info, pass_index
         self.object_name, self.asset_name = object_name, asset_name
+        self.intercepts, self.lengths = _along(self.keys, self.curve_keys)
+        if intercepts is not None:
+            self.intercepts = np.asarray(intercepts, np.float64).reshape(len(self.keys))
+        if lengths is not None:
+            self.lengths = np.asarray(lengths, np.float64).reshape(n)
+        self.first_index = int(first_index)
         # the strand of each segment, and the key each segment starts at
         self.segment_curve = np.repeat(np.arange(n, dtype=np.int64), lengths - 1)
         starts = np.repeat(self.curve_keys[:-1], lengths - 1)
@@ -132,19 +143,38 @@ class HairCurves:
         return rows, first
 
 
+def _along(keys, curve_keys):
+    """(each key's fraction of its strand's length, each strand's length), measured
+    along the keys."""
+    step = np.linalg.norm(np.diff(keys, axis=0), axis=1)
+    run = np.concatenate([[0.0], np.cumsum(step)])
+    start = run[np.repeat(curve_keys[:-1], np.diff(curve_keys))]
+    lengths = run[curve_keys[1:] - 1] - run[curve_keys[:-1]]
+    total = np.repeat(lengths, np.diff(curve_keys))
+    along = np.divide(run - start, total, out=np.zeros_like(run), where=total > 0)
+    return along, lengths
+
+
 def pack_curves(curves: list, first_prim: int):
     """The strands of a scene as the kernels read them (engine.kernels.curve_hit):
     every object's control points one after the other, each segment's first control
-    point, and the global ids the segments take (first_prim on)."""
-    from .kernels.curve_hit import PackedCurves
-    points, first, base = [], [], 0
+    point, what the Hair Info node reads of it (its keys' intercepts, its strand's
+    length and Random) and the global ids the segments take (first_prim on)."""
+    from .kernels.curve_hit import PackedCurves, strand_randoms
+    points, first, info, base = [], [], [], 0
     for c in curves:
         rows, f = c.control_points()
         points.append(rows)
         first.append(f + base)
         base += len(rows)
+        rand = np.empty(c.curve_count)
+        strand_randoms(c.first_index, rand)
+        k = c.segment_key
+        info.append(np.stack([c.intercepts[k], c.intercepts[k + 1],
+                              c.lengths[c.segment_curve], rand[c.segment_curve]], axis=1))
     count = sum(len(f) for f in first)
     return PackedCurves(np.array([first_prim, first_prim + count], np.int64),
                         np.concatenate(points) if points else np.zeros((0, 4)),
                         np.concatenate(first).astype(np.int64) if first
-                        else np.zeros(0, np.int64))
+                        else np.zeros(0, np.int64),
+                        np.concatenate(info) if info else np.zeros((0, 4)))

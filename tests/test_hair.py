@@ -186,3 +186,36 @@ def test_bad_strands_are_refused_with_a_clear_error():
         HairCurves("neg", [[0, 0, 0], [1, 0, 0]], [0.1, -0.1], [0, 2])
     with pytest.raises(ValueError, match="material index"):
         Scene(Camera(np.eye(4)), 4, 4, [], [grey()], curves=[strand(material=3)])
+
+
+def test_curves_info_reads_each_strand_where_it_is_hit():
+    """The Curves (Hair) Info node's fields at a hit, emitted as a colour: Intercept (red)
+    runs from 0 at the root to 1 at the tip, linear between keys; Thickness (green) is
+    twice the radius, linear between keys; Random (blue) is Cycles' hash of the strand's
+    index in its object (first_index 7 here). A strand of 5 evenly spaced keys from x = -2
+    to 2 tapering from radius 0.2 to 0, seen from the front: at the middle row, in the
+    interior segments the camera sees (x in [-1, 1]), every field is its closed form at
+    the pixel's x."""
+    from engine.nodes import context as C
+    from engine.nodes import converter_nodes as V
+    from engine.nodes import input_nodes as I
+    from engine.nodes.hash import hash_uint2, uint_to_float
+    from engine.nodes.program import ProgramBuilder
+    b = ProgramBuilder()
+    fields = [b.emit(I.IN_HIT1, "float", [f], varying=True) for f in
+              (C.H_HAIR_INTERCEPT, C.H_HAIR_THICKNESS, C.H_HAIR_RANDOM)]
+    b.output("emission", b.emit(V.CV_COMBINE, "color", fields))
+    glow = Material("glow", (0.0, 0.0, 0.0), specular_ior_level=0.0, shader=b.build())
+    keys = np.stack([np.linspace(-2, 2, 5), np.zeros(5), np.zeros(5)], axis=1)
+    hair = HairCurves("taper", keys, np.linspace(0.2, 0.0, 5), [0, 5], first_index=7)
+    cam = Camera(look_at((0, -5, 0), (0, 0, 0)), kind="ORTHO", ortho_scale=2.0)
+    scene = Scene(cam, 32, 32, [], [glow], [], World((0, 0, 0)), curves=[hair])
+    img = render(scene, RenderSettings(samples=16, seed=6, max_bounces=0))[0].mean()
+    x = -1 + (np.arange(32) + 0.5) * 2 / 32
+    row = img[15:17].mean(axis=0)
+    seen = x <= 0.0                      # where the strand covers the middle rows whole
+    np.testing.assert_allclose(row[seen, 0], (x[seen] + 2) / 4, atol=2e-3)
+    np.testing.assert_allclose(row[seen, 1], 2 * (0.2 - 0.05 * (x[seen] + 2)), atol=2e-3)
+    np.testing.assert_allclose(row[seen, 2], uint_to_float(hash_uint2(7, 0)), rtol=1e-6)
+    # off hair (the world behind) nothing is emitted
+    assert np.all(img[:8] == 0.0)

@@ -3,8 +3,9 @@ drawn as Cycles' default 3D curves, at Blender's defaults otherwise.
 
 The scene: a sphere with 400 particle hairs 0.45 m long (Render Steps 3: 9 keys each;
 Hair Shape at Blender's defaults: root 1, tip 0, Radius Scale 0.01, Close Tip: 1 cm
-thick at the root) in a second material slot, and a Curves object of six curling strands
-with a radius attribute, on the grey floor under a point lamp and a dim world. Means
+thick at the root) in a second material slot, coloured from root to tip by Curves Info >
+Intercept, and a Curves object of six curling strands with a radius attribute, each its
+own red by Curves Info > Random, on the grey floor under a point lamp and a dim world. Means
 within 2 % per channel and 8 x 8 blocks within 5 % of the image mean (the tolerances of
 the other comparisons). The control, View Layer > Filter > Curves off in DRT (no hair, as
 before hair was drawn), must fail that. Measured numbers are in the test's output and
@@ -35,7 +36,15 @@ def _scene(bpy, hair=True):
     bpy.ops.object.shade_smooth()
     ball = bpy.context.object
     ball.data.materials.append(_principled(bpy, "skin", (0.8, 0.7, 0.6), 0.5))
-    ball.data.materials.append(_principled(bpy, "fur", (0.6, 0.25, 0.05), 0.4))
+    fur = _principled(bpy, "fur", (0.6, 0.25, 0.05), 0.4)
+    ball.data.materials.append(fur)
+    # the fur darkens from root to tip: Curves Info > Intercept through a Color Ramp
+    nt = fur.node_tree
+    info, ramp = nt.nodes.new("ShaderNodeHairInfo"), nt.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].color = (0.9, 0.6, 0.3, 1.0)
+    ramp.color_ramp.elements[1].color = (0.15, 0.05, 0.02, 1.0)
+    nt.links.new(info.outputs["Intercept"], ramp.inputs["Fac"])
+    nt.links.new(ramp.outputs["Color"], nt.nodes["Principled BSDF"].inputs["Base Color"])
     mod = ball.modifiers.new("Fur", "PARTICLE_SYSTEM")
     st = mod.particle_system.settings
     st.type, st.count, st.hair_length = "HAIR", 400, 0.45
@@ -53,7 +62,14 @@ def _scene(bpy, hair=True):
     curves.attributes["position"].data.foreach_set("vector", pos)
     curves.attributes.new("radius", "FLOAT", "POINT").data.foreach_set("value", radius)
     curls = bpy.data.objects.new("Curls", curves)
-    curls.data.materials.append(_principled(bpy, "curls", (0.1, 0.3, 0.7), 0.3))
+    curl = _principled(bpy, "curls", (0.1, 0.3, 0.7), 0.3)
+    curls.data.materials.append(curl)
+    # each curl its own red: Curves Info > Random
+    nt = curl.node_tree
+    info, rgb = nt.nodes.new("ShaderNodeHairInfo"), nt.nodes.new("ShaderNodeCombineColor")
+    rgb.inputs["Green"].default_value, rgb.inputs["Blue"].default_value = 0.3, 0.7
+    nt.links.new(info.outputs["Random"], rgb.inputs["Red"])
+    nt.links.new(rgb.outputs["Color"], nt.nodes["Principled BSDF"].inputs["Base Color"])
     scene.collection.objects.link(curls)
     bpy.ops.object.light_add(type="POINT", location=(1.0, -1.5, 2.5))
     bpy.context.object.data.energy = 300.0
@@ -77,9 +93,23 @@ def test_particle_hair_and_curves_match_cycles(bpy_drt):
     cycles = _render(bpy_drt, scene, "CYCLES", 512)
     drt = _render(bpy_drt, scene, "DRT", 256)
     assert_matches(drt, cycles, 0.02, 0.05)
+    # F12 reads Render Steps: 2^3 + 1 keys a strand
+    from drt_addon import render_engine
+    fur = next(c for c in render_engine.last_render["scene"].curves
+               if c.name.startswith("Sphere"))
+    assert fur.curve_count == 400 and np.all(np.diff(fur.curve_keys) == 9)
+    # the controls: no hair; the fur's colour not by Intercept (the ramp's middle)
     bald = _render(bpy_drt, scene, "DRT", 64, hair=False)
     rel, block = compare(bald, cycles)
     print(f"control, no hair: mean {np.round(100 * rel, 2)} %, "
+          f"worst block {100 * block:.2f} %")
+    assert block > 0.05, block
+    nt = bpy_drt.data.materials["fur"].node_tree
+    nt.links.remove(nt.nodes["Color Ramp"].inputs["Fac"].links[0])
+    nt.nodes["Color Ramp"].inputs["Fac"].default_value = 0.5
+    flat = _render(bpy_drt, scene, "DRT", 64)
+    rel, block = compare(flat, cycles)
+    print(f"control, no Intercept: mean {np.round(100 * rel, 2)} %, "
           f"worst block {100 * block:.2f} %")
     assert block > 0.05, block
 

@@ -73,7 +73,7 @@ def particle_hair(obj, matrix, slots: list, render: bool = True, uv_map=None,
     own = np.asarray(obj.matrix_world, np.float64)
     to_object = np.linalg.inv(own)          # co_hair gives the object's world keys
     scale = _uniform_scale(matrix)
-    out = []
+    out, first_index = [], 0          # Cycles numbers the strands of all systems at once
     for mod, psys in hair_systems(obj, render):
         st = psys.settings
         steps = (1 << (st.render_step if render else st.display_step)) + 1
@@ -105,7 +105,9 @@ def particle_hair(obj, matrix, slots: list, render: bool = True, uv_map=None,
         out.append(engine.HairCurves(
             f"{name or obj.name} ({psys.name})", _place(local.reshape(-1, 3), matrix),
             radii.reshape(-1) * scale, np.arange(count + 1) * steps, materials=material,
-            uvs=uvs))
+            uvs=uvs, intercepts=along.reshape(-1), lengths=total.reshape(-1),
+            first_index=first_index))
+        first_index += count
     return out
 
 
@@ -158,7 +160,10 @@ def curves_object(obj, matrix, slots: list, name: str = ""):
         keys, radii = keys[rows], radii[rows]
         sizes = sizes[keep]
     matrix = np.asarray(matrix, np.float64)
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    radii = np.maximum(radii, 0.0)
+    local = engine.HairCurves(name or obj.name, keys, radii, offsets)  # object space
     return engine.HairCurves(name or obj.name, _place(keys, matrix),
-                             np.maximum(radii, 0.0) * _uniform_scale(matrix),
-                             np.concatenate([[0], np.cumsum(sizes)]),
-                             materials=slots[0] if slots else 0)
+                             radii * _uniform_scale(matrix), offsets,
+                             materials=slots[0] if slots else 0,
+                             intercepts=local.intercepts, lengths=local.lengths)

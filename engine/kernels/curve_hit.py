@@ -17,6 +17,7 @@ import numpy as np
 
 from .frame import dot
 from .jit import kernel
+from ..nodes.hash import hash_uint2, uint_to_float
 
 
 class PackedCurves(NamedTuple):
@@ -24,6 +25,9 @@ class PackedCurves(NamedTuple):
     span: np.ndarray     # (2,) int64: the segments' first global primitive id, and the end
     points: np.ndarray   # (P, 4) float64 control points: x, y, z, radius (world space)
     first: np.ndarray    # (S,) int64 each segment's first control point (4 from it)
+    # (S, 4) what the Hair Info node reads: the intercepts of the segment's two keys,
+    # its strand's length and Random
+    info: np.ndarray
 
 
 @kernel(inline="always")
@@ -91,3 +95,35 @@ def curve_surface(C, center, prim, u, ox, oy, oz, t, dx, dy, dz):
         for a in range(3):
             scale = max(scale, abs(C.points[i + k, a] - center[a]))
     return px, py, pz, nx, ny, nz, nx, ny, nz, True, scale + r
+
+
+@kernel
+def strand_randoms(first_index, out):
+    """The Hair Info node's Random of strands first_index, first_index + 1, ... of an
+    object: Cycles' hash_uint2_to_float(index, 0)."""
+    for i in range(out.shape[0]):
+        out[i] = uint_to_float(hash_uint2(first_index + i, 0))
+
+
+@kernel(allocates=False)
+def strand_info(C, prim, u, ix, iy, iz):
+    """What the Hair Info node reads at a hit on primitive prim at parameter u, seen
+    from the direction i (towards the ray's origin): (is strand, intercept, length,
+    thickness, random, tangent normal); zeros on a triangle, as in Cycles. Intercept and
+    thickness run linearly between the segment's two keys, as Cycles interpolates curve
+    attributes; the tangent normal is i made perpendicular to the spline's tangent."""
+    if not is_curve(C, prim):
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    seg = prim - C.span[0]
+    info = C.info
+    intercept = info[seg, 0] + u * (info[seg, 1] - info[seg, 0])
+    i = C.first[seg]
+    r = C.points[i + 1, 3] + u * (C.points[i + 2, 3] - C.points[i + 1, 3])
+    _, _, _, _, tx, ty, tz = curve_point(C, seg, u)
+    lt2 = tx * tx + ty * ty + tz * tz
+    k = dot(ix, iy, iz, tx, ty, tz) / lt2 if lt2 > 0.0 else 0.0
+    nx, ny, nz = ix - k * tx, iy - k * ty, iz - k * tz
+    ln = math.sqrt(nx * nx + ny * ny + nz * nz)
+    if ln > 0.0:
+        nx, ny, nz = nx / ln, ny / ln, nz / ln
+    return 1.0, intercept, info[seg, 2], 2.0 * r, info[seg, 3], nx, ny, nz

@@ -64,7 +64,14 @@ N_UNDISPLACED = 12
 # the object's linear part M (3 x 3, row-major, object -> world; the identity without an
 # object), for the nodes that work in object space (engine.nodes.bump)
 H_OBJ_MATRIX = H_UNDISPLACED + N_UNDISPLACED
-N_HIT = H_OBJ_MATRIX + 9
+# the Hair Info node's outputs (engine.kernels.curve_hit.strand_info; 0 off hair)
+H_HAIR_IS_STRAND = H_OBJ_MATRIX + 9
+H_HAIR_INTERCEPT = H_HAIR_IS_STRAND + 1
+H_HAIR_LENGTH = H_HAIR_IS_STRAND + 2
+H_HAIR_THICKNESS = H_HAIR_IS_STRAND + 3
+H_HAIR_RANDOM = H_HAIR_IS_STRAND + 4
+H_HAIR_TANGENT_NORMAL = H_HAIR_IS_STRAND + 5   # (3)
+N_HIT = H_HAIR_IS_STRAND + 8
 
 # ---------------------------------------------------------------- object table columns
 O_TO_OBJECT = 0      # 3 x 4 world -> object, row-major (12)

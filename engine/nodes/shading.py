@@ -15,7 +15,10 @@ import numpy as np
 from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
 from ..kernels.textures import I_TEXTURE, INPUTS, TEX_EMISSION
-from .context import fill, mirrors, set_undisplaced, to_world_direction
+from ..kernels.curve_hit import strand_info
+from .context import (H_HAIR_INTERCEPT, H_HAIR_IS_STRAND, H_HAIR_LENGTH, H_HAIR_RANDOM,
+                      H_HAIR_TANGENT_NORMAL, H_HAIR_THICKNESS, fill, mirrors,
+                      set_undisplaced, to_world_direction)
 from .differentials import fill_differentials
 from .interpreter import reads_differentials, run
 from .pack import MIX, OUTS
@@ -62,6 +65,9 @@ def program_hit(T, geometry, m, prim, inst, bu, bv, uu, vv, px, py, pz, gx, gy, 
     camera = geometry[12]
     fill(hit, px, py, pz, nx, ny, nz, gx, gy, gz, dx, dy, dz, uu, vv, front, ray, depth,
          length, objects, obj, camera, tx, ty, tz, ts, cr, cg, cb, ca)
+    (hit[H_HAIR_IS_STRAND], hit[H_HAIR_INTERCEPT], hit[H_HAIR_LENGTH], hit[H_HAIR_THICKNESS],
+     hit[H_HAIR_RANDOM], hit[H_HAIR_TANGENT_NORMAL], hit[H_HAIR_TANGENT_NORMAL + 1],
+     hit[H_HAIR_TANGENT_NORMAL + 2]) = strand_info(geometry[15], prim, bu, -dx, -dy, -dz)
     undisplaced = geometry[14]
     if undisplaced.shape[0] > 0 and not math.isnan(undisplaced[prim, 0, 0]):
         b0 = 1.0 - bu - bv

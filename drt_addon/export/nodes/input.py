@@ -88,6 +88,22 @@ def _object_info(c, node, out):
     raise Unsupported(f"the Object Info output {name} is not evaluated")
 
 
+HAIR_INFO = {"Is Strand": C.H_HAIR_IS_STRAND, "Intercept": C.H_HAIR_INTERCEPT,
+             "Length": C.H_HAIR_LENGTH, "Thickness": C.H_HAIR_THICKNESS,
+             "Random": C.H_HAIR_RANDOM}
+
+
+def _hair_info(c, node, out):
+    """Curves Info (Hair Info): what the strand hit is (engine.kernels.curve_hit
+    .strand_info); zeros off hair, as in Cycles."""
+    name = out.identifier
+    if name in HAIR_INFO:
+        return hit1(c, HAIR_INFO[name])
+    if name == "Tangent Normal":
+        return hit3(c, C.H_HAIR_TANGENT_NORMAL)
+    raise Unsupported(f"the Curves Info output {name} is not evaluated")
+
+
 def _value(c, node, out):
     return c.const(float(out.default_value))
 
@@ -172,6 +188,7 @@ TRANSLATORS = {
     "ShaderNodeUVMap": _uv_map,
     "ShaderNodeNewGeometry": _geometry,
     "ShaderNodeObjectInfo": _object_info,
+    "ShaderNodeHairInfo": _hair_info,
     "ShaderNodeValue": _value,
     "ShaderNodeRGB": _rgb,
     "ShaderNodeFresnel": _fresnel,
