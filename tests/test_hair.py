@@ -219,3 +219,36 @@ def test_curves_info_reads_each_strand_where_it_is_hit():
     np.testing.assert_allclose(row[seen, 2], uint_to_float(hash_uint2(7, 0)), rtol=1e-6)
     # off hair (the world behind) nothing is emitted
     assert np.all(img[:8] == 0.0)
+
+
+CULLED_IN_PYTHON = """
+import numpy as np
+from engine.accel import Accelerator
+from engine.curves import HairCurves
+h = HairCurves("s", [[-3, 0, 0], [-1, 0, 0], [1, 0, 0], [3, 0, 0]], np.full(4, 0.1), [0, 4])
+a = Accelerator([], curves=[h])
+o = np.array([[0, -5, 0], [0, 0, 0], [-10, 0, 0.0], [0, 0.05, 0], [0, 5, 0]])
+d = np.array([[0, 1, 0], [0, 1, 0], [1, 0, 0.0], [0, -1, 0], [0, -1, 0]])
+hits = a.intersect(o, d, np.full(5, np.inf))
+print(hits.prim.tolist(), a.occluded(o, d, np.full(5, 100.0)).tolist())
+"""
+
+
+def test_the_culling_filter_runs_as_plain_python_too():
+    """With NUMBA_DISABLE_JIT=1 (every kernel as the Python it is written in) the curve
+    filter is a ctypes callback of the same Python: the same hits as compiled."""
+    import os
+    import subprocess
+    import sys
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1", PYTHONPATH=root)
+    proc = subprocess.run([sys.executable, "-c", CULLED_IN_PYTHON], cwd=root, env=env,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    accel = Accelerator([], curves=[strand()])
+    o = np.array([[0, -5, 0], [0, 0, 0], [-10, 0, 0.0], [0, 0.05, 0], [0, 5, 0]])
+    d = np.array([[0, 1, 0], [0, 1, 0], [1, 0, 0.0], [0, -1, 0], [0, -1, 0]])
+    compiled = (accel.intersect(o, d, np.full(5, np.inf)).prim.tolist(),
+                accel.occluded(o, d, np.full(5, 100.0)).tolist())
+    assert proc.stdout.strip() == f"{compiled[0]} {compiled[1]}", (proc.stdout, compiled)
+    assert compiled[0][1:4] == [-1, -1, -1]           # culled: what the filter decides

@@ -13,17 +13,35 @@ scene has curves.
 """
 from __future__ import annotations
 
+import ctypes
+
 import numpy as np
-from numba import carray, cfunc, types
-from numba.core import cgutils
+from numba import carray, cfunc, njit, types
+from numba.core import cgutils, config
 from numba.extending import intrinsic
 
 # RTCFilterFunctionNArguments: int* valid, void* geometryUserPtr, context, RTCRayN* ray,
 # RTCHitN* hit, unsigned int N (each a 64-bit word here)
 _VALID, _RAY, _HIT, _N = 0, 3, 4, 5
 # RTCRayN / RTCHitN hold each field for the N rays one after the other (field k of ray i
-# at float k * N + i)
-_DIR_X, _NG_X = 4, 0
+# at float k * N + i): a ray's 12 fields, its direction the 5th to 7th; a hit's normal
+# its first 3
+_RAY_FIELDS, _DIR_X, _NG_X = 12, 4, 0
+
+
+def _reject_backfacing(valid, ray, hit, n):
+    """Mark invalid each of the n candidate hits whose normal faces along the ray."""
+    for i in range(n):
+        if valid[i] == 0:
+            continue
+        d = (ray[_DIR_X * n + i] * hit[_NG_X * n + i]
+             + ray[(_DIR_X + 1) * n + i] * hit[(_NG_X + 1) * n + i]
+             + ray[(_DIR_X + 2) * n + i] * hit[(_NG_X + 2) * n + i])
+        if d > 0.0:
+            valid[i] = 0
+
+
+_reject = njit(cache=True)(_reject_backfacing)
 
 
 @intrinsic
@@ -37,26 +55,38 @@ def _pointer(typingctx, address):
 def _cull(args):
     words = carray(args, 6, np.uint64)
     n = np.int64(words[_N] & np.uint64(0xFFFFFFFF))
-    valid = carray(_pointer(words[_VALID]), n, np.int32)
-    ray = carray(_pointer(words[_RAY]), 12 * n, np.float32)
-    hit = carray(_pointer(words[_HIT]), 3 * n, np.float32)
-    for i in range(n):
-        if valid[i] == 0:
-            continue
-        d = (ray[_DIR_X * n + i] * hit[_NG_X * n + i]
-             + ray[(_DIR_X + 1) * n + i] * hit[(_NG_X + 1) * n + i]
-             + ray[(_DIR_X + 2) * n + i] * hit[(_NG_X + 2) * n + i])
-        if d > 0.0:
-            valid[i] = 0
+    _reject(carray(_pointer(words[_VALID]), n, np.int32),
+            carray(_pointer(words[_RAY]), _RAY_FIELDS * n, np.float32),
+            carray(_pointer(words[_HIT]), 3 * n, np.float32), n)
+
+
+def _view(address, count, ctype):
+    return np.ctypeslib.as_array(ctypes.cast(int(address), ctypes.POINTER(ctype)), (count,))
+
+
+def _cull_python(args):
+    """_cull as plain Python (NUMBA_DISABLE_JIT=1), through ctypes."""
+    words = np.ctypeslib.as_array(args, (6,))
+    n = int(words[_N]) & 0xFFFFFFFF
+    _reject(_view(words[_VALID], n, ctypes.c_int32),
+            _view(words[_RAY], _RAY_FIELDS * n, ctypes.c_float),
+            _view(words[_HIT], 3 * n, ctypes.c_float), n)
 
 
 _FILTER = None
 
 
 def filter_address() -> int:
-    """The address of the compiled filter (RTCFilterFunctionN), compiled on first use."""
+    """The address of the compiled filter (RTCFilterFunctionN), compiled on first use (a
+    ctypes callback of the plain Python when kernels run uncompiled)."""
     global _FILTER
     if _FILTER is None:
-        _FILTER = cfunc(types.void(types.CPointer(types.uint64)), cache=True,
-                        nopython=True)(_cull)
+        if config.DISABLE_JIT:
+            proto = ctypes.CFUNCTYPE(None, ctypes.POINTER(ctypes.c_uint64))
+            _FILTER = proto(_cull_python)
+        else:
+            _FILTER = cfunc(types.void(types.CPointer(types.uint64)), cache=True,
+                            nopython=True)(_cull)
+    if config.DISABLE_JIT:
+        return ctypes.cast(_FILTER, ctypes.c_void_p).value
     return _FILTER.address
