@@ -185,9 +185,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 offset = 0.0          # Cycles lifts smooth faces only (a flat mesh's normals
                 #                       may come from its displacement's bump: displaced_mesh)
             # an instance is seen by the rays that see both it and its instancer (Cycles)
-            seen = object_visibility(obj) & (
-                object_visibility(inst.parent) if inst.is_instance and inst.parent is not None
-                else 31)
+            seen = _instance_visibility(inst, obj)
             programmed = any(materials[i].shader is not None for i in slots)
             color, pass_index, texspace = object_values(obj)
             source = Source(groups.group(local, slots, name, holdout, offset, seen,
@@ -254,10 +252,19 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                         film_transparent=bool(scene.render.film_transparent), curves=curves)
 
 
+def _instance_visibility(inst, obj) -> int:
+    """The ray kinds that see an instance: those that see both it and its instancer, as
+    in Cycles (engine.visibility)."""
+    seen = object_visibility(obj)
+    if inst.is_instance and inst.parent is not None:
+        seen &= object_visibility(inst.parent)
+    return seen
+
+
 def _hair(inst, obj, k, material_id, materials, override, view_layer, rendering) -> list:
     """The strands of one instance (export.hair): a Curves object's, or a mesh's
     particle hair, with the object's materials, holdout, ray visibility and names."""
-    if obj.type == "MESH" and not any(True for _ in hair_systems(obj, rendering)):
+    if obj.type == "MESH" and next(hair_systems(obj, rendering), None) is None:
         return []
     mats = slot_materials(obj, override)
     slots = [material_id(m, k) for m in mats] or [material_id(None)]
@@ -267,9 +274,7 @@ def _hair(inst, obj, k, material_id, materials, override, view_layer, rendering)
     else:
         found = particle_hair(obj, inst.matrix_world, slots, rendering, uv_request(mats),
                               name)
-    seen = object_visibility(obj) & (
-        object_visibility(inst.parent) if inst.is_instance and inst.parent is not None
-        else 31)
+    seen = _instance_visibility(inst, obj)
     for c in found:
         c.holdout = _is_holdout(inst, obj, view_layer)
         c.visibility = seen
