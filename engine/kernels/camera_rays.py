@@ -68,14 +68,14 @@ def interp_guided(x, xp, fp, guide):
     return slope * (x - xp[lo]) + fp[lo]
 
 
-@kernel
+@kernel(allocates=False)
 def filter_offset(cam, xs, cdf, guide, u):
     if xs.shape[0] == 0:
         return (u - 0.5) * (2.0 * cam[C_BOX_RADIUS])
     return interp_guided(u, cdf, xs, guide)
 
 
-@kernel
+@kernel(allocates=False)
 def aperture_point(cam, u0, u1):
     """engine.thin_lens.sample_aperture for one point."""
     blades = int(cam[C_BLADES])
@@ -98,7 +98,7 @@ def aperture_point(cam, u0, u1):
     return x, y
 
 
-@kernel
+@kernel(allocates=False)
 def generate(cam, xs, cdf, guide, kind, spp, pkey, pixel, index, origins, dirs, tmax):
     """The camera ray of every (pixel, sample index) of a unit into origins, dirs, tmax."""
     w, h = int(cam[C_W]), int(cam[C_H])

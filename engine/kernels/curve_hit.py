@@ -97,7 +97,7 @@ def curve_surface(C, center, prim, u, ox, oy, oz, t, dx, dy, dz):
     return px, py, pz, nx, ny, nz, nx, ny, nz, True, scale + r
 
 
-@kernel
+@kernel(allocates=False)
 def strand_randoms(first_index, out):
     """The Hair Info node's Random of strands first_index, first_index + 1, ... of an
     object: Cycles' hash_uint2_to_float(index, 0)."""

@@ -10,17 +10,17 @@ import math
 from .jit import kernel
 
 
-@kernel
+@kernel(allocates=False)
 def dot(ax, ay, az, bx, by, bz):
     return ax * bx + ay * by + az * bz
 
 
-@kernel
+@kernel(allocates=False)
 def cross(ax, ay, az, bx, by, bz):
     return ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
 
 
-@kernel
+@kernel(allocates=False)
 def basis(nx, ny, nz):
     """Tangents (t, b) with (t, b, n) right-handed and orthonormal, for unit n."""
     sign = 1.0 if nz >= 0.0 else -1.0
@@ -30,20 +30,20 @@ def basis(nx, ny, nz):
             b, sign + ny * ny * a, -ny)
 
 
-@kernel
+@kernel(allocates=False)
 def to_local(vx, vy, vz, nx, ny, nz):
     tx, ty, tz, bx, by, bz = basis(nx, ny, nz)
     return (vx * tx + vy * ty + vz * tz, vx * bx + vy * by + vz * bz,
             vx * nx + vy * ny + vz * nz)
 
 
-@kernel
+@kernel(allocates=False)
 def to_world(lx, ly, lz, nx, ny, nz):
     tx, ty, tz, bx, by, bz = basis(nx, ny, nz)
     return (lx * tx + ly * bx + lz * nx, lx * ty + ly * by + lz * ny,
             lx * tz + ly * bz + lz * nz)
 
 
-@kernel
+@kernel(allocates=False)
 def length(x, y, z):
     return math.sqrt(x * x + y * y + z * z)

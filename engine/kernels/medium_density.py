@@ -167,7 +167,7 @@ def advance(maj, row, mu_fixed, ox, oy, oz, dx, dy, dz, s, t, tau):
     return t, mu, True
 
 
-@kernel
+@kernel(allocates=False)
 def path_key(pkey, index, depth):
     """The tracking's random stream of one path at one bounce."""
     return stream_key(pkey, index, HET_DIM, depth)

@@ -35,7 +35,7 @@ from .volume import EQUIANGULAR, distance_pdf, hg_phase, hg_sample, medium, volu
 C_VOLUME_BOUNCES = 14      # cfg entry: Cycles' max volume bounces
 
 
-@kernel
+@kernel(allocates=False)
 def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb, g, bounce,
             vbounce, beta, cont, prev_pdf, prev_pos, ray_bits, L, lights, vol, stacks,
             sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns,
@@ -118,7 +118,7 @@ def distance_weight(lights, k, recv, time, dx, dy, dz, segment):
                            * by_segment)
 
 
-@kernel
+@kernel(allocates=False)
 def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, t_max,
                       br, bg, bb, channels, method, bounce, vbounce, L, lights, vol, stacks,
                       sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns):

@@ -18,7 +18,7 @@ ROULETTE_START = 3
 _INF = np.inf
 
 
-@kernel
+@kernel(allocates=False)
 def power_heuristic(a, b):
     if math.isinf(a):
         return 1.0
@@ -28,7 +28,7 @@ def power_heuristic(a, b):
     return a2 / (a2 + b2) if a2 + b2 > 0.0 else 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def hit_weight(mode, prev_pdf, light_pdf):
     """Weight of emission found by a BSDF-sampled ray (pdf prev_pdf; inf after a camera
     ray or a specular bounce) that light sampling reaches with light_pdf."""
@@ -39,7 +39,7 @@ def hit_weight(mode, prev_pdf, light_pdf):
     return 1.0
 
 
-@kernel
+@kernel(allocates=False)
 def nee_weight(mode, light_pdf, bsdf_pdf, delta):
     """Weight of a light sample that the BSDF would have sampled with bsdf_pdf."""
     if mode == MIS:
@@ -49,7 +49,7 @@ def nee_weight(mode, light_pdf, bsdf_pdf, delta):
     return 1.0 if (delta or not bsdf_pdf > 0.0) else 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def clamp_scale(r, g, b, limit):
     """Cycles' clamp (its film_clamp_light): the factor that scales (r, g, b) so that the
     sum of its channels is at most 3 x limit. A saturated colour keeps most of its light:
@@ -78,7 +78,7 @@ def _add(L, p, r, g, b, limit):
     L[p, 2] += b * s
 
 
-@kernel
+@kernel(allocates=False)
 def uncovered(br, bg, bb):
     """Alpha of a camera sample whose ray got through with throughput b. A camera
     sample's coverage is 1 unless its camera ray, possibly continued through transparent
@@ -104,7 +104,7 @@ def holdout_share(h, u_lobe, b, alpha, p, br, bg, bb):
     return False, u_lobe
 
 
-@kernel
+@kernel(allocates=False)
 def add_unoccluded(L, sh_path, sh_contrib, blocked, sh_bounce, clamp_direct, clamp_indirect):
     """Add the contributions of the shadow rays that reached their light, clamped (the
     direct clamp for shadow rays of a path's first vertex, sh_bounce 0)."""
@@ -114,7 +114,7 @@ def add_unoccluded(L, sh_path, sh_contrib, blocked, sh_bounce, clamp_direct, cla
                  clamp_direct if sh_bounce[i] == 0 else clamp_indirect)
 
 
-@kernel
+@kernel(allocates=False)
 def add_transmitted(L, sh_path, sh_contrib, trans, sh_bounce, clamp_direct, clamp_indirect):
     """Add the contributions of shadow rays times their transmittance, clamped."""
     for i in range(sh_path.shape[0]):

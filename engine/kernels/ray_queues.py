@@ -9,7 +9,7 @@ import math
 from .jit import kernel
 
 
-@kernel
+@kernel(allocates=False)
 def towards(sox, soy, soz, px, py, pz, wx, wy, wz, dist, margin, scene_radius):
     """Direction and length of the shadow ray from origin so (for the shading point p)
     towards direction w for `dist` (inf: a sun or the world): to the sampled point,

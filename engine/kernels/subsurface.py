@@ -47,7 +47,7 @@ WALK_DIM = 1 << 27         # the walk's own random stream (hashed: any count)
 INV_2PI = 0.5 / math.pi
 
 
-@kernel
+@kernel(allocates=False)
 def walk_key(pkey, index, depth):
     """The random stream of path (pkey, index)'s walk at wavefront step `depth`."""
     return stream_key(pkey, index, WALK_DIM, depth)
@@ -69,14 +69,14 @@ FIT_F = (2.40602999408, -2.51814844609, 9.18494908356, -79.2191708682, 259.08286
          -403.613804597, 302.85712436, -87.4370473567)
 
 
-@kernel
+@kernel(allocates=False)
 def _poly7(g, c):
     """c[0] + c[1] g + ... + c[7] g^7 (Horner)."""
     return c[0] + g * (c[1] + g * (c[2] + g * (c[3] + g * (c[4] + g * (c[5] + g * (
         c[6] + g * c[7]))))))
 
 
-@kernel
+@kernel(allocates=False)
 def remap(albedo, d, g):
     """(sigma_t, alpha) of one channel: the medium whose walk reflects about `albedo`,
     for mean free path d and anisotropy g (Chiang et al. 2016, with Cycles' fit in g)."""
@@ -94,14 +94,14 @@ def remap(albedo, d, g):
     return 1.0 / (max(d, 1e-16) * (1.0 - g)), alpha
 
 
-@kernel
+@kernel(allocates=False)
 def dipole_rd(alpha_prime, four_thirds_a):
     """The dipole's total diffuse reflectance for reduced albedo alpha_prime."""
     s = math.sqrt(3.0 * (1.0 - alpha_prime))
     return 0.5 * alpha_prime * (1.0 + math.exp(-four_thirds_a * s)) * math.exp(-s)
 
 
-@kernel
+@kernel(allocates=False)
 def skin_radius_scale(albedo, ior):
     """Random Walk (Skin)'s factor on the radius: sqrt(3 (1 - alpha')), alpha' the
     reduced albedo whose dipole reflectance is `albedo` (12 bisection steps, as Cycles)."""
@@ -123,7 +123,7 @@ def skin_radius_scale(albedo, ior):
     return math.sqrt(3.0 * (1.0 - ap))
 
 
-@kernel
+@kernel(allocates=False)
 def walk_radius(radius, albedo, ior, skin):
     """The mean free path the walk uses for one channel of Radius x Scale `radius`."""
     if skin:
@@ -131,7 +131,7 @@ def walk_radius(radius, albedo, ior, skin):
     return radius * 0.25 / math.pi
 
 
-@kernel
+@kernel(allocates=False)
 def diffusion_length(alpha):
     """Dwivedi's diffusion length for single-scattering albedo alpha (d'Eon and
     Krivanek 2020, eq. 67)."""
@@ -139,13 +139,13 @@ def diffusion_length(alpha):
 
 
 # --------------------------------------------------------------------------- local rays
-@kernel
+@kernel(allocates=False)
 def object_of(mesh_start, prim):
     """The mesh (engine.accel's order) global triangle `prim` belongs to."""
     return bisect_last(mesh_start, prim, 0, mesh_start.shape[0] - 1)
 
 
-@kernel
+@kernel(allocates=False)
 def local_hit(rays, f, w, mesh, inst, ox, oy, oz, dx, dy, dz, tmax, time):
     """The first hit within tmax of the surface of mesh `mesh` placed as instance `inst`
     (-1: not instanced) along o + t d, passing other objects' triangles. rays: (Embree
@@ -170,7 +170,7 @@ def local_hit(rays, f, w, mesh, inst, ox, oy, oz, dx, dy, dz, tmax, time):
 
 
 # --------------------------------------------------------------------------- the walk
-@kernel
+@kernel(allocates=False)
 def _pick(u, w0, w1, w2):
     """The channel u picks with weights w (normalised; equal where all are 0)."""
     s = w0 + w1 + w2
@@ -182,7 +182,7 @@ def _pick(u, w0, w1, w2):
     return c, w0, w1, w2
 
 
-@kernel
+@kernel(allocates=False)
 def _from_cosine(nx, ny, nz, cos_theta, u):
     """The direction at angle acos(cos_theta) from n, at azimuth 2 pi u."""
     s = math.sqrt(max(0.0, 1.0 - cos_theta * cos_theta))
@@ -190,7 +190,7 @@ def _from_cosine(nx, ny, nz, cos_theta, u):
     return to_world(s * math.cos(phi), s * math.sin(phi), cos_theta, nx, ny, nz)
 
 
-@kernel
+@kernel(allocates=False)
 def walk(rays, f, w, key, time, mesh, inst, px, py, pz, dx, dy, dz, nx, ny, nz, albedo,
          radius, g, beta, guided_walk):
     """Walk from p (just inside the surface) along d, the surface's normal at the entry
@@ -299,7 +299,7 @@ def walk(rays, f, w, key, time, mesh, inst, px, py, pz, dx, dy, dz, nx, ny, nz, 
     return False, -1, -1, 0.0, 0.0, dx, dy, dz, 0.0, 0.0, 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def _guided_pdf(classic, sigma_t, t, hit, gf, have_opposite, back_fraction, fwd_stretch,
                 back_stretch, fwd_factor, back_factor):
     """One channel's density of a step after the first, over the classic, forward-guided

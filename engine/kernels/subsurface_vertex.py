@@ -47,7 +47,7 @@ from ..nodes.shading import bump_shadowing
 EXIT_STEP = MAX_BOUNCES + 1     # the walk stream's step whose numbers the exit uses
 
 
-@kernel
+@kernel(allocates=False)
 def entry_direction(row, dx, dy, dz, nx, ny, nz, u1, u2):
     """The direction into the surface for a ray along d hitting shading normal n (facing
     the ray), or ok False."""
@@ -78,7 +78,7 @@ def entry_direction(row, dx, dy, dz, nx, ny, nz, u1, u2):
     return -eta * wix + k * hx, -eta * wiy + k * hy, -eta * wiz + k * hz, True
 
 
-@kernel
+@kernel(allocates=False)
 def walk_params(row):
     """(albedo, walk radius) per channel, and the anisotropy, of material row `row`."""
     skin = row[P_SSS_SKIN] != 0.0
@@ -92,7 +92,7 @@ def walk_params(row):
     return (a0, a1, a2), (r0, r1, r2), row[P_SSS_ANISOTROPY]
 
 
-@kernel
+@kernel(allocates=False)
 def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, py, pz,
                   gx, gy, gz, nx, ny, nz, scale, dx, dy, dz, u1, u2, br, bg, bb, bounce,
                   counts, beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, L, lights,

@@ -242,7 +242,7 @@ def _placed_hit(p0x, p0y, p0z, p1x, p1y, p1z, p2x, p2y, p2z, corner_normals, pri
     return px, py, pz, fx, fy, fz, sx, sy, sz, front
 
 
-@kernel
+@kernel(allocates=False)
 def rebuild_batch(geometry, prim, inst, u, v, o, t, d, time, position, geometric, shading,
                   front, scale):
     """`surface_at` for n hits of the rays o + t d (time may be empty: 0): writes the hit
@@ -267,7 +267,7 @@ def _place(verts, row, a00, a01, a02, a10, a11, a12, a20, a21, a22, tx, ty, tz):
             a20 * x + a21 * y + a22 * z + tz)
 
 
-@kernel
+@kernel(allocates=False)
 def offset_origin(px, py, pz, nx, ny, nz, scale, dx, dy, dz):
     """The origin of a ray leaving p along d: p pushed along n to d's side."""
     side = 1.0 if dot(nx, ny, nz, dx, dy, dz) >= 0.0 else -1.0
@@ -275,7 +275,7 @@ def offset_origin(px, py, pz, nx, ny, nz, scale, dx, dy, dz):
     return px + nx * eps, py + ny * eps, pz + nz * eps
 
 
-@kernel
+@kernel(allocates=False)
 def hit_uv(corner_uvs, prim, u, v):
     """Texture coordinates at barycentrics (u, v) of triangle prim, from its corner UVs
     (T, 3, 2) float32; (0, 0) when the scene has none (Cycles' missing UV map)."""

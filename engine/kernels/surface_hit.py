@@ -14,7 +14,7 @@ from ..nodes.shading import (apply_rows, pick_closure, program_emission, program
                              program_normal)
 
 
-@kernel
+@kernel(allocates=False)
 def run_program(programs, params, geometry, counts, path_info, p, m, prim, inst, hu, hv, uu, vv,
                 px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front, ray_bit, b, t_geom,
                 hit_row, regs, u_lobe):
@@ -34,7 +34,7 @@ def run_program(programs, params, geometry, counts, path_info, p, m, prim, inst,
     return ms, u_lobe, sx, sy, sz, rx, ry, rz, bent, correct
 
 
-@kernel
+@kernel(allocates=False)
 def surface_emission(programs, textures, emission, m, uu, vv, regs, programmed):
     """Material m's emitted radiance at the hit: its (textured) emission, or what its
     program (run by `run_program` when `programmed`) says."""
@@ -44,11 +44,12 @@ def surface_emission(programs, textures, emission, m, uu, vv, regs, programmed):
     return er, eg, eb
 
 
-@kernel
+@kernel(allocates=False)
 def material_row(params, textures, programs, ms, uu, vv, regs, programmed, row):
     """Fill `row` with material ms's parameters at the hit: its plain row, its textures
     at (uu, vv), its program's outputs."""
-    row[:] = params[ms]
+    for c in range(row.shape[0]):
+        row[c] = params[ms, c]
     if textures[1].shape[0] > 0:
         apply_to_row(textures, ms, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
     if programs is not None and programmed:

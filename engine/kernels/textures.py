@@ -155,7 +155,7 @@ def texture_info(t, offset) -> tuple:
 
 
 # ---------------------------------------------------------------- texel lookup
-@kernel
+@kernel(allocates=False)
 def srgb_to_linear(c):
     """The sRGB decoding curve (engine.textures.srgb_to_linear), one value."""
     if c <= 0.04045:
@@ -163,7 +163,7 @@ def srgb_to_linear(c):
     return ((max(c, 0.04045) + 0.055) / 1.055) ** 2.4
 
 
-@kernel
+@kernel(allocates=False)
 def wrap(i, n, extension):
     """(texel index in [0, n), 1.0 or 0.0): `engine.textures._wrap` for one tap; the
     factor is 0 for a CLIP tap outside the image (it reads zero)."""
@@ -180,7 +180,7 @@ def wrap(i, n, extension):
     return j, 1.0
 
 
-@kernel
+@kernel(allocates=False)
 def _texel(px, base, w, x, y, f):
     """RGBA of texel (x, y) times f (1 or 0: exactly what NumPy's mask product gives)."""
     k = base + (y * w + x) * 4
@@ -188,7 +188,7 @@ def _texel(px, base, w, x, y, f):
             np.float64(px[k + 2]) * f, np.float64(px[k + 3]) * f)
 
 
-@kernel
+@kernel(allocates=False)
 def _blend(tx, ty, a, b, c, d):
     """Bilinear blend of taps a = (x0, y0), b = (x1, y0), c = (x0, y1), d = (x1, y1)."""
     return (1.0 - ty) * ((1.0 - tx) * a + tx * b) + ty * ((1.0 - tx) * c + tx * d)
@@ -243,7 +243,7 @@ def texture_rgba(T, tex_id, u, v):
     return r, g, b, a
 
 
-@kernel
+@kernel(allocates=False)
 def apply_channel(r, g, b, a, channel):
     """`engine.textures.apply_channel` of one RGBA: (x, y, z), the scalar channels
     ('luminance', 'alpha') repeated in all three."""

@@ -43,7 +43,7 @@ TRANSPARENT_DIM = 1 << 24      # the pass-through numbers' own dimensions (see p
 SHADOW_BIT = visibility.SHADOW
 
 
-@kernel
+@kernel(allocates=False)
 def alpha_dim(depth, layer):
     return TRANSPARENT_DIM + depth * 1024 + min(layer, 1023)
 
@@ -70,7 +70,7 @@ def _hit_alpha(geometry, materials, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz,
     return a, m, px, py, pz, gx, gy, gz, scale
 
 
-@kernel
+@kernel(allocates=False)
 def _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, dx, dy, dz,
           far):
     """Entry n_out of out_*: ray r goes on from just beyond the surface point p (geometric
@@ -81,7 +81,7 @@ def _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, d
     out_far[n_out] = max(far, 0.0)
 
 
-@kernel
+@kernel(allocates=False)
 def _pass_through(geometry, prim, inst, u, v, ox, oy, oz, t, d, r, time, far, out_rows,
                   out_org, out_far, n_out):
     """Ray r (origin o, direction d[r]) goes on, unchanged, beyond the surface it hit at
@@ -210,7 +210,7 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
     return n_out
 
 
-@kernel
+@kernel(allocates=False)
 def merge_layer(rows, travelled, found, hits):
     """The hits `found` beyond a transparent layer replace the rows' `hits` (t from the
     start; both engine.accel.HitArrays)."""

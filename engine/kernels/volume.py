@@ -81,7 +81,7 @@ def pack_volumes(materials, world_volume) -> np.ndarray:
     return vol
 
 
-@kernel
+@kernel(allocates=False)
 def volume_dim(depth, offset):
     return VOLUME_DIM + depth * 8 + offset
 
@@ -159,7 +159,7 @@ def sample_method(vol, stacks, p):
 
 
 # --------------------------------------------------------------------------- segments
-@kernel
+@kernel(allocates=False)
 def _emitted(e, st, t):
     """Emission e per metre integrated along t through extinction st."""
     if e <= 0.0:
@@ -169,7 +169,7 @@ def _emitted(e, st, t):
     return e * t if math.isfinite(t) else 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def _tr(st, t):
     if st <= 0.0:
         return 1.0
@@ -231,7 +231,7 @@ def distance_pdf(str_, stg, stb, wr, wg, wb, t):
             + wb * stb * math.exp(-stb * t))
 
 
-@kernel
+@kernel(allocates=False)
 def passed(mode, str_, stg, stb, wr, wg, wb, t):
     """The throughput factor of getting past distance t of a segment without scattering
     (T / P(pass) for a sampled distance, T for absorption, 1 outside media)."""
@@ -247,7 +247,7 @@ def passed(mode, str_, stg, stb, wr, wg, wb, t):
 
 
 # --------------------------------------------------------------------------- phase
-@kernel
+@kernel(allocates=False)
 def hg_phase(g, cos_theta):
     """Henyey-Greenstein phase function of the angle between the propagation directions
     before and after scattering (g > 0 favours going on forward)."""
@@ -255,7 +255,7 @@ def hg_phase(g, cos_theta):
     return (1.0 - g * g) * _INV_4PI / (max(d, 1e-12) * math.sqrt(max(d, 1e-12)))
 
 
-@kernel
+@kernel(allocates=False)
 def hg_sample(g, dx, dy, dz, u1, u2):
     """A direction scattered from propagation direction d, and its pdf."""
     if abs(g) < 1e-3:

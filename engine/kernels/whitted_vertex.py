@@ -51,7 +51,7 @@ from ..nodes.shading import bent_diffuse
 CENTRE = 0.5           # the fixed point of every lamp: its sample at (1/2, 1/2)
 
 
-@kernel
+@kernel(allocates=False)
 def lamp_rays(lights):
     """Shadow rays per shading point: one per lamp that is not the world."""
     count = 0
@@ -63,7 +63,7 @@ def lamp_rays(lights):
     return count
 
 
-@kernel
+@kernel(allocates=False)
 def mirror_row(row):
     """The material row of the lobes Whitted follows: roughness zero (the coat's too),
     no translucency or subsurface scattering (diffuse lobes), no Filter Glossy."""

@@ -65,7 +65,7 @@ def _swapped(i):
     return base + k
 
 
-@kernel
+@kernel(allocates=False)
 def bent_normal(hit, nx, ny, nz, strength, distance, width, dhx, dhy):
     """Cycles' bump normal for the input normal n (see the module's docstring)."""
     return _bent(hit[H_DX + H_P], hit[H_DX + H_P + 1], hit[H_DX + H_P + 2], hit[H_DY + H_P],
@@ -78,7 +78,7 @@ def _m(hit, r, c):
     return hit[H_OBJ_MATRIX + 3 * r + c]
 
 
-@kernel
+@kernel(allocates=False)
 def _times(hit, x, y, z, transpose):
     """M v, or M^T v."""
     if transpose:
@@ -90,7 +90,7 @@ def _times(hit, x, y, z, transpose):
             _m(hit, 2, 0) * x + _m(hit, 2, 1) * y + _m(hit, 2, 2) * z)
 
 
-@kernel
+@kernel(allocates=False)
 def _cofactor_times(hit, x, y, z, transpose):
     """cof(M) v, or cof(M)^T v (cof(M) = det(M) M^-T: M^-T v and M^-1 v up to det)."""
     c00 = _m(hit, 1, 1) * _m(hit, 2, 2) - _m(hit, 1, 2) * _m(hit, 2, 1)
@@ -109,7 +109,7 @@ def _cofactor_times(hit, x, y, z, transpose):
             c20 * x + c21 * y + c22 * z)
 
 
-@kernel
+@kernel(allocates=False)
 def _unit(x, y, z):
     ln = math.sqrt(x * x + y * y + z * z)
     if not ln > 0.0:
@@ -117,13 +117,13 @@ def _unit(x, y, z):
     return x / ln, y / ln, z / ln
 
 
-@kernel
+@kernel(allocates=False)
 def _det(hit):
     c0, c1, c2 = _cofactor_times(hit, 1.0, 0.0, 0.0, True)
     return _m(hit, 0, 0) * c0 + _m(hit, 0, 1) * c1 + _m(hit, 0, 2) * c2
 
 
-@kernel
+@kernel(allocates=False)
 def bent_normal_object(hit, nx, ny, nz, strength, distance, width, dhx, dhy):
     """`bent_normal` worked out in the object's space, as Cycles' Bump with
     use_object_space: the normal into object space (M^T n, normalised), the steps by
@@ -145,7 +145,7 @@ def bent_normal_object(hit, nx, ny, nz, strength, distance, width, dhx, dhy):
     return _unit(wx, wy, wz)
 
 
-@kernel
+@kernel(allocates=False)
 def displacement_object(hit, nx, ny, nz, h):
     """The Displacement node in Object space: M normalize(M^T n) h (world)."""
     tx, ty, tz = _times(hit, nx, ny, nz, True)
@@ -153,7 +153,7 @@ def displacement_object(hit, nx, ny, nz, h):
     return _times(hit, ox * h, oy * h, oz * h, False)
 
 
-@kernel
+@kernel(allocates=False)
 def _bent(ax, ay, az, bx, by, bz, nx, ny, nz, strength, distance, width, dhx, dhy):
     """Cycles' bump normal for the input normal n and surface steps a (x), b (y)."""
     rxx, rxy, rxz = by * nz - bz * ny, bz * nx - bx * nz, bx * ny - by * nx

@@ -14,7 +14,7 @@ from ..kernels.camera_rays import (C_HALF_X, C_HALF_Y, C_PERSP, C_POS, C_ROT, C_
 from ..kernels.jit import kernel
 
 
-@kernel
+@kernel(allocates=False)
 def camera_local(cam, px, py, pz):
     """The point in the camera object's local space (its rotation is orthonormal)."""
     r = cam[C_ROT:C_ROT + 9]
@@ -23,7 +23,7 @@ def camera_local(cam, px, py, pz):
             r[2] * x + r[5] * y + r[8] * z)
 
 
-@kernel
+@kernel(allocates=False)
 def camera_space(cam, px, py, pz):
     """Camera coordinates of a world point (zeros without a camera)."""
     if cam.shape[0] < N_CAM:
@@ -32,7 +32,7 @@ def camera_space(cam, px, py, pz):
     return x, y, -z
 
 
-@kernel
+@kernel(allocates=False)
 def window(cam, px, py, pz):
     """Window coordinates of a world point (zeros without a camera, or for a point in
     the plane of a perspective camera's eye)."""

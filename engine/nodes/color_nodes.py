@@ -46,7 +46,7 @@ BLEND_MODES = ("MIX", "DARKEN", "MULTIPLY", "BURN", "LIGHTEN", "SCREEN", "DODGE"
 RAMP_TABLE_SIZE = 256
 
 
-@kernel
+@kernel(allocates=False)
 def rgb_to_hsv(r, g, b):
     cmax = max(r, g, b)
     cmin = min(r, g, b)
@@ -68,7 +68,7 @@ def rgb_to_hsv(r, g, b):
     return h, s, v
 
 
-@kernel
+@kernel(allocates=False)
 def hsv_to_rgb(h, s, v):
     if s == 0.0:
         return v, v, v
@@ -93,12 +93,12 @@ def hsv_to_rgb(h, s, v):
     return v, p, q
 
 
-@kernel
+@kernel(allocates=False)
 def _lerp(a, b, t):
     return (1.0 - t) * a + t * b
 
 
-@kernel
+@kernel(allocates=False)
 def _dodge(a, b, t):
     if a == 0.0:
         return a
@@ -109,7 +109,7 @@ def _dodge(a, b, t):
     return 1.0 if tmp > 1.0 else tmp
 
 
-@kernel
+@kernel(allocates=False)
 def _burn(a, b, t):
     tmp = (1.0 - t) + t * b
     if tmp <= 0.0:
@@ -118,14 +118,14 @@ def _burn(a, b, t):
     return min(max(tmp, 0.0), 1.0)
 
 
-@kernel
+@kernel(allocates=False)
 def _overlay(a, b, t):
     if a < 0.5:
         return a * ((1.0 - t) + 2.0 * t * b)
     return 1.0 - ((1.0 - t) + 2.0 * t * (1.0 - b)) * (1.0 - a)
 
 
-@kernel
+@kernel(allocates=False)
 def _channel(mode, a, b, t):
     """The per-channel blend modes."""
     if mode == 0:
@@ -163,7 +163,7 @@ def _channel(mode, a, b, t):
     return a
 
 
-@kernel
+@kernel(allocates=False)
 def mix(mode, t, r1, g1, b1, r2, g2, b2):
     if mode < 15:
         return (_channel(mode, r1, r2, t), _channel(mode, g1, g2, t),
@@ -182,7 +182,7 @@ def mix(mode, t, r1, g1, b1, r2, g2, b2):
     return hsv_to_rgb(h1, s1, (1.0 - t) * v1 + t * v2)     # VALUE
 
 
-@kernel
+@kernel(allocates=False)
 def ramp(data, start, f, interpolate, channel):
     """Cycles' rgb_ramp_lookup (no extrapolation) of one RGBA channel."""
     n = RAMP_TABLE_SIZE
@@ -197,7 +197,7 @@ def ramp(data, start, f, interpolate, channel):
     return v
 
 
-@kernel
+@kernel(allocates=False)
 def extrapolated(data, start, f, channel):
     """Cycles' rgb_ramp_lookup with extrapolation: linear beyond [0, 1] from the end
     entries' slope, interpolated inside."""
@@ -213,7 +213,7 @@ def extrapolated(data, start, f, channel):
     return ramp(data, start, f, 1, channel)
 
 
-@kernel
+@kernel(allocates=False)
 def tabulated(data, start, x, channel):
     """Channel `channel` of the COL_TABLE table at `start`, at x (0 for NaN)."""
     x0, x1, n = data[start], data[start + 1], int(data[start + 2])

@@ -223,7 +223,7 @@ def set_undisplaced(hit, objects, obj, x, y, z):
     hit[H_UNDISPLACED + 3], hit[H_UNDISPLACED + 4], hit[H_UNDISPLACED + 5] = x, y, z
 
 
-@kernel
+@kernel(allocates=False)
 def path_fields(hit, counts, used, p, footprint):
     """The path's fields of a hit row: path p's diffuse, glossy and transmission bounces
     (counts[p]), its transparent ones (used[p]) and the ray's footprint at the hit."""

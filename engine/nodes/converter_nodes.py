@@ -50,12 +50,12 @@ MAP_RANGE_TYPES = ("LINEAR", "STEPPED", "SMOOTHSTEP", "SMOOTHERSTEP")
 LUM_R, LUM_G, LUM_B = (float(x) for x in LUMINANCE)
 
 
-@kernel
+@kernel(allocates=False)
 def safe_divide(a, b):
     return a / b if b != 0.0 else 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def smoothmin(a, b, c):
     if c != 0.0:
         h = max(c - abs(a - b), 0.0) / c
@@ -63,7 +63,7 @@ def smoothmin(a, b, c):
     return min(a, b)
 
 
-@kernel
+@kernel(allocates=False)
 def wrap(value, hi, lo):
     rng = hi - lo
     if rng != 0.0:
@@ -71,19 +71,19 @@ def wrap(value, hi, lo):
     return lo
 
 
-@kernel
+@kernel(allocates=False)
 def fract(x):
     return x - math.floor(x)
 
 
-@kernel
+@kernel(allocates=False)
 def pingpong(a, b):
     if b != 0.0:
         return abs(fract((a - b) / (b * 2.0)) * b * 2.0 - b)
     return 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def safe_modulo(a, b):
     if b == 0.0:
         return 0.0
@@ -91,7 +91,7 @@ def safe_modulo(a, b):
     return -r if a < 0.0 else r
 
 
-@kernel
+@kernel(allocates=False)
 def math_op(op, a, b, c):
     """Cycles' svm_math of operation MATH_OPS[op] (the safe variants: no NaN from a
     division by zero, a negative root or logarithm)."""
@@ -184,7 +184,7 @@ def math_op(op, a, b, c):
     return a * (180.0 / math.pi)
 
 
-@kernel
+@kernel(allocates=False)
 def smoothstep(e0, e1, x):
     if x < e0:
         return 0.0
@@ -194,13 +194,13 @@ def smoothstep(e0, e1, x):
     return t * t * (3.0 - 2.0 * t)
 
 
-@kernel
+@kernel(allocates=False)
 def smootherstep(e0, e1, x):
     x = min(max(safe_divide(x - e0, e1 - e0), 0.0), 1.0)
     return x * x * x * (x * (x * 6.0 - 15.0) + 10.0)
 
 
-@kernel
+@kernel(allocates=False)
 def map_range(value, fmin, fmax, tmin, tmax, steps, kind, clamp):
     if fmax == fmin:
         return 0.0
@@ -221,7 +221,7 @@ def map_range(value, fmin, fmax, tmin, tmax, steps, kind, clamp):
     return result
 
 
-@kernel
+@kernel(allocates=False)
 def _hue_to_rgb(p, q, t):
     if t < 0.0:
         t += 1.0
@@ -236,7 +236,7 @@ def _hue_to_rgb(p, q, t):
     return p
 
 
-@kernel
+@kernel(allocates=False)
 def rgb_to_hsl(r, g, b):
     cmax, cmin = max(r, g, b), min(r, g, b)
     l = min((cmax + cmin) * 0.5, 1.0)
@@ -253,7 +253,7 @@ def rgb_to_hsl(r, g, b):
     return h / 6.0, s, l
 
 
-@kernel
+@kernel(allocates=False)
 def hsl_to_rgb(h, s, l):
     if s == 0.0:
         return l, l, l

@@ -30,7 +30,7 @@ from .context import (H_CAMERA, H_COLOR, H_DX, H_DY, H_FOOTPRINT, H_GENERATED, H
                       O_TEX_SIZE, O_TO_OBJECT, to_world_direction)
 
 
-@kernel
+@kernel(allocates=False)
 def _step(ax, ay, az, bx, by, bz):
     ln = math.sqrt(ax * ax + ay * ay + az * az)
     lx = ax / ln - bx
@@ -39,7 +39,7 @@ def _step(ax, ay, az, bx, by, bz):
     return math.sqrt(lx * lx + ly * ly + lz * lz)
 
 
-@kernel
+@kernel(allocates=False)
 def camera_cone(cam, dx, dy, dz):
     """(footprint at the ray's origin, spread) of a camera ray of world direction d
     (unit) starting at the near clip plane; (0, 0) without a camera."""
@@ -72,19 +72,19 @@ def camera_cones(cam, dirs):
     return out
 
 
-@kernel
+@kernel(allocates=False)
 def cone_at(cone, p, t):
     """The footprint of path p's ray at distance t (cone: (n, 2) per path)."""
     return cone[p, 0] + cone[p, 1] * t
 
 
-@kernel
+@kernel(allocates=False)
 def cone_moves(cone, p, t):
     """Path p's next ray starts where its ray hit, at distance t."""
     cone[p, 0] += cone[p, 1] * t
 
 
-@kernel
+@kernel(allocates=False)
 def _barycentric_step(e1x, e1y, e1z, e2x, e2y, e2z, sx, sy, sz):
     """(b1, b2) with e1 b1 + e2 b2 the projection of the step s onto the triangle's plane
     (edges e1, e2)."""
@@ -99,7 +99,7 @@ def _barycentric_step(e1x, e1y, e1z, e2x, e2y, e2z, sx, sy, sz):
     return (a22 * r1 - a12 * r2) / det, (a11 * r2 - a12 * r1) / det
 
 
-@kernel
+@kernel(allocates=False)
 def _corner_step(corners, prim, k, b1, b2):
     """The change of a per-corner attribute (column k) over barycentric steps b1, b2."""
     c = corners[prim]
@@ -169,7 +169,7 @@ def _fill_step(hit, block, geometry, prim, obj, placed, camera, sx, sy, sz):
         hit[block + H_WINDOW + 1] = wy - hit[H_WINDOW + 1]
 
 
-@kernel
+@kernel(allocates=False)
 def orthonormals(nx, ny, nz):
     """Cycles' make_orthonormals as Blender 5.0 has it: a = (1, 1, 1) x n (or
     (-1, 1, 1) x n when the components are equal), normalised, and b = n x a. (Not the

@@ -23,12 +23,12 @@ SEED = 0xDEADBEEF
 INV_2_32 = 1.0 / 4294967296.0     # float(0xFFFFFFFF) rounds to 2^32 in float32
 
 
-@kernel
+@kernel(allocates=False)
 def rot(x, k):
     return ((x << k) | (x >> (32 - k))) & M32
 
 
-@kernel
+@kernel(allocates=False)
 def mix(a, b, c):
     """lookup3's mix(a, b, c)."""
     a = ((a - c) & M32) ^ rot(c, 4)
@@ -46,7 +46,7 @@ def mix(a, b, c):
     return a, b, c
 
 
-@kernel
+@kernel(allocates=False)
 def final(a, b, c):
     """lookup3's final(a, b, c): the mixed c."""
     c = ((c ^ b) - rot(b, 14)) & M32
@@ -59,83 +59,83 @@ def final(a, b, c):
     return c
 
 
-@kernel
+@kernel(allocates=False)
 def hash_uint(kx):
     a = (SEED + (1 << 2) + 13) & M32
     return final((a + kx) & M32, a, a)
 
 
-@kernel
+@kernel(allocates=False)
 def hash_uint2(kx, ky):
     a = (SEED + (2 << 2) + 13) & M32
     return final((a + kx) & M32, (a + ky) & M32, a)
 
 
-@kernel
+@kernel(allocates=False)
 def hash_uint3(kx, ky, kz):
     a = (SEED + (3 << 2) + 13) & M32
     return final((a + kx) & M32, (a + ky) & M32, (a + kz) & M32)
 
 
-@kernel
+@kernel(allocates=False)
 def hash_uint4(kx, ky, kz, kw):
     s = (SEED + (4 << 2) + 13) & M32
     a, b, c = mix((s + kx) & M32, (s + ky) & M32, (s + kz) & M32)
     return final((a + kw) & M32, b, c)
 
 
-@kernel
+@kernel(allocates=False)
 def float_bits(x):
     """The bit pattern of x rounded to float32, as a non-negative int."""
     return np.int64(np.float32(x).view(np.uint32))
 
 
-@kernel
+@kernel(allocates=False)
 def uint_to_float(n):
     """[0, 2^32) -> [0, 1] as Cycles' uint_to_float_incl: float32(n) / 2^32."""
     return float(np.float32(n)) * INV_2_32
 
 
-@kernel
+@kernel(allocates=False)
 def hash_float_to_float(x):
     return uint_to_float(hash_uint(float_bits(x)))
 
 
-@kernel
+@kernel(allocates=False)
 def hash_float2_to_float(x, y):
     return uint_to_float(hash_uint2(float_bits(x), float_bits(y)))
 
 
-@kernel
+@kernel(allocates=False)
 def hash_float3_to_float(x, y, z):
     return uint_to_float(hash_uint3(float_bits(x), float_bits(y), float_bits(z)))
 
 
-@kernel
+@kernel(allocates=False)
 def hash_float4_to_float(x, y, z, w):
     return uint_to_float(hash_uint4(float_bits(x), float_bits(y), float_bits(z),
                                     float_bits(w)))
 
 
-@kernel
+@kernel(allocates=False)
 def hash_float1_to_float3(x):
     return (hash_float_to_float(x), hash_float2_to_float(x, 1.0),
             hash_float2_to_float(x, 2.0))
 
 
-@kernel
+@kernel(allocates=False)
 def hash_float2_to_float3(x, y):
     return (hash_float2_to_float(x, y), hash_float3_to_float(x, y, 1.0),
             hash_float3_to_float(x, y, 2.0))
 
 
-@kernel
+@kernel(allocates=False)
 def hash_float3_to_float3(x, y, z):
     return (hash_float3_to_float(x, y, z), hash_float4_to_float(x, y, z, 1.0),
             hash_float4_to_float(x, y, z, 2.0))
 
 
-@kernel
+@kernel(allocates=False)
 def hash_float4_to_float3(x, y, z, w):
     return (hash_float4_to_float(x, y, z, w), hash_float4_to_float(z, x, w, y),
             hash_float4_to_float(w, z, y, x))
@@ -147,18 +147,18 @@ PCG_C = 1013904223
 INV_2_31 = 1.0 / 2147483648.0     # float(0x7FFFFFFF) rounds to 2^31 in float32
 
 
-@kernel
+@kernel(allocates=False)
 def i32(x):
     """x wrapped to a signed 32-bit integer."""
     return ((x + 0x80000000) & M32) - 0x80000000
 
 
-@kernel
+@kernel(allocates=False)
 def pcg_to_float(h):
     return float(np.float32(h & 0x7FFFFFFF)) * INV_2_31
 
 
-@kernel
+@kernel(allocates=False)
 def hash_int2_to_float2(x, y):
     x = i32(x * PCG_A + PCG_C)
     y = i32(y * PCG_A + PCG_C)
@@ -170,7 +170,7 @@ def hash_int2_to_float2(x, y):
     return pcg_to_float(x), pcg_to_float(y)
 
 
-@kernel
+@kernel(allocates=False)
 def hash_int3_to_float3(x, y, z):
     x = i32(x * PCG_A + PCG_C)
     y = i32(y * PCG_A + PCG_C)
@@ -184,7 +184,7 @@ def hash_int3_to_float3(x, y, z):
     return pcg_to_float(x), pcg_to_float(y), pcg_to_float(z)
 
 
-@kernel
+@kernel(allocates=False)
 def hash_int4_to_float4(x, y, z, w):
     x = i32(x * PCG_A + PCG_C)
     y = i32(y * PCG_A + PCG_C)

@@ -24,7 +24,7 @@ IN_LAYER_FRESNEL = 4
 IN_LAYER_FACING = 5
 
 
-@kernel
+@kernel(allocates=False)
 def fresnel_dielectric_cos(cosi, eta):
     """Unpolarised Fresnel reflectance of a dielectric of relative IOR eta at cos(angle)
     cosi (total internal reflection: 1), as Cycles' node functions compute it."""

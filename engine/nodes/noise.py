@@ -29,24 +29,24 @@ MULTIFRACTAL, FBM, HYBRID_MULTIFRACTAL, RIDGED_MULTIFRACTAL, HETERO_TERRAIN = ra
 NOISE_SCALE = (0.0, 0.25, 0.6616, 0.9820, 0.8344)     # per dimension (OSL's constants)
 
 
-@kernel
+@kernel(allocates=False)
 def fade(t):
     return t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
 
 
-@kernel
+@kernel(allocates=False)
 def lerp(a, b, t):
     return (1.0 - t) * a + t * b
 
 
-@kernel
+@kernel(allocates=False)
 def grad1(h, x):
     h = h & 15
     g = 1.0 + (h & 7)
     return -g * x if h & 8 else g * x
 
 
-@kernel
+@kernel(allocates=False)
 def grad2(h, x, y):
     h = h & 7
     u = x if h < 4 else y
@@ -54,7 +54,7 @@ def grad2(h, x, y):
     return (-u if h & 1 else u) + (-v if h & 2 else v)
 
 
-@kernel
+@kernel(allocates=False)
 def grad3(h, x, y, z):
     h = h & 15
     u = x if h < 8 else y
@@ -62,7 +62,7 @@ def grad3(h, x, y, z):
     return (-u if h & 1 else u) + (-v if h & 2 else v)
 
 
-@kernel
+@kernel(allocates=False)
 def grad4(h, x, y, z, w):
     h = h & 31
     u = x if h < 24 else y
@@ -71,7 +71,7 @@ def grad4(h, x, y, z, w):
     return (-u if h & 1 else u) + (-v if h & 2 else v) + (-s if h & 4 else s)
 
 
-@kernel
+@kernel(allocates=False)
 def perlin(dim, x, y, z, w):
     """Unscaled Perlin noise of the point's first `dim` coordinates."""
     fx, fy, fz, fw = math.floor(x), math.floor(y), math.floor(z), math.floor(w)
@@ -111,7 +111,7 @@ def perlin(dim, x, y, z, w):
     return r
 
 
-@kernel
+@kernel(allocates=False)
 def snoise(dim, x, y, z, w):
     """Signed noise, about [-1, 1]."""
     r = perlin(dim, np.fmod(x, 100000.0), np.fmod(y, 100000.0), np.fmod(z, 100000.0),
@@ -119,7 +119,7 @@ def snoise(dim, x, y, z, w):
     return NOISE_SCALE[dim] * r
 
 
-@kernel
+@kernel(allocates=False)
 def fbm(dim, x, y, z, w, detail, roughness, lacunarity, normalize):
     fscale = 1.0
     amp = 1.0
@@ -139,7 +139,7 @@ def fbm(dim, x, y, z, w, detail, roughness, lacunarity, normalize):
     return 0.5 * total / maxamp + 0.5 if normalize else total
 
 
-@kernel
+@kernel(allocates=False)
 def multi_fractal(dim, x, y, z, w, detail, roughness, lacunarity):
     value = 1.0
     pwr = 1.0
@@ -153,7 +153,7 @@ def multi_fractal(dim, x, y, z, w, detail, roughness, lacunarity):
     return value
 
 
-@kernel
+@kernel(allocates=False)
 def hetero_terrain(dim, x, y, z, w, detail, roughness, lacunarity, offset):
     pwr = roughness
     value = offset + snoise(dim, x, y, z, w)
@@ -168,7 +168,7 @@ def hetero_terrain(dim, x, y, z, w, detail, roughness, lacunarity, offset):
     return value
 
 
-@kernel
+@kernel(allocates=False)
 def hybrid_multi_fractal(dim, x, y, z, w, detail, roughness, lacunarity, offset, gain):
     pwr = 1.0
     value = 0.0
@@ -189,7 +189,7 @@ def hybrid_multi_fractal(dim, x, y, z, w, detail, roughness, lacunarity, offset,
     return value
 
 
-@kernel
+@kernel(allocates=False)
 def ridged_multi_fractal(dim, x, y, z, w, detail, roughness, lacunarity, offset, gain):
     pwr = roughness
     signal = offset - abs(snoise(dim, x, y, z, w))
@@ -206,7 +206,7 @@ def ridged_multi_fractal(dim, x, y, z, w, detail, roughness, lacunarity, offset,
     return value
 
 
-@kernel
+@kernel(allocates=False)
 def fractal(kind, dim, x, y, z, w, detail, roughness, lacunarity, offset, gain, normalize):
     """The Noise Texture's fractal of type `kind` (FRACTAL_TYPES index)."""
     if kind == MULTIFRACTAL:
@@ -222,7 +222,7 @@ def fractal(kind, dim, x, y, z, w, detail, roughness, lacunarity, offset, gain, 
     return fbm(dim, x, y, z, w, detail, roughness, lacunarity, normalize)
 
 
-@kernel
+@kernel(allocates=False)
 def random_offset(dim, seed, k):
     """Component k of Cycles' random_float{dim}_offset(seed): in [100, 200]."""
     if dim == 1:
@@ -230,21 +230,21 @@ def random_offset(dim, seed, k):
     return 100.0 + hash_float2_to_float(seed, float(k)) * 100.0
 
 
-@kernel
+@kernel(allocates=False)
 def offset_point(dim, seed, x, y, z, w):
     return (x + random_offset(dim, seed, 0), y + random_offset(dim, seed, 1) if dim > 1 else y,
             z + random_offset(dim, seed, 2) if dim > 2 else z,
             w + random_offset(dim, seed, 3) if dim > 3 else w)
 
 
-@kernel
+@kernel(allocates=False)
 def distorted(dim, k, x, y, z, w):
     """The noise that distorts coordinate k of the point (at random offset k)."""
     ox, oy, oz, ow = offset_point(dim, float(k), x, y, z, w)
     return snoise(dim, ox, oy, oz, ow)
 
 
-@kernel
+@kernel(allocates=False)
 def noise_texture(dim, x, y, z, w, detail, roughness, lacunarity, offset, gain, distortion,
                   kind, normalize, color):
     """The Noise Texture node on an already scaled point: (Fac, r, g, b); the colour is

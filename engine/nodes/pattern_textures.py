@@ -25,7 +25,7 @@ WAVE_MAX_DETAIL = 64.0       # octaves past float32's precision long before this
 
 
 # ---------------------------------------------------------------- white noise
-@kernel
+@kernel(allocates=False)
 def white_noise(dim, x, y, z, w, color):
     """White Noise's Color (color) or (Value, 0, 0); a 1D point is w, 2D (x, y), 3D
     (x, y, z), 4D all four."""
@@ -42,7 +42,7 @@ def white_noise(dim, x, y, z, w, color):
 
 
 # ---------------------------------------------------------------- wave
-@kernel
+@kernel(allocates=False)
 def wave(kind, bands_direction, rings_direction, profile, x, y, z, distortion, detail,
          detail_scale, detail_roughness, phase):
     """The Wave Texture's Fac at a point already multiplied by its Scale."""
@@ -77,7 +77,7 @@ def wave(kind, bands_direction, rings_direction, profile, x, y, z, distortion, d
 
 
 # ---------------------------------------------------------------- magic
-@kernel
+@kernel(allocates=False)
 def magic(x, y, z, scale, depth, distortion):
     """The Magic Texture's colour (Fac is its average)."""
     two_pi = 2.0 * math.pi
@@ -115,7 +115,7 @@ def magic(x, y, z, scale, depth, distortion):
 
 
 # ---------------------------------------------------------------- brick
-@kernel
+@kernel(allocates=False)
 def brick_noise(n):
     """Cycles' integer noise of a brick's number: [0, 1)."""
     n = (n + 1013) & 0x7FFFFFFF
@@ -125,7 +125,7 @@ def brick_noise(n):
     return 0.5 * (nn / 1073741824.0)
 
 
-@kernel
+@kernel(allocates=False)
 def brick(x, y, mortar_size, mortar_smooth, bias, brick_width, row_height, offset_amount,
           offset_frequency, squash_amount, squash_frequency):
     """(tint, mortar) of the Brick Texture at a point already multiplied by its Scale."""

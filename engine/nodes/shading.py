@@ -126,7 +126,7 @@ def program_alpha(T, m, regs, a):
     return min(max(regs[k], 0.0), 1.0)
 
 
-@kernel
+@kernel(allocates=False)
 def valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z):
     """Cycles' ensure_valid_specular_reflection: the normal n (unit) tilted towards the
     geometric normal g (facing the viewer I) just enough that I mirrored about it leaves
@@ -178,7 +178,7 @@ def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz, correct):
     return vx, vy, vz, x, y, z
 
 
-@kernel
+@kernel(allocates=False)
 def normal_rows(T, material, regs, ns, ng, incoming, correct):
     """`program_normal` (its specular normal) for hits given as arrays, for the NumPy
     reference: (n, 3). correct: each hit's Bump Map Correction."""
@@ -207,7 +207,7 @@ def bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz, softe
     return fr * k, fg * k, fb * k
 
 
-@kernel
+@kernel(allocates=False)
 def bump_rejects(sx, sy, sz, nx, ny, nz, lx, ly, lz):
     """Cycles 5.0's test of a lobe on a normal n that is not the surface's own shading
     normal s: light from direction l is refused when l and n lie on opposite sides of
@@ -221,7 +221,7 @@ def bump_rejects(sx, sy, sz, nx, ny, nz, lx, ly, lz):
     return s_l * s_n * n_l < 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def bump_shadowing(sx, sy, sz, nx, ny, nz, lx, ly, lz, soften):
     """Cycles 5.0's bump_shadowing_term for a diffuse lobe on a normal n bent away from the
     surface's shading normal s (Conty Estevez, Lecocq and Stein, "A Microfacet-Based

@@ -41,7 +41,7 @@ GRADIENT_TYPES = ("LINEAR", "QUADRATIC", "EASING", "DIAGONAL", "SPHERICAL",
                   "QUADRATIC_SPHERE", "RADIAL")
 
 
-@kernel
+@kernel(allocates=False)
 def checker(x, y, z, scale):
     """1 on the first colour's squares, 0 on the second's (Cycles' svm_checker)."""
     x = (x * scale + 0.000001) * 0.999999
@@ -53,7 +53,7 @@ def checker(x, y, z, scale):
     return 1.0 if (xi % 2 == yi % 2) == (zi % 2 == 1) else 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def gradient(x, y, z, kind):
     if kind == 0:                      # LINEAR
         r = x
@@ -76,7 +76,7 @@ def gradient(x, y, z, kind):
     return min(max(r, 0.0), 1.0)
 
 
-@kernel
+@kernel(allocates=False)
 def execute(ins, regs, T):
     code, out = ins[0], ins[1]
     v = ins[2]

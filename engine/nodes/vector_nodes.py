@@ -33,7 +33,7 @@ VALUE_OPS = ("DOT_PRODUCT", "DISTANCE", "LENGTH")
 MAPPING_TYPES = ("POINT", "TEXTURE", "VECTOR", "NORMAL")
 
 
-@kernel
+@kernel(allocates=False)
 def _normalize(x, y, z):
     ln = math.sqrt(x * x + y * y + z * z)
     if ln > 0.0:
@@ -48,12 +48,12 @@ _AS_MATH = np.array([MATH_OPS.index(o) if o in MATH_OPS else
                     np.int64)
 
 
-@kernel
+@kernel(allocates=False)
 def _component(op, a, b, c):
     return math_op(_AS_MATH[op], a, b, c)
 
 
-@kernel
+@kernel(allocates=False)
 def vector_math(op, ax, ay, az, bx, by, bz, cx, cy, cz, s):
     """(vector, value) of Cycles' svm_vector_math for operation VECTOR_OPS[op]."""
     if op == 5:
@@ -94,7 +94,7 @@ def vector_math(op, ax, ay, az, bx, by, bz, cx, cy, cz, s):
             _component(op, az, bz, cz), 0.0)
 
 
-@kernel
+@kernel(allocates=False)
 def euler_rows(rx, ry, rz):
     """The rotation matrix of Euler XYZ angles (X applied first), row-major."""
     c1, c2, c3 = math.cos(rx), math.cos(ry), math.cos(rz)
@@ -104,7 +104,7 @@ def euler_rows(rx, ry, rz):
             -s2, c2 * s1, c2 * c1)
 
 
-@kernel
+@kernel(allocates=False)
 def mapping(kind, x, y, z, lx, ly, lz, rx, ry, rz, sx, sy, sz):
     m = euler_rows(rx, ry, rz)
     if kind == 1:                             # TEXTURE: the inverse of POINT
@@ -127,7 +127,7 @@ def mapping(kind, x, y, z, lx, ly, lz, rx, ry, rz, sx, sy, sz):
     return tx, ty, tz
 
 
-@kernel
+@kernel(allocates=False)
 def normal_map(hit, cr, cg, cb, strength):
     """Cycles' tangent-space normal map: the colour (2c - 1) in the frame of the tangent,
     sign x N x T and the interpolated normal N (un-flipped for the maths, flipped back on
@@ -156,7 +156,7 @@ def normal_map(hit, cr, cg, cb, strength):
     return x, y, z
 
 
-@kernel
+@kernel(allocates=False)
 def execute(ins, regs, hit):
     code, out = ins[0], ins[1]
     if code == VEC_MATH or code == VEC_MATH_VALUE:

@@ -31,7 +31,7 @@ EUCLIDEAN, MANHATTAN, CHEBYCHEV, MINKOWSKI = range(4)
 FLT_MAX = 3.4028234663852886e38
 
 
-@kernel
+@kernel(allocates=False)
 def cell_point(dim, x, y, z, w):
     """The jitter in [0, 1]^dim of the cell at integer coordinates (x, y, z, w) (floats):
     1D hashes the float cell, 2D-4D their integers (PCG)."""
@@ -46,7 +46,7 @@ def cell_point(dim, x, y, z, w):
     return hash_int4_to_float4(int(x), int(y), int(z), int(w))
 
 
-@kernel
+@kernel(allocates=False)
 def neighbour_point(dim, randomness, cx, cy, cz, cw, i, j, k, u):
     """The point of the cell at offset (i, j, k, u) from the cell (cx, cy, cz, cw),
     relative to that cell's corner."""
@@ -54,7 +54,7 @@ def neighbour_point(dim, randomness, cx, cy, cz, cw, i, j, k, u):
     return i + jx * randomness, j + jy * randomness, k + jz * randomness, u + jw * randomness
 
 
-@kernel
+@kernel(allocates=False)
 def cell_color(dim, x, y, z, w):
     """The colour of the cell at integer coordinates (x, y, z, w)."""
     if dim == 1:
@@ -67,7 +67,7 @@ def cell_color(dim, x, y, z, w):
     return a, b, c
 
 
-@kernel
+@kernel(allocates=False)
 def distance(dim, metric, exponent, dx, dy, dz, dw):
     """The length of (dx, dy, dz, dw)'s first dim components under `metric`."""
     if dim == 1:
@@ -87,13 +87,13 @@ def distance(dim, metric, exponent, dx, dy, dz, dw):
     return math.sqrt(ax * ax + ay * ay + az * az + aw * aw)
 
 
-@kernel
+@kernel(allocates=False)
 def reach(dim, axis, r):
     """The neighbourhood's extent along `axis`: r for a used axis, else 0."""
     return r if axis < dim else 0
 
 
-@kernel
+@kernel(allocates=False)
 def smoothstep01(x):
     if x < 0.0:
         return 0.0
@@ -102,7 +102,7 @@ def smoothstep01(x):
     return (3.0 - 2.0 * x) * (x * x)
 
 
-@kernel
+@kernel(allocates=False)
 def octave(dim, feature, metric, exponent, randomness, smoothness, x, y, z, w):
     """One octave of F1, F2 or Smooth F1 at a point: (distance, r, g, b, px, py, pz,
     pw), the position in the point's coordinates."""
@@ -157,7 +157,7 @@ def octave(dim, feature, metric, exponent, randomness, smoothness, x, y, z, w):
     return d1, cr, cg, cb, cx + p1[0], cy + p1[1], cz + p1[2], cw + p1[3]
 
 
-@kernel
+@kernel(allocates=False)
 def edge_1d(randomness, x):
     c = math.floor(x)
     lx = x - c
@@ -167,7 +167,7 @@ def edge_1d(randomness, x):
     return min(abs((mid + left) / 2.0 - lx), abs((mid + right) / 2.0 - lx))
 
 
-@kernel
+@kernel(allocates=False)
 def distance_to_edge(dim, randomness, x, y, z, w):
     """One octave of Distance to Edge."""
     if dim == 1:
@@ -202,7 +202,7 @@ def distance_to_edge(dim, randomness, x, y, z, w):
     return best
 
 
-@kernel
+@kernel(allocates=False)
 def n_sphere_radius(dim, randomness, x, y, z, w):
     cx, cy, cz, cw = math.floor(x), math.floor(y), math.floor(z), math.floor(w)
     lx, ly, lz, lw = x - cx, y - cy, z - cz, w - cw
@@ -237,12 +237,12 @@ def n_sphere_radius(dim, randomness, x, y, z, w):
     return distance(dim, EUCLIDEAN, 1.0, sx - qx, sy - qy, sz - qz, sw - qw) / 2.0
 
 
-@kernel
+@kernel(allocates=False)
 def lerp(a, b, t):
     return a + t * (b - a)
 
 
-@kernel
+@kernel(allocates=False)
 def fractal_features(dim, feature, metric, exponent, randomness, smoothness, detail,
                      roughness, lacunarity, x, y, z, w):
     """F1 / F2 / Smooth F1 summed over octaves: (distance, r, g, b, px, py, pz, pw, the
@@ -278,7 +278,7 @@ def fractal_features(dim, feature, metric, exponent, randomness, smoothness, det
     return d, cr, cg, cb, px, py, pz, pw, max_amp
 
 
-@kernel
+@kernel(allocates=False)
 def fractal_edge(dim, randomness, detail, roughness, lacunarity, max_distance, normalize,
                  x, y, z, w):
     amp = 1.0
@@ -302,7 +302,7 @@ def fractal_edge(dim, randomness, detail, roughness, lacunarity, max_distance, n
     return d / max_amp if normalize else d
 
 
-@kernel
+@kernel(allocates=False)
 def voronoi_texture(dim, feature, metric, normalize, x, y, z, w, scale, detail, roughness,
                     lacunarity, smoothness, exponent, randomness):
     """The Voronoi Texture node at a point already multiplied by `scale`: (Distance, r,

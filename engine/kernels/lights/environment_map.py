@@ -24,14 +24,14 @@ def has_map(L):
     return L[ENV_MAP][M_HAS] != 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def direction_to_uv(x, y, z):
     """engine.environment_map.direction_to_uv for one direction (any length > 0)."""
     theta = math.atan2(math.hypot(x, y), z)
     return 0.5 - math.atan2(y, x) / TWO_PI, 1.0 - theta / PI
 
 
-@kernel
+@kernel(allocates=False)
 def uv_to_direction(u, v):
     """engine.environment_map.uv_to_direction: (x, y, z, sin theta)."""
     phi = PI - TWO_PI * u
@@ -40,7 +40,7 @@ def uv_to_direction(u, v):
     return s * math.cos(phi), s * math.sin(phi), math.cos(theta), s
 
 
-@kernel
+@kernel(allocates=False)
 def _apply(m, base, x, y, z):
     """The 3x3 row-major matrix m[base:base + 9] times (x, y, z)."""
     return (m[base] * x + m[base + 1] * y + m[base + 2] * z,
@@ -62,14 +62,14 @@ def map_radiance(L, dx, dy, dz):
     return texture_radiance(L, 0, dx, dy, dz)
 
 
-@kernel
+@kernel(allocates=False)
 def seen_by_camera(L, dx, dy, dz):
     """What a camera ray sees of the map along one direction: the camera's own image
     where the world shows the camera another background (M_CAMERA), else the map's."""
     return texture_radiance(L, 1 if L[ENV_MAP][M_CAMERA] != 0.0 else 0, dx, dy, dz)
 
 
-@kernel
+@kernel(allocates=False)
 def texture_radiance(L, index, dx, dy, dz):
     """Image `index` of L[ENV_TEXTURE] along one direction, times the map's strength."""
     params = L[ENV_MAP]
@@ -79,7 +79,7 @@ def texture_radiance(L, index, dx, dy, dz):
     return (r * params[M_STRENGTH], g * params[M_STRENGTH + 1], b * params[M_STRENGTH + 2])
 
 
-@kernel
+@kernel(allocates=False)
 def invert_cdf(cdf, u, guide):
     """The inverse of one CDF row at u: (cell, offset in [0, 1]); the search
     starts from the row's guide (kernels.cdf_search), the same cell as a full search."""

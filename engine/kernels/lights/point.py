@@ -32,7 +32,7 @@ def spot_factor(lamps, k, dx, dy, dz):
     return 1.0 if c > cos_half else 0.0
 
 
-@kernel
+@kernel(allocates=False)
 def sphere_one_minus_cos(radius, d2):
     """1 - cos(theta_max) of the cone a sphere lamp subtends, without cancellation."""
     sin2 = radius * radius / (1e-300 if d2 < 1e-300 else d2)

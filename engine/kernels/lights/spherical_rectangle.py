@@ -40,13 +40,13 @@ from .pack import C_CORNER, C_LX, C_LY, C_XH, C_YH, C_ZH
 from ..warp import TWO_PI, clip, sign
 
 
-@kernel
+@kernel(allocates=False)
 def _corner(x, y, z, z2, s):
     """The corner's angle as a complex number (real, imaginary), any length."""
     return s * x * y, z * math.sqrt(x * x + y * y + z2)
 
 
-@kernel
+@kernel(allocates=False)
 def _times(ar, ai, br, bi):
     """a b, scaled so that its larger part is 1 (the argument is all that counts)."""
     r, i = ar * br - ai * bi, ar * bi + ai * br
@@ -85,7 +85,7 @@ def spherical_rectangle(lamps, k, px, py, pz):
     return x0, x1, y0, y1, zs, z, br / norm, -bi / norm, omega
 
 
-@kernel
+@kernel(allocates=False)
 def _one_minus_plus(y, dd2):
     """(1 - h, 1 + h) for h = y / sqrt(dd2 + y^2), each without cancellation."""
     r = math.sqrt(dd2 + y * y)

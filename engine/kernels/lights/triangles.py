@@ -16,7 +16,7 @@ from .pack import (TRI_AREA, TRI_E1, TRI_E2, TRI_ENTRY, TRI_NORMAL, TRI_RADIANCE
 GRAZING = 1e-9
 
 
-@kernel
+@kernel(allocates=False)
 def square_to_triangle(u0, u1):
     """Heitz's square-to-triangle map: edge weights (b1, b2), uniform in area."""
     if u1 > u0:
