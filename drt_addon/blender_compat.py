@@ -38,12 +38,12 @@ def prepare_corner_normals(mesh) -> None:
         mesh.calc_normals_split()
 
 
-# The index and environment passes' names: Blender 5.0 calls Cycles' IndexOB, IndexMA and
-# Env passes "Object Index", "Material Index" and "Environment" (the compositor's Render
-# Layers sockets follow the names).
-OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, ENVIRONMENT_PASS = (
-    ("Object Index", "Material Index", "Environment") if bpy.app.version >= (5, 0, 0)
-    else ("IndexOB", "IndexMA", "Env"))
+# The index, environment and AO passes' names: Blender 5.0 calls Cycles' IndexOB, IndexMA,
+# Env and AO passes "Object Index", "Material Index", "Environment" and "Ambient
+# Occlusion" (the compositor's Render Layers sockets follow the names).
+OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, ENVIRONMENT_PASS, AO_PASS = (
+    ("Object Index", "Material Index", "Environment", "Ambient Occlusion")
+    if bpy.app.version >= (5, 0, 0) else ("IndexOB", "IndexMA", "Env", "AO"))
 
 # Blender 4.2+ takes a render pass's pixels as one flat buffer; 3.4 wants one row per pixel
 # (pixels, channels). Which release between changed it is not known here, so before 4.2 the

@@ -19,6 +19,8 @@ layer (Properties > View Layer > Passes):
   pixel's first camera sample hits, as Cycles writes them (sample 0 alone).
 - Environment (`use_pass_environment`; Env before Blender 5.0): the world as camera rays
   that hit nothing see it, as Cycles' Environment pass.
+- Ambient Occlusion (`use_pass_ambient_occlusion`; AO before Blender 5.0): Cycles' AO
+  pass, from the first hits (engine.ambient_occlusion).
 - Cryptomatte Object, Material and Asset (`use_pass_cryptomatte_*`, Levels:
   `pass_cryptomatte_depth`): CryptoObject00, 01, ... as Cycles writes them, (id,
   coverage) pairs of the names each pixel shows, with the manifest in the render
@@ -47,8 +49,8 @@ import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
 from . import denoise
-from .blender_compat import (ENVIRONMENT_PASS, MATERIAL_INDEX_PASS, OBJECT_INDEX_PASS,
-                             set_pass_pixels)
+from .blender_compat import (AO_PASS, ENVIRONMENT_PASS, MATERIAL_INDEX_PASS,
+                             OBJECT_INDEX_PASS, set_pass_pixels)
 from .render_passes import (CRYPTOMATTE, FIRST_HIT, PASSES, FirstHit, cryptomatte_passes,
                             enabled_passes)
 
@@ -285,7 +287,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                                         cancelled=lambda: self._polled("tracing"),
                                         compiling=compiling)
             image, alpha = film.mean(), film.mean_alpha()
-            first_hit = FirstHit(ctx, render_world(scene, view_layer), description)
+            first_hit = FirstHit(ctx, render_world(scene, view_layer), description,
+                                 ambient_occlusion=AO_PASS in enabled_passes(view_layer))
             if not stats.cancelled and denoise.wanted(scene, view_layer):
                 self.update_stats("", "DRT: denoising")
                 clean = denoise.denoised(scene, image, first_hit, reporter)
@@ -363,7 +366,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                            "Mist": first.mist, "Position": first.position, "UV": first.uv,
                            OBJECT_INDEX_PASS: first.object_index,
                            MATERIAL_INDEX_PASS: first.material_index,
-                           ENVIRONMENT_PASS: first.environment})
+                           ENVIRONMENT_PASS: first.environment,
+                           AO_PASS: first.ambient_occlusion})
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
         for name in wanted:

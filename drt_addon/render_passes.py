@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from importlib import import_module
 
-from .blender_compat import ENVIRONMENT_PASS, MATERIAL_INDEX_PASS, OBJECT_INDEX_PASS
+from .blender_compat import AO_PASS, ENVIRONMENT_PASS, MATERIAL_INDEX_PASS, OBJECT_INDEX_PASS
 
 
 # (name, channels, channel ids, type) of each pass DRT can write, and when it is enabled.
@@ -21,9 +21,10 @@ PASSES = {
     OBJECT_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_object_index),
     MATERIAL_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_material_index),
     ENVIRONMENT_PASS: (3, "RGB", "COLOR", lambda vl: vl.use_pass_environment),
+    AO_PASS: (3, "RGB", "COLOR", lambda vl: vl.use_pass_ambient_occlusion),
 }
 FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position",
-             "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, ENVIRONMENT_PASS)
+             "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, ENVIRONMENT_PASS, AO_PASS)
 
 
 CRYPTOMATTE = {"object": "Object", "material": "Material", "asset": "Asset"}
@@ -38,6 +39,16 @@ def cryptomatte_passes(view_layer) -> dict:
             if getattr(view_layer, f"use_pass_cryptomatte_{kind}", False)}
 
 
+def _ambient_occlusion(engine, world):
+    """World > Ambient Occlusion > Distance (Cycles' 10 m without a world) as
+    engine.ambient_occlusion.AmbientOcclusion."""
+    ao = import_module(engine.__name__ + ".ambient_occlusion")
+    light = getattr(world, "light_settings", None)
+    if light is None:
+        return ao.AmbientOcclusion()
+    return ao.AmbientOcclusion(distance=max(0.0, float(light.distance)))
+
+
 def _mist(aov, world):
     """World > Mist Pass (Blender's defaults without a world) as engine.aov.Mist."""
     m = getattr(world, "mist_settings", None)
@@ -49,16 +60,19 @@ def _mist(aov, world):
 
 class FirstHit:
     """engine.aov's first-hit passes of a render, computed on the first call (for the
-    passes, or for the denoiser's albedo and normal) and kept: (passes, camera matrix)."""
+    passes, or for the denoiser's albedo and normal) and kept: (passes, camera matrix).
+    The AO pass is computed with them when `ambient_occlusion` is set (its own rays)."""
 
-    def __init__(self, ctx, world, description):
+    def __init__(self, ctx, world, description, ambient_occlusion=False):
         self.ctx, self.world, self.description, self.passes = ctx, world, description, None
+        self.ambient_occlusion = ambient_occlusion
 
     def __call__(self):
         if self.passes is None:
             from .engine_link import engine
             aov = import_module(engine.__name__ + ".aov")   # in either package layout
-            self.passes = aov.first_hit_passes(self.ctx, mist=_mist(aov, self.world))
+            ao = _ambient_occlusion(engine, self.world) if self.ambient_occlusion else None
+            self.passes = aov.first_hit_passes(self.ctx, mist=_mist(aov, self.world), ao=ao)
         return self.passes, self.description.camera.matrix
 
 

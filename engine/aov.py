@@ -26,7 +26,9 @@ intersection each, no shading), with Cycles' meanings:
 - environment: what camera rays that hit nothing see of the world (Cycles'
   Environment pass: the background seen directly, as the camera sees it), averaged the
   same way; 0 where a sample hits a surface (through a transparent one too, which
-  Cycles looks through).
+  Cycles looks through);
+- ambient_occlusion, when asked for: Cycles' AO pass from the same hits
+  (engine.ambient_occlusion).
 Emitting lights (area and sphere lights) are not surfaces here: rays see through them.
 """
 from __future__ import annotations
@@ -35,6 +37,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .ambient_occlusion import occlusion
 from .camera import CameraModel
 from .render import camera_rays
 
@@ -74,6 +77,7 @@ class FirstHitPasses:
     object_index: np.ndarray = None    # (h, w) float64
     material_index: np.ndarray = None  # (h, w) float64
     environment: np.ndarray = None     # (h, w, 3) float64
+    ambient_occlusion: np.ndarray = None  # (h, w, 3) float64, when asked for
 
     def camera_normal(self, camera_matrix) -> np.ndarray:
         """The normal pass in camera space (x right, y up, z towards the viewer), as
@@ -105,7 +109,8 @@ def _world_seen(ctx, directions) -> np.ndarray:
 def sample_hits(ctx, k: int, chunk: int = 1 << 16):
     """The first hits of the first k camera samples of every pixel, a chunk at a time:
     (pixel and sample index of each sample, the samples that hit something, their
-    engine.surface.SurfaceHit or None when none did, the rays' directions)."""
+    engine.surface.SurfaceHit or None when none did, the rays' directions, the samples'
+    shutter times or None when nothing moves)."""
     n_pix = ctx.scene.width * ctx.scene.height
     per_chunk = max(1, chunk // k)
     for start in range(0, n_pix, per_chunk):
@@ -116,7 +121,7 @@ def sample_hits(ctx, k: int, chunk: int = 1 << 16):
         hits = _intersect(ctx, rays.origins, rays.directions, rays.tmax, time)
         hit = np.nonzero(hits.hit)[0]
         si = _build(ctx, hits, hit, rays.origins, rays.directions, time) if hit.size else None
-        yield pixel, index, hit, si, rays.directions
+        yield pixel, index, hit, si, rays.directions, time
 
 
 def cryptomatte(ctx, kinds, depth: int, samples: int = AOV_SAMPLES) -> dict:
@@ -129,7 +134,7 @@ def cryptomatte(ctx, kinds, depth: int, samples: int = AOV_SAMPLES) -> dict:
     k = int(max(1, min(samples, ctx.settings.samples)))
     w, h = ctx.scene.width, ctx.scene.height
     found = {kind: ([], []) for kind in kinds}
-    for pixel, _, hit, si, _ in sample_hits(ctx, k):
+    for pixel, _, hit, si, _, _ in sample_hits(ctx, k):
         if si is None:
             continue
         for kind in kinds:
@@ -146,9 +151,10 @@ def cryptomatte(ctx, kinds, depth: int, samples: int = AOV_SAMPLES) -> dict:
 
 
 def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
-                     mist: Mist = Mist()) -> FirstHitPasses:
+                     mist: Mist = Mist(), ao=None) -> FirstHitPasses:
     """Depth, normal, albedo, position, mist and UV passes for the scene of `ctx` (an
-    engine.RenderContext)."""
+    engine.RenderContext); with `ao` (an engine.ambient_occlusion.AmbientOcclusion) the
+    Ambient Occlusion pass too."""
     scene = ctx.scene
     width, height = scene.width, scene.height
     n_pix = width * height
@@ -187,7 +193,10 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
                              or [0.0])
     ortho = scene.camera.kind == "ORTHO"
     environment = np.zeros((n_pix, 3))
-    for pixel, index, hit, si, directions in sample_hits(ctx, k, chunk):
+    occluded = np.zeros((n_pix, 3)) if ao is not None else None
+    m = ao.rays_per_sample(ctx.settings.samples, k) if ao is not None else 0
+    for pixel, index, hit, si, directions, time in sample_hits(ctx, k, max(1, chunk // m)
+                                                               if m else chunk):
         missed = np.ones(len(pixel), bool)
         missed[hit] = False
         if missed.any():
@@ -197,6 +206,11 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
                                                  minlength=n_pix)
         if si is None:
             continue
+        if ao is not None:
+            seen = occlusion(ctx, ao, pixel[hit], index[hit], si,
+                             None if time is None else time[hit], m)
+            for c in range(3):
+                occluded[:, c] += np.bincount(pixel[hit], weights=seen[:, c], minlength=n_pix)
         for c in range(3):
             normal[:, c] += np.bincount(pixel[hit], weights=si.shading_normal[:, c],
                                         minlength=n_pix)
@@ -222,4 +236,5 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
                           (mist_sum / k).reshape(height, width), (uv / k).reshape(shape),
                           object_index.reshape(height, width),
                           material_index.reshape(height, width),
-                          (environment / k).reshape(shape))
+                          (environment / k).reshape(shape),
+                          None if ao is None else (occluded / k).reshape(shape))

@@ -71,7 +71,8 @@ _NULL_SCATTERING = ("DRT renders volumes without ray marching steps: homogeneous
 _SIMPLIFY = ("scene.render.use_simplify", (True,))
 _ADAPTIVE = ("scene.cycles.use_adaptive_sampling", (True,))
 WRITTEN_PASSES = ("Combined, Depth, Mist, Normal, Position, UV, Object Index, Material "
-                  "Index, Environment, Cryptomatte, Denoising Data and DRT Noise")
+                  "Index, Environment, Ambient Occlusion, Cryptomatte, Denoising Data and "
+                  "DRT Noise")
 _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
 
 # Render passes DRT does not write, as (path, label).
@@ -95,7 +96,6 @@ _UNWRITTEN_PASSES = [
     ("view_layer.cycles.use_pass_volume_transmit", "Volume Transmit"),
     ("view_layer.cycles.use_pass_volume_majorant", "Volume Majorant"),
     ("view_layer.use_pass_emit", "Emission"),
-    ("view_layer.use_pass_ambient_occlusion", "Ambient Occlusion"),
     ("view_layer.use_pass_shadow", "Shadow"),
     ("view_layer.cycles.use_pass_shadow_catcher", "Shadow Catcher"),
     ("view_layer.cycles.denoising_store_passes", "Denoising Data (Cycles')"),
@@ -162,6 +162,12 @@ SETTINGS: list[FileSetting] = [
     _s("view_layer.use_pass_environment", "Passes > Environment", READ,
        "written: the world as camera rays that hit nothing see it (Cycles' Environment; "
        "a sample through a transparent surface adds nothing)"),
+    _s("view_layer.use_pass_ambient_occlusion", "Passes > Ambient Occlusion", READ,
+       "written: the share of cosine-weighted directions from the first hit that reach "
+       "World > Ambient Occlusion > Distance unoccluded (Cycles' AO), min(samples, 64) "
+       "rays per pixel"),
+    _s("scene.world.light_settings.distance", "World > Ambient Occlusion > Distance", READ,
+       "read by the Ambient Occlusion pass (10 m without a world, as Cycles)"),
     _s("view_layer.use_pass_material_index", "Passes > Material Index", READ,
        "written: the Pass Index of the material the pixel's first sample hits (Cycles' "
        "IndexMA)"),

@@ -175,7 +175,7 @@ class CompiledPathIntegrator:
             layer += 1
         return found, factor, stopped
 
-    def _transmittance(self, org, dirs, far, time, stacks, keys):
+    def shadow_transmittance(self, org, dirs, far, time, stacks, keys):
         """Transmittance (n, 3) of shadow rays through transparent layers and volumes
         (stacks: each ray's volume stack, updated as it crosses boundaries; (0, STACK)
         without volumes); time: their shutter times (None when nothing moves); keys:
@@ -270,7 +270,7 @@ class CompiledPathIntegrator:
                 if self.any_transparent or self.skips_shadows or self.has_volumes:
                     keys = (shadow_keys(pkey, index, sh_path[:ns], depth)
                             if self.heterogeneous else no_keys)
-                    trans = self._transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns], sh_time,
+                    trans = self.shadow_transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns], sh_time,
                                                 sh_stack[:ns] if k else sh_stack, keys)
                     add_transmitted(L, sh_path[:ns], sh_contrib[:ns], trans, *clamps)
                 else:
