@@ -126,12 +126,13 @@ def write(rows, images, bpy):
         "Combined pass; the noisy one is kept as the Noisy Image pass. OIDN comes from the "
         "pinned `pyoidn` binding, which the extension zip bundles. The albedo and normal "
         "it is given are DRT's Denoising Albedo and Denoising Normal passes: the first "
-        "surface's diffuse albedo from its material's Base Color value and its "
-        "interpolated camera-space normal. Two differences from Cycles' guides are named "
-        "here and measured below: Cycles evaluates the material there (textures on Base "
-        "Color, bump and normal maps; the product shot's procedural backdrop and bumped "
-        "finishes), and it follows paths through mirror-like surfaces (roughness under "
-        "0.075) to the first rough one (the glass and metal scenes).",
+        "surface's diffuse albedo, its Base Color and Metallic as the path tracer "
+        "shades them there (textures and shader programs), and its interpolated "
+        "camera-space normal. Two differences from Cycles' guides are named here and "
+        "measured below: Cycles' normal is the material's (bump and normal maps; the "
+        "product shot's bumped finishes), and it follows paths through mirror-like "
+        "surfaces (roughness under 0.075) to the first rough one (the glass and metal "
+        "scenes).",
         "",
         f"Each scene scaled to {SIZE} pixels on its longer side (the size is beside its "
         "name), both engines denoised at Cycles' defaults. The error is against Cycles at "

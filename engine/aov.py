@@ -13,7 +13,8 @@ intersection each, no shading), with Cycles' meanings:
   nothing, so edge pixels are weighted by coverage as in Cycles;
 - albedo: the diffuse albedo of the Principled BSDF hit, base colour x (1 - metallic) x
   (1 - transmission), averaged the same way (what Cycles writes to Denoising Albedo for
-  a rough surface);
+  a rough surface); base colour and metallic as the path tracer shades them there, from
+  textures and shader programs (`hit_albedo`);
 - position: the world-space hit point, averaged the same way (Cycles' Position);
 - uv: (u, v, 1) of the hit's texture coordinates (the mesh's UVs, (0, 0) without any),
   averaged the same way, so the third channel is the pixel's coverage (Cycles' UV);
@@ -106,6 +107,47 @@ def _world_seen(ctx, directions) -> np.ndarray:
     return world_escaped_batch(integ.lights, integ.world, directions, CAMERA)[0]
 
 
+def _corner_lerp(corners: np.ndarray, prim: np.ndarray, bary: np.ndarray) -> np.ndarray:
+    """Per-corner values (T, 3, c) at barycentrics (u, v) of triangles prim: (n, c)."""
+    c = corners[prim].astype(np.float64)
+    u, v = bary[:, 0:1], bary[:, 1:2]
+    return (1.0 - u - v) * c[:, 0] + u * c[:, 1] + v * c[:, 2]
+
+
+def hit_albedo(ctx, si) -> np.ndarray:
+    """(n, 3) diffuse albedo at first hits `si`: base colour x (1 - metallic) x
+    (1 - transmission), base colour and metallic read as the path tracer reads them at
+    a camera hit (textures, and shader programs given the hit's position, normals, UV,
+    object, tangent and colour attribute: engine.nodes.shading.program_hit)."""
+    from .nodes.context import hit_rows
+    from .visibility import CAMERA
+    mats = ctx.materials
+    m = si.material
+    transmits = 1.0 - np.clip(mats.transmission[m], 0.0, 1.0)
+    if not any(name in mats.programmed or mats.textured.get(name, np.zeros(1)).any()
+               for name in ("base_color", "metallic")):
+        return mats.base_color[m] * ((1.0 - np.clip(mats.metallic[m], 0.0, 1.0))
+                                     * transmits)[:, None]
+    g = ctx.integrator.geometry
+    tri_object, objects, tangents, colors = g[8], g[9], g[10], g[11]
+    n = len(m)
+    prim = si.prim
+    bary = si.bary if si.bary is not None else np.zeros((n, 2))
+    inst = si.inst if si.inst is not None else np.full(n, -1, np.int64)
+    obj = np.where(inst >= 0, inst, tri_object[prim] if len(tri_object) else -1)
+    tangent = _corner_lerp(tangents, prim, bary) if len(tangents) else None
+    if tangent is not None:      # unit tangents and a bitangent sign (program_hit's)
+        tangent[:, :3] /= np.maximum(np.linalg.norm(tangent[:, :3], axis=1), 1e-30)[:, None]
+        tangent[:, 3] = np.sign(tangent[:, 3])
+    hits = hit_rows(si.position, si.shading_normal, si.geometric_normal, si.direction,
+                    si.uv, si.front_facing, ray=CAMERA, objects=objects, obj=obj,
+                    tangent=tangent,
+                    color=_corner_lerp(colors, prim, bary) if len(colors) else None)
+    base = mats.lookup("base_color", m, si.uv, hits)
+    metallic = mats.lookup("metallic", m, si.uv, hits)
+    return base * ((1.0 - np.clip(metallic, 0.0, 1.0)) * transmits)[:, None]
+
+
 def sample_hits(ctx, k: int, chunk: int = 1 << 16):
     """The first hits of the first k camera samples of every pixel, a chunk at a time:
     (pixel and sample index of each sample, the samples that hit something, their
@@ -159,9 +201,6 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
     width, height = scene.width, scene.height
     n_pix = width * height
     k = int(max(1, min(samples, ctx.settings.samples)))
-    mats = ctx.materials
-    diffuse = (mats.base_color * ((1.0 - np.clip(mats.metallic, 0.0, 1.0))
-                                  * (1.0 - np.clip(mats.transmission, 0.0, 1.0)))[:, None])
 
     # Depth: the pinhole ray through each pixel centre (the lens centre for a thin lens).
     pinhole = CameraModel(replace(scene.camera, aperture_radius=0.0), width, height,
@@ -211,10 +250,11 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
                              None if time is None else time[hit], m)
             for c in range(3):
                 occluded[:, c] += np.bincount(pixel[hit], weights=seen[:, c], minlength=n_pix)
+        hit_albedo_c = hit_albedo(ctx, si)
         for c in range(3):
             normal[:, c] += np.bincount(pixel[hit], weights=si.shading_normal[:, c],
                                         minlength=n_pix)
-            albedo[:, c] += np.bincount(pixel[hit], weights=diffuse[si.material, c],
+            albedo[:, c] += np.bincount(pixel[hit], weights=hit_albedo_c[:, c],
                                         minlength=n_pix)
             position[:, c] += np.bincount(pixel[hit], weights=si.position[:, c],
                                           minlength=n_pix)
