@@ -21,6 +21,9 @@ layer (Properties > View Layer > Passes):
   that hit nothing see it, as Cycles' Environment pass.
 - Ambient Occlusion (`use_pass_ambient_occlusion`; AO before Blender 5.0): Cycles' AO
   pass, from the first hits (engine.ambient_occlusion).
+- Shader AOVs (View Layer > Shader AOV): what the materials' AOV Output nodes say at
+  the first hits, a Color AOV as RGB and the share of samples that wrote it, a Value
+  AOV as one value (engine.shader_aovs).
 - Cryptomatte Object, Material and Asset (`use_pass_cryptomatte_*`, Levels:
   `pass_cryptomatte_depth`): CryptoObject00, 01, ... as Cycles writes them, (id,
   coverage) pairs of the names each pixel shows, with the manifest in the render
@@ -52,7 +55,7 @@ from . import denoise
 from .blender_compat import (AO_PASS, ENVIRONMENT_PASS, MATERIAL_INDEX_PASS,
                              OBJECT_INDEX_PASS, set_pass_pixels)
 from .render_passes import (CRYPTOMATTE, FIRST_HIT, PASSES, FirstHit, cryptomatte_passes,
-                            enabled_passes)
+                            enabled_passes, shader_aov_passes)
 
 # The tracer (engine: kernels compiled by Numba, Embree through its C API) and the export
 # are imported by the first DRT render, not when Blender registers the add-on: a Blender
@@ -163,6 +166,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         for names in cryptomatte_passes(renderlayer).values():
             for name in names:
                 self.register_pass(scene, renderlayer, name, 4, "RGBA", "COLOR")
+        for name, channels, chan_id, kind in shader_aov_passes(renderlayer):
+            self.register_pass(scene, renderlayer, name, channels, chan_id, kind)
 
     def render(self, depsgraph):
         from .export import ExportError
@@ -288,7 +293,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                                         compiling=compiling)
             image, alpha = film.mean(), film.mean_alpha()
             first_hit = FirstHit(ctx, render_world(scene, view_layer), description,
-                                 ambient_occlusion=AO_PASS in enabled_passes(view_layer))
+                                 ambient_occlusion=AO_PASS in enabled_passes(view_layer),
+                                 aovs=shader_aov_passes(view_layer))
             if not stats.cancelled and denoise.wanted(scene, view_layer):
                 self.update_stats("", "DRT: denoising")
                 clean = denoise.denoised(scene, image, first_hit, reporter)
@@ -299,7 +305,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                                         _rgba_bottom_up(noisy, alpha))
                     last_render["passes"][denoise.NOISY_PASS] = noisy
             set_pass_pixels(combined, _rgba_bottom_up(image, alpha))
-            extra = enabled_passes(view_layer) or cryptomatte_passes(view_layer)
+            extra = (enabled_passes(view_layer) or cryptomatte_passes(view_layer)
+                     or shader_aov_passes(view_layer))
             if not stats.cancelled and extra and self._polled("passes"):
                 stats.cancelled = True             # cancelled before the extra passes
                 last_render["cancelled_in"] = "passes"
@@ -354,7 +361,9 @@ class DRTRenderEngine(bpy.types.RenderEngine):
     def _write_passes(self, layer, ctx, film, view_layer, description, first_hit):
         wanted = [name for name in enabled_passes(view_layer)
                   if layer.passes.get(name) is not None]
-        if not wanted:
+        aovs = [row for row in shader_aov_passes(view_layer)
+                if layer.passes.get(row[0]) is not None]
+        if not wanted and not aovs:
             return
         images = {}
         if any(n in wanted for n in FIRST_HIT):
@@ -368,6 +377,13 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                            MATERIAL_INDEX_PASS: first.material_index,
                            ENVIRONMENT_PASS: first.environment,
                            AO_PASS: first.ambient_occlusion})
+        if aovs:
+            self.update_stats("", "DRT: shader AOVs")
+            first, _ = first_hit()
+            for name, channels, _, _ in aovs:
+                v = first.shader_aovs[name]          # (h, w, 4) RGBA or (h, w, 1)
+                images[name] = v[..., 0] if channels == 1 else v
+                wanted.append(name)
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
         for name in wanted:

@@ -61,19 +61,35 @@ def _mist(aov, world):
 class FirstHit:
     """engine.aov's first-hit passes of a render, computed on the first call (for the
     passes, or for the denoiser's albedo and normal) and kept: (passes, camera matrix).
-    The AO pass is computed with them when `ambient_occlusion` is set (its own rays)."""
+    The AO pass is computed with them when `ambient_occlusion` is set (its own rays),
+    and the shader AOV passes `aovs` (shader_aov_passes' rows)."""
 
-    def __init__(self, ctx, world, description, ambient_occlusion=False):
+    def __init__(self, ctx, world, description, ambient_occlusion=False, aovs=()):
         self.ctx, self.world, self.description, self.passes = ctx, world, description, None
         self.ambient_occlusion = ambient_occlusion
+        self.aovs = aovs            # shader_aov_passes' rows
 
     def __call__(self):
         if self.passes is None:
             from .engine_link import engine
             aov = import_module(engine.__name__ + ".aov")   # in either package layout
             ao = _ambient_occlusion(engine, self.world) if self.ambient_occlusion else None
-            self.passes = aov.first_hit_passes(self.ctx, mist=_mist(aov, self.world), ao=ao)
+            kinds = import_module(engine.__name__ + ".shader_aovs")
+            aovs = [kinds.AovPass(name, kind) for name, _, _, kind in self.aovs]
+            self.passes = aov.first_hit_passes(self.ctx, mist=_mist(aov, self.world), ao=ao,
+                                               aov_passes=aovs)
         return self.passes, self.description.camera.matrix
+
+
+def shader_aov_passes(view_layer) -> list:
+    """(name, channels, channel ids, type) of the view layer's valid shader AOVs, as
+    Cycles registers them: a Color AOV as RGBA, a Value AOV as one value."""
+    out = []
+    for aov in getattr(view_layer, "aovs", ()):
+        if aov.is_valid and aov.name:
+            out.append((aov.name, 4, "RGBA", "COLOR") if aov.type == "COLOR"
+                       else (aov.name, 1, "X", "VALUE"))
+    return out
 
 
 def _drt_layer(view_layer, name) -> bool:

@@ -29,7 +29,9 @@ intersection each, no shading), with Cycles' meanings:
   same way; 0 where a sample hits a surface (through a transparent one too, which
   Cycles looks through);
 - ambient_occlusion, when asked for: Cycles' AO pass from the same hits
-  (engine.ambient_occlusion).
+  (engine.ambient_occlusion);
+- shader_aovs, when asked for: the view layer's AOV passes, what the materials' AOV
+  Output nodes say at the same hits (engine.shader_aovs).
 Emitting lights (area and sphere lights) are not surfaces here: rays see through them.
 """
 from __future__ import annotations
@@ -40,6 +42,7 @@ import numpy as np
 
 from .ambient_occlusion import occlusion
 from .camera import CameraModel
+from .shader_aovs import aov_values
 from .render import camera_rays
 
 DEPTH_MISS = 1.0e10
@@ -79,6 +82,7 @@ class FirstHitPasses:
     material_index: np.ndarray = None  # (h, w) float64
     environment: np.ndarray = None     # (h, w, 3) float64
     ambient_occlusion: np.ndarray = None  # (h, w, 3) float64, when asked for
+    shader_aovs: dict = None     # {AOV name: (h, w, 4) RGBA or (h, w, 1)}, when asked for
 
     def camera_normal(self, camera_matrix) -> np.ndarray:
         """The normal pass in camera space (x right, y up, z towards the viewer), as
@@ -114,23 +118,15 @@ def _corner_lerp(corners: np.ndarray, prim: np.ndarray, bary: np.ndarray) -> np.
     return (1.0 - u - v) * c[:, 0] + u * c[:, 1] + v * c[:, 2]
 
 
-def hit_albedo(ctx, si) -> np.ndarray:
-    """(n, 3) diffuse albedo at first hits `si`: base colour x (1 - metallic) x
-    (1 - transmission), base colour and metallic read as the path tracer reads them at
-    a camera hit (textures, and shader programs given the hit's position, normals, UV,
-    object, tangent and colour attribute: engine.nodes.shading.program_hit)."""
+def first_hit_rows(ctx, si) -> np.ndarray:
+    """(n, engine.nodes.context.N_HIT) the hit rows shader programs read at first hits
+    `si` of camera rays, as the path tracer fills them there (the hit's position,
+    normals, UV, object, tangent and colour attribute: engine.nodes.shading.program_hit)."""
     from .nodes.context import hit_rows
     from .visibility import CAMERA
-    mats = ctx.materials
-    m = si.material
-    transmits = 1.0 - np.clip(mats.transmission[m], 0.0, 1.0)
-    if not any(name in mats.programmed or mats.textured.get(name, np.zeros(1)).any()
-               for name in ("base_color", "metallic")):
-        return mats.base_color[m] * ((1.0 - np.clip(mats.metallic[m], 0.0, 1.0))
-                                     * transmits)[:, None]
     g = ctx.integrator.geometry
     tri_object, objects, tangents, colors = g[8], g[9], g[10], g[11]
-    n = len(m)
+    n = len(si.material)
     prim = si.prim
     bary = si.bary if si.bary is not None else np.zeros((n, 2))
     inst = si.inst if si.inst is not None else np.full(n, -1, np.int64)
@@ -139,10 +135,24 @@ def hit_albedo(ctx, si) -> np.ndarray:
     if tangent is not None:      # unit tangents and a bitangent sign (program_hit's)
         tangent[:, :3] /= np.maximum(np.linalg.norm(tangent[:, :3], axis=1), 1e-30)[:, None]
         tangent[:, 3] = np.sign(tangent[:, 3])
-    hits = hit_rows(si.position, si.shading_normal, si.geometric_normal, si.direction,
+    return hit_rows(si.position, si.shading_normal, si.geometric_normal, si.direction,
                     si.uv, si.front_facing, ray=CAMERA, objects=objects, obj=obj,
                     tangent=tangent,
                     color=_corner_lerp(colors, prim, bary) if len(colors) else None)
+
+
+def hit_albedo(ctx, si) -> np.ndarray:
+    """(n, 3) diffuse albedo at first hits `si`: base colour x (1 - metallic) x
+    (1 - transmission), base colour and metallic read as the path tracer reads them at
+    a camera hit (textures, and shader programs on `first_hit_rows`)."""
+    mats = ctx.materials
+    m = si.material
+    transmits = 1.0 - np.clip(mats.transmission[m], 0.0, 1.0)
+    if not any(name in mats.programmed or mats.textured.get(name, np.zeros(1)).any()
+               for name in ("base_color", "metallic")):
+        return mats.base_color[m] * ((1.0 - np.clip(mats.metallic[m], 0.0, 1.0))
+                                     * transmits)[:, None]
+    hits = first_hit_rows(ctx, si)
     base = mats.lookup("base_color", m, si.uv, hits)
     metallic = mats.lookup("metallic", m, si.uv, hits)
     return base * ((1.0 - np.clip(metallic, 0.0, 1.0)) * transmits)[:, None]
@@ -193,10 +203,11 @@ def cryptomatte(ctx, kinds, depth: int, samples: int = AOV_SAMPLES) -> dict:
 
 
 def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
-                     mist: Mist = Mist(), ao=None) -> FirstHitPasses:
+                     mist: Mist = Mist(), ao=None, aov_passes=()) -> FirstHitPasses:
     """Depth, normal, albedo, position, mist and UV passes for the scene of `ctx` (an
     engine.RenderContext); with `ao` (an engine.ambient_occlusion.AmbientOcclusion) the
-    Ambient Occlusion pass too."""
+    Ambient Occlusion pass too, and the shader AOV passes `aov_passes`
+    (engine.shader_aovs.AovPass)."""
     scene = ctx.scene
     width, height = scene.width, scene.height
     n_pix = width * height
@@ -233,6 +244,7 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
     ortho = scene.camera.kind == "ORTHO"
     environment = np.zeros((n_pix, 3))
     occluded = np.zeros((n_pix, 3)) if ao is not None else None
+    aov_sums = {p.name: np.zeros((n_pix, p.width)) for p in aov_passes}
     m = ao.rays_per_sample(ctx.settings.samples, k) if ao is not None else 0
     for pixel, index, hit, si, directions, time in sample_hits(ctx, k, max(1, chunk // m)
                                                                if m else chunk):
@@ -251,6 +263,13 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
             for c in range(3):
                 occluded[:, c] += np.bincount(pixel[hit], weights=seen[:, c], minlength=n_pix)
         hit_albedo_c = hit_albedo(ctx, si)
+        if aov_passes:
+            values = aov_values(scene.materials, aov_passes, si.material,
+                                first_hit_rows(ctx, si))
+            for name, v in values.items():
+                for c in range(v.shape[1]):
+                    aov_sums[name][:, c] += np.bincount(pixel[hit], weights=v[:, c],
+                                                        minlength=n_pix)
         for c in range(3):
             normal[:, c] += np.bincount(pixel[hit], weights=si.shading_normal[:, c],
                                         minlength=n_pix)
@@ -277,4 +296,6 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
                           object_index.reshape(height, width),
                           material_index.reshape(height, width),
                           (environment / k).reshape(shape),
-                          None if ao is None else (occluded / k).reshape(shape))
+                          None if ao is None else (occluded / k).reshape(shape),
+                          {name: (v / k).reshape(height, width, -1)
+                           for name, v in aov_sums.items()} if aov_passes else None)

@@ -136,6 +136,8 @@ class Material:
     holdout_weight: float = 0.0          # a Holdout shader's share of the opaque part (a
     #                                      Mix Shader with a Holdout): that share of the
     #                                      hits is a hole for the camera, black to others
+    aovs: Optional[object] = None        # engine.shader_aovs.ShaderAOVs: its AOV Output
+    #                                      nodes, for the view layer's AOV passes
     displacement: Optional[object] = None    # engine.displacement.Displacement: moves the
     #                                      vertices of its meshes at export (true displacement)
 

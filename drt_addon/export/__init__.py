@@ -186,7 +186,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 #                       may come from its displacement's bump: displaced_mesh)
             # an instance is seen by the rays that see both it and its instancer (Cycles)
             seen = _instance_visibility(inst, obj)
-            programmed = any(materials[i].shader is not None for i in slots)
+            programmed = any(_runs_program(materials[i]) for i in slots)
             color, pass_index, texspace = object_values(obj)
             source = Source(groups.group(local, slots, name, holdout, offset, seen,
                                          programmed, texspace),
@@ -280,9 +280,15 @@ def _hair(inst, obj, k, material_id, materials, override, view_layer, rendering)
         c.visibility = seen
         c.pass_index = int(getattr(obj, "pass_index", 0))
         c.object_name, c.asset_name = crypto_names(inst, obj)
-        if any(materials[i].shader is not None for i in slots):
+        if any(_runs_program(materials[i]) for i in slots):
             c.object_info = object_info(inst, obj, inst.matrix_world)
     return found
+
+
+def _runs_program(material) -> bool:
+    """Whether a material runs a shader program at hits (its own, or its AOV Output
+    nodes'): its objects then carry what programs read of them (ObjectInfo)."""
+    return material.shader is not None or getattr(material, "aovs", None) is not None
 
 
 def _place_volume(inst, obj, k, groups, material_id, reporter, view_layer,

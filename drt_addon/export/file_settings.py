@@ -365,8 +365,9 @@ SETTINGS: list[FileSetting] = [
              0.5, when=("view_layer.use_pass_z", (True,))),
     _s("view_layer.cycles.use_denoising", "View Layer > Denoising", READ,
        "off: this view layer is not denoised, as in Cycles"),
-    _ignored("view_layer.aovs", "View Layer > Shader AOV",
-             "DRT writes no shader AOVs (count shown)", 0),
+    _s("view_layer.aovs", "View Layer > Shader AOV", READ,
+       "written: what the materials' AOV Output nodes say at the first hits (a Color AOV "
+       "as RGB and the share of samples that wrote it, a Value AOV as one value)"),
     _ignored("view_layer.lightgroups", "View Layer > Light Groups",
              "DRT writes no light group passes (count shown)", 0),
     *[_ignored(path, f"Passes > {label}", _PASSES_HOW, False, group="passes")

@@ -97,6 +97,7 @@ from .images import image_cache
 from .nodes import NodeCompiler
 from .nodes.displacement import displacement_normal, true_displacement
 from .nodes.errors import Unsupported
+from .nodes.aov_output import material_aovs
 from .nodes.links import _all_nodes, _link, _output_node, tree_problems, uses_nodes
 from .nodes.shader import _closure
 from .volumes import default_volume, export_volume
@@ -212,6 +213,11 @@ def export_material(mat, reporter: Reporter, grids=None,
         ctx.issues = [f"DRT could not read its nodes ({type(e).__name__}: {e}); it renders "
                       "with its viewport colour"]
         result = fallback
+    if result is not fallback:
+        try:
+            result.aovs = material_aovs(mat, ctx)      # its AOV Output nodes
+        except Exception as e:
+            ctx.issue(f"its AOV Output nodes are not written ({type(e).__name__}: {e})")
     if ctx.issues and reporter is not None:
         reporter.warn(f"DRT: material {name!r}: " + "; ".join(ctx.issues),
                       key=(name, "material"))
