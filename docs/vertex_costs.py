@@ -76,7 +76,7 @@ def _rebuild(geometry, part, n):
         dx, dy, dz = _direction(i)
         prim = (i * 7919) % ntri
         if part:
-            r = rebuild_at_time(geometry, prim, 0.5 * u, 0.5 * v, dx, dy, -dz, 0.5)
+            r = rebuild_at_time(geometry, prim, -1, 0.5 * u, 0.5 * v, dx, dy, -dz, 0.5)
             acc += r[0] + r[6]
         else:
             acc += prim + u + v + dx + dy + dz

@@ -19,6 +19,7 @@ an emissive strand is seen by camera and BSDF rays, not sampled, as in Cycles.
 """
 from __future__ import annotations
 
+from functools import cached_property
 from typing import Optional
 
 import numpy as np
@@ -35,7 +36,11 @@ class HairCurves:
     What the Hair Info node reads (as Cycles has them, in the object's own space):
     intercepts: optional (K,) each key's fraction of its strand's length, lengths:
     optional (C,) each strand's length (both measured along the keys in world space when
-    not given); first_index: the strands' first index in the object, for Random."""
+    not given); first_index: the strands' first index in the object, for Random;
+    strand_index: optional (C,) each strand's index after first_index (default 0, 1, ...:
+    a strand's place among its object's curves, which a left-out curve does not close up).
+    The per-segment tables (`triangles`, `material_indices`, `uvs`, `colors`) are
+    computed once."""
 
     # what a triangle mesh may have and strands have not
     corner_normals = None
@@ -49,7 +54,7 @@ class HairCurves:
                  colors=None, holdout: bool = False, visibility: int = 31,
                  object_info: Optional[object] = None, pass_index: int = 0,
                  object_name: str = "", asset_name: str = "", intercepts=None,
-                 lengths=None, first_index: int = 0):
+                 lengths=None, first_index: int = 0, strand_index=None):
         self.name = name
         self.keys = np.ascontiguousarray(keys, np.float64).reshape(-1, 3)
         self.radii = np.ascontiguousarray(radii, np.float64).reshape(-1)
@@ -85,6 +90,14 @@ class HairCurves:
         if lengths is not None:
             self.lengths = np.asarray(lengths, np.float64).reshape(n)
         self.first_index = int(first_index)
+        # each strand's index for the Hair Info node's Random: its place among its
+        # object's curves (Cycles counts the one-point curves the export leaves out)
+        own = np.arange(n, dtype=np.int64) if strand_index is None \
+            else np.asarray(strand_index, np.int64).reshape(-1)
+        if len(own) != n or (n and own.min() < 0):
+            raise ValueError(f"hair {name!r}: {len(own)} strand indices for {n} strands "
+                             "(each >= 0)")
+        self.strand_index = self.first_index + own
         # the strand of each segment, and the key each segment starts at
         self.segment_curve = np.repeat(np.arange(n, dtype=np.int64), lengths - 1)
         starts = np.repeat(self.curve_keys[:-1], lengths - 1)
@@ -104,22 +117,22 @@ class HairCurves:
     def positions(self) -> np.ndarray:
         return self.keys
 
-    @property
+    @cached_property
     def triangles(self) -> np.ndarray:
         a = self.segment_key.astype(np.int32)
         return np.stack([a, a + 1, a + 1], axis=1)
 
-    @property
+    @cached_property
     def material_indices(self) -> np.ndarray:
         return self.curve_materials[self.segment_curve]
 
-    @property
+    @cached_property
     def uvs(self):
         if self.curve_uvs is None:
             return None
         return np.repeat(self.curve_uvs[self.segment_curve][:, None, :], 3, axis=1)
 
-    @property
+    @cached_property
     def colors(self):
         if self.curve_colors is None:
             return None
@@ -167,8 +180,10 @@ def pack_curves(curves: list, first_prim: int):
         points.append(rows)
         first.append(f + base)
         base += len(rows)
-        rand = np.empty(c.curve_count)
-        strand_randoms(c.first_index, rand)
+        lo = int(c.strand_index.min()) if c.curve_count else 0
+        span = np.empty(int(c.strand_index.max()) + 1 - lo if c.curve_count else 0)
+        strand_randoms(lo, span)
+        rand = span[c.strand_index - lo]
         k = c.segment_key
         info.append(np.stack([c.intercepts[k], c.intercepts[k + 1],
                               c.lengths[c.segment_curve], rand[c.segment_curve]], axis=1))

@@ -252,3 +252,38 @@ def test_the_culling_filter_runs_as_plain_python_too():
                 accel.occluded(o, d, np.full(5, 100.0)).tolist())
     assert proc.stdout.strip() == f"{compiled[0]} {compiled[1]}", (proc.stdout, compiled)
     assert compiled[0][1:4] == [-1, -1, -1]           # culled: what the filter decides
+
+
+def test_random_counts_the_curves_the_export_leaves_out():
+    """Cycles' Random of a strand is the hash of its index among its object's curves,
+    one-point curves (which draw nothing) included: a strand after a left-out curve keeps
+    its own index, here 2 (and 7 after first_index 5)."""
+    from engine.curves import pack_curves
+    from engine.nodes.hash import hash_uint2, uint_to_float
+    keys = [[0, 0, 0], [0, 0, 1], [1, 0, 0], [1, 0, 1], [1, 0, 2]]
+    hair = HairCurves("gap", keys, np.full(5, 0.1), [0, 2, 5], first_index=5,
+                      strand_index=[0, 2])
+    info = pack_curves([hair], 0).info
+    want = [uint_to_float(hash_uint2(i, 0)) for i in (5, 7, 7)]   # one segment, then two
+    np.testing.assert_allclose(info[:, 3], want, rtol=0, atol=0)
+    with pytest.raises(ValueError):
+        HairCurves("bad", keys, np.full(5, 0.1), [0, 2, 5], strand_index=[0, 1, 2])
+
+
+def test_a_curves_object_keeps_the_index_of_each_curve(bpy_drt):
+    """Exported from a Curves object of curves of 3, 1 and 3 points: two strands, the
+    second with index 2 (the one-point curve's place kept, as Cycles numbers them)."""
+    from drt_addon.export.hair import curves_object
+    bpy = bpy_drt
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    data = bpy.data.hair_curves.new("Gappy")
+    data.add_curves([3, 1, 3])
+    data.attributes["position"].data.foreach_set(
+        "vector", np.arange(21, dtype=np.float32) * 0.1)
+    obj = bpy.data.objects.new("Gappy", data)
+    bpy.context.scene.collection.objects.link(obj)
+    hair = curves_object(obj.evaluated_get(bpy.context.evaluated_depsgraph_get()),
+                         np.eye(4), [0])
+    assert hair.curve_count == 2
+    np.testing.assert_array_equal(hair.strand_index, [0, 2])
+    assert hair.triangles is hair.triangles            # computed once

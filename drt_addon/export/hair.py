@@ -151,7 +151,7 @@ def curves_object(obj, matrix, slots: list, name: str = ""):
         radii = values.astype(np.float64)
     keys = position.reshape(-1, 3).astype(np.float64)
     sizes = np.diff(offsets)
-    keep = sizes >= 2                      # a one-point curve draws nothing
+    keep = sizes >= 2      # a one-point curve draws nothing (but keeps its index)
     if not keep.any():
         return None
     if not keep.all():
@@ -166,4 +166,5 @@ def curves_object(obj, matrix, slots: list, name: str = ""):
     return engine.HairCurves(name or obj.name, _place(keys, matrix),
                              radii * _uniform_scale(matrix), offsets,
                              materials=slots[0] if slots else 0,
-                             intercepts=local.intercepts, lengths=local.lengths)
+                             intercepts=local.intercepts, lengths=local.lengths,
+                             strand_index=np.nonzero(keep)[0])
