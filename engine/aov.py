@@ -141,10 +141,11 @@ def first_hit_rows(ctx, si) -> np.ndarray:
                     color=_corner_lerp(colors, prim, bary) if len(colors) else None)
 
 
-def hit_albedo(ctx, si) -> np.ndarray:
+def hit_albedo(ctx, si, hits=None) -> np.ndarray:
     """(n, 3) diffuse albedo at first hits `si`: base colour x (1 - metallic) x
     (1 - transmission), base colour and metallic read as the path tracer reads them at
-    a camera hit (textures, and shader programs on `first_hit_rows`)."""
+    a camera hit (textures, and shader programs on the hits' `first_hit_rows`, `hits`
+    when the caller has them)."""
     mats = ctx.materials
     m = si.material
     transmits = 1.0 - np.clip(mats.transmission[m], 0.0, 1.0)
@@ -152,7 +153,7 @@ def hit_albedo(ctx, si) -> np.ndarray:
                for name in ("base_color", "metallic")):
         return mats.base_color[m] * ((1.0 - np.clip(mats.metallic[m], 0.0, 1.0))
                                      * transmits)[:, None]
-    hits = first_hit_rows(ctx, si)
+    hits = first_hit_rows(ctx, si) if hits is None else hits
     base = mats.lookup("base_color", m, si.uv, hits)
     metallic = mats.lookup("metallic", m, si.uv, hits)
     return base * ((1.0 - np.clip(metallic, 0.0, 1.0)) * transmits)[:, None]
@@ -200,6 +201,12 @@ def cryptomatte(ctx, kinds, depth: int, samples: int = AOV_SAMPLES) -> dict:
         out[kind] = (i.reshape(h, w, depth), c.reshape(h, w, depth))
     out["names"] = names.names
     return out
+
+
+def _add(total: np.ndarray, pixel: np.ndarray, values: np.ndarray) -> None:
+    """total (n_pix, c) += the per-sample `values` (m, c) of pixels `pixel` (m,)."""
+    for c in range(total.shape[1]):
+        total[:, c] += np.bincount(pixel, weights=values[:, c], minlength=len(total))
 
 
 def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
@@ -251,36 +258,23 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
         missed = np.ones(len(pixel), bool)
         missed[hit] = False
         if missed.any():
-            seen = _world_seen(ctx, directions[missed])
-            for c in range(3):
-                environment[:, c] += np.bincount(pixel[missed], weights=seen[:, c],
-                                                 minlength=n_pix)
+            _add(environment, pixel[missed], _world_seen(ctx, directions[missed]))
         if si is None:
             continue
         if ao is not None:
-            seen = occlusion(ctx, ao, pixel[hit], index[hit], si,
-                             None if time is None else time[hit], m)
-            for c in range(3):
-                occluded[:, c] += np.bincount(pixel[hit], weights=seen[:, c], minlength=n_pix)
-        hit_albedo_c = hit_albedo(ctx, si)
+            _add(occluded, pixel[hit], occlusion(ctx, ao, pixel[hit], index[hit], si,
+                                                 None if time is None else time[hit], m))
+        rows = first_hit_rows(ctx, si) if aov_passes else None    # once for both
         if aov_passes:
-            values = aov_values(scene.materials, aov_passes, si.material,
-                                first_hit_rows(ctx, si))
-            for name, v in values.items():
-                for c in range(v.shape[1]):
-                    aov_sums[name][:, c] += np.bincount(pixel[hit], weights=v[:, c],
-                                                        minlength=n_pix)
-        for c in range(3):
-            normal[:, c] += np.bincount(pixel[hit], weights=si.shading_normal[:, c],
-                                        minlength=n_pix)
-            albedo[:, c] += np.bincount(pixel[hit], weights=hit_albedo_c[:, c],
-                                        minlength=n_pix)
-            position[:, c] += np.bincount(pixel[hit], weights=si.position[:, c],
-                                          minlength=n_pix)
+            for name, v in aov_values(scene.materials, aov_passes, si.material,
+                                      rows).items():
+                _add(aov_sums[name], pixel[hit], v)
+        _add(normal, pixel[hit], si.shading_normal)
+        _add(albedo, pixel[hit], hit_albedo(ctx, si, rows))
+        _add(position, pixel[hit], si.position)
         uv[:, 2] += np.bincount(pixel[hit], minlength=n_pix)
         if si.uv is not None:
-            for c in range(2):
-                uv[:, c] += np.bincount(pixel[hit], weights=si.uv[:, c], minlength=n_pix)
+            _add(uv[:, :2], pixel[hit], si.uv)
         first = index[hit] == 0            # the pixels' sample 0: the index passes
         object_index[pixel[hit][first]] = ctx.surfaces.pass_indices(si.prim[first],
                                                                     si.inst[first])
