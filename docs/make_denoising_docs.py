@@ -4,7 +4,7 @@ For each scene, both engines render with Render > Denoise at Cycles' defaults
 (OpenImageDenoise, albedo and normal, Accurate prefilter, High quality) at a ladder of
 sample counts, in this one process, each render timed from the render call to its end
 (export or sync, the acceleration structure, sampling and the denoiser; the first render
-of each engine is a warm-up, not kept). Errors are against one reference: Cycles at
+of each engine, and DRT's first of each scene, are warm-ups, not kept). Errors are against one reference: Cycles at
 REFERENCE_SAMPLES, not denoised. DRT's error at each Cycles render's time is read off
 DRT's own ladder (interpolated in log error against log seconds), so the table says what
 each engine's denoised image is worth for the same wait.
@@ -74,9 +74,11 @@ def _at_time(seconds, ladder_seconds, ladder_errors):
 def measure(bpy):
     from engine.image_error import flip, relmse
     rows, images = [], {}
-    _render(bpy, SCENES[0], "DRT", 1, True)            # warm-ups: kernels, OIDN
-    _render(bpy, SCENES[0], "CYCLES", 1, True)
+    _render(bpy, SCENES[0], "CYCLES", 1, True)          # warm-up: OIDN
     for name in SCENES:
+        # each scene's own warm-up: the kernels its features need (a scene's first
+        # render would otherwise compile them inside a timed render when the cache is cold)
+        _render(bpy, name, "DRT", 1, True)
         ref, _, ref_seconds = _render(bpy, name, "CYCLES", REFERENCE_SAMPLES, False)
         ladder = []
         for spp in DRT_LADDER:
