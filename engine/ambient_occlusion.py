@@ -15,7 +15,7 @@ min(samples, AOV_SAMPLES) camera samples of a pixel), `rays_per_sample` from eac
 that a pixel gets min(samples, max_rays) rays in all; their directions are the
 sampler's numbers of the first bounce's BSDF direction (Cycles' AO takes the BSDF's
 numbers too), stratified over the pixel's rays. Above max_rays samples the pass is
-noisier than Cycles' (docs/passes.md measures it).
+noisier than Cycles' (docs/index.md; tests/test_ao_pass.py measures it at 64).
 """
 from __future__ import annotations
 
@@ -59,7 +59,8 @@ def occlusion(ctx, ao: AmbientOcclusion, pixel: np.ndarray, index: np.ndarray, s
         return np.zeros((n, 3))
     rows = np.repeat(np.arange(n), m)
     sample = (np.asarray(index, np.int64)[:, None] * m + np.arange(m)).ravel()
-    u = ctx.sampler.get_2d(D.bounce_dim(0, D.BSDF_DIR), np.repeat(pixel, m), sample)
+    pixels = np.repeat(pixel, m)
+    u = ctx.sampler.get_2d(D.bounce_dim(0, D.BSDF_DIR), pixels, sample)
     normal = si.shading_normal[rows]
     d = to_world(cosine_hemisphere(u), normal)
     above = (d * si.geometric_normal[rows]).sum(1) > 0.0
@@ -73,7 +74,7 @@ def occlusion(ctx, ao: AmbientOcclusion, pixel: np.ndarray, index: np.ndarray, s
         far = np.full(len(r), ao.distance)
         t = None if time is None else np.asarray(time)[rows[r]]
         passed[r] = _transmitted(ctx, o, np.ascontiguousarray(d[r]), far, t,
-                                 np.repeat(pixel, m)[r], sample[r])
+                                 pixels[r], sample[r])
     return passed.reshape(n, m, 3).mean(axis=1)
 
 

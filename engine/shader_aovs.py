@@ -49,6 +49,7 @@ def aov_values(materials, passes, material: np.ndarray, hits: np.ndarray) -> dic
     (indices into `materials`, engine.scene.Material), whose hit rows
     (engine.nodes.context) are `hits`; 0 where a material has no AOV Output node of that
     name."""
+    from .nodes.interpreter import evaluate_registers
     n = len(material)
     out = {p.name: np.zeros((n, p.width)) for p in passes}
     if n == 0:
@@ -61,7 +62,6 @@ def aov_values(materials, passes, material: np.ndarray, hits: np.ndarray) -> dic
         wanted = [p for p in passes if p.name in aovs.outputs]
         if not wanted:
             continue
-        from .nodes.interpreter import evaluate_registers
         regs = evaluate_registers(aovs.program, np.ascontiguousarray(hits[rows]))
         for p in wanted:
             color, value = aovs.outputs[p.name]
