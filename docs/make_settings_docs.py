@@ -33,7 +33,8 @@ SECTIONS = [
      "warns about both until they are turned off. Rows marked *with ...* are part of "
      "another row's warning."),
     ("no effect", "No effect on the final image",
-     "Speed, memory, the viewport (DRT's viewport is EEVEE's) or baking; never warned."),
+     "Speed, memory, the Rendered viewport (its own samples and denoiser) or baking; "
+     "never warned."),
 ]
 
 

@@ -39,7 +39,13 @@ def settings(scene):
     c = scene.cycles
     return denoiser.DenoiseSettings(input_passes=c.denoising_input_passes,
                                     prefilter=c.denoising_prefilter,
-                                    quality=c.denoising_quality)
+                                    quality=quality(c, "denoising_quality"))
+
+
+def quality(cycles, name: str) -> str:
+    """Denoise > Quality (`name`), or HIGH, OIDN's own, in a Blender before 4.1 that has
+    no such setting."""
+    return getattr(cycles, name, "HIGH")
 
 
 def denoised(scene, image, first_hit, reporter):

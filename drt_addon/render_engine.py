@@ -1,39 +1,7 @@
-"""The RenderEngine Blender selects as 'DRT' (F12, `blender -b file.blend -E DRT -f 1`).
+"""The RenderEngine Blender selects as 'DRT' (F12, `blender -b file.blend -E DRT -f 1`, and
+the 3D view's Rendered mode: view_update and view_draw, drt_addon.viewport).
 
-Render passes, declared in `update_render_passes` and written when enabled in the view
-layer (Properties > View Layer > Passes):
-- Depth (`use_pass_z`): distance along the camera's view axis to the first hit, as
-  Cycles' Z pass; 1e10 where nothing is hit.
-- Normal (`use_pass_normal`): world-space shading normal of the first hit.
-- Denoising Normal and Denoising Albedo (`view_layer.drt.use_pass_denoising_data`):
-  camera-space normal and diffuse albedo, the inputs of the compositor's Denoise node.
-- DRT Noise (`view_layer.drt.use_pass_noise`): per pixel and channel, the standard error
-  of the pixel's mean radiance (sqrt of engine.film.Film.variance_of_mean); inf where a
-  pixel has fewer than two samples.
-- Mist (`use_pass_mist`): Cycles' mist of the first hit, by World > Mist Pass.
-- Position (`use_pass_position`): world-space position of the first hit.
-- UV (`use_pass_uv`): u, v of the first hit (the active UV map unless a material names
-  one) and its coverage, as Cycles' UV pass.
-- Object Index and Material Index (`use_pass_object_index`, `use_pass_material_index`;
-  named IndexOB and IndexMA before Blender 5.0, as Cycles names them): the Pass Index of the object and of the material the
-  pixel's first camera sample hits, as Cycles writes them (sample 0 alone).
-- Environment (`use_pass_environment`; Env before Blender 5.0): the world as camera rays
-  that hit nothing see it, as Cycles' Environment pass.
-- Ambient Occlusion (`use_pass_ambient_occlusion`; AO before Blender 5.0): Cycles' AO
-  pass, from the first hits (engine.ambient_occlusion).
-- Shader AOVs (View Layer > Shader AOV): what the materials' AOV Output nodes say at
-  the first hits, a Color AOV as RGB and the share of samples that wrote it, a Value
-  AOV as one value (engine.shader_aovs).
-- Cryptomatte Object, Material and Asset (`use_pass_cryptomatte_*`, Levels:
-  `pass_cryptomatte_depth`): CryptoObject00, 01, ... as Cycles writes them, (id,
-  coverage) pairs of the names each pixel shows, with the manifest in the render
-  result's metadata, so that Blender's Cryptomatte node picks mattes by name
-  (engine.cryptomatte).
-- Noisy Image (when Render > Denoise and the view layer's Denoising are on, Cycles'
-  settings): the render before denoising; Combined is then denoised (drt_addon.denoise).
-Depth, Normal, Mist, Position, UV, the index passes, Cryptomatte and the denoising passes
-come from engine.aov (a first-hit query on the same camera samples), not from the path
-tracer.
+The render passes it writes besides Combined are listed in drt_addon.render_passes.
 
 Border render (Render Region): only the border's pixels are traced; the result covers
 just that rectangle, which Blender places in the frame (or crops to, with Crop to Render
@@ -141,7 +109,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
     bl_use_preview = True                 # material previews render with DRT
     bl_use_postprocess = True
     bl_use_shading_nodes_custom = False   # keep Cycles' shader nodes editable
-    bl_use_eevee_viewport = True          # Material Preview and viewport use EEVEE
+    bl_use_eevee_viewport = True          # Material Preview uses EEVEE; Rendered, DRT
 
     @classmethod
     def register(cls):
@@ -155,6 +123,40 @@ class DRTRenderEngine(bpy.types.RenderEngine):
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)  # required since Blender 4.4
+        self.viewport = None               # drt_addon.viewport.ViewportSession
+
+    def __del__(self):
+        # Blender invalidates the engine before deleting it: its own attribute lookup
+        # would raise, the instance's dictionary still holds the session
+        try:
+            viewport = object.__getattribute__(self, "viewport")
+        except (AttributeError, ReferenceError):
+            return
+        if viewport is not None:
+            viewport.free()
+
+    # -- the Rendered viewport (drt_addon.viewport) --
+    def view_update(self, context, depsgraph):
+        from .export import ExportError, Reporter
+        try:
+            if self.viewport is None:
+                from .viewport import ViewportSession
+                self.viewport = ViewportSession(self._tag_redraw)
+            self.viewport.sync(depsgraph, context, Reporter(self.report))
+        except (ExportError, ValueError) as e:
+            self.update_stats("", f"DRT: {e}")
+            self.report({"ERROR"}, str(e))
+
+    def view_draw(self, context, depsgraph):
+        if self.viewport is not None:
+            self.viewport.draw(context, depsgraph, self)
+            self.update_stats("", self.viewport.status())
+
+    def _tag_redraw(self):
+        try:
+            self.tag_redraw()
+        except ReferenceError:             # the engine was freed while a pass finished
+            pass
 
     def update_render_passes(self, scene=None, renderlayer=None):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")

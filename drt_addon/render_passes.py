@@ -1,6 +1,41 @@
 """The render passes DRT writes besides Combined: which the view layer asks for, their
 channels, and the first-hit passes (engine.aov) computed once per render for the passes
-and the denoiser. drt_addon.render_engine writes them into Blender's render result."""
+and the denoiser. drt_addon.render_engine writes them into Blender's render result.
+
+Render passes, declared in `update_render_passes` and written when enabled in the view
+layer (Properties > View Layer > Passes):
+- Depth (`use_pass_z`): distance along the camera's view axis to the first hit, as
+  Cycles' Z pass; 1e10 where nothing is hit.
+- Normal (`use_pass_normal`): world-space shading normal of the first hit.
+- Denoising Normal and Denoising Albedo (`view_layer.drt.use_pass_denoising_data`):
+  camera-space normal and diffuse albedo, the inputs of the compositor's Denoise node.
+- DRT Noise (`view_layer.drt.use_pass_noise`): per pixel and channel, the standard error
+  of the pixel's mean radiance (sqrt of engine.film.Film.variance_of_mean); inf where a
+  pixel has fewer than two samples.
+- Mist (`use_pass_mist`): Cycles' mist of the first hit, by World > Mist Pass.
+- Position (`use_pass_position`): world-space position of the first hit.
+- UV (`use_pass_uv`): u, v of the first hit (the active UV map unless a material names
+  one) and its coverage, as Cycles' UV pass.
+- Object Index and Material Index (`use_pass_object_index`, `use_pass_material_index`;
+  named IndexOB and IndexMA before Blender 5.0, as Cycles names them): the Pass Index of the object and of the material the
+  pixel's first camera sample hits, as Cycles writes them (sample 0 alone).
+- Environment (`use_pass_environment`; Env before Blender 5.0): the world as camera rays
+  that hit nothing see it, as Cycles' Environment pass.
+- Ambient Occlusion (`use_pass_ambient_occlusion`; AO before Blender 5.0): Cycles' AO
+  pass, from the first hits (engine.ambient_occlusion).
+- Shader AOVs (View Layer > Shader AOV): what the materials' AOV Output nodes say at
+  the first hits, a Color AOV as RGB and the share of samples that wrote it, a Value
+  AOV as one value (engine.shader_aovs).
+- Cryptomatte Object, Material and Asset (`use_pass_cryptomatte_*`, Levels:
+  `pass_cryptomatte_depth`): CryptoObject00, 01, ... as Cycles writes them, (id,
+  coverage) pairs of the names each pixel shows, with the manifest in the render
+  result's metadata, so that Blender's Cryptomatte node picks mattes by name
+  (engine.cryptomatte).
+- Noisy Image (when Render > Denoise and the view layer's Denoising are on, Cycles'
+  settings): the render before denoising; Combined is then denoised (drt_addon.denoise).
+Depth, Normal, Mist, Position, UV, the index passes, Cryptomatte and the denoising passes
+come from engine.aov (a first-hit query on the same camera samples), not from the path
+tracer."""
 from __future__ import annotations
 
 from importlib import import_module

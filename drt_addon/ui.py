@@ -43,15 +43,20 @@ class DRT_PT_sampling(DRTPanel, bpy.types.Panel):
         col.prop(s, "threads")
 
 
-class DRT_PT_denoise(DRTPanel, bpy.types.Panel):
-    """Render > Denoise: Cycles' own settings (scene.cycles), which DRT renders with
-    (drt_addon.denoise)."""
-    bl_label = "Denoise"
+class CyclesSettingsPanel(DRTPanel):
+    """A sub-panel of Sampling that draws Cycles' own settings (scene.cycles): shown
+    where the Cycles add-on is on."""
     bl_parent_id = "DRT_PT_sampling"
 
     @classmethod
     def poll(cls, context):
         return super().poll(context) and hasattr(context.scene, "cycles")
+
+
+class DRT_PT_denoise(CyclesSettingsPanel, bpy.types.Panel):
+    """Render > Denoise: Cycles' own settings (scene.cycles), which DRT renders with
+    (drt_addon.denoise)."""
+    bl_label = "Denoise"
 
     def draw_header(self, context):
         self.layout.prop(context.scene.cycles, "use_denoising", text="")
@@ -66,7 +71,28 @@ class DRT_PT_denoise(DRTPanel, bpy.types.Panel):
         sub = col.column()
         sub.active = cycles.denoising_input_passes != "RGB"
         sub.prop(cycles, "denoising_prefilter", text="Prefilter")
-        col.prop(cycles, "denoising_quality", text="Quality")
+        if hasattr(cycles, "denoising_quality"):               # Blender 4.1+
+            col.prop(cycles, "denoising_quality", text="Quality")
+
+
+class DRT_PT_viewport(CyclesSettingsPanel, bpy.types.Panel):
+    """Sampling > Viewport: the Rendered viewport's samples and denoiser, Cycles' own
+    settings (scene.cycles), which DRT's viewport renders with (drt_addon.viewport)."""
+    bl_label = "Viewport"
+
+    def draw(self, context):
+        cycles = context.scene.cycles
+        col = self.layout.column()
+        col.use_property_split = True
+        col.prop(cycles, "preview_samples", text="Max Samples")
+        col.prop(cycles, "use_preview_denoising", text="Denoise")
+        sub = col.column()
+        sub.active = cycles.use_preview_denoising
+        sub.prop(cycles, "preview_denoising_input_passes", text="Passes")
+        sub.prop(cycles, "preview_denoising_prefilter", text="Prefilter")
+        if hasattr(cycles, "preview_denoising_quality"):       # Blender 4.1+
+            sub.prop(cycles, "preview_denoising_quality", text="Quality")
+        sub.prop(cycles, "preview_denoising_start_sample", text="Start Sample")
 
 
 class DRT_PT_light_paths(DRTPanel, bpy.types.Panel):
@@ -129,7 +155,8 @@ class DRT_PT_passes(DRTPanel, bpy.types.Panel):
             col.prop(drt, "use_pass_noise")
 
 
-CLASSES = (DRT_PT_sampling, DRT_PT_denoise, DRT_PT_light_paths, DRT_PT_film, DRT_PT_passes)
+CLASSES = (DRT_PT_sampling, DRT_PT_denoise, DRT_PT_viewport, DRT_PT_light_paths, DRT_PT_film,
+           DRT_PT_passes)
 
 # Blender's generic panels for what Cycles draws in panels of its own add-on: depth of
 # field, light type/colour/power, spot shape, the material slots and node surfaces.

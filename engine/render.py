@@ -14,12 +14,13 @@ sample index, dimension), see `engine.sampling`.
 """
 from __future__ import annotations
 
+import copy
 import os
 import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -127,6 +128,30 @@ class RenderContext:
 
     def close(self):
         self.accel.close()
+
+    def view(self, camera, width: int, height: int) -> "RenderContext":
+        """This scene seen through `camera` at `width` x `height` (the Rendered viewport
+        navigating, or rendering its first passes at a lower resolution): the
+        acceleration structure, materials and lights are this context's, not rebuilt;
+        the camera model, the camera kernel and the integrator (which packs the camera)
+        are new. The lights are rebuilt only when the camera leaves the scene's bounds
+        (lights at infinity are placed by the scene radius). Close only the context the
+        scene was built for: views share its acceleration structure."""
+        other = copy.copy(self)
+        other.scene = replace(self.scene, camera=camera, width=int(width), height=int(height))
+        other.camera = CameraModel(camera, other.scene.width, other.scene.height,
+                                   other.scene.pixel_aspect)
+        other.camera_kernel = None if other.has_motion else pack_camera(other.camera,
+                                                                        other.filter)
+        radius = _scene_radius(other.scene, self.accel)
+        if radius > self.scene_radius * (1.0 + 1e-9):
+            other.scene_radius = radius
+            sun = getattr(other.scene.world, "sun", None)
+            lamps = list(other.scene.lights) + ([sun] if sun is not None else [])
+            other.lights = LightSet(lamps, radius, mesh_lights=self.lights.mesh,
+                                    world=self.world)
+        other.integrator = make_integrator(self.settings.integrator, other)
+        return other
 
     def entry_kernels(self) -> list:
         """The compiled kernels this render calls from Python: the camera's, the ray

@@ -101,16 +101,11 @@ def test_blender_panels_are_shared_with_drt(bpy_drt):
     assert "DRT" not in bpy.types.VIEWLAYER_PT_freestyle.COMPAT_ENGINES
 
 
-def test_light_paths_panel_edits_the_files_cycles_settings(bpy_drt):
-    """DRT's Light Paths panel draws Cycles' own properties, which DRT renders with (one
-    vocabulary): what an artist sets there is what Cycles uses too."""
-    import types
-    from drt_addon import ui
-    scene = bpy_drt.context.scene
-    drawn = []
-
+def _recording_layout(drawn: list):
+    """A stand-in for a panel's layout that records each (data, property) drawn."""
     class Layout:
         use_property_split = False
+        active = True
 
         def column(self, **kw):
             return self
@@ -120,6 +115,17 @@ def test_light_paths_panel_edits_the_files_cycles_settings(bpy_drt):
 
         def label(self, **kw):
             drawn.append(("label", kw.get("text")))
+    return Layout
+
+
+def test_light_paths_panel_edits_the_files_cycles_settings(bpy_drt):
+    """DRT's Light Paths panel draws Cycles' own properties, which DRT renders with (one
+    vocabulary): what an artist sets there is what Cycles uses too."""
+    import types
+    from drt_addon import ui
+    scene = bpy_drt.context.scene
+    drawn = []
+    Layout = _recording_layout(drawn)
     ui.DRT_PT_light_paths.draw(types.SimpleNamespace(layout=Layout()),
                                types.SimpleNamespace(scene=scene))
     assert [d for d, _ in drawn] == [scene.cycles] * len(drawn)
@@ -136,16 +142,7 @@ def test_denoise_panel_shows_the_files_cycles_denoise_settings(bpy_drt):
     from drt_addon import ui
     scene = bpy_drt.context.scene
     drawn = []
-
-    class Layout:
-        use_property_split = False
-        active = True
-
-        def column(self, **kw):
-            return self
-
-        def prop(self, data, name, **kw):
-            drawn.append((data, name))
+    Layout = _recording_layout(drawn)
     context = types.SimpleNamespace(scene=scene, engine="DRT")
     panel = types.SimpleNamespace(layout=Layout())
     assert ui.DRT_PT_denoise.poll(context)
@@ -155,6 +152,26 @@ def test_denoise_panel_shows_the_files_cycles_denoise_settings(bpy_drt):
     assert drawn == [(scene.cycles, n) for n in (
         "use_denoising", "denoiser", "denoising_input_passes", "denoising_prefilter",
         "denoising_quality")]
+
+
+def test_viewport_panel_shows_the_files_cycles_viewport_settings(bpy_drt):
+    """Sampling > Viewport draws Cycles' own viewport samples and denoiser, which DRT's
+    Rendered viewport renders with (drt_addon.viewport); the engine has the viewport's
+    methods, so Blender's Rendered mode is DRT's, not EEVEE's."""
+    import types
+    from drt_addon import ui
+    from drt_addon.render_engine import DRTRenderEngine
+    scene = bpy_drt.context.scene
+    drawn = []
+    Layout = _recording_layout(drawn)
+    context = types.SimpleNamespace(scene=scene, engine="DRT")
+    assert ui.DRT_PT_viewport.poll(context)
+    ui.DRT_PT_viewport.draw(types.SimpleNamespace(layout=Layout()), context)
+    assert drawn == [(scene.cycles, n) for n in (
+        "preview_samples", "use_preview_denoising", "preview_denoising_input_passes",
+        "preview_denoising_prefilter", "preview_denoising_quality",
+        "preview_denoising_start_sample")]
+    assert callable(DRTRenderEngine.view_update) and callable(DRTRenderEngine.view_draw)
 
 
 def test_manifest_is_a_valid_extension_manifest():

@@ -24,70 +24,17 @@ Without a `blender` on PATH the tests are skipped, saying that they did not run.
 """
 from __future__ import annotations
 
-import hashlib
-import importlib.util
 import os
 import re
 import shutil
-import subprocess
 import sys
-import tempfile
 
 import numpy as np
 import pytest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCENE_SCRIPT = os.path.join(ROOT, "tests", "legacy_blender_scene.py")
+from legacy_blender import SCENE_SCRIPT, LegacyBlender
+
 SAMPLES = 4             # tests/legacy_blender_scene.py
-BUNDLED = ("embreex", "numba", "llvmlite")   # what the extension zip bundles besides numpy
-
-
-def _package_dirs(name: str) -> list[str]:
-    """The installed folder of package `name` and its auditwheel `NAME.libs` sibling."""
-    spec = importlib.util.find_spec(name)
-    if spec is None or not spec.submodule_search_locations:
-        pytest.skip(f"{name} is not installed here: the Debian Blender test did not run")
-    folder = list(spec.submodule_search_locations)[0]
-    libs = folder + ".libs"
-    return [folder] + ([libs] if os.path.isdir(libs) else [])
-
-
-def _link(target: str, link: str) -> None:
-    """`link` -> `target`, made or corrected (another checkout may have used the path)."""
-    if os.path.islink(link) and os.readlink(link) == target:
-        return
-    os.makedirs(os.path.dirname(link), exist_ok=True)
-    tmp = f"{link}.{os.getpid()}"
-    os.symlink(target, tmp)
-    os.replace(tmp, link)
-
-
-class LegacyBlender:
-    """The blender binary with DRT as a legacy add-on: throwaway preferences and packages
-    folder per test module; the add-on's link kept per checkout."""
-
-    def __init__(self, blender: str, home):
-        self.blender, self.home = blender, home
-        stable = os.path.join(tempfile.gettempdir(), "drt-legacy-blender-"
-                              + hashlib.sha1(ROOT.encode()).hexdigest()[:12])
-        scripts = os.path.join(stable, "scripts")
-        _link(ROOT, os.path.join(scripts, "addons", "drt"))
-        site = home / "site"
-        site.mkdir()
-        for name in BUNDLED:
-            for folder in _package_dirs(name):
-                os.symlink(folder, site / os.path.basename(folder))
-        self.env = {**os.environ, "BLENDER_USER_SCRIPTS": scripts,
-                    "BLENDER_USER_CONFIG": str(home / "config"), "PYTHONPATH": str(site)}
-        self.env.pop("NUMBA_CACHE_DIR", None)       # the checkout's own cache
-        self.blend = str(home / "scene.blend")
-
-    def run(self, *args) -> subprocess.CompletedProcess:
-        proc = subprocess.run([self.blender, "-b", *args], env=self.env, cwd=str(self.home),
-                              capture_output=True, text=True, timeout=600)
-        proc.log = proc.stdout + proc.stderr
-        return proc
-
 
 @pytest.fixture(scope="module")
 def legacy_blender(tmp_path_factory):

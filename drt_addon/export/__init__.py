@@ -58,7 +58,8 @@ def crypto_names(inst, obj) -> tuple:
 
 def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
                  region: RenderRegion | None = None, stats: dict | None = None,
-                 render_engine=None, check_cancel=None) -> "engine.Scene":
+                 render_engine=None, check_cancel=None, memo=None,
+                 view=None) -> "engine.Scene":
     """The scene as DRT's description.
 
     region: the pixels to render (default: Blender's render size and border, see
@@ -73,30 +74,41 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
 
     The file's render settings DRT does not honour are warned about through `reporter`
     (export.file_settings). check_cancel, if given, is called before each object is
-    exported (the RenderEngine's cancel: it raises to stop the export)."""
+    exported (the RenderEngine's cancel: it raises to stop the export).
+
+    The Rendered viewport passes `view`, (engine.Camera, width, height) of the 3D view
+    (drt_addon.viewport_camera; the scene needs no camera then, and there is no motion
+    blur, as in Cycles' viewport), and `memo`, an export.memo.ExportMemo whose geometry and
+    materials are reused from the last export unless an update dropped them."""
     reporter = reporter or Reporter()
     check_file_settings(depsgraph.scene, depsgraph.view_layer, reporter)
     for message in missing_library_messages():
         reporter.warn(f"DRT: {message}")
-    blur = read_settings(depsgraph.scene)
+    blur = read_settings(depsgraph.scene) if view is None else None
     if blur is None:
-        return _export_scene(depsgraph, reporter, size, region, stats, None, check_cancel)
+        return _export_scene(depsgraph, reporter, size, region, stats, None, check_cancel,
+                             memo, view)
     with MotionExport(depsgraph, blur, reporter, render_engine) as tracker:
         return _export_scene(depsgraph, reporter, size, region, stats,
                              tracker if tracker.usable else None, check_cancel)
 
 
 def _export_scene(depsgraph, reporter, size, region, stats, tracker,
-                  check_cancel=None) -> "engine.Scene":
+                  check_cancel=None, memo=None, view=None) -> "engine.Scene":
     t0 = time.perf_counter()
     scene = depsgraph.scene
-    if region is None:
+    if view is not None:
+        region = RenderRegion(view[1], view[2], 0, 0, view[1], view[2])
+    elif region is None:
         if size is not None:
             region = RenderRegion(size[0], size[1], 0, 0, size[0], size[1])
         else:
             region = render_region(scene)
     aspect = scene.render.pixel_aspect_x / max(scene.render.pixel_aspect_y, 1e-9)
-    camera = window_camera(export_camera(scene.camera, depsgraph), region, aspect)
+    if view is not None:
+        camera, aspect = view[0], 1.0
+    else:
+        camera = window_camera(export_camera(scene.camera, depsgraph), region, aspect)
     if tracker is not None:
         tracker.note_camera(scene.camera)
     view_layer = depsgraph.view_layer
@@ -114,7 +126,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         key = mat.name_full if mat is not None else None
         if key not in material_index:
             material_index[key] = len(materials)
-            materials.append(export_material(mat, reporter))
+            materials.append(memo.material(mat, reporter) if memo is not None
+                             else export_material(mat, reporter))
             het_owner[key] = owner
         index = material_index[key]
         if is_heterogeneous(materials[index]) and het_owner[key] != owner:
@@ -128,8 +141,9 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
 
     # the UV pass reads every mesh's UVs (its active map, where no material names one)
     override = material_override(view_layer)
-    cache = MeshCache(reporter, uv_pass=bool(getattr(view_layer, "use_pass_uv", False)),
-                      override=override)
+    uv_pass = bool(getattr(view_layer, "use_pass_uv", False))
+    cache = (memo.begin(reporter, uv_pass, override) if memo is not None
+             else MeshCache(reporter, uv_pass=uv_pass, override=override))
     meshes, lights = [], []
     groups = InstanceGroups()
     displaced = DisplacedMeshes()
@@ -238,6 +252,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         reporter.warn(dark, key=BLACK_IMAGE)
     if stats is not None:
         stats.update(mesh_evaluations=cache.evaluations, mesh_reuses=cache.reuses,
+                     material_exports=(memo.material_exports if memo is not None
+                                       else len(material_index)),
                      displaced_meshes=displaced.displaced,
                      meshes=len(meshes), lights=len(lights), holdouts=holdouts,
                      triangles=int(sum(len(m.triangles) for m in meshes)),

@@ -380,18 +380,29 @@ SETTINGS: list[FileSetting] = [
         ("tile_size", "Performance > Memory > Tile Size", "not read"),
         ("debug_use_spatial_splits", "Performance > Acceleration Structure", "DRT uses "
          "Embree with its own settings"),
-        ("preview_samples", "Sampling > Viewport", "DRT's viewport is EEVEE's"),
-        ("use_preview_denoising", "Sampling > Viewport > Denoise", "DRT's viewport is EEVEE's"),
-        ("texture_limit", "Simplify > Viewport > Texture Limit", "DRT's viewport is EEVEE's"),
+        ("preview_samples", "Sampling > Viewport > Max Samples", "the Rendered viewport's "
+         "samples (0: no limit), as in Cycles (drt_addon.viewport)"),
+        ("use_preview_denoising", "Sampling > Viewport > Denoise", "the Rendered viewport "
+         "is denoised with OpenImageDenoise, as in Cycles"),
+        ("preview_denoising_input_passes", "Sampling > Viewport > Denoise > Passes",
+         "the viewport denoiser's inputs"),
+        ("preview_denoising_prefilter", "Sampling > Viewport > Denoise > Prefilter",
+         "the viewport denoiser's prefilter"),
+        ("preview_denoising_quality", "Sampling > Viewport > Denoise > Quality",
+         "the viewport denoiser's quality"),
+        ("preview_denoising_start_sample", "Sampling > Viewport > Denoise > Start Sample",
+         "the viewport is denoised from this sample on"),
+        ("texture_limit", "Simplify > Viewport > Texture Limit", "not read: the Rendered "
+         "viewport uses full-size textures"),
         ("bake_type", "Bake", "DRT does not bake"),
     ]],
-    *_no_effect(["preview_pause", "preview_denoiser", "preview_denoising_prefilter",
-                 "preview_denoising_quality", "preview_denoising_input_passes",
-                 "preview_denoising_start_sample", "preview_denoising_use_gpu",
+    *_no_effect(["preview_pause", "preview_denoiser", "preview_denoising_use_gpu",
                  "preview_scrambling_distance", "use_preview_adaptive_sampling",
                  "preview_adaptive_threshold", "preview_adaptive_min_samples",
                  "volume_preview_step_rate", "preview_dicing_rate", "ao_bounces"],
-                "viewport only (DRT's viewport is EEVEE's)"),
+                "viewport only, not read (DRT's Rendered viewport does not pause, denoises "
+                "with OpenImageDenoise on the CPU, samples every pixel alike and renders "
+                "volumes and displacement as the final render does)"),
     *_no_effect(["debug_bvh_type", "debug_use_hair_bvh", "debug_use_compact_bvh",
                  "debug_bvh_time_steps", "debug_use_cpu_avx2", "debug_use_cpu_sse42",
                  "debug_bvh_layout", "debug_use_cuda_adaptive_compile",

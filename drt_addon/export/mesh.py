@@ -167,8 +167,12 @@ class MeshCache:
         self.evaluations = 0      # to_mesh calls
         self.reuses = 0           # instances served from the cache
 
+    def key(self, obj):
+        """What identifies `obj`'s evaluated geometry in this cache (`_cache_key`)."""
+        return _cache_key(obj)
+
     def local(self, obj) -> Optional[LocalMesh]:
-        key = _cache_key(obj)
+        key = self.key(obj)
         materials = slot_materials(obj, self.override)
         want_uv = uv_request(materials)
         if want_uv is None and self.uv_pass:
