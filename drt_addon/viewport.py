@@ -37,11 +37,15 @@ from importlib import import_module
 import numpy as np
 
 from .engine_link import engine
+from .export.memo import ExportMemo
 from .viewport_camera import ViewportView, view_of
 
 START_RESOLUTION = 64    # pixels on the longer side of the first, coarsest image (Cycles')
 PASS_SECONDS = 0.5       # a full-resolution pass grows towards this long
 UNLIMITED = 1 << 24      # preview_samples 0: Cycles' "no limit"
+# Paths per work unit: a restart waits for the units running (they cannot be
+# interrupted), so they are small: ~0.1 s at 3 us a path
+UNIT_PATHS = 1 << 15
 
 # The newest session's timings and counts, for tests and docs (last_render's twin).
 last_viewport = {}
@@ -49,12 +53,13 @@ last_viewport = {}
 
 def viewport_settings(scene):
     """engine.RenderSettings of the viewport: the render's own, with Sampling > Viewport's
-    samples (Cycles' preview_samples; 1024 without the Cycles add-on) and no adaptive
-    sampling or time limit."""
+    samples (Cycles' preview_samples; 1024 without the Cycles add-on), no adaptive
+    sampling or time limit, and small work units (UNIT_PATHS)."""
     settings = scene.drt.to_engine_settings()
     samples = int(getattr(getattr(scene, "cycles", None), "preview_samples", 1024))
     return replace(settings, samples=samples if samples > 0 else UNLIMITED,
-                   adaptive_sampling=False, time_limit=0.0)
+                   adaptive_sampling=False, time_limit=0.0,
+                   chunk_paths=min(settings.chunk_paths, UNIT_PATHS))
 
 
 def denoise_settings(scene):
@@ -90,8 +95,7 @@ class _Run:
 
 class ViewportSession:
     def __init__(self, tag_redraw):
-        memo = import_module(__package__ + ".export.memo")
-        self.memo = memo.ExportMemo()
+        self.memo = ExportMemo()
         self.tag_redraw = tag_redraw
         self.ctx = None              # the context of the newest export
         self.view = None
