@@ -23,7 +23,7 @@ from . import denoise
 from .blender_compat import (AO_PASS, ENVIRONMENT_PASS, MATERIAL_INDEX_PASS,
                              OBJECT_INDEX_PASS, set_pass_pixels)
 from .render_passes import (CRYPTOMATTE, FIRST_HIT, PASSES, FirstHit, cryptomatte_passes,
-                            enabled_passes, shader_aov_passes)
+                            enabled_passes, shader_aov_passes, vector_pass)
 
 # The tracer (engine: kernels compiled by Numba, Embree through its C API) and the export
 # are imported by the first DRT render, not when Blender registers the add-on: a Blender
@@ -146,11 +146,23 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         except (ExportError, ValueError) as e:
             self.update_stats("", f"DRT: {e}")
             self.report({"ERROR"}, str(e))
+        except Exception as e:      # never into Blender's event loop: said, and printed
+            traceback.print_exc()
+            self.update_stats("", f"DRT viewport: {type(e).__name__}: {e}")
+            self.report({"ERROR"}, f"DRT viewport: {type(e).__name__}: {e}")
 
     def view_draw(self, context, depsgraph):
-        if self.viewport is not None:
+        if self.viewport is None:
+            return
+        try:
             self.viewport.draw(context, depsgraph, self)
             self.update_stats("", self.viewport.status())
+        except Exception as e:
+            if self.viewport.error is None:        # said once, not at every redraw
+                traceback.print_exc()
+                self.viewport.error = f"DRT viewport: {type(e).__name__}: {e}"
+                self.report({"ERROR"}, self.viewport.error)
+            self.update_stats("", self.viewport.error)
 
     def _tag_redraw(self):
         try:
@@ -315,7 +327,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             elif stats.cancelled:
                 last_render["cancelled_in"] = "tracing"
             if not stats.cancelled:
-                self._write_passes(layer, ctx, film, view_layer, description, first_hit)
+                self._write_passes(layer, ctx, film, view_layer, description, first_hit,
+                                   lambda: vector_pass(self, depsgraph, settings, region))
                 self._write_cryptomatte(result, layer, ctx, view_layer)
         finally:
             ctx.close()
@@ -360,7 +373,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 result.stamp_data_add_field(key, value)
             last_render["metadata"].update(fields)
 
-    def _write_passes(self, layer, ctx, film, view_layer, description, first_hit):
+    def _write_passes(self, layer, ctx, film, view_layer, description, first_hit, vectors):
         wanted = [name for name in enabled_passes(view_layer)
                   if layer.passes.get(name) is not None]
         aovs = [row for row in shader_aov_passes(view_layer)
@@ -388,6 +401,9 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 wanted.append(name)
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
+        if "Vector" in wanted:
+            self.update_stats("", "DRT: Vector pass")
+            images["Vector"] = vectors()
         for name in wanted:
             set_pass_pixels(layer.passes[name], _bottom_up(images[name]))
             last_render["passes"][name] = images[name]

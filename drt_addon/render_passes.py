@@ -23,6 +23,9 @@ layer (Properties > View Layer > Passes):
   that hit nothing see it, as Cycles' Environment pass.
 - Ambient Occlusion (`use_pass_ambient_occlusion`; AO before Blender 5.0): Cycles' AO
   pass, from the first hits (engine.ambient_occlusion).
+- Vector (`use_pass_vector`): Cycles' motion vectors for Vector Blur, from the pixel
+  centres' surfaces one frame before and after (engine.motion_vectors); zeros with
+  motion blur on, as Cycles writes it.
 - Shader AOVs (View Layer > Shader AOV): what the materials' AOV Output nodes say at
   the first hits, a Color AOV as RGB and the share of samples that wrote it, a Value
   AOV as one value (engine.shader_aovs).
@@ -39,6 +42,8 @@ tracer."""
 from __future__ import annotations
 
 from importlib import import_module
+
+import numpy as np
 
 from .blender_compat import AO_PASS, ENVIRONMENT_PASS, MATERIAL_INDEX_PASS, OBJECT_INDEX_PASS
 
@@ -57,6 +62,7 @@ PASSES = {
     MATERIAL_INDEX_PASS: (1, "X", "VALUE", lambda vl: vl.use_pass_material_index),
     ENVIRONMENT_PASS: (3, "RGB", "COLOR", lambda vl: vl.use_pass_environment),
     AO_PASS: (3, "RGB", "COLOR", lambda vl: vl.use_pass_ambient_occlusion),
+    "Vector": (4, "XYZW", "VECTOR", lambda vl: vl.use_pass_vector),
 }
 FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position",
              "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, ENVIRONMENT_PASS, AO_PASS)
@@ -114,6 +120,28 @@ class FirstHit:
             self.passes = aov.first_hit_passes(self.ctx, mist=_mist(aov, self.world), ao=ao,
                                                aov_passes=aovs)
         return self.passes, self.description.camera.matrix
+
+
+def vector_pass(render_engine, depsgraph, settings, region):
+    """Cycles' Vector pass (engine.motion_vectors), (h, w, 4) top-down: zeros with motion
+    blur on, as Cycles writes it; else from the scene exported once more with motion over
+    the frames f - 1 to f + 1 (Blender's frame is moved and restored by the export)."""
+    from .engine_link import engine
+    from .export import Reporter, export_scene
+    from .export.motion import MotionSettings
+    scene = depsgraph.scene
+    if scene.render.use_motion_blur:
+        return np.zeros((region.height, region.width, 4))
+    shutter = MotionSettings(int(scene.frame_current), float(scene.frame_subframe), 2.0,
+                             "CENTER")
+    description = export_scene(depsgraph, Reporter(None), region=region,
+                               render_engine=render_engine, motion=shutter)
+    vectors = import_module(engine.__name__ + ".motion_vectors")
+    ctx = engine.RenderContext(description, settings)
+    try:
+        return vectors.vector_pass(ctx)
+    finally:
+        ctx.close()
 
 
 def shader_aov_passes(view_layer) -> list:

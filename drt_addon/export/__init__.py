@@ -59,7 +59,7 @@ def crypto_names(inst, obj) -> tuple:
 def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
                  region: RenderRegion | None = None, stats: dict | None = None,
                  render_engine=None, check_cancel=None, memo=None,
-                 view=None) -> "engine.Scene":
+                 view=None, motion=None) -> "engine.Scene":
     """The scene as DRT's description.
 
     region: the pixels to render (default: Blender's render size and border, see
@@ -79,12 +79,15 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
     The Rendered viewport passes `view`, (engine.Camera, width, height) of the 3D view
     (drt_addon.viewport_camera; the scene needs no camera then, and there is no motion
     blur, as in Cycles' viewport), and `memo`, an export.memo.ExportMemo whose geometry and
-    materials are reused from the last export unless an update dropped them."""
+    materials are reused from the last export unless an update dropped them.
+
+    `motion` (an export.motion.MotionSettings) exports the scene with that shutter whatever
+    the file's motion blur says: the Vector pass's scene over frames f - 1 to f + 1."""
     reporter = reporter or Reporter()
     check_file_settings(depsgraph.scene, depsgraph.view_layer, reporter)
     for message in missing_library_messages():
         reporter.warn(f"DRT: {message}")
-    blur = read_settings(depsgraph.scene) if view is None else None
+    blur = motion or (read_settings(depsgraph.scene) if view is None else None)
     if blur is None:
         return _export_scene(depsgraph, reporter, size, region, stats, None, check_cancel,
                              memo, view)

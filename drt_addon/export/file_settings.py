@@ -70,14 +70,13 @@ _NULL_SCATTERING = ("DRT renders volumes without ray marching steps: homogeneous
                     "unbiased as Cycles' default")
 _SIMPLIFY = ("scene.render.use_simplify", (True,))
 _ADAPTIVE = ("scene.cycles.use_adaptive_sampling", (True,))
-WRITTEN_PASSES = ("Combined, Depth, Mist, Normal, Position, UV, Object Index, Material "
-                  "Index, Environment, Ambient Occlusion, Cryptomatte, Denoising Data and "
-                  "DRT Noise")
+WRITTEN_PASSES = ("Combined, Depth, Mist, Normal, Position, UV, Vector, Object Index, "
+                  "Material Index, Environment, Ambient Occlusion, Cryptomatte, Denoising "
+                  "Data and DRT Noise")
 _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
 
 # Render passes DRT does not write, as (path, label).
 _UNWRITTEN_PASSES = [
-    ("view_layer.use_pass_vector", "Vector"),
     ("view_layer.use_pass_diffuse_direct", "Diffuse Direct"),
     ("view_layer.use_pass_diffuse_indirect", "Diffuse Indirect"),
     ("view_layer.use_pass_diffuse_color", "Diffuse Color"),
@@ -162,6 +161,9 @@ SETTINGS: list[FileSetting] = [
     _s("view_layer.use_pass_environment", "Passes > Environment", READ,
        "written: the world as camera rays that hit nothing see it (Cycles' Environment; "
        "a sample through a transparent surface adds nothing)"),
+    _s("view_layer.use_pass_vector", "Passes > Vector", READ,
+       "written: motion vectors from the frames before and after, as Cycles' (zeros with "
+       "motion blur on, as Cycles writes them)"),
     _s("view_layer.use_pass_ambient_occlusion", "Passes > Ambient Occlusion", READ,
        "written: the share of cosine-weighted directions from the first hit that reach "
        "World > Ambient Occlusion > Distance unoccluded (Cycles' AO), min(samples, 64) "
