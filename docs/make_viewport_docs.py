@@ -190,7 +190,7 @@ def write(scenes, steps, why_not):
             "OpenGL), DRT as its add-on: the 3D view in camera view switched to Rendered, "
             "then (left to right, top to bottom) the cube's Base Color made green, the cube "
             "moved, the lamp's power x4, the view turned out of camera view, Sampling > "
-            "Viewport > Denoise on (this scene is nearly noiseless at 8 samples). The same "
+            "Viewport > Denoise on (this scene is nearly noiseless at 4 samples). The same "
             "run is tests/test_viewport_window.py.*",
             "",
             "| step | exported again: meshes | materials | edit to first image drawn | "

@@ -12,10 +12,11 @@ Open Image Denoise), as Cycles does for a final render:
   and says why.
 
 The albedo and normal OIDN is given are DRT's Denoising Albedo and Denoising Normal
-passes (engine.aov: the first hit's diffuse albedo from its material's Base Color value,
-and its interpolated camera-space normal). Cycles' guides differ in two ways, measured in
-docs/denoising.md: they evaluate the material (textures on Base Color, bump and normal
-maps), and they follow paths through mirror-like surfaces to the first rough one.
+passes (engine.aov: the first hit's diffuse albedo, its Base Color and Metallic as the
+path tracer shades them there, textures and shader programs included, and its
+interpolated camera-space normal). Cycles' guides differ in two ways, measured in
+docs/denoising.md: its normal is the material's (bump and normal maps), and it follows
+paths through mirror-like surfaces to the first rough one.
 """
 from __future__ import annotations
 

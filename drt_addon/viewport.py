@@ -175,6 +175,8 @@ class ViewportSession:
         """The viewport's stats line: samples done of the viewport's, or what went wrong."""
         if self.error:
             return self.error
+        if self.view is not None and (self.view.region.width < 1 or self.view.region.height < 1):
+            return "DRT: the Render Region is empty"
         with self.lock:
             published = self.published
         if published is None or published[0] != self.generation:
@@ -211,6 +213,7 @@ class ViewportSession:
     def _restart(self, view: ViewportView) -> None:
         self.generation += 1
         self.view = view
+        self.error = None                     # a new start: said again if it recurs
         run = _Run(self.generation, self.ctx, view, self.settings, self.denoise)
         if view.region.width < 1 or view.region.height < 1:
             return                            # an empty Render Region: nothing to trace

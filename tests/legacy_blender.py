@@ -73,7 +73,7 @@ class LegacyBlender:
             ) -> subprocess.CompletedProcess:
         """Blender with `args`: in the background, or with `window` in a window on a
         virtual screen (xvfb-run, Mesa's software OpenGL)."""
-        command = ([self.xvfb_run, "-a", "-s", "-screen 0 1024x768x24", self.blender]
+        command = ([self.xvfb_run, "-a", "-s", "-screen 0 800x600x24", self.blender]
                    if window else [self.blender, "-b"])
         proc = subprocess.run([*command, *args], env=self.env, cwd=str(self.home),
                               capture_output=True, text=True, timeout=timeout)

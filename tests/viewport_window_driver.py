@@ -3,7 +3,7 @@ THIS -- OUT_DIR`) by tests/test_viewport_window.py: drives DRT's Rendered viewpo
 artist would, from Blender's own event loop (a timer), and writes what it saw to
 OUT_DIR/viewport.json, with a screenshot of the 3D view after each step.
 
-Steps, each waiting until the viewport has drawn its samples (Sampling > Viewport = 8):
+Steps, each waiting until the viewport has drawn its samples (Sampling > Viewport = 4):
   start      the 3D view (camera view, no overlays) switched to Rendered;
   material   the cube's Base Color from red to green;
   move       the cube moved 1.5 m along x;
@@ -25,7 +25,7 @@ import traceback
 import bpy
 
 OUT = sys.argv[sys.argv.index("--") + 1]
-SAMPLES = 8
+SAMPLES = 4
 TIMEOUT = 240.0
 results = {"steps": [], "error": None}
 try:                                  # the add-on folder is the package `drt`
