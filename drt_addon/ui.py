@@ -178,14 +178,26 @@ def _builtin_panels():
             yield cls
 
 
+def draw_pause(self, context):
+    """The 3D view header's pause button in Rendered shading, Cycles' own property
+    (`scene.cycles.preview_pause`), which DRT's viewport follows (drt_addon.viewport)."""
+    cycles = getattr(context.scene, "cycles", None)
+    space = context.space_data
+    if (context.engine == ENGINE and cycles is not None and space is not None
+            and space.shading.type == "RENDERED"):
+        self.layout.prop(cycles, "preview_pause", icon="PLAY", text="")
+
+
 def register():
     for cls in CLASSES:
         bpy.utils.register_class(cls)
     for panel in _builtin_panels():
         panel.COMPAT_ENGINES.add(ENGINE)
+    bpy.types.VIEW3D_HT_header.append(draw_pause)
 
 
 def unregister():
+    bpy.types.VIEW3D_HT_header.remove(draw_pause)
     for panel in _builtin_panels():
         panel.COMPAT_ENGINES.discard(ENGINE)
     for cls in reversed(CLASSES):

@@ -7,7 +7,8 @@ view_draw call `sync` and `draw`), as Cycles' viewport session works:
   viewport's depsgraph (viewport visibility, no motion blur) with an export.memo.ExportMemo;
   later syncs read `depsgraph.updates`, drop the geometry and materials the edit touched,
   and export again reusing the rest (a moved object or a lamp's strength evaluates no
-  mesh). The acceleration structure is rebuilt from the exported arrays.
+  mesh). The acceleration structure is rebuilt from the exported arrays, except after an
+  edit of lamps or the world alone (`RenderContext.relit` keeps it).
 - **Navigation re-exports nothing.** The view's camera comes from the 3D view's matrices
   (drt_addon.viewport_camera); a new view gets a new camera on the same
   engine.RenderContext (`RenderContext.view`).
@@ -78,6 +79,12 @@ def denoise_settings(scene):
     return s, max(1, int(c.preview_denoising_start_sample))
 
 
+def is_paused(scene) -> bool:
+    """Cycles' Pause of the Rendered viewport (`scene.cycles.preview_pause`, the header's
+    pause button): the view keeps its last image and traces nothing until resumed."""
+    return bool(getattr(getattr(scene, "cycles", None), "preview_pause", False))
+
+
 def _original(scene):
     """The scene the artist edits: an edit of a render setting reaches the depsgraph's
     evaluated copy only with the next evaluation, and Blender may not evaluate for it."""
@@ -110,6 +117,7 @@ class ViewportSession:
         self.reporter = None
         self.error = None
         self.note = ""               # what the status line adds (a denoiser missing)
+        self.paused = False          # Cycles' Pause (scene.cycles.preview_pause)
 
     # -- main thread: Blender's view_update and view_draw ---------------------------------
 
@@ -122,6 +130,8 @@ class ViewportSession:
         scene = _original(depsgraph.scene)
         settings, denoise = viewport_settings(scene), denoise_settings(scene)
         first = self.ctx is None
+        if first:
+            self.paused = is_paused(scene)
         if not first and not settings_changed:
             kinds = self.memo.forget_updated(depsgraph.updates)
             if not kinds or (kinds == {"SCENE"} and settings == self.settings
@@ -134,8 +144,14 @@ class ViewportSession:
                                    view=(view.camera, view.width, view.height))
         settings.validate()
         t_export = time.perf_counter()
-        ctx = engine.RenderContext(description, settings)
-        if self.ctx is not None:
+        relight = (not first and not settings_changed and self.memo.lights_only
+                   and settings == self.settings
+                   and (getattr(description.world, "volume", None) is None)
+                   == (getattr(self.ctx.scene.world, "volume", None) is None))
+        # lamps or the world alone: the acceleration structure and materials are kept
+        ctx = self.ctx.relit(description) if relight else engine.RenderContext(description,
+                                                                              settings)
+        if self.ctx is not None and not relight:   # a relit context shares its structure
             self.retired.append(self.ctx)
         self.ctx, self.settings, self.denoise = ctx, settings, denoise
         self.note = ""
@@ -146,6 +162,7 @@ class ViewportSession:
         last_viewport.update(syncs=last_viewport.get("syncs", 0) + 1, export_stats=stats,
                              export_seconds=t_export - t0,
                              build_seconds=time.perf_counter() - t_export, first_sync=first,
+                             rebuilt=not relight,
                              edit_time=t0, first_image_seconds=None)
         self._restart(view)
 
@@ -155,11 +172,14 @@ class ViewportSession:
         if self.ctx is None:
             return
         scene = _original(depsgraph.scene)
+        self.follow_pause(scene, context, depsgraph)
         if (viewport_settings(scene), denoise_settings(scene)) != (self.settings, self.denoise):
             self.sync(depsgraph, context, self.reporter, settings_changed=True)
         self.look(view_of(context, depsgraph))
         with self.lock:
             published = self.published
+        if self.paused and published is not None:
+            published = (self.generation,) + published[1:]   # paused: the last image
         if published is None or published[0] != self.generation:
             return                           # nothing of this view yet: keep the last frame
         self._upload(published)
@@ -175,6 +195,8 @@ class ViewportSession:
         """The viewport's stats line: samples done of the viewport's, or what went wrong."""
         if self.error:
             return self.error
+        if self.paused:
+            return "DRT: paused"
         if self.view is not None and (self.view.region.width < 1 or self.view.region.height < 1):
             return "DRT: the Render Region is empty"
         with self.lock:
@@ -186,6 +208,18 @@ class ViewportSession:
         denoised = " (denoised)" if last_viewport.get("denoised") else ""
         return (f"Sample {samples}{limit}{denoised}{self.note}" if samples
                 else "DRT: rendering")
+
+    def follow_pause(self, scene, context, depsgraph) -> None:
+        """Pause (the thread stops, the last image stays) or resume (a restart) as the
+        scene's Pause says."""
+        paused = is_paused(scene)
+        if paused == self.paused:
+            return
+        self.paused = paused
+        if paused:
+            self.generation += 1
+        else:
+            self._restart(view_of(context, depsgraph))
 
     def look(self, view: ViewportView) -> bool:
         """Trace `view` from now on if it is not the one traced (navigation: nothing is
@@ -215,8 +249,8 @@ class ViewportSession:
         self.view = view
         self.error = None                     # a new start: said again if it recurs
         run = _Run(self.generation, self.ctx, view, self.settings, self.denoise)
-        if view.region.width < 1 or view.region.height < 1:
-            return                            # an empty Render Region: nothing to trace
+        if view.region.width < 1 or view.region.height < 1 or self.paused:
+            return                            # an empty Render Region, or paused
         run.thread = threading.Thread(target=self._trace, args=(run,), daemon=True,
                                       name=f"DRT viewport {run.generation}")
         self.runs.append(run)
@@ -304,10 +338,10 @@ class ViewportSession:
 
     def _close_finished(self) -> None:
         self.runs = [r for r in self.runs if r.thread is not None and r.thread.is_alive()]
-        busy = {id(r.ctx) for r in self.runs}
+        busy = {id(r.ctx.accel) for r in self.runs}     # relit contexts share theirs
         keep = []
         for ctx in self.retired:
-            if id(ctx) in busy:
+            if id(ctx.accel) in busy:
                 keep.append(ctx)
             else:
                 ctx.close()

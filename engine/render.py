@@ -129,6 +129,29 @@ class RenderContext:
     def close(self):
         self.accel.close()
 
+    def relit(self, scene: Scene) -> "RenderContext":
+        """This context with `scene`'s lamps and world, for a scene whose geometry and
+        materials are this one's (the Rendered viewport after an edit of lamps or the
+        world alone): the acceleration structure, the materials and the emissive
+        triangles are kept; the lights, the world and the integrator are new."""
+        other = copy.copy(self)
+        other.scene = scene
+        other.camera = CameraModel(scene.camera, scene.width, scene.height, scene.pixel_aspect)
+        other.camera_kernel = None if self.has_motion else pack_camera(other.camera,
+                                                                       self.filter)
+        other.world = world_model(scene.world)
+        other.world_radiance = np.asarray(getattr(other.world, "radiance", np.zeros(3)),
+                                          dtype=np.float64)[:3]
+        other.scene_radius = _scene_radius(scene, self.accel)
+        sun = getattr(scene.world, "sun", None)
+        lamps = list(scene.lights) + ([sun] if sun is not None else [])
+        other.lights = LightSet(lamps, other.scene_radius, mesh_lights=self.lights.mesh,
+                                world=other.world)
+        other.light_visible_camera = np.array(
+            [getattr(m, "visible_camera", True) for m in other.lights.models] or [True])
+        other.integrator = make_integrator(self.settings.integrator, other)
+        return other
+
     def view(self, camera, width: int, height: int) -> "RenderContext":
         """This scene seen through `camera` at `width` x `height` (the Rendered viewport
         navigating, or rendering its first passes at a lower resolution): the

@@ -172,6 +172,15 @@ def test_viewport_panel_shows_the_files_cycles_viewport_settings(bpy_drt):
         "preview_denoising_prefilter", "preview_denoising_quality",
         "preview_denoising_start_sample")]
     assert callable(DRTRenderEngine.view_update) and callable(DRTRenderEngine.view_draw)
+    # the 3D view header's pause button, in Rendered shading with DRT only
+    assert ui.draw_pause in bpy_drt.types.VIEW3D_HT_header._dyn_ui_initialize()
+    for engine, shading, shown in (("DRT", "RENDERED", True), ("DRT", "SOLID", False),
+                                   ("CYCLES", "RENDERED", False)):
+        drawn.clear()
+        space = types.SimpleNamespace(shading=types.SimpleNamespace(type=shading))
+        ui.draw_pause(types.SimpleNamespace(layout=Layout()), types.SimpleNamespace(
+            scene=scene, engine=engine, space_data=space))
+        assert drawn == ([(scene.cycles, "preview_pause")] if shown else []), engine
 
 
 def test_manifest_is_a_valid_extension_manifest():

@@ -214,6 +214,8 @@ def test_viewport_renders_the_final_renders_image_and_follows_edits(session):
         stats = last_viewport["export_stats"]
         assert stats["mesh_evaluations"] == 0, (name, stats)
         assert stats["material_exports"] == (1 if name == "colour" else 0), (name, stats)
+        # a lamp's edit keeps the acceleration structure (RenderContext.relit)
+        assert last_viewport["rebuilt"] == (name != "lamp"), name
         image = _image(_wait(s, SAMPLES))
         print(f"viewport {name}: export {last_viewport['export_seconds']:.3f} s, build "
               f"{last_viewport['build_seconds']:.3f} s, first image "
@@ -336,3 +338,37 @@ def test_viewport_settings_read_cycles_viewport_samples(scene):
     assert viewport_settings(bpy.context.scene).samples == 24
     c.preview_samples = 0                                   # Cycles: no limit
     assert viewport_settings(bpy.context.scene).samples == UNLIMITED
+
+
+def test_pause_keeps_the_image_and_traces_nothing(scene):
+    """Cycles' Pause (scene.cycles.preview_pause, the header's button): a paused view
+    starts no thread and says so; resumed, it traces again; paused mid-render, its thread
+    stops."""
+    bpy = scene
+    from drt_addon.export import Reporter
+    from drt_addon.viewport import ViewportSession
+
+    def tracing():
+        return [t for t in threading.enumerate() if t.name.startswith("DRT viewport")
+                and t.is_alive()]
+    c = bpy.context.scene.cycles
+    c.preview_pause, c.preview_samples = True, 1 << 20
+    s = ViewportSession(lambda: None)
+    try:
+        ctx = _context(_camera_view(bpy, bpy.context.scene.camera))
+        dg = bpy.context.evaluated_depsgraph_get()
+        s.sync(dg, ctx, Reporter())
+        assert s.paused and s.status() == "DRT: paused" and not tracing()
+        c.preview_pause = False
+        s.follow_pause(bpy.context.scene, ctx, dg)
+        _wait(s, 1)
+        assert tracing()                              # refining towards 2^20 samples
+        c.preview_pause = True
+        s.follow_pause(bpy.context.scene, ctx, dg)
+        t0 = time.perf_counter()
+        while tracing() and time.perf_counter() - t0 < 30.0:
+            time.sleep(0.02)
+        assert not tracing() and s.published is not None
+    finally:
+        c.preview_pause = False
+        s.free()

@@ -85,6 +85,8 @@ def test_edits_show_without_re_exporting_meshes(viewport_run):
     assert now - was > 40, (was, now)                        # the cube moved right
     lamp = _view(steps["lamp"]["screenshot"])
     assert steps["lamp"]["mesh_evaluations"] == 0
+    # a lamp's edit keeps the acceleration structure; a move rebuilds it
+    assert steps["lamp"]["rebuilt"] is False and steps["move"]["rebuilt"] is True
     lower = slice(-moved.shape[0] // 3, None)
     assert lamp[lower].mean() > 1.3 * moved[lower].mean()    # four times the power
     assert np.abs(start - material).max() > 50

@@ -140,7 +140,7 @@ def _tick():
         "first_image_seconds": lv.get("first_image_seconds"),
         "export_seconds": lv.get("export_seconds"), "build_seconds": lv.get("build_seconds"),
         "samples": lv.get("drawn_samples"), "error": lv.get("error"),
-        "denoised": lv.get("denoised"),
+        "denoised": lv.get("denoised"), "rebuilt": lv.get("rebuilt"),
         "screenshot": screenshot(name)})
     state["step"] += 1
     state["since"] = None

@@ -398,13 +398,15 @@ SETTINGS: list[FileSetting] = [
          "viewport uses full-size textures"),
         ("bake_type", "Bake", "DRT does not bake"),
     ]],
-    *_no_effect(["preview_pause", "preview_denoiser", "preview_denoising_use_gpu",
+    _s("scene.cycles.preview_pause", "Viewport > Pause (the 3D view header)", NO_EFFECT,
+       "the Rendered viewport stops tracing and keeps its image, as in Cycles"),
+    *_no_effect(["preview_denoiser", "preview_denoising_use_gpu",
                  "preview_scrambling_distance", "use_preview_adaptive_sampling",
                  "preview_adaptive_threshold", "preview_adaptive_min_samples",
                  "volume_preview_step_rate", "preview_dicing_rate", "ao_bounces"],
-                "viewport only, not read (DRT's Rendered viewport does not pause, denoises "
-                "with OpenImageDenoise on the CPU, samples every pixel alike and renders "
-                "volumes and displacement as the final render does)"),
+                "viewport only, not read (DRT's Rendered viewport denoises with "
+                "OpenImageDenoise on the CPU, samples every pixel alike and renders volumes "
+                "and displacement as the final render does)"),
     *_no_effect(["debug_bvh_type", "debug_use_hair_bvh", "debug_use_compact_bvh",
                  "debug_bvh_time_steps", "debug_use_cpu_avx2", "debug_use_cpu_sse42",
                  "debug_bvh_layout", "debug_use_cuda_adaptive_compile",

@@ -64,6 +64,7 @@ class ExportMemo:
         self._mesh_args = None
         self.materials = {}         # material name (None: an empty slot) -> engine.Material
         self.material_exports = 0   # export_material calls in the last export
+        self.lights_only = False    # the last updates changed lamps or the world alone
 
     def begin(self, reporter, uv_pass: bool, override) -> MeshCache:
         """Start an export: its counts start at 0; returns the lasting mesh cache for an
@@ -93,12 +94,18 @@ class ExportMemo:
         kinds = set()
         objects, datas, everything = set(), set(), False
         updates = list(updates)
-        # Blender 3.4 reports an edit in a material's node tree as the tree alone
-        materials_named = any(_kind(u.id) == "MATERIAL" for u in updates)
+        # an edit in an embedded node tree comes with its owner's update (a material,
+        # a world, a lamp); Blender 3.4 reports a material's as the tree alone
+        owners_named = any(_kind(u.id) in ("MATERIAL", "WORLD", "LIGHT") for u in updates)
+        self.lights_only = True
         for u in updates:
             id_ = u.id
             kind = _kind(id_)
             kinds.add(kind)
+            self.lights_only &= kind in ("LIGHT", "WORLD", "SCENE") or (
+                kind == "OBJECT" and getattr(id_, "type", "") == "LIGHT") or (
+                kind == "NODETREE" and getattr(id_, "is_embedded_data", False)
+                and not any(_kind(v.id) == "MATERIAL" for v in updates))
             if kind == "OBJECT":
                 if u.is_updated_geometry:
                     obj = id_.original if id_.original is not None else id_
@@ -113,7 +120,7 @@ class ExportMemo:
             elif kind in _SHADING_INPUTS:
                 # a material's own tree updates with its material (since Blender 3.5);
                 # a shared node group, an image or a texture may be in any material
-                if not (getattr(id_, "is_embedded_data", False) and materials_named):
+                if not (getattr(id_, "is_embedded_data", False) and owners_named):
                     self.materials.clear()
             elif kind not in _READ_EVERY_TIME and u.is_updated_geometry:
                 original = id_.original if id_.original is not None else id_
