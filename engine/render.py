@@ -107,24 +107,29 @@ class RenderContext:
                                  curves=scene.curves)
         self.surfaces = SurfaceBuilder(self.accel, [getattr(m, "holdout", False)
                                                     for m in scene.materials])
+        self._light(scene, EmissiveTriangles.from_scene(scene, self.accel,
+                                                        self.materials.emission))
+        self.integrator = make_integrator(settings.integrator, self)
+        # A camera that does not move gets its rays from one compiled kernel.
+        self.camera_kernel = None if self.has_motion else pack_camera(self.camera, self.filter)
+
+    def _light(self, scene: Scene, mesh_lights, world=None) -> None:
+        """The scene radius, the world model and the light set of `scene` (its lamps, a
+        Sky Texture's sun disc, the emissive triangles `mesh_lights`); `world`: the
+        world model when it is already built."""
         self.scene_radius = _scene_radius(scene, self.accel)
         # the uniform world's radiance (zeros under an environment map), and the world
         # model (engine.world_light) escaped rays read
-        self.world = world_model(scene.world)
+        self.world = world_model(scene.world) if world is None else world
         self.world_radiance = np.asarray(getattr(self.world, "radiance", np.zeros(3)),
                                          dtype=np.float64)[:3]
         # a Sky Texture's sun disc is one more lamp (engine.scene.World.sun)
         sun = getattr(scene.world, "sun", None)
         lamps = list(scene.lights) + ([sun] if sun is not None else [])
-        self.lights = LightSet(lamps, self.scene_radius,
-                               mesh_lights=EmissiveTriangles.from_scene(
-                                   scene, self.accel, self.materials.emission),
+        self.lights = LightSet(lamps, self.scene_radius, mesh_lights=mesh_lights,
                                world=self.world)
         self.light_visible_camera = np.array(
             [getattr(m, "visible_camera", True) for m in self.lights.models] or [True])
-        self.integrator = make_integrator(settings.integrator, self)
-        # A camera that does not move gets its rays from one compiled kernel.
-        self.camera_kernel = None if self.has_motion else pack_camera(self.camera, self.filter)
 
     def close(self):
         self.accel.close()
@@ -139,16 +144,7 @@ class RenderContext:
         other.camera = CameraModel(scene.camera, scene.width, scene.height, scene.pixel_aspect)
         other.camera_kernel = None if self.has_motion else pack_camera(other.camera,
                                                                        self.filter)
-        other.world = world_model(scene.world)
-        other.world_radiance = np.asarray(getattr(other.world, "radiance", np.zeros(3)),
-                                          dtype=np.float64)[:3]
-        other.scene_radius = _scene_radius(scene, self.accel)
-        sun = getattr(scene.world, "sun", None)
-        lamps = list(scene.lights) + ([sun] if sun is not None else [])
-        other.lights = LightSet(lamps, other.scene_radius, mesh_lights=self.lights.mesh,
-                                world=other.world)
-        other.light_visible_camera = np.array(
-            [getattr(m, "visible_camera", True) for m in other.lights.models] or [True])
+        other._light(scene, self.lights.mesh)
         other.integrator = make_integrator(self.settings.integrator, other)
         return other
 
@@ -166,13 +162,8 @@ class RenderContext:
                                    other.scene.pixel_aspect)
         other.camera_kernel = None if other.has_motion else pack_camera(other.camera,
                                                                         other.filter)
-        radius = _scene_radius(other.scene, self.accel)
-        if radius > self.scene_radius * (1.0 + 1e-9):
-            other.scene_radius = radius
-            sun = getattr(other.scene.world, "sun", None)
-            lamps = list(other.scene.lights) + ([sun] if sun is not None else [])
-            other.lights = LightSet(lamps, radius, mesh_lights=self.lights.mesh,
-                                    world=self.world)
+        if _scene_radius(other.scene, self.accel) > self.scene_radius * (1.0 + 1e-9):
+            other._light(other.scene, self.lights.mesh, self.world)
         other.integrator = make_integrator(self.settings.integrator, other)
         return other
 
