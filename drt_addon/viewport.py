@@ -92,7 +92,7 @@ def _original(scene):
 
 
 class _Run:
-    """One restart's work: its generation, context, view, settings, and results."""
+    """One restart's work: its generation, context, view, settings and thread."""
 
     def __init__(self, generation, ctx, view: ViewportView, settings, denoise):
         self.generation, self.ctx, self.view = generation, ctx, view

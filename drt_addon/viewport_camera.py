@@ -77,7 +77,7 @@ def _pixel_size(scene) -> int:
     return int(size) if size.isdigit() else 1
 
 
-def _camera_frame(scene, depsgraph, window_matrix, width, height):
+def _camera_frame(scene, depsgraph, window_matrix):
     """The scene camera's frame in camera view, as (x0, y0, x1, y1) fractions of the
     view: its view-plane corners through the window matrix."""
     from .export import render_size
@@ -116,7 +116,7 @@ def view_of(context, depsgraph) -> ViewportView:
     dof = export_camera(scene.camera, depsgraph) if in_camera else None
     camera = projection_camera(rv3d.view_matrix, rv3d.window_matrix, dof)
     if in_camera and scene.render.use_border:
-        fx0, fy0, fx1, fy1 = _camera_frame(scene, depsgraph, rv3d.window_matrix, width, height)
+        fx0, fy0, fx1, fy1 = _camera_frame(scene, depsgraph, rv3d.window_matrix)
         r = scene.render
         rect = _border((fx0 + (fx1 - fx0) * r.border_min_x, fy0 + (fy1 - fy0) * r.border_min_y,
                         fx0 + (fx1 - fx0) * r.border_max_x, fy0 + (fy1 - fy0) * r.border_max_y),

@@ -15,7 +15,6 @@ from .mesh import MeshCache, _cache_key
 
 # ID types whose updates change no kept geometry or material (read again every export).
 _READ_EVERY_TIME = {"LIGHT", "WORLD", "CAMERA", "SCENE", "OBJECT"}
-_MATERIAL_TYPES = {"MATERIAL"}
 _SHADING_INPUTS = {"IMAGE", "TEXTURE", "NODETREE"}
 
 
@@ -96,7 +95,10 @@ class ExportMemo:
         updates = list(updates)
         # an edit in an embedded node tree comes with its owner's update (a material,
         # a world, a lamp); Blender 3.4 reports a material's as the tree alone
-        owners_named = any(_kind(u.id) in ("MATERIAL", "WORLD", "LIGHT") for u in updates)
+        named = {_kind(u.id) for u in updates}
+        owners_named = bool(named & {"MATERIAL", "WORLD", "LIGHT"})
+        # a tree of a lamp or the world, not of a material
+        light_tree = "MATERIAL" not in named and bool(named & {"WORLD", "LIGHT"})
         self.lights_only = True
         for u in updates:
             id_ = u.id
@@ -104,8 +106,7 @@ class ExportMemo:
             kinds.add(kind)
             self.lights_only &= kind in ("LIGHT", "WORLD", "SCENE") or (
                 kind == "OBJECT" and getattr(id_, "type", "") == "LIGHT") or (
-                kind == "NODETREE" and getattr(id_, "is_embedded_data", False)
-                and not any(_kind(v.id) == "MATERIAL" for v in updates))
+                kind == "NODETREE" and getattr(id_, "is_embedded_data", False) and light_tree)
             if kind == "OBJECT":
                 if u.is_updated_geometry:
                     obj = id_.original if id_.original is not None else id_
@@ -113,7 +114,7 @@ class ExportMemo:
                     # instances made by its modifiers or particles carry its name too
                     everything |= bool(obj.modifiers) or bool(
                         getattr(obj, "particle_systems", ())) or obj.is_instancer
-            elif kind in _MATERIAL_TYPES:
+            elif kind == "MATERIAL":
                 self.materials.pop(id_.name_full, None)
             elif kind == "NODETREE" and getattr(id_, "type", "") == "GEOMETRY":
                 everything = True                      # a geometry node group
