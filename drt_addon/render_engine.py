@@ -19,7 +19,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
-from . import denoise
+from . import denoise, light_passes
 from .blender_compat import (AO_PASS, ENVIRONMENT_PASS, MATERIAL_INDEX_PASS,
                              OBJECT_INDEX_PASS, set_pass_pixels)
 from .render_passes import (CRYPTOMATTE, FIRST_HIT, PASSES, FirstHit, cryptomatte_passes,
@@ -182,6 +182,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 self.register_pass(scene, renderlayer, name, 4, "RGBA", "COLOR")
         for name, channels, chan_id, kind in shader_aov_passes(renderlayer):
             self.register_pass(scene, renderlayer, name, channels, chan_id, kind)
+        for name in light_passes.enabled(renderlayer) + light_passes.group_passes(renderlayer):
+            self.register_pass(scene, renderlayer, name, 3, "RGB", "COLOR")
 
     def render(self, depsgraph):
         from .export import ExportError
@@ -245,6 +247,10 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         settings = scene.drt.to_engine_settings()
         if self.is_preview:
             settings = preview_settings(settings)
+            description.light_groups = ()
+        else:
+            # the path tracer splits its light only when a light pass is asked for
+            settings.light_passes = bool(light_passes.enabled(view_layer))
         try:
             settings.validate()
         except ValueError as e:
@@ -320,7 +326,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                     last_render["passes"][denoise.NOISY_PASS] = noisy
             set_pass_pixels(combined, _rgba_bottom_up(image, alpha))
             extra = (enabled_passes(view_layer) or cryptomatte_passes(view_layer)
-                     or shader_aov_passes(view_layer))
+                     or shader_aov_passes(view_layer) or light_passes.enabled(view_layer)
+                     or light_passes.group_passes(view_layer))
             if not stats.cancelled and extra and self._polled("passes"):
                 stats.cancelled = True             # cancelled before the extra passes
                 last_render["cancelled_in"] = "passes"
@@ -378,9 +385,13 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                   if layer.passes.get(name) is not None]
         aovs = [row for row in shader_aov_passes(view_layer)
                 if layer.passes.get(row[0]) is not None]
-        if not wanted and not aovs:
+        lights = [name for name in (light_passes.enabled(view_layer)
+                                    + light_passes.group_passes(view_layer))
+                  if layer.passes.get(name) is not None]
+        if not wanted and not aovs and not lights:
             return
-        images = {}
+        images = light_passes.images(film, description.light_groups, lights)
+        wanted += lights
         if any(n in wanted for n in FIRST_HIT):
             self.update_stats("", "DRT: first-hit passes")
             first, _ = first_hit()

@@ -13,12 +13,25 @@ of every other sample, as Cycles keeps for adaptive sampling. The difference bet
 whole mean and that half's mean estimates the error of the pixel honestly even for
 stratified and quasi-Monte Carlo samples, whose sum of squares overstates it
 (engine.adaptive_sampling).
+
+With `extra` channels it also sums, per pixel, that many more RGB values of each sample
+(the light passes and light groups of engine.light_passes).
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .kernels.jit import kernel
+
+
+@kernel
+def _accumulate_extra(pixel, extra, extra_sum):
+    """Add each sample's extra channels (n, k, 3) to its pixel's sums."""
+    for i in range(pixel.shape[0]):
+        p = pixel[i]
+        for j in range(extra.shape[1]):
+            for c in range(3):
+                extra_sum[p, j, c] += extra[i, j, c]
 
 
 @kernel
@@ -42,9 +55,10 @@ def _accumulate(pixel, index, radiance, alpha, count, total, total_sq, alpha_sum
 
 
 class Film:
-    def __init__(self, width: int, height: int):
+    def __init__(self, width: int, height: int, extra: int = 0):
         self.width, self.height = int(width), int(height)
         n = self.width * self.height
+        self.extra_sum = np.zeros((n, int(extra), 3), dtype=np.float64)
         self.count = np.zeros(n, dtype=np.int64)
         self.sum = np.zeros((n, 3), dtype=np.float64)
         self.sum_sq = np.zeros((n, 3), dtype=np.float64)
@@ -53,9 +67,9 @@ class Film:
         self.sum_odd = np.zeros((n, 3), dtype=np.float64)
 
     def add(self, pixel: np.ndarray, radiance: np.ndarray, alpha: np.ndarray | None = None,
-            *, index: np.ndarray) -> None:
+            *, index: np.ndarray, extra: np.ndarray | None = None) -> None:
         """Add samples: `pixel` and sample `index` (n,), radiance (n, 3), alpha (n,)
-        or None (opaque)."""
+        or None (opaque), and the extra channels (n, k, 3) when the film keeps k."""
         pixel = np.ascontiguousarray(pixel, dtype=np.int64)
         index = np.ascontiguousarray(index, dtype=np.int64)
         if len(pixel) and (pixel.min() < 0 or pixel.max() >= self.count.size):
@@ -66,8 +80,13 @@ class Film:
                     np.zeros(0) if alpha is None else np.ascontiguousarray(alpha, np.float64),
                     self.count, self.sum, self.sum_sq, self.alpha_sum,
                     self.count_odd, self.sum_odd)
+        if self.extra_sum.shape[1]:
+            if extra is None or extra.shape != (len(pixel),) + self.extra_sum.shape[1:]:
+                raise ValueError("this film keeps extra channels: one row of them per sample")
+            _accumulate_extra(pixel, np.ascontiguousarray(extra, np.float64), self.extra_sum)
 
-    STATISTICS = ("count", "sum", "sum_sq", "alpha_sum", "count_odd", "sum_odd")
+    STATISTICS = ("count", "sum", "sum_sq", "alpha_sum", "count_odd", "sum_odd",
+                  "extra_sum")
 
     def statistics(self) -> dict:
         """Every per-pixel array by name: all a film is, to ship to another process and
@@ -76,9 +95,11 @@ class Film:
 
     @classmethod
     def from_statistics(cls, width: int, height: int, arrays: dict) -> "Film":
-        film = cls(width, height)
+        extra = arrays.get("extra_sum")
+        film = cls(width, height, extra=extra.shape[1] if np.ndim(extra) == 3 else 0)
         for name in cls.STATISTICS:
-            getattr(film, name)[:] = arrays[name]
+            if name in arrays:
+                getattr(film, name)[:] = arrays[name]
         return film
 
     def merge(self, other: "Film") -> "Film":

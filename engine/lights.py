@@ -169,6 +169,9 @@ def make_light(light):
     raise TypeError(f"unknown light type {type(light).__name__}")
 
 
+WORLD = "world"         # LightSet.sources' name for the world's own light
+
+
 class LightSet:
     """All lights of a scene: the lamps (`models`) followed by the emissive triangles
     (`mesh`, an engine.mesh_lights.EmissiveTriangles, may be None), as one list of
@@ -179,6 +182,8 @@ class LightSet:
 
     def __init__(self, lights, scene_radius: float, mesh_lights=None, world=None):
         self.models = [make_light(l) for l in lights]
+        # what each model was made from: a lamp of `lights`, or WORLD (light groups)
+        self.sources = list(lights)
         # the world: a model (engine.world_light), a World or an RGB triple; kept even
         # when it is too dark to be a light, for what escaped rays see
         self.world = None if world is None else (
@@ -191,10 +196,12 @@ class LightSet:
         # Cycles' escaping rays see.
         if self.world is not None and getattr(self.world, "light_sampling", True):
             self.models.append(self.world)
+            self.sources.append(WORLD)
         power = np.array([max(m.power(scene_radius), 0.0) for m in self.models], dtype=np.float64)
         power = np.where(np.isfinite(power), power, 0.0)
         keep = power > 0
         self.models = [m for m, k in zip(self.models, keep) if k]
+        self.sources = [m for m, k in zip(self.sources, keep) if k]
         self.n_lamps = len(self.models)
         env = [k for k, m in enumerate(self.models) if getattr(m, "is_environment", False)]
         self.env_index = env[0] if env else None

@@ -29,7 +29,7 @@ from .adaptive_sampling import AdaptiveSampling
 from .bsdf.material_table import MaterialTable
 from .camera import CameraModel, CameraRays
 from .film import Film
-from . import instancing
+from . import instancing, light_passes
 from .integrators import make_integrator
 from .kernels.camera_rays import generate as generate_camera_rays
 from .kernels.camera_rays import pack_camera
@@ -241,15 +241,21 @@ def camera_rays(ctx: RenderContext, pixel: np.ndarray, index: np.ndarray):
 def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sample_end: int):
     """Radiance of samples [sample_start, sample_end) of each pixel in `pixels`.
     Returns (pixel ids, sample indices, radiance (n, 3) float64, alpha (n,) or None when
-    the film is opaque)."""
+    the film is opaque, the light passes and groups (n, k, 3) of engine.light_passes or
+    None when the render asks for none)."""
     k = sample_end - sample_start
     pixel = np.repeat(pixels.astype(np.int64), k)
     index = np.tile(np.arange(sample_start, sample_end, dtype=np.int64), len(pixels))
     rays, time = camera_rays(ctx, pixel, index)
     alpha = np.ones(len(pixel)) if ctx.scene.needs_alpha() else None
-    radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
-                                       time=time, alpha_out=alpha)
-    return pixel, index, radiance, alpha
+    if not light_passes.channels(ctx):
+        radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions,
+                                           rays.tmax, time=time, alpha_out=alpha)
+        return pixel, index, radiance, alpha, None
+    tally = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
+                                    time=time, alpha_out=alpha, split=True)
+    return pixel, index, tally.L, alpha, light_passes.per_sample(tally, len(pixel),
+                                                                 light_passes.channels(ctx))
 
 
 def plan_passes(total: int, first: int = 1, growth: float = 2.0, largest: int = 64):
@@ -280,7 +286,7 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
     sample_end = settings.samples if sample_end is None else sample_end
     if not (0 <= sample_start < sample_end):
         raise ValueError(f"empty or negative sample range [{sample_start}, {sample_end})")
-    film = Film(scene.width, scene.height)
+    film = Film(scene.width, scene.height, extra=light_passes.channels(ctx))
     stats = RenderStats()
     n_pixels = scene.width * scene.height
     threads = settings.threads or min(os.cpu_count() or 1, 8)
@@ -302,19 +308,23 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
                 return 0
             running[0] += 1
         try:
-            pix, index, rad, alpha = render_unit(ctx, pixels, a, b)
+            pix, index, rad, alpha, extra = render_unit(ctx, pixels, a, b)
         finally:
             with lock:
                 running[0] -= 1
         bad = ~np.isfinite(rad).all(axis=1)
         if bad.any():
             rad[bad] = 0.0
+            if extra is not None:
+                extra[bad] = 0.0
         if settings.film_exposure != 1.0:
             rad *= settings.film_exposure      # Film > Exposure, on the way into the film
+            if extra is not None:
+                light_passes.scale_light(extra, settings.film_exposure)
         with lock:
             if abandoned.is_set():             # finished after render() returned
                 return 0
-            film.add(pix, rad, alpha, index=index)
+            film.add(pix, rad, alpha, index=index, extra=extra)
             stats.paths += len(pix)
             stats.nonfinite_samples += int(bad.sum())
             stats.units_done += 1

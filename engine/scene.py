@@ -297,6 +297,7 @@ class TriangleMesh:
     # then gives only the texture space; Object Info reads the places' own values)
     instances: Optional[Instances] = None
     pass_index: int = 0            # Blender's object Pass Index (IndexOB pass)
+    lightgroup: str = ""           # its emission's light group (Scene.light_groups)
     # the names Cryptomatte gives its hits (engine.cryptomatte): the Blender object's and
     # its topmost parent's ("": the mesh's name, and the object name)
     object_name: str = ""
@@ -354,6 +355,7 @@ class PointLight:
     soft_falloff: bool = False
     visibility: int = 31           # the ray kinds that see it (engine.visibility)
     motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
+    lightgroup: str = ""           # its light group's name (Scene.light_groups; "": none)
 
 
 @dataclass
@@ -366,6 +368,7 @@ class SunLight:
     name: str = "sun"
     visibility: int = 31           # the ray kinds that see it (engine.visibility)
     motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
+    lightgroup: str = ""           # its light group's name (Scene.light_groups; "": none)
 
 
 @dataclass
@@ -385,6 +388,7 @@ class AreaLight:
     name: str = "area"
     visibility: int = 31           # the ray kinds that see it (engine.visibility)
     motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
+    lightgroup: str = ""           # its light group's name (Scene.light_groups; "": none)
 
 
 @dataclass
@@ -446,6 +450,7 @@ class World:
     camera_texture: Optional[object] = None
     sun: Optional[SunLight] = None
     light_sampling: bool = True
+    lightgroup: str = ""           # its light's group (Scene.light_groups; "": none)
 
 
 @dataclass
@@ -461,6 +466,9 @@ class Scene:
     shutter: Optional[object] = None     # engine.motion.Shutter; None = motion blur off
     film_transparent: bool = False       # Blender's Film > Transparent: background alpha 0
     curves: list = field(default_factory=list)   # hair: engine.curves.HairCurves
+    # the view layer's light groups (Cycles' Combined_<name> passes): lamps, emissive
+    # meshes and the world name theirs by `lightgroup`
+    light_groups: tuple = ()
 
     def __post_init__(self):
         if self.width < 1 or self.height < 1:

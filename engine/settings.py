@@ -47,6 +47,10 @@ class RenderSettings:
     # Seconds of tracing after which the render stops (0 = no limit), as Cycles' Time
     # Limit: export and the acceleration structure do not count.
     time_limit: float = 0.0
+    # Cycles' light passes (Diffuse, Glossy, Transmission and Volume Direct / Indirect,
+    # the Color passes, Emission, Environment): the path tracer splits its light
+    # (engine.light_passes). Light groups are asked for by Scene.light_groups.
+    light_passes: bool = False
     # Execution: paths per work unit bounds memory (about 1 KB of state per path).
     chunk_paths: int = 1 << 15
     threads: int = 0                   # 0 = all cores

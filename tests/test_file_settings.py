@@ -346,12 +346,12 @@ def test_settings_that_only_matter_with_another_warn_only_then(factory_scene):
 def test_unwritten_passes_warn_together(factory_scene):
     _quiet_defaults(factory_scene)
     layer = factory_scene.view_layers[0]
-    layer.use_pass_vector = layer.use_pass_diffuse_direct = True
+    layer.use_pass_subsurface_direct = layer.use_pass_shadow = True
     layer.use_pass_z = layer.use_pass_normal = True           # DRT writes these
     layer.use_pass_mist = layer.use_pass_position = True
     warnings = _warnings(factory_scene)
     assert len(warnings) == 1, warnings
-    assert "Vector" in warnings[0] and "Diffuse Direct" in warnings[0]
+    assert "Subsurface Direct" in warnings[0] and "Shadow" in warnings[0]
     listed = warnings[0].split("(it writes")[0]          # the passes warned about
     assert "Mist" not in listed and "Position" not in listed, warnings[0]
 

@@ -206,7 +206,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             programmed = any(_runs_program(materials[i]) for i in slots)
             color, pass_index, texspace = object_values(obj)
             source = Source(groups.group(local, slots, name, holdout, offset, seen,
-                                         programmed, texspace),
+                                         programmed, texspace, _lightgroup(obj)),
                             color, pass_index, holdout, crypto_names(inst, obj))
             if tracker is None:
                 # without motion blur, repeated geometry becomes instances (export.instances)
@@ -222,6 +222,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                 meshes[-1].object_info = object_info(inst, obj, inst.matrix_world)
             meshes[-1].visibility = seen
             meshes[-1].pass_index = int(getattr(obj, "pass_index", 0))
+            meshes[-1].lightgroup = _lightgroup(obj)
             meshes[-1].object_name, meshes[-1].asset_name = crypto_names(inst, obj)
             tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
             # with motion blur, each place is a mesh of its own until the shutter is
@@ -232,6 +233,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         elif obj.type == "LIGHT":
             light = export_light(obj, inst.matrix_world.copy(), reporter)
             if light is not None:
+                light.lightgroup = _lightgroup(obj)
                 lights.append(light)
                 if tracker is not None:
                     tracker.note_light(inst, obj, len(lights) - 1)
@@ -246,6 +248,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     world = export_world(world_id, reporter)
     if world_id is not None:
         world.volume = world_volume(world_id, reporter)
+        world.lightgroup = _lightgroup(world_id)
     shutter = None
     if tracker is not None:
         shutter = tracker.finish(meshes, camera, lights)
@@ -268,7 +271,19 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         stats.update(hair_strands=int(sum(c.curve_count for c in curves)))
     return engine.Scene(camera, region.width, region.height, meshes, materials, lights, world,
                         pixel_aspect=aspect, shutter=shutter,
-                        film_transparent=bool(scene.render.film_transparent), curves=curves)
+                        film_transparent=bool(scene.render.film_transparent), curves=curves,
+                        # (the viewport draws Combined alone)
+                        light_groups=light_groups(view_layer) if view is None else ())
+
+
+def light_groups(view_layer) -> tuple:
+    """The view layer's light groups (View Layer > Light Groups), by name."""
+    return tuple(g.name for g in getattr(view_layer, "lightgroups", ()) if g.name)
+
+
+def _lightgroup(id_block) -> str:
+    """An object's or a world's Light Group (Blender 3.2+; "" for none)."""
+    return str(getattr(id_block, "lightgroup", "") or "")
 
 
 def _instance_visibility(inst, obj) -> int:

@@ -77,24 +77,12 @@ _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
 
 # Render passes DRT does not write, as (path, label).
 _UNWRITTEN_PASSES = [
-    ("view_layer.use_pass_diffuse_direct", "Diffuse Direct"),
-    ("view_layer.use_pass_diffuse_indirect", "Diffuse Indirect"),
-    ("view_layer.use_pass_diffuse_color", "Diffuse Color"),
-    ("view_layer.use_pass_glossy_direct", "Glossy Direct"),
-    ("view_layer.use_pass_glossy_indirect", "Glossy Indirect"),
-    ("view_layer.use_pass_glossy_color", "Glossy Color"),
-    ("view_layer.use_pass_transmission_direct", "Transmission Direct"),
-    ("view_layer.use_pass_transmission_indirect", "Transmission Indirect"),
-    ("view_layer.use_pass_transmission_color", "Transmission Color"),
     ("view_layer.use_pass_subsurface_direct", "Subsurface Direct"),
     ("view_layer.use_pass_subsurface_indirect", "Subsurface Indirect"),
     ("view_layer.use_pass_subsurface_color", "Subsurface Color"),
-    ("view_layer.cycles.use_pass_volume_direct", "Volume Direct"),
-    ("view_layer.cycles.use_pass_volume_indirect", "Volume Indirect"),
     ("view_layer.cycles.use_pass_volume_scatter", "Volume Scatter"),
     ("view_layer.cycles.use_pass_volume_transmit", "Volume Transmit"),
     ("view_layer.cycles.use_pass_volume_majorant", "Volume Majorant"),
-    ("view_layer.use_pass_emit", "Emission"),
     ("view_layer.use_pass_shadow", "Shadow"),
     ("view_layer.cycles.use_pass_shadow_catcher", "Shadow Catcher"),
     ("view_layer.cycles.denoising_store_passes", "Denoising Data (Cycles')"),
@@ -161,6 +149,20 @@ SETTINGS: list[FileSetting] = [
     _s("view_layer.use_pass_environment", "Passes > Environment", READ,
        "written: the world as camera rays that hit nothing see it (Cycles' Environment; "
        "a sample through a transparent surface adds nothing)"),
+    *[_s(f"view_layer.use_pass_{kind}_{part}", f"Passes > {kind.title()} {part.title()}",
+         READ, f"written: the light of paths that first scattered off a {kind} lobe "
+         f"({'next-event estimation at the first surface and what its bounce finds' if part == 'direct' else 'every later bounce'}), divided by {kind.title()} Color as Cycles "
+         "writes it")
+      for kind in ("diffuse", "glossy", "transmission") for part in ("direct", "indirect")],
+    *[_s(f"view_layer.use_pass_{kind}_color", f"Passes > {kind.title()} Color", READ,
+         f"written: what the first surface's {kind} lobes weigh at the view (their albedo "
+         "estimates), as Cycles' closure weights")
+      for kind in ("diffuse", "glossy", "transmission")],
+    *[_s(f"view_layer.cycles.use_pass_volume_{part}", f"Passes > Volume {part.title()}",
+         READ, "written: the light of paths that first scattered in a medium")
+      for part in ("direct", "indirect")],
+    _s("view_layer.use_pass_emit", "Passes > Emission", READ,
+       "written: what camera rays see emitted (lamps, emissive surfaces and media)"),
     _s("view_layer.use_pass_vector", "Passes > Vector", READ,
        "written: motion vectors from the frames before and after, as Cycles' (zeros with "
        "motion blur on, as Cycles writes them)"),
@@ -370,8 +372,9 @@ SETTINGS: list[FileSetting] = [
     _s("view_layer.aovs", "View Layer > Shader AOV", READ,
        "written: what the materials' AOV Output nodes say at the first hits (a Color AOV "
        "as RGB and the share of samples that wrote it, a Value AOV as one value)"),
-    _ignored("view_layer.lightgroups", "View Layer > Light Groups",
-             "DRT writes no light group passes (count shown)", 0),
+    _s("view_layer.lightgroups", "View Layer > Light Groups", READ,
+       "written: a Combined_<group> pass per group, the light of the lamps, emissive "
+       "objects and world in it (Object and World > Light Group)"),
     *[_ignored(path, f"Passes > {label}", _PASSES_HOW, False, group="passes")
       for path, label in _UNWRITTEN_PASSES],
     # -- speed, memory, the viewport or baking: never the final image

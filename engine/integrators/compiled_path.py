@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import visibility
+from .. import light_passes, visibility
 from ..accel import HitArrays
 from ..surface import or_empty
 from ..kernels import lights as klights
@@ -27,8 +27,8 @@ from ..bsdf.material_table import flatten_mixes
 from ..kernels.camera_rays import pack_camera
 from ..kernels.jit import Kernel
 from ..kernels.path_vertex import shade
-from ..kernels.path_weights import (BSDF_ONLY, LIGHT_ONLY, MIS, add_transmitted,
-                                    add_unoccluded)
+from ..kernels.light_tally import add_transmitted, add_unoccluded, new_tally
+from ..kernels.path_weights import BSDF_ONLY, LIGHT_ONLY, MIS
 from ..kernels.transparency import alpha_pass, merge_layer, shadow_pass
 from ..kernels.majorant_bounds import bound_majorants
 from ..kernels.medium_density import shadow_keys
@@ -47,6 +47,8 @@ VOLUME_BOUNDS_MAX = 256     # volume boundaries one path may cross (Cycles: 1024
 class CompiledPathIntegrator:
     """Kajiya's path tracer; subclasses change the vertex kernel (`vertex`, one of
     path_vertex.shade's signature) or the bounce limits, and keep this wavefront loop."""
+
+    splits_light = True       # its vertex kernel writes light passes and light groups
 
     def __init__(self, ctx):
         self.ctx = ctx
@@ -113,6 +115,12 @@ class CompiledPathIntegrator:
                          self.vol if self.heterogeneous else None, rays)
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
                             else np.full(STACK, -1, np.int32))
+        # Cycles' light passes and light groups, when the render asks for them
+        passes, groups = light_passes.wanted(ctx)
+        self.light_passes = passes and self.splits_light
+        self.light_groups = groups if self.splits_light else ()
+        self.group_tables = (light_passes.group_tables(ctx, groups) if self.light_groups
+                             else None)
 
     def entry_kernels(self) -> list:
         """The compiled kernels this integrator calls from Python (engine.render's
@@ -199,14 +207,17 @@ class CompiledPathIntegrator:
             layer += 1
         return trans
 
-    def radiance(self, pixel, index, origins, dirs, tmax, time=None, alpha_out=None):
+    def radiance(self, pixel, index, origins, dirs, tmax, time=None, alpha_out=None,
+                 split=False):
+        """Radiance (n, 3) of the camera rays (origins, dirs, tmax) of samples `index` of
+        pixels `pixel`; with `split`, the whole LightTally (engine.kernels.light_tally),
+        with the light passes and groups this integrator was asked for."""
         if self._mode not in _MODE_IDS:
             raise ValueError(f"mis_mode must be one of {MIS_MODES}, got {self._mode!r}")
         ctx, s = self.ctx, self.ctx.settings
         n = len(pixel)
         pkey = pixel_keys(np.uint64(ctx.sampler.seed), np.asarray(pixel, np.int64))
         index = np.ascontiguousarray(index, dtype=np.int64)
-        L = np.zeros((n, 3))
         coverage = alpha_out if alpha_out is not None else np.zeros(0)
         beta = np.ones((n, 3))
         counts = np.zeros((n, 3), dtype=np.int64)
@@ -227,6 +238,8 @@ class CompiledPathIntegrator:
         stacks = np.ascontiguousarray(np.tile(self.start_stack, (k, 1)), np.int32)
         ns_max = n * self.shadow_rays_per_path       # the shadow rays one bounce may queue
         sh_stack = np.full((ns_max if k else 0, STACK), -1, np.int32)   # one per shadow ray
+        tally = new_tally(n, ns_max, split and self.light_passes,
+                          len(self.light_groups) if split else 0, self.group_tables)
         sh_bounce = np.empty(ns_max, np.int64)
         media = (bounce, vbounce, self.vol, stacks, sh_stack, sh_bounce, self.het_runs)
         no_keys = np.zeros(0, np.uint64)
@@ -257,7 +270,7 @@ class CompiledPathIntegrator:
                     depth, (pkey, index), live, used, ray_bits, path_time, ray_time, o, d,
                     tm, hits)
                 beta[live] *= factor
-            ns, nn = self.vertex(depth, self.cfg, pkey, index, beta, counts, L, coverage,
+            ns, nn = self.vertex(depth, self.cfg, pkey, index, beta, counts, tally, coverage,
                            prev_pdf, prev_pos, ray_bits, min_pdf, cont, path_time, live, o, d,
                            tm, found, stopped, self.geometry, self.params,
                            self.emission, self.textures, self.tables, self.lights,
@@ -272,12 +285,12 @@ class CompiledPathIntegrator:
                             if self.heterogeneous else no_keys)
                     trans = self.shadow_transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns], sh_time,
                                                 sh_stack[:ns] if k else sh_stack, keys)
-                    add_transmitted(L, sh_path[:ns], sh_contrib[:ns], trans, *clamps)
+                    add_transmitted(tally, sh_path[:ns], sh_contrib[:ns], trans, *clamps)
                 else:
                     blocked = ctx.accel.occluded(sh_org[:ns], sh_dir[:ns], sh_far[:ns],
                                                  sh_time)
-                    add_unoccluded(L, sh_path[:ns], sh_contrib[:ns], blocked, *clamps)
+                    add_unoccluded(tally, sh_path[:ns], sh_contrib[:ns], blocked, *clamps)
             live = nx_path[:nn].copy()
             o, d = nx_org[:nn].copy(), nx_dir[:nn].copy()
             tm = np.full(nn, np.inf)
-        return L
+        return tally if split else tally.L

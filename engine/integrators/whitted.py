@@ -10,6 +10,8 @@ from .compiled_path import CompiledPathIntegrator
 
 
 class WhittedIntegrator(CompiledPathIntegrator):
+    splits_light = False      # no light passes (its vertex kernel adds to Combined alone)
+
     def __init__(self, ctx):
         super().__init__(ctx)
         self._lamp_rays = lamp_rays(self.lights)

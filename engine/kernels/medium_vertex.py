@@ -28,7 +28,9 @@ from . import equiangular as eq
 from . import lights as lt
 from . import ray_queues
 from .jit import kernel
-from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, keep_receiver,
+from . import light_tally as tl
+from .light_tally import VOLUME_SHARES
+from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, keep_receiver,
                            nee_weight, power_heuristic, roulette)
 from .volume import EQUIANGULAR, distance_pdf, hg_phase, hg_sample, medium, volume_dim
 
@@ -37,7 +39,7 @@ C_VOLUME_BOUNCES = 14      # cfg entry: Cycles' max volume bounces
 
 @kernel(allocates=False)
 def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb, g, bounce,
-            vbounce, beta, cont, prev_pdf, prev_pos, ray_bits, L, lights, vol, stacks,
+            vbounce, beta, cont, prev_pdf, prev_pos, ray_bits, tally, lights, vol, stacks,
             sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns,
             nx_path, nx_org, nx_dir, nn, segment):
     """Path p (throughput b, after the segment's weight, shutter time `time`) scattered at
@@ -68,13 +70,15 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
             if not w > 0.0:
                 pass                         # the equiangular sample's alone
             elif not seen & SHADOW_BIT:
-                _add(L, p, cr, cg, cb, clamp)
+                tl.lit(tally, p, bounce[p], cr, cg, cb, clamp, VOLUME_SHARES,
+                       tl.entry_group(tally, k))
             else:
                 sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz,
                                                          dist, margin, cfg[9])
                 ns = ray_queues.push(ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr,
                                       cg, cb, sh_path, sh_org, sh_dir, sh_far, sh_contrib,
                                       sh_bounce, stacks, sh_stack)
+                tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))
     if not goes_on:
         return ns, nn
     u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.BSDF_DIR)
@@ -85,6 +89,8 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
     if not (max(br, bg, bb) > 0.0 and pdf > 0.0):
         return ns, nn
     beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb     # phase / pdf = 1
+    if bounce[p] == 0:
+        tl.left_first(tally, p, VOLUME_SHARES)
     bounce[p] += 1
     vbounce[p] += 1
     ray_bits[p] = DIFFUSE_BIT
@@ -120,7 +126,7 @@ def distance_weight(lights, k, recv, time, dx, dy, dz, segment):
 
 @kernel(allocates=False)
 def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, t_max,
-                      br, bg, bb, channels, method, bounce, vbounce, L, lights, vol, stacks,
+                      br, bg, bb, channels, method, bounce, vbounce, tally, lights, vol, stacks,
                       sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns):
     """The equiangular half of a homogeneous segment's direct light: path p (throughput
     b before the segment, roulette applied) travels o + t d, t in [0, t_max], through its
@@ -170,10 +176,12 @@ def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, 
     cb = bb * ssb * math.exp(-stb * t) * lb * w
     if not seen & SHADOW_BIT:
         clamp = cfg[6] if bounce[p] == 0 else cfg[7]
-        _add(L, p, cr, cg, cb, clamp)
+        tl.lit(tally, p, bounce[p], cr, cg, cb, clamp, VOLUME_SHARES, tl.entry_group(tally, k))
         return ns
     sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz, dist, margin,
                                              cfg[9])
-    return ray_queues.push(ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr, cg, cb,
-                           sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, stacks,
-                           sh_stack)
+    ns = ray_queues.push(ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr, cg, cb,
+                         sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, stacks,
+                         sh_stack)
+    tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))
+    return ns

@@ -46,9 +46,11 @@ from .bsdf.state import S_WALTER
 from . import ray_queues
 from .frame import dot, length, to_local, to_world
 from .jit import kernel
+from . import light_tally as tl
+from .pass_shares import NO_SHARES, bounce_shares, light_shares, lobe_colours
 from .medium_vertex import equiangular_light, scatter
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
-                           TRANSMISSION_BIT, _add, _INF, continues, hit_weight, holdout_share,
+                           TRANSMISSION_BIT, _INF, continues, hit_weight, holdout_share,
                            keep_receiver, nee_weight, previous_receiver, roulette, uncovered)
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium, passed,
@@ -93,7 +95,7 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
 
 
 @kernel
-def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, ray_bits,
+def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_pos, ray_bits,
           min_pdf, cont, path_time, live, ro, rd, rt, hits, stopped,
           geometry, params, emission, textures, tables, lights, world, media,
           sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir, path_info,
@@ -123,7 +125,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
     probability q, 0 it ends there after the emission found). Writes the shadow rays to
     sh_* (their contributions before the clamp, which `add_transmitted` applies) and the
     continuing paths' next rays to nx_*; returns (shadow count, next count). beta,
-    counts, L, alpha, prev_pdf, prev_pos are per-path state, updated in place.
+    counts, alpha, prev_pdf, prev_pos are per-path state, updated in place. tally:
+    where the light goes (engine.kernels.light_tally: Combined, and the light passes and
+    light groups when the render asks for them).
     path_info: (transparent bounces per path, ray cone per path (n, 2): footprint at the
     ray's origin and spread, see engine.nodes.differentials), what shader programs read
     of the path; the cone moves on to the next ray's origin.
@@ -220,9 +224,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                     ns_out = equiangular_light(
                         depth, cfg, pkey, index, p, path_time[p], ox, oy, oz, dx, dy, dz,
                         t_geom, b0r / cont[p], b0g / cont[p], b0b / cont[p], (wcr, wcg, wcb),
-                        method, bounce, vbounce, L, lights, vol, stacks, sh_path, sh_org,
+                        method, bounce, vbounce, tally, lights, vol, stacks, sh_path, sh_org,
                         sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns_out)
-            _add(L, p, er, eg, eb, clamp_hit)
+            tl.found(tally, p, b, er, eg, eb, clamp_hit, False, -1)   # a medium's: no group
         # 1a. area and sphere lamps in front of the geometry: the ray passes through
         # lamps (as in Cycles) and finds every one before what it hits
         for k_l in range(n_lamps):
@@ -243,7 +247,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             lpdf = lt.lamp_pdf(lights, k_l, previous_receiver(prev_pos, p), dx, dy, dz, t_l,
                                path_time[p])
             w = hit_weight(mode, prev_pdf[p], lpdf)
-            _add(L, p, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w, clamp_hit)
+            tl.found(tally, p, b, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w,
+                     clamp_hit, False, tl.entry_group(tally, k_l))
         if volumes is not None and scattered:
             q = continues(cont, p)             # the roulette, after the emission found
             if q == 0.0:
@@ -253,7 +258,7 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             ns_out, nn_out = scatter(depth, cfg, pkey, index, p, path_time[p], ox + dx * t_end,
                                      oy + dy * t_end, oz + dz * t_end, dx, dy, dz, br, bg, bb,
                                      g_phase, bounce, vbounce, beta, cont, prev_pdf, prev_pos,
-                                     ray_bits, L, lights, vol, stacks, sh_path, sh_org, sh_dir,
+                                     ray_bits, tally, lights, vol, stacks, sh_path, sh_org, sh_dir,
                                      sh_far, sh_contrib, sh_bounce, sh_stack, ns_out, nx_path,
                                      nx_org, nx_dir, nn_out, segment_mis)
             continue
@@ -268,13 +273,27 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                                                 path_time[p])
             w = hit_weight(mode, prev_pdf[p], epdf)
             er, eg, eb = er * w, eg * w, eb * w
+            wr, wg, wb = er, eg, eb               # the world's own part (light groups)
             for s in range(lt.n_suns(lights)):
                 sr, sg, sb, spdf = lt.sun_escaped(lights, s, dx, dy, dz, recv, path_time[p])
                 w = hit_weight(mode, prev_pdf[p], spdf)
                 er += sr * w
                 eg += sg * w
                 eb += sb * w
-            _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)
+            # (what a camera ray sees here, sun discs included, is the Environment pass)
+            world_only = wr == er and wg == eg and wb == eb
+            kr, kg, kb = tl.found(tally, p, b, br * er, bg * eg, bb * eb, clamp_hit, True,
+                                  tally.world_group[0] if world_only else -1)
+            if tl.grouped(tally) and not world_only:
+                # each source to its group, with the clamp's factor of the whole
+                tl.to_group(tally, p, tally.world_group[0], br * wr * kr, bg * wg * kg,
+                            bb * wb * kb)
+                for s in range(lt.n_suns(lights)):
+                    sr, sg, sb, spdf = lt.sun_escaped(lights, s, dx, dy, dz, recv,
+                                                      path_time[p])
+                    w = hit_weight(mode, prev_pdf[p], spdf)
+                    tl.to_group(tally, p, tl.entry_group(tally, lt.sun_entry(lights, s)),
+                                br * sr * w * kr, bg * sg * w * kg, bb * sb * w * kb)
             continue
         if stopped[j]:
             continue                      # past the transparent bounce limit
@@ -337,7 +356,8 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             lpdf = lt.mesh_pdf(lights, prim, previous_receiver(prev_pos, p), px, py, pz,
                                path_time[p])
             w = hit_weight(mode, prev_pdf[p], lpdf)
-            _add(L, p, br * er * w, bg * eg * w, bb * eb * w, clamp_hit)
+            tl.found(tally, p, b, br * er * w, bg * eg * w, bb * eb * w, clamp_hit, False,
+                     tl.prim_group(tally, prim))
         q = continues(cont, p)            # the roulette, after the emission found
         if q == 0.0:
             continue
@@ -346,6 +366,9 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
+        if b == 0 and tl.on(tally):
+            d_col, g_col, t_col = lobe_colours(state, woz)
+            tl.colours(tally, p, br, bg, bb, d_col, g_col, t_col)
         # the point lights are picked for (lights/tree.py): light from below the surface
         # counts where it transmits, or where a bent normal makes "below" uncertain
         recv = lt.receiver(px, py, pz, nx, ny, nz,
@@ -400,14 +423,21 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
                 bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
                                      see_d, see_g, see_t)
                 w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine
+                shares = NO_SHARES
+                if b == 0 and tl.on(tally):
+                    shares = light_shares(state, wox, woy, woz, lx, ly, lz, see_d, see_g,
+                                          see_t, bent, fr, fg, fb, s0x, s0y, s0z, rx, ry,
+                                          rz, wx, wy, wz, correct)
+                group = tl.entry_group(tally, k)
                 if not seen & SHADOW_BIT:        # a light casting no shadow: no shadow ray
-                    _add(L, p, br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w,
-                         clamp_direct if b == 0 else clamp_indirect)
+                    tl.lit(tally, p, b, br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w,
+                           clamp_direct if b == 0 else clamp_indirect, shares, group)
                 else:
                     ns_out = ray_queues.push(ns_out, p, b, sox, soy, soz, sdx, sdy, sdz, far,
                                               br * fr * lr * w, bg * fg * lg * w,
                                               bb * fb * lb * w, sh_path, sh_org, sh_dir,
                                               sh_far, sh_contrib, sh_bounce, stacks, sh_stack)
+                    tl.queued(tally, ns_out - 1, p, b, shares, group)
                     if (vol.shape[0] > 0 and vol[m, V_HAS] != 0.0
                             and dot(wx, wy, wz, gx, gy, gz) < 0.0):
                         # towards a light through the surface: the shadow ray enters or
@@ -424,12 +454,14 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
             continue
         if skind == SUBSURFACE:
             if sss is not None:
+                if b == 0:
+                    tl.left_first(tally, p, tl.one_class(tl.DIFFUSE_CLASS))
                 cone_moves(path_info[1], p, t_geom)
                 ns_out, nn_out = scatter_below(
                     cfg, walk_key(pkey[p], index[p], depth), p, path_time[p], sss, f_ray,
                     w_ray, geometry, row, prim, hit_inst[j], px, py, pz, gx, gy, gz, nx, ny,
                     nz, scale, dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, bounce, counts,
-                    beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, L, lights, stacks,
+                    beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, tally, lights, stacks,
                     sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack,
                     ns_out, nx_path, nx_org, nx_dir, nn_out, programs, params, path_info,
                     hit_row, regs)
@@ -449,6 +481,10 @@ def shade(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos, r
         side = dot(wx, wy, wz, gx, gy, gz)
         if (side >= 0.0) if skind == TRANSMISSION else (side <= 0.0):
             continue       # reflection leaves on the geometric normal's side, refraction through
+        if b == 0 and tl.on(tally):
+            tl.left_first(tally, p, bounce_shares(state, wox, woy, woz, ix, iy, iz, skind,
+                                                  sdelta, bent, s0x, s0y, s0z, rx, ry, rz,
+                                                  wx, wy, wz, correct))
         br, bg, bb = br * wr, bg * wg, bb * wb
         if b + 1 >= ROULETTE_START:
             u_rr = sample_1d(kind, pkey[p], spp, index[p], base + D.ROULETTE)

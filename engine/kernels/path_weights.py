@@ -76,6 +76,7 @@ def _add(L, p, r, g, b, limit):
     L[p, 0] += r * s
     L[p, 1] += g * s
     L[p, 2] += b * s
+    return r * s, g * s, b * s          # what was added (engine.kernels.light_tally)
 
 
 @kernel(allocates=False)
@@ -102,26 +103,6 @@ def holdout_share(h, u_lobe, b, alpha, p, br, bg, bb):
             return True, u_lobe
         return False, min((u_lobe - h) / (1.0 - h), 1.0 - 1e-16)
     return False, u_lobe
-
-
-@kernel(allocates=False)
-def add_unoccluded(L, sh_path, sh_contrib, blocked, sh_bounce, clamp_direct, clamp_indirect):
-    """Add the contributions of the shadow rays that reached their light, clamped (the
-    direct clamp for shadow rays of a path's first vertex, sh_bounce 0)."""
-    for i in range(sh_path.shape[0]):
-        if not blocked[i]:
-            _add(L, sh_path[i], sh_contrib[i, 0], sh_contrib[i, 1], sh_contrib[i, 2],
-                 clamp_direct if sh_bounce[i] == 0 else clamp_indirect)
-
-
-@kernel(allocates=False)
-def add_transmitted(L, sh_path, sh_contrib, trans, sh_bounce, clamp_direct, clamp_indirect):
-    """Add the contributions of shadow rays times their transmittance, clamped."""
-    for i in range(sh_path.shape[0]):
-        if trans[i, 0] > 0.0 or trans[i, 1] > 0.0 or trans[i, 2] > 0.0:
-            _add(L, sh_path[i], sh_contrib[i, 0] * trans[i, 0], sh_contrib[i, 1] * trans[i, 1],
-                 sh_contrib[i, 2] * trans[i, 2],
-                 clamp_direct if sh_bounce[i] == 0 else clamp_indirect)
 
 
 @kernel(allocates=False)

@@ -33,8 +33,10 @@ from .bsdf.params import (P_BASE, P_ROUGHNESS, P_SETS_NORMAL, P_SSS_ALPHA,
                           P_SSS_ANISOTROPY, P_SSS_IOR, P_SSS_RADIUS, P_SSS_SKIN)
 from .frame import dot, to_local, to_world
 from .jit import kernel
+from . import light_tally as tl
+from .light_tally import DIFFUSE_SHARES
 from ..sampling.hashing import stream_uniform
-from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, _add, keep_receiver,
+from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, keep_receiver,
                            nee_weight, roulette)
 from .subsurface import MAX_BOUNCES, object_of, walk, walk_radius
 from .surface import hit_uv, offset_origin, rebuild_at_time
@@ -95,7 +97,7 @@ def walk_params(row):
 @kernel(allocates=False)
 def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, py, pz,
                   gx, gy, gz, nx, ny, nz, scale, dx, dy, dz, u1, u2, br, bg, bb, bounce,
-                  counts, beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, L, lights,
+                  counts, beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, tally, lights,
                   stacks, sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack,
                   ns, nx_path, nx_org, nx_dir, nn, programs, params, path_info, hit_row,
                   regs):
@@ -157,7 +159,8 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
             wt = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine * INV_PI
             cr, cg, cb = tr * lr * wt, tg * lg * wt, tb * lb * wt
             if not seen & SHADOW_BIT:
-                _add(L, p, cr, cg, cb, cfg[6] if b == 0 else cfg[7])
+                tl.lit(tally, p, b, cr, cg, cb, cfg[6] if b == 0 else cfg[7], DIFFUSE_SHARES,
+                       tl.entry_group(tally, k))
             else:
                 sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[4],
                                               geometry[13], geometry[9], prim2, inst2, u, v,
@@ -168,6 +171,7 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
                 ns = ray_queues.push(ns, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr, cg,
                                       cb, sh_path, sh_org, sh_dir, sh_far, sh_contrib,
                                       sh_bounce, stacks, sh_stack)
+                tl.queued(tally, ns - 1, p, b, DIFFUSE_SHARES, tl.entry_group(tally, k))
     if not goes_on:
         return ns, nn
     # the diffuse bounce from the exit (f cos / pdf = 1)

@@ -76,7 +76,7 @@ def mirror_row(row):
 
 
 @kernel
-def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, prev_pos,
+def shade_whitted(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_pos,
                   ray_bits, min_pdf, cont, path_time, live, ro, rd, rt, hits,
                   stopped, geometry, params, emission, textures, tables,
                   lights, world, media, sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path,
@@ -115,7 +115,7 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
             t_l, lr, lg, lb = lt.lamp_hit(lights, k, ox, oy, oz, dx, dy, dz, ray_bits[p],
                                           path_time[p])
             if t_l < t_geom:
-                _add(L, p, br * lr, bg * lg, bb * lb, clamp_hit)
+                _add(tally.L, p, br * lr, bg * lg, bb * lb, clamp_hit)
         if not hit:
             if b == 0 and film_transparent:
                 alpha[p] = uncovered(br, bg, bb)
@@ -127,7 +127,7 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
             for s in range(lt.n_suns(lights)):
                 sr, sg, sb, _ = lt.sun_escaped(lights, s, dx, dy, dz, recv, path_time[p])
                 er, eg, eb = er + sr, eg + sg, eb + sb
-            _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)
+            _add(tally.L, p, br * er, bg * eg, bb * eb, clamp_hit)
             continue
         if stopped[j]:
             continue                      # past the transparent bounce limit
@@ -159,7 +159,7 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
             continue                      # a Holdout's share: a hole, or no light
         er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
                                       programmed)
-        _add(L, p, br * er, bg * eg, bb * eb, clamp_hit)
+        _add(tally.L, p, br * er, bg * eg, bb * eb, clamp_hit)
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
         material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)
         row[P_SSS_WEIGHT] = 0.0          # Whitted's model: subsurface light is diffuse
@@ -191,7 +191,7 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, L, alpha, prev_pdf, pre
             w = 1.0 / lpdf
             cr, cg, cb = br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w
             if not seen & SHADOW_BIT:            # a lamp casting no shadow
-                _add(L, p, cr, cg, cb, clamp)
+                _add(tally.L, p, cr, cg, cb, clamp)
                 continue
             sox, soy, soz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
             sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy, wz,

@@ -69,7 +69,7 @@ from .state import (NSTATE, S_ALPHA, S_BECKMANN, S_BLINN, S_DIFFUSE,  # noqa: F4
                     S_EST, S_ETA_GLASS, S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH,
                     S_GLASS_TINTED, S_LAYERED, S_METAL_CONST, S_METAL_F0, S_METAL_F82,
                     S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY,
-                    S_SPEC_TINTED, S_EST_SSS, S_SSS, S_TINT, S_W_GLASS, S_W_METAL,
+                    S_SPEC_TINTED, S_EST_SSS, S_E_SPEC, S_SSS, S_TINT, S_W_GLASS, S_W_METAL,
                     S_W_SPEC, S_WALTER)
 from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX,  # noqa: F401
                      GLOSSY_MULTI_GGX, NPARAM, P_BASE, P_GLASS_COLOR, P_GLOSSY_MODEL,
@@ -174,6 +174,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
                 e_est = ms.layer_reflectance(cos_o, alpha, eta_spec, tables) * state[S_MS_E]
                 e_spec = max(e_est, e_spec) * state[S_MS_SPEC]
         est_spec = w_spec * e_spec
+    state[S_E_SPEC] = e_spec
     est_diff = 0.0
     below = 1.0 - min(e_spec, 1.0)
     for c in range(3):

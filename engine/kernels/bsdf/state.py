@@ -33,4 +33,5 @@ S_GLASS_TINTED = layers.NSTATE + 14  # 1: the glass lobe has a Specular Tint (sp
 S_GLASS_F0 = layers.NSTATE + 15      # 3: ... its tinted F0 per channel
 S_SSS = layers.NSTATE + 18          # 3: the subsurface lobe's weight (subsurface_lobe.py)
 S_EST_SSS = layers.NSTATE + 21      # its selection estimate
-NSTATE = layers.NSTATE + 22
+S_E_SPEC = layers.NSTATE + 22       # the specular layer's albedo at wo (the Glossy Color pass)
+NSTATE = layers.NSTATE + 23

@@ -39,7 +39,7 @@ Use:
     mesh_pdf(L, prim, recv, qx, qy, qz, time)
     environment_pdf(L, dx, dy, dz, recv, time);  environment_radiance(L) -> (r, g, b)
     world_escaped(L, world, ray_bit, dx, dy, dz, recv, time) -> (r, g, b, pdf)
-    n_suns(L);  sun_escaped(L, j, dx, dy, dz, recv, time) -> (r, g, b, pdf)
+    n_suns(L);  sun_escaped(L, j, dx, dy, dz, recv, time) -> (r, g, b, pdf);  sun_entry(L, j)
     n_entries(L);  entry_visibility(L, k)
     select_pdf(L, k, recv, time)                     # the probability `sample` picks k
     pick_entry(L, recv, u_pick, time) -> (k, probability)   # as `sample` picks
@@ -56,7 +56,8 @@ that time (pack.py, TimeSlicedLight). Array drivers for tests: `batch`.
 from .light_set import (entry_center, environment_pdf, environment_radiance, hit_lamps,
                         is_uniform_world, lamp_hit, lamp_pdf, entry_visibility, mesh_pdf,
                         n_entries, n_lamps, n_suns, pick, pick_entry, sample,
-                        sample_entry, select_pdf, sun_escaped, world_escaped)
+                        sample_entry, select_pdf, sun_entry, sun_escaped,
+                        world_escaped)
 from .pack import pack_lights
 from .tree import OMNI, ONE_SIDED, SEGMENT, TWO_SIDED, receiver, segment_receiver
 

@@ -324,6 +324,12 @@ def n_suns(L):
 
 
 @kernel(allocates=False)
+def sun_entry(L, j):
+    """The light entry of the j-th non-delta sun."""
+    return L[SUNS][j]
+
+
+@kernel(allocates=False)
 def sun_escaped(L, j, dx, dy, dz, recv, time):
     """The j-th non-delta sun seen by an escaped ray d at shutter time `time`: (r, g, b,
     pdf) with the radiance of sun.escaped(d) and pdf = sun.pdf(None, d, None) x its pick

@@ -1,0 +1,78 @@
+"""Cycles' light passes and light groups as Blender's render result holds them: their
+names (Blender 5 spells them out, 4.x abbreviates), when the view layer asks for them,
+and their images from the film (engine.light_passes).
+
+- Diffuse, Glossy and Transmission Direct / Indirect: the light whose path first
+  scattered off a lobe of that kind, divided by that kind's Color (0 where the Color is
+  0), as Cycles' film divides them; Direct is next-event estimation at the first
+  surface and the light its bounce finds, Indirect the rest.
+- Diffuse, Glossy and Transmission Color: what the first surface's lobes of that kind
+  weigh at the view (their albedo estimates).
+- Volume Direct / Indirect: the light of paths that first scattered in a medium.
+- Emission: what camera rays see emitted (lamps, emissive surfaces and media).
+- Combined_<group>: the light of the lamps, emissive objects and world of one of the
+  view layer's light groups (View Layer > Light Groups; Object and World > Light Group).
+Combined = (DiffDir + DiffInd) DiffCol + (GlossDir + GlossInd) GlossCol + (TransDir +
+TransInd) TransCol + VolumeDir + VolumeInd + Emission + Environment, per pixel, as in
+Cycles (docs/passes.md).
+"""
+from __future__ import annotations
+
+from importlib import import_module
+
+import bpy
+
+FIVE = bpy.app.version >= (5, 0, 0)
+
+
+def _vl(prop):
+    return lambda vl: bool(getattr(vl, prop, False))
+
+
+def _cycles(prop):
+    return lambda vl: bool(getattr(getattr(vl, "cycles", None), prop, False))
+
+
+# Blender's name: (engine.light_passes slot, its Color slot or None, enabled)
+LIGHT_PASSES = {}
+for _kind, _short, _long in (("diffuse", "Diff", "Diffuse"), ("glossy", "Gloss", "Glossy"),
+                             ("transmission", "Trans", "Transmission")):
+    for _part, _abbr in (("direct", "Dir"), ("indirect", "Ind")):
+        _name = f"{_long} {_part.title()}" if FIVE else f"{_short}{_abbr}"
+        LIGHT_PASSES[_name] = (f"{_kind}_{_part}", f"{_kind}_color",
+                               _vl(f"use_pass_{_kind}_{_part}"))
+    LIGHT_PASSES[f"{_long} Color" if FIVE else f"{_short}Col"] = (
+        f"{_kind}_color", None, _vl(f"use_pass_{_kind}_color"))
+LIGHT_PASSES["Volume Direct" if FIVE else "VolumeDir"] = (
+    "volume_direct", None, _cycles("use_pass_volume_direct"))
+LIGHT_PASSES["Volume Indirect" if FIVE else "VolumeInd"] = (
+    "volume_indirect", None, _cycles("use_pass_volume_indirect"))
+LIGHT_PASSES["Emission" if FIVE else "Emit"] = ("emission", None, _vl("use_pass_emit"))
+
+
+def enabled(view_layer) -> list:
+    """The light passes the view layer asks for, by Blender's names."""
+    return [name for name, (_, _, on) in LIGHT_PASSES.items() if on(view_layer)]
+
+
+def group_passes(view_layer) -> list:
+    """Combined_<name> of each of the view layer's light groups, as Cycles names them."""
+    from .export import light_groups
+    return ["Combined_" + name for name in light_groups(view_layer)]
+
+
+def images(film, scene_groups: tuple, names) -> dict:
+    """{Blender pass name: (h, w, 3) image, row 0 at the top} for `names` (light passes
+    and Combined_<group> passes)."""
+    from .engine_link import engine
+    split = import_module(engine.__name__ + ".light_passes")
+    slots = split.images(film, tuple(scene_groups))
+    out = {}
+    for name in names:
+        if name.startswith("Combined_"):
+            out[name] = slots["group:" + name[len("Combined_"):]]
+            continue
+        slot, colour, _ = LIGHT_PASSES[name]
+        out[name] = (split.divide_by_colour(slots[slot], slots[colour]) if colour
+                     else slots[slot])
+    return out
