@@ -76,6 +76,8 @@ WRITTEN_PASSES = ("Combined, Depth, Mist, Normal, Position, UV, Vector, Object I
 _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
 
 # Render passes DRT does not write, as (path, label).
+_PART_HOW = {"direct": "next-event estimation at the first surface and what its bounce finds",
+             "indirect": "every later bounce"}
 _UNWRITTEN_PASSES = [
     ("view_layer.use_pass_subsurface_direct", "Subsurface Direct"),
     ("view_layer.use_pass_subsurface_indirect", "Subsurface Indirect"),
@@ -151,8 +153,7 @@ SETTINGS: list[FileSetting] = [
        "a sample through a transparent surface adds nothing)"),
     *[_s(f"view_layer.use_pass_{kind}_{part}", f"Passes > {kind.title()} {part.title()}",
          READ, f"written: the light of paths that first scattered off a {kind} lobe "
-         f"({'next-event estimation at the first surface and what its bounce finds' if part == 'direct' else 'every later bounce'}), divided by {kind.title()} Color as Cycles "
-         "writes it")
+         f"({_PART_HOW[part]}), divided by {kind.title()} Color as Cycles writes it")
       for kind in ("diffuse", "glossy", "transmission") for part in ("direct", "indirect")],
     *[_s(f"view_layer.use_pass_{kind}_color", f"Passes > {kind.title()} Color", READ,
          f"written: what the first surface's {kind} lobes weigh at the view (their albedo "

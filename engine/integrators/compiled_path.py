@@ -26,6 +26,8 @@ from ..kernels.bsdf import principled as kbsdf
 from ..bsdf.material_table import flatten_mixes
 from ..kernels.camera_rays import pack_camera
 from ..kernels.jit import Kernel
+from ..kernels.path_config import path_config
+from ..kernels.ray_queues import NextQueue, ShadowQueue
 from ..kernels.path_vertex import shade
 from ..kernels.light_tally import add_transmitted, add_unoccluded, new_tally
 from ..kernels.path_weights import BSDF_ONLY, LIGHT_ONLY, MIS
@@ -40,7 +42,6 @@ from .volume_stack import camera_stack
 
 _MODE_IDS = {"mis": MIS, "light": LIGHT_ONLY, "bsdf": BSDF_ONLY}
 MIS_MODES = tuple(_MODE_IDS)
-DIFFUSE_LIMIT = 3           # cfg's diffuse bounce limit (see path_vertex.shade)
 VOLUME_BOUNDS_MAX = 256     # volume boundaries one path may cross (Cycles: 1024)
 
 
@@ -61,13 +62,7 @@ class CompiledPathIntegrator:
             else np.zeros(0)
         self.transparent_limit = s.transparent_bounces
         self._mode = "mis"
-        self.cfg = np.array([ctx.sampler.kind, ctx.sampler.pattern, s.max_bounces,
-                             s.diffuse_bounces, s.glossy_bounces, s.transmission_bounces,
-                             s.clamp_direct, s.clamp_indirect, MIS, ctx.scene_radius,
-                             float(ctx.scene.film_transparent), s.filter_glossy,
-                             float(s.caustics_reflective), float(s.caustics_refractive),
-                             s.volume_bounces],
-                            dtype=np.float64)
+        self.cfg = path_config(ctx.sampler, s, ctx.scene_radius, ctx.scene.film_transparent)
         self.geometry = surf.geometry(self.camera)
         self.params = kbsdf.pack_materials(mats)
         self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)
@@ -149,7 +144,7 @@ class CompiledPathIntegrator:
     def mis_mode(self, mode: str):
         self._mode = mode
         if mode in _MODE_IDS:
-            self.cfg[8] = _MODE_IDS[mode]
+            self.cfg = self.cfg._replace(mis_mode=_MODE_IDS[mode])
 
     # -- transparency: repeated queries through surfaces with alpha < 1 ----------------
     def _through_transparent(self, depth, paths, live, used, ray_bits, path_time, time, o,
@@ -169,7 +164,7 @@ class CompiledPathIntegrator:
         layer = 0
         seg_org = np.ascontiguousarray(o, np.float64)    # where the hits cur are measured from
         while rows.size:
-            k = alpha_pass(depth, layer, self.transparent_limit, int(cfg[0]), int(cfg[1]),
+            k = alpha_pass(depth, layer, self.transparent_limit, cfg.sampler, cfg.spp,
                            paths[0], paths[1], live, used, ray_bits, path_time, rows, seg_org,
                            d, tm, cur, travelled, factor, stopped,
                            self.geometry, self.materials, out_rows, out_org, out_far)
@@ -237,22 +232,21 @@ class CompiledPathIntegrator:
         k = n if self.has_volumes else 0
         stacks = np.ascontiguousarray(np.tile(self.start_stack, (k, 1)), np.int32)
         ns_max = n * self.shadow_rays_per_path       # the shadow rays one bounce may queue
-        sh_stack = np.full((ns_max if k else 0, STACK), -1, np.int32)   # one per shadow ray
         tally = new_tally(n, ns_max, split and self.light_passes,
                           len(self.light_groups) if split else 0, self.group_tables)
-        sh_bounce = np.empty(ns_max, np.int64)
-        media = (bounce, vbounce, self.vol, stacks, sh_stack, sh_bounce, self.het_runs)
+        # the shadow rays a bounce queues (a copy of the volume stack each), the next rays
+        shadows = ShadowQueue(np.empty(ns_max, np.int64), np.empty((ns_max, 3)),
+                              np.empty((ns_max, 3)), np.empty(ns_max), np.empty((ns_max, 3)),
+                              np.empty(ns_max, np.int64),
+                              np.full((ns_max if k else 0, STACK), -1, np.int32))
+        nexts = NextQueue(np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 3)))
+        media = (bounce, vbounce, self.vol, stacks, self.het_runs)
         no_keys = np.zeros(0, np.uint64)
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(dirs, dtype=np.float64)
         # a writable copy: a read-only view (np.broadcast_to) would be another type to
         # Numba, and load a second copy of the shading kernel (15 MB, 0.1 s per process)
         tm = np.array(np.broadcast_to(tmax, (n,)), dtype=np.float64)
-        sh_path = np.empty(ns_max, np.int64)
-        sh_org, sh_dir = np.empty((ns_max, 3)), np.empty((ns_max, 3))
-        sh_far, sh_contrib = np.empty(ns_max), np.empty((ns_max, 3))
-        nx_path = np.empty(n, np.int64)
-        nx_org, nx_dir = np.empty((n, 3)), np.empty((n, 3))
         no_stop = np.zeros(n, bool)
         # each path's shutter time, kept for all its rays (zeros when nothing moves)
         moving = time is not None
@@ -274,23 +268,23 @@ class CompiledPathIntegrator:
                            prev_pdf, prev_pos, ray_bits, min_pdf, cont, path_time, live, o, d,
                            tm, found, stopped, self.geometry, self.params,
                            self.emission, self.textures, self.tables, self.lights,
-                           self.world, media,
-                           sh_path, sh_org, sh_dir, sh_far, sh_contrib,
-                           nx_path, nx_org, nx_dir, (used, cone), *self.features)
+                           self.world, media, shadows, nexts, (used, cone), *self.features)
             if ns:
-                sh_time = path_time[sh_path[:ns]] if moving else None
-                clamps = (sh_bounce[:ns], s.clamp_direct, s.clamp_indirect)
+                sh = shadows
+                sh_time = path_time[sh.path[:ns]] if moving else None
+                clamps = (sh.bounce[:ns], s.clamp_direct, s.clamp_indirect)
                 if self.any_transparent or self.skips_shadows or self.has_volumes:
-                    keys = (shadow_keys(pkey, index, sh_path[:ns], depth)
+                    keys = (shadow_keys(pkey, index, sh.path[:ns], depth)
                             if self.heterogeneous else no_keys)
-                    trans = self.shadow_transmittance(sh_org[:ns], sh_dir[:ns], sh_far[:ns], sh_time,
-                                                sh_stack[:ns] if k else sh_stack, keys)
-                    add_transmitted(tally, sh_path[:ns], sh_contrib[:ns], trans, *clamps)
+                    trans = self.shadow_transmittance(sh.org[:ns], sh.dir[:ns], sh.far[:ns],
+                                                      sh_time,
+                                                      sh.stack[:ns] if k else sh.stack, keys)
+                    add_transmitted(tally, sh.path[:ns], sh.contrib[:ns], trans, *clamps)
                 else:
-                    blocked = ctx.accel.occluded(sh_org[:ns], sh_dir[:ns], sh_far[:ns],
+                    blocked = ctx.accel.occluded(sh.org[:ns], sh.dir[:ns], sh.far[:ns],
                                                  sh_time)
-                    add_unoccluded(tally, sh_path[:ns], sh_contrib[:ns], blocked, *clamps)
-            live = nx_path[:nn].copy()
-            o, d = nx_org[:nn].copy(), nx_dir[:nn].copy()
+                    add_unoccluded(tally, sh.path[:ns], sh.contrib[:ns], blocked, *clamps)
+            live = nexts.path[:nn].copy()
+            o, d = nexts.org[:nn].copy(), nexts.dir[:nn].copy()
             tm = np.full(nn, np.inf)
         return tally if split else tally.L

@@ -13,10 +13,10 @@ does.
 """
 from __future__ import annotations
 
-from .compiled_path import CompiledPathIntegrator, DIFFUSE_LIMIT
+from .compiled_path import CompiledPathIntegrator
 
 
 class DistributionIntegrator(CompiledPathIntegrator):
     def __init__(self, ctx):
         super().__init__(ctx)
-        self.cfg[DIFFUSE_LIMIT] = 0.0         # no diffuse interreflection
+        self.cfg = self.cfg._replace(diffuse_bounces=0)   # no diffuse interreflection

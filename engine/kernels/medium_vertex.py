@@ -34,27 +34,25 @@ from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, keep_receive
                            nee_weight, power_heuristic, roulette)
 from .volume import EQUIANGULAR, distance_pdf, hg_phase, hg_sample, medium, volume_dim
 
-C_VOLUME_BOUNCES = 14      # cfg entry: Cycles' max volume bounces
 
 
 @kernel(allocates=False)
 def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb, g, bounce,
             vbounce, beta, cont, prev_pdf, prev_pos, ray_bits, tally, lights, vol, stacks,
-            sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns,
-            nx_path, nx_org, nx_dir, nn, segment):
+            shadows, ns, nexts, nn, segment):
     """Path p (throughput b, after the segment's weight, shutter time `time`) scattered at
     point x moving along d, by a Henyey-Greenstein phase function of anisotropy g. Writes
     at most one shadow ray (returned count ns) and one next ray (nn). `segment` = (ox,
     oy, oz, t_max, t, pdf, method): the homogeneous segment the distance t was sampled
     on, that sample's density and the medium's sampling method, for the weight against
     equiangular sampling (pdf 0: none, the distance sample's alone)."""
-    kind, spp = int(cfg[0]), int(cfg[1])
-    mode = int(cfg[8])
-    clamp = cfg[6] if bounce[p] == 0 else cfg[7]
+    kind, spp = cfg.sampler, cfg.spp
+    mode = cfg.mis_mode
+    clamp = cfg.clamp_direct if bounce[p] == 0 else cfg.clamp_indirect
     base = D.FIRST_BOUNCE + depth * D.PER_BOUNCE
     # whether the phase function samples a next ray; if not, light sampling alone finds
     # the light (its MIS weight is then 1, as a BSDF's at the last bounce)
-    goes_on = bounce[p] < int(cfg[2]) and vbounce[p] < int(cfg[C_VOLUME_BOUNCES])
+    goes_on = bounce[p] < cfg.max_bounces and vbounce[p] < cfg.volume_bounces
     recv = lt.receiver(px, py, pz, 0.0, 0.0, 0.0, lt.OMNI)    # a point with no normal
     if lt.n_entries(lights) > 0:
         u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK)
@@ -74,10 +72,9 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
                        tl.entry_group(tally, k))
             else:
                 sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz,
-                                                         dist, margin, cfg[9])
-                ns = ray_queues.push(ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr,
-                                      cg, cb, sh_path, sh_org, sh_dir, sh_far, sh_contrib,
-                                      sh_bounce, stacks, sh_stack)
+                                                         dist, margin, cfg.scene_radius)
+                ns = ray_queues.push(shadows, ns, p, bounce[p], px, py, pz, sdx, sdy, sdz,
+                                     far, cr, cg, cb, stacks)
                 tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))
     if not goes_on:
         return ns, nn
@@ -96,7 +93,7 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
     ray_bits[p] = DIFFUSE_BIT
     keep_receiver(prev_pos, p, recv)
     prev_pdf[p] = pdf
-    return ns, ray_queues.push_next(nn, p, px, py, pz, wx, wy, wz, nx_path, nx_org, nx_dir)
+    return ns, ray_queues.push_next(nexts, nn, p, px, py, pz, wx, wy, wz)
 
 
 @kernel(allocates=False)
@@ -127,7 +124,7 @@ def distance_weight(lights, k, recv, time, dx, dy, dz, segment):
 @kernel(allocates=False)
 def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, t_max,
                       br, bg, bb, channels, method, bounce, vbounce, tally, lights, vol, stacks,
-                      sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns):
+                      shadows, ns):
     """The equiangular half of a homogeneous segment's direct light: path p (throughput
     b before the segment, roulette applied) travels o + t d, t in [0, t_max], through its
     medium, whose distance sampling picked the channels with weights `channels` (RGB),
@@ -136,8 +133,8 @@ def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, 
     its position and a point on it from there, and queues the shadow ray (returned count
     ns). Its weight against phase sampling takes the light's pick probability for that
     point, as a scattering there would pick it."""
-    kind, spp = int(cfg[0]), int(cfg[1])
-    mode = int(cfg[8])
+    kind, spp = cfg.sampler, cfg.spp
+    mode = cfg.mis_mode
     if lt.n_entries(lights) == 0:
         return ns
     u_pick = sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 2))
@@ -166,7 +163,7 @@ def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, 
     select = lt.select_pdf(lights, k, lt.receiver(px, py, pz, 0.0, 0.0, 0.0, lt.OMNI), time)
     if not select > 0.0:
         return ns                      # the light cannot reach this point (tree.py)
-    goes_on = bounce[p] < int(cfg[2]) and vbounce[p] < int(cfg[C_VOLUME_BOUNCES])
+    goes_on = bounce[p] < cfg.max_bounces and vbounce[p] < cfg.volume_bounces
     ph = hg_phase(g, dx * wx + dy * wy + dz * wz)
     w_t = 1.0 if method == EQUIANGULAR else power_heuristic(pe * by_segment, pd * select)
     w = (nee_weight(mode, ppoint * select, ph if goes_on else 0.0, delta)
@@ -175,13 +172,12 @@ def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, 
     cg = bg * ssg * math.exp(-stg * t) * lg * w
     cb = bb * ssb * math.exp(-stb * t) * lb * w
     if not seen & SHADOW_BIT:
-        clamp = cfg[6] if bounce[p] == 0 else cfg[7]
+        clamp = cfg.clamp_direct if bounce[p] == 0 else cfg.clamp_indirect
         tl.lit(tally, p, bounce[p], cr, cg, cb, clamp, VOLUME_SHARES, tl.entry_group(tally, k))
         return ns
     sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz, dist, margin,
-                                             cfg[9])
-    ns = ray_queues.push(ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr, cg, cb,
-                         sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, stacks,
-                         sh_stack)
+                                             cfg.scene_radius)
+    ns = ray_queues.push(shadows, ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr, cg,
+                         cb, stacks)
     tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))
     return ns

@@ -73,48 +73,47 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
     """Cycles' two changes to a hit's BSDF that depend on the path so far (its
     surface_shader_prepare_closures), applied to the material row before setup:
 
-    Filter Glossy (cfg[11], Cycles' `blur_glossy`; 0 = off): after bounces that were
+    Filter Glossy (cfg.filter_glossy, Cycles' `blur_glossy`; 0 = off): after bounces that were
     unlikely (the smallest BSDF pdf along the path, min_pdf, below blur_glossy), every
     microfacet lobe is widened to at least GGX alpha = 0.5 sqrt(1 - min_pdf /
     blur_glossy). A bias that trades sharp caustics and fireflies for blur. As in Cycles,
     whose closure blur follows the closures' setup, only the lobes widen: the energy
     compensation and the layering keep the material's alpha (row[P_FILTER_ALPHA]).
 
-    Caustics (cfg[12] reflective, cfg[13] refractive; 1 = on): with one off, a hit of a
+    Caustics (cfg.caustics_reflective, cfg.caustics_refractive): with one off, a hit of a
     ray that left a diffuse bounce has no glossy reflection (resp. refraction) lobes.
 
     Returns (keep glossy lobes, keep transmission lobes)."""
-    blur = cfg[11]
+    blur = cfg.filter_glossy
     if blur > 0.0 and min_pdf < _INF:
         blur_pdf = min_pdf / blur
         if blur_pdf < 1.0:
             alpha = 0.5 * math.sqrt(1.0 - blur_pdf)
             row[P_FILTER_ALPHA] = alpha     # the lobes only (principled.setup)
     after_diffuse = ray_bit == DIFFUSE_BIT
-    return (cfg[12] != 0.0 or not after_diffuse), (cfg[13] != 0.0 or not after_diffuse)
+    return ((cfg.caustics_reflective or not after_diffuse),
+            (cfg.caustics_refractive or not after_diffuse))
 
 
 @kernel
 def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_pos, ray_bits,
           min_pdf, cont, path_time, live, ro, rd, rt, hits, stopped,
           geometry, params, emission, textures, tables, lights, world, media,
-          sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path, nx_org, nx_dir, path_info,
+          shadows, nexts, path_info,
           programs, volumes, het, sss):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`
     (engine.accel.HitArrays: t, prim, inst, u, v per ray; prim -1 where missed).
 
-    cfg: float64 [sampler kind, spp, max_bounces, diffuse, glossy, transmission limits,
-    clamp_direct, clamp_indirect, mis mode, scene radius, film transparent, filter glossy,
-    reflective caustics, refractive caustics] (see `prepare_closures`).
+    cfg: the render's engine.kernels.path_config.PathConfig (see `prepare_closures`).
     geometry: (vertex positions, each triangle's corners as rows of them, the static
     scene's centre, material, corner_normals, holdout, corner_uvs, moving objects,
     triangle objects, object table, corner tangents, corner colours, camera, terminator
     cutoffs) of every triangle (corner normals, holdout, UVs, objects, tangents, colours
-    and cutoffs may be empty; see
-    `surface.surface_at` and engine.nodes.shading). textures: the packed textures
-    and shader programs (engine.nodes.pack.pack_shading); a material with a program
-    runs it at each hit, and its outputs replace the parameters they drive. path_time: each path's shutter time (its
-    moving triangles are placed at that time). alpha: each path's film coverage, or
+    and cutoffs may be empty; see `surface.surface_at` and engine.nodes.shading).
+    textures: the packed textures and shader programs (engine.nodes.pack.pack_shading);
+    a material with a program runs it at each hit, and its outputs replace the
+    parameters they drive. path_time: each path's shutter time (its moving triangles are
+    placed at that time). alpha: each path's film coverage, or
     empty when the film is opaque. stopped: rays that ended at the transparent bounce
     limit. ray_bits: the kind of each path's current ray (engine.visibility: CAMERA,
     then the bit of the lobe it left by), which decides the lamps it sees; next-event
@@ -123,8 +122,9 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
     far (Filter Glossy, `prepare_closures`). cont: each path's Russian roulette verdict
     for the vertex its ray finds (`path_weights.roulette`: 1 none, q it survived with
     probability q, 0 it ends there after the emission found). Writes the shadow rays to
-    sh_* (their contributions before the clamp, which `add_transmitted` applies) and the
-    continuing paths' next rays to nx_*; returns (shadow count, next count). beta,
+    `shadows` (ray_queues.ShadowQueue; their contributions before the clamp, which
+    light_tally.add_transmitted applies) and the continuing paths' next rays to `nexts`
+    (ray_queues.NextQueue); returns (shadow count, next count). beta,
     counts, alpha, prev_pdf, prev_pos are per-path state, updated in place. tally:
     where the light goes (engine.kernels.light_tally: Combined, and the light passes and
     light groups when the render asks for them).
@@ -132,11 +132,11 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
     ray's origin and spread, see engine.nodes.differentials), what shader programs read
     of the path; the cone moves on to the next ray's origin.
 
-    media: (bounce, volume bounces, VOL, stacks, shadow stacks, shadow bounces,
-    heterogeneous count): each path's bounces so far (depth counts the wavefront's
-    steps, which include crossings of volume boundaries) and volume scatterings, the
-    volume table and the paths' volume stacks (engine.kernels.volume; empty when the
-    scene has no media), the shadow rays' copies of them and a (1,) int64 counter of
+    media: (bounce, volume bounces, VOL, stacks, heterogeneous count): each path's
+    bounces so far (depth counts the wavefront's steps, which include crossings of
+    volume boundaries) and volume scatterings, the volume table and the paths' volume
+    stacks (engine.kernels.volume; empty when the scene has no media; the shadow queue
+    keeps each shadow ray's copy) and a (1,) int64 counter of
     the shader program runs inside heterogeneous media. A ray in a medium first travels
     through it (`volume.segment`, or `medium_density.tracked_segment` when a medium of
     its stack is heterogeneous): it may scatter there (`medium_vertex.scatter` shades that
@@ -152,16 +152,16 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
     scene for rays cast inside a kernel (engine.kernels.subsurface.local_hit) when a
     material scatters below its surface: a sampled subsurface lobe then walks there
     (engine.kernels.subsurface_vertex), queueing one more shadow ray for its exit."""
-    bounce, vbounce, vol, stacks, sh_stack, sh_bounce, het_count = media
+    bounce, vbounce, vol, stacks, het_count = media
     hit_t, hit_prim, hit_inst, hit_u, hit_v = hits.t, hits.prim, hits.inst, hits.u, hits.v
     het_scene = has_heterogeneous(vol)
     vhit = np.zeros(N_HIT)
     tri_material, holdout, corner_uvs = geometry[3], geometry[5], geometry[6]
-    film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
-    kind, spp = int(cfg[0]), int(cfg[1])
-    max_bounces = int(cfg[2])
-    clamp_direct, clamp_indirect, mode = cfg[6], cfg[7], int(cfg[8])
-    scene_radius = cfg[9]
+    film_transparent = cfg.film_transparent and alpha.shape[0] > 0
+    kind, spp = cfg.sampler, cfg.spp
+    max_bounces = cfg.max_bounces
+    clamp_direct, clamp_indirect, mode = cfg.clamp_direct, cfg.clamp_indirect, cfg.mis_mode
+    scene_radius = cfg.scene_radius
     n_lights = lt.n_entries(lights)
     n_lamps = lt.n_lamps(lights)
     state = np.empty(bsdf.NSTATE)
@@ -224,8 +224,7 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
                     ns_out = equiangular_light(
                         depth, cfg, pkey, index, p, path_time[p], ox, oy, oz, dx, dy, dz,
                         t_geom, b0r / cont[p], b0g / cont[p], b0b / cont[p], (wcr, wcg, wcb),
-                        method, bounce, vbounce, tally, lights, vol, stacks, sh_path, sh_org,
-                        sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack, ns_out)
+                        method, bounce, vbounce, tally, lights, vol, stacks, shadows, ns_out)
             tl.found(tally, p, b, er, eg, eb, clamp_hit, False, -1)   # a medium's: no group
         # 1a. area and sphere lamps in front of the geometry: the ray passes through
         # lamps (as in Cycles) and finds every one before what it hits
@@ -258,9 +257,8 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
             ns_out, nn_out = scatter(depth, cfg, pkey, index, p, path_time[p], ox + dx * t_end,
                                      oy + dy * t_end, oz + dz * t_end, dx, dy, dz, br, bg, bb,
                                      g_phase, bounce, vbounce, beta, cont, prev_pdf, prev_pos,
-                                     ray_bits, tally, lights, vol, stacks, sh_path, sh_org, sh_dir,
-                                     sh_far, sh_contrib, sh_bounce, sh_stack, ns_out, nx_path,
-                                     nx_org, nx_dir, nn_out, segment_mis)
+                                     ray_bits, tally, lights, vol, stacks, shadows, ns_out,
+                                     nexts, nn_out, segment_mis)
             continue
         # 1b. escaped rays: the world and sun discs (or, for camera rays on a transparent
         # film, no colour and the coverage left)
@@ -312,8 +310,7 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
             cone_moves(path_info[1], p, t_geom)
             beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
             nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
-            nn_out = ray_queues.push_next(nn_out, p, nox, noy, noz, dx, dy, dz, nx_path,
-                                          nx_org, nx_dir)
+            nn_out = ray_queues.push_next(nexts, nn_out, p, nox, noy, noz, dx, dy, dz)
             continue
         if cont[p] == 0.0 and not may_emit(textures, emission, m):
             continue                      # ended by the roulette, and nothing to find here
@@ -374,9 +371,9 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
         recv = lt.receiver(px, py, pz, nx, ny, nz,
                            lt.TWO_SIDED if bent or bsdf.transmits(state) else lt.ONE_SIDED)
         room = b < max_bounces
-        ad = room and counts[p, 0] < cfg[3]
-        ag = room and counts[p, 1] < cfg[4] and keep_g
-        at = room and counts[p, 2] < cfg[5] and keep_t
+        ad = room and counts[p, 0] < cfg.diffuse_bounces
+        ag = room and counts[p, 1] < cfg.glossy_bounces and keep_g
+        at = room and counts[p, 2] < cfg.transmission_bounces and keep_t
         # 2. next-event estimation: one light entry, one point, one shadow ray
         if n_lights > 0:
             # (one light: nothing to pick, and no number drawn for it)
@@ -433,16 +430,15 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
                     tl.lit(tally, p, b, br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w,
                            clamp_direct if b == 0 else clamp_indirect, shares, group)
                 else:
-                    ns_out = ray_queues.push(ns_out, p, b, sox, soy, soz, sdx, sdy, sdz, far,
-                                              br * fr * lr * w, bg * fg * lg * w,
-                                              bb * fb * lb * w, sh_path, sh_org, sh_dir,
-                                              sh_far, sh_contrib, sh_bounce, stacks, sh_stack)
+                    ns_out = ray_queues.push(shadows, ns_out, p, b, sox, soy, soz, sdx, sdy,
+                                             sdz, far, br * fr * lr * w, bg * fg * lg * w,
+                                             bb * fb * lb * w, stacks)
                     tl.queued(tally, ns_out - 1, p, b, shares, group)
                     if (vol.shape[0] > 0 and vol[m, V_HAS] != 0.0
                             and dot(wx, wy, wz, gx, gy, gz) < 0.0):
                         # towards a light through the surface: the shadow ray enters or
                         # leaves the material's volume there, as the refracted path does
-                        stack_cross(sh_stack, ns_out - 1, m, front)
+                        stack_cross(shadows.stack, ns_out - 1, m, front)
             state[S_WALTER] = 0.0
         # 3. continue by BSDF sampling
         if not (ad or ag or at):
@@ -462,9 +458,8 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
                     w_ray, geometry, row, prim, hit_inst[j], px, py, pz, gx, gy, gz, nx, ny,
                     nz, scale, dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, bounce, counts,
                     beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, tally, lights, stacks,
-                    sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack,
-                    ns_out, nx_path, nx_org, nx_dir, nn_out, programs, params, path_info,
-                    hit_row, regs)
+                    shadows, ns_out, nexts, nn_out, programs, params, path_info, hit_row,
+                    regs)
             continue
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
         if bent and ad and not sdelta and spdf > 0.0:
@@ -501,8 +496,7 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
             min_pdf[p] = min(min_pdf[p], spdf)
         nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
         cone_moves(path_info[1], p, t_geom)
-        nn_out = ray_queues.push_next(nn_out, p, nox, noy, noz, wx, wy, wz, nx_path, nx_org,
-                                      nx_dir)
+        nn_out = ray_queues.push_next(nexts, nn_out, p, nox, noy, noz, wx, wy, wz)
         keep_receiver(prev_pos, p, recv)
         prev_pdf[p] = _INF if sdelta else spdf
     return ns_out, nn_out

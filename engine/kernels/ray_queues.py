@@ -5,6 +5,9 @@ path's next ray; the caller traces them after the stage."""
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
+
+import numpy as np
 
 from .jit import kernel
 
@@ -28,28 +31,47 @@ def towards(sox, soy, soz, px, py, pz, wx, wy, wz, dist, margin, scene_radius):
     return sdx, sdy, sdz, max(far, 0.0)
 
 
+class ShadowQueue(NamedTuple):
+    """The shadow rays one bounce queues: each one's path, origin, direction, length,
+    contribution if unoccluded, the bounce of the vertex it left (the clamp that applies)
+    and a copy of the path's volume stack (no rows without media)."""
+    path: np.ndarray
+    org: np.ndarray
+    dir: np.ndarray
+    far: np.ndarray
+    contrib: np.ndarray
+    bounce: np.ndarray
+    stack: np.ndarray
+
+
+class NextQueue(NamedTuple):
+    """The continuing paths' next rays: each one's path, origin and direction."""
+    path: np.ndarray
+    org: np.ndarray
+    dir: np.ndarray
+
+
 @kernel(allocates=False)
-def push(n, p, b, ox, oy, oz, dx, dy, dz, far, cr, cg, cb, sh_path, sh_org, sh_dir, sh_far,
-         sh_contrib, sh_bounce, stacks, sh_stack):
+def push(q, n, p, b, ox, oy, oz, dx, dy, dz, far, cr, cg, cb, stacks):
     """Write shadow ray n of path p at its bounce b (contribution c if unoccluded; the
-    clamp that applies depends on b), with a copy of the path's volume stack when the
-    scene has volumes. Returns n + 1."""
-    sh_path[n] = p
-    sh_bounce[n] = b
-    sh_org[n, 0], sh_org[n, 1], sh_org[n, 2] = ox, oy, oz
-    sh_dir[n, 0], sh_dir[n, 1], sh_dir[n, 2] = dx, dy, dz
-    sh_far[n] = far
-    sh_contrib[n, 0], sh_contrib[n, 1], sh_contrib[n, 2] = cr, cg, cb
-    if sh_stack.shape[0] > 0:
-        for i in range(sh_stack.shape[1]):    # element-wise: a slice copy allocates
-            sh_stack[n, i] = stacks[p, i]
+    clamp that applies depends on b) to the ShadowQueue q, with a copy of the path's
+    volume stack when the scene has volumes. Returns n + 1."""
+    q.path[n] = p
+    q.bounce[n] = b
+    q.org[n, 0], q.org[n, 1], q.org[n, 2] = ox, oy, oz
+    q.dir[n, 0], q.dir[n, 1], q.dir[n, 2] = dx, dy, dz
+    q.far[n] = far
+    q.contrib[n, 0], q.contrib[n, 1], q.contrib[n, 2] = cr, cg, cb
+    if q.stack.shape[0] > 0:
+        for i in range(q.stack.shape[1]):     # element-wise: a slice copy allocates
+            q.stack[n, i] = stacks[p, i]
     return n + 1
 
 
 @kernel(allocates=False)
-def push_next(n, p, ox, oy, oz, dx, dy, dz, nx_path, nx_org, nx_dir):
-    """Write next ray n: path p goes on from o along d. Returns n + 1."""
-    nx_path[n] = p
-    nx_org[n, 0], nx_org[n, 1], nx_org[n, 2] = ox, oy, oz
-    nx_dir[n, 0], nx_dir[n, 1], nx_dir[n, 2] = dx, dy, dz
+def push_next(q, n, p, ox, oy, oz, dx, dy, dz):
+    """Write next ray n to the NextQueue q: path p goes on from o along d. Returns n + 1."""
+    q.path[n] = p
+    q.org[n, 0], q.org[n, 1], q.org[n, 2] = ox, oy, oz
+    q.dir[n, 0], q.dir[n, 1], q.dir[n, 2] = dx, dy, dz
     return n + 1

@@ -98,8 +98,7 @@ def walk_params(row):
 def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, py, pz,
                   gx, gy, gz, nx, ny, nz, scale, dx, dy, dz, u1, u2, br, bg, bb, bounce,
                   counts, beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, tally, lights,
-                  stacks, sh_path, sh_org, sh_dir, sh_far, sh_contrib, sh_bounce, sh_stack,
-                  ns, nx_path, nx_org, nx_dir, nn, programs, params, path_info, hit_row,
+                  stacks, shadows, ns, nexts, nn, programs, params, path_info, hit_row,
                   regs):
     """Path p (throughput b, the lobe's weight included) enters the surface it hit at p
     (triangle prim of instance inst; geometric normal g and shading normal n facing the
@@ -140,8 +139,8 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
                 mx, my, mz = bx, by, bz
                 if params[m2, P_SETS_NORMAL] != 0.0:     # a Set Normal: the surface's own
                     n0x, n0y, n0z = bx, by, bz
-    goes_on = b < int(cfg[2]) and counts[p, 0] < cfg[3]
-    mode = int(cfg[8])
+    goes_on = b < cfg.max_bounces and counts[p, 0] < cfg.diffuse_bounces
+    mode = cfg.mis_mode
     # next-event estimation on the exit's Lambertian surface (lights picked for it:
     # one-sided, unless a bump bends its normal)
     recv = lt.receiver(qx, qy, qz, mx, my, mz, lt.TWO_SIDED if bent else lt.ONE_SIDED)
@@ -159,18 +158,17 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
             wt = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine * INV_PI
             cr, cg, cb = tr * lr * wt, tg * lg * wt, tb * lb * wt
             if not seen & SHADOW_BIT:
-                tl.lit(tally, p, b, cr, cg, cb, cfg[6] if b == 0 else cfg[7], DIFFUSE_SHARES,
-                       tl.entry_group(tally, k))
+                clamp = cfg.clamp_direct if b == 0 else cfg.clamp_indirect
+                tl.lit(tally, p, b, cr, cg, cb, clamp, DIFFUSE_SHARES, tl.entry_group(tally, k))
             else:
                 sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[4],
                                               geometry[13], geometry[9], prim2, inst2, u, v,
                                               qx, qy, qz, hx, hy, hz, n0x, n0y, n0z,
                                               escale, lx, ly, lz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, qx, qy, qz, lx, ly,
-                                                         lz, dist, margin, cfg[9])
-                ns = ray_queues.push(ns, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr, cg,
-                                      cb, sh_path, sh_org, sh_dir, sh_far, sh_contrib,
-                                      sh_bounce, stacks, sh_stack)
+                                                         lz, dist, margin, cfg.scene_radius)
+                ns = ray_queues.push(shadows, ns, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr, cg,
+                                      cb, stacks)
                 tl.queued(tally, ns - 1, p, b, DIFFUSE_SHARES, tl.entry_group(tally, k))
     if not goes_on:
         return ns, nn
@@ -197,5 +195,4 @@ def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, 
     keep_receiver(prev_pos, p, recv)
     prev_pdf[p] = pdf
     nox, noy, noz = offset_origin(qx, qy, qz, hx, hy, hz, escale, ox, oy, oz)
-    return ns, ray_queues.push_next(nn, p, nox, noy, noz, ox, oy, oz, nx_path, nx_org,
-                                    nx_dir)
+    return ns, ray_queues.push_next(nexts, nn, p, nox, noy, noz, ox, oy, oz)

@@ -79,21 +79,21 @@ def mirror_row(row):
 def shade_whitted(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_pos,
                   ray_bits, min_pdf, cont, path_time, live, ro, rd, rt, hits,
                   stopped, geometry, params, emission, textures, tables,
-                  lights, world, media, sh_path, sh_org, sh_dir, sh_far, sh_contrib, nx_path,
-                  nx_org, nx_dir, path_info, programs, volumes, het, sss):
+                  lights, world, media, shadows, nexts, path_info, programs, volumes, het, sss):
     """Whitted's bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`.
     The arguments are `path_vertex.shade`'s (read its docstring); this kernel reads no
     roulette verdict, MIS state or volume (min_pdf, cont, prev_pdf, prev_pos, volumes,
-    het and sss are unused: subsurface scattering is its diffuse lobe here), and queues up to `lamp_rays(lights)` shadow rays per path, so sh_*
-    must hold that many times the live paths. Returns (shadow count, next count)."""
-    bounce, sh_bounce, stacks, sh_stack = media[0], media[5], media[3], media[4]
+    het and sss are unused: subsurface scattering is its diffuse lobe here), and queues
+    up to `lamp_rays(lights)` shadow rays per path, so the shadow queue must hold that
+    many times the live paths. Returns (shadow count, next count)."""
+    bounce, stacks = media[0], media[3]
     hit_t, hit_prim, hit_inst, hit_u, hit_v = hits.t, hits.prim, hits.inst, hits.u, hits.v
     tri_material, holdout, corner_uvs = geometry[3], geometry[5], geometry[6]
-    film_transparent = cfg[10] > 0.0 and alpha.shape[0] > 0
-    kind, spp = int(cfg[0]), int(cfg[1])
-    max_bounces = int(cfg[2])
-    clamp_direct, clamp_indirect = cfg[6], cfg[7]
-    scene_radius = cfg[9]
+    film_transparent = cfg.film_transparent and alpha.shape[0] > 0
+    kind, spp = cfg.sampler, cfg.spp
+    max_bounces = cfg.max_bounces
+    clamp_direct, clamp_indirect = cfg.clamp_direct, cfg.clamp_indirect
+    scene_radius = cfg.scene_radius
     lamps = lights[LAMPS]
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
@@ -196,15 +196,16 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf,
             sox, soy, soz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
             sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy, wz,
                                                      dist, 0.0, scene_radius)
-            ns_out = ray_queues.push(ns_out, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr,
-                                      cg, cb, sh_path, sh_org, sh_dir, sh_far, sh_contrib,
-                                      sh_bounce, stacks, sh_stack)
+            ns_out = ray_queues.push(shadows, ns_out, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr,
+                                      cg, cb, stacks)
         # 3. one ray of Whitted's tree: mirror reflection or refraction
         if b >= max_bounces:
             continue
         mirror_row(row)
         bsdf.setup(row, front, wox, woy, woz, tables, state)
-        ad, ag, at = False, counts[p, 1] < cfg[4], counts[p, 2] < cfg[5]
+        ad = False
+        ag = counts[p, 1] < cfg.glossy_bounces
+        at = counts[p, 2] < cfg.transmission_bounces
         if not (ag or at):
             continue
         ix, iy, iz, wr, wg, wb, spdf, skind, sdelta, valid = bsdf.sample(
@@ -224,6 +225,5 @@ def shade_whitted(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf,
         ray_bits[p] = DIFFUSE_BIT << skind
         nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
         cone_moves(path_info[1], p, t_geom)
-        nn_out = ray_queues.push_next(nn_out, p, nox, noy, noz, wx, wy, wz, nx_path, nx_org,
-                                      nx_dir)
+        nn_out = ray_queues.push_next(nexts, nn_out, p, nox, noy, noz, wx, wy, wz)
     return ns_out, nn_out
