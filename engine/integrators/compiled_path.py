@@ -27,6 +27,7 @@ from ..bsdf.material_table import flatten_mixes
 from ..kernels.camera_rays import pack_camera
 from ..kernels.jit import Kernel
 from ..kernels.path_config import path_config
+from ..kernels.path_state import TracedScene, new_paths
 from ..kernels.ray_queues import NextQueue, ShadowQueue
 from ..kernels.path_vertex import shade
 from ..kernels.light_tally import add_transmitted, add_unoccluded, new_tally
@@ -110,6 +111,10 @@ class CompiledPathIntegrator:
                          self.vol if self.heterogeneous else None, rays)
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
                             else np.full(STACK, -1, np.int32))
+        # the scene as the vertex kernels read it
+        self.scene = TracedScene(self.geometry, self.params, self.emission, self.textures,
+                                 self.tables, self.lights, self.world, self.vol,
+                                 self.het_runs)
         # Cycles' light passes and light groups, when the render asks for them
         passes, groups = light_passes.wanted(ctx)
         self.light_passes = passes and self.splits_light
@@ -214,23 +219,17 @@ class CompiledPathIntegrator:
         pkey = pixel_keys(np.uint64(ctx.sampler.seed), np.asarray(pixel, np.int64))
         index = np.ascontiguousarray(index, dtype=np.int64)
         coverage = alpha_out if alpha_out is not None else np.zeros(0)
-        beta = np.ones((n, 3))
-        counts = np.zeros((n, 3), dtype=np.int64)
-        used = np.zeros(n, dtype=np.int64)         # transparent bounces per path
         cone = camera_cones(self.camera, np.ascontiguousarray(dirs, dtype=np.float64))
-        ray_bits = np.full(n, visibility.CAMERA, dtype=np.int64)   # each path's ray kind
-        min_pdf = np.full(n, np.inf)               # smallest BSDF pdf so far per path
-        cont = np.ones(n)                          # the roulette's verdict for the next vertex
-        prev_pdf = np.full(n, np.inf)              # camera rays count as specular: weight 1
-        # each path's last vertex, as its light sample's receiver (point, normal, mode:
-        # kernels/lights/tree.py); the camera's, with no normal
-        prev_pos = np.zeros((n, 7))
-        prev_pos[:, :3] = origins
-        live = np.arange(n, dtype=np.int64)
-        bounce = np.zeros(n, dtype=np.int64)       # bounces per path (not boundaries)
-        vbounce = np.zeros(n, dtype=np.int64)      # volume scatterings per path
         k = n if self.has_volumes else 0
         stacks = np.ascontiguousarray(np.tile(self.start_stack, (k, 1)), np.int32)
+        # each path's shutter time, kept for all its rays (zeros when nothing moves)
+        moving = time is not None
+        path_time = np.ascontiguousarray(time, np.float64) if moving else np.zeros(n)
+        paths = new_paths(pkey, index, path_time, coverage, stacks, cone)
+        # each path's last vertex, as its light sample's receiver (point, normal, mode:
+        # kernels/lights/tree.py); the camera's, with no normal
+        paths.prev_pos[:, :3] = origins
+        live = np.arange(n, dtype=np.int64)
         ns_max = n * self.shadow_rays_per_path       # the shadow rays one bounce may queue
         tally = new_tally(n, ns_max, split and self.light_passes,
                           len(self.light_groups) if split else 0, self.group_tables)
@@ -240,7 +239,6 @@ class CompiledPathIntegrator:
                               np.empty(ns_max, np.int64),
                               np.full((ns_max if k else 0, STACK), -1, np.int32))
         nexts = NextQueue(np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 3)))
-        media = (bounce, vbounce, self.vol, stacks, self.het_runs)
         no_keys = np.zeros(0, np.uint64)
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(dirs, dtype=np.float64)
@@ -248,9 +246,6 @@ class CompiledPathIntegrator:
         # Numba, and load a second copy of the shading kernel (15 MB, 0.1 s per process)
         tm = np.array(np.broadcast_to(tmax, (n,)), dtype=np.float64)
         no_stop = np.zeros(n, bool)
-        # each path's shutter time, kept for all its rays (zeros when nothing moves)
-        moving = time is not None
-        path_time = np.ascontiguousarray(time, np.float64) if moving else np.zeros(n)
         # one step per bounce, and per crossing of a volume's boundary
         steps = self.max_bounces + 1 + (VOLUME_BOUNDS_MAX if self.has_volumes else 0)
         for depth in range(steps):
@@ -261,14 +256,11 @@ class CompiledPathIntegrator:
             found, stopped = hits.arrays(), no_stop
             if self.any_transparent or self.skips_hits:
                 found, factor, stopped = self._through_transparent(
-                    depth, (pkey, index), live, used, ray_bits, path_time, ray_time, o, d,
-                    tm, hits)
-                beta[live] *= factor
-            ns, nn = self.vertex(depth, self.cfg, pkey, index, beta, counts, tally, coverage,
-                           prev_pdf, prev_pos, ray_bits, min_pdf, cont, path_time, live, o, d,
-                           tm, found, stopped, self.geometry, self.params,
-                           self.emission, self.textures, self.tables, self.lights,
-                           self.world, media, shadows, nexts, (used, cone), *self.features)
+                    depth, (pkey, index), live, paths.used, paths.ray_bits, path_time,
+                    ray_time, o, d, tm, hits)
+                paths.beta[live] *= factor
+            ns, nn = self.vertex(depth, self.cfg, paths, tally, live, o, d, tm, found, stopped,
+                                 self.scene, shadows, nexts, *self.features)
             if ns:
                 sh = shadows
                 sh_time = path_time[sh.path[:ns]] if moving else None

@@ -37,15 +37,17 @@ from .volume import EQUIANGULAR, distance_pdf, hg_phase, hg_sample, medium, volu
 
 
 @kernel(allocates=False)
-def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb, g, bounce,
-            vbounce, beta, cont, prev_pdf, prev_pos, ray_bits, tally, lights, vol, stacks,
+def scatter(depth, cfg, paths, p, px, py, pz, dx, dy, dz, br, bg, bb, g, tally, lights, vol,
             shadows, ns, nexts, nn, segment):
-    """Path p (throughput b, after the segment's weight, shutter time `time`) scattered at
+    """Path p of `paths` (path_state.PathState; throughput b, after the segment's weight)
+    scattered at
     point x moving along d, by a Henyey-Greenstein phase function of anisotropy g. Writes
     at most one shadow ray (returned count ns) and one next ray (nn). `segment` = (ox,
     oy, oz, t_max, t, pdf, method): the homogeneous segment the distance t was sampled
     on, that sample's density and the medium's sampling method, for the weight against
     equiangular sampling (pdf 0: none, the distance sample's alone)."""
+    pkey, index, time, bounce, vbounce = paths.key, paths.index, paths.time[p], \
+        paths.bounce, paths.vbounce
     kind, spp = cfg.sampler, cfg.spp
     mode = cfg.mis_mode
     clamp = cfg.clamp_direct if bounce[p] == 0 else cfg.clamp_indirect
@@ -74,7 +76,7 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
                 sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz,
                                                          dist, margin, cfg.scene_radius)
                 ns = ray_queues.push(shadows, ns, p, bounce[p], px, py, pz, sdx, sdy, sdz,
-                                     far, cr, cg, cb, stacks)
+                                     far, cr, cg, cb, paths.stacks)
                 tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))
     if not goes_on:
         return ns, nn
@@ -82,17 +84,17 @@ def scatter(depth, cfg, pkey, index, p, time, px, py, pz, dx, dy, dz, br, bg, bb
     wx, wy, wz, pdf = hg_sample(g, dx, dy, dz, u1, u2)
     if bounce[p] + 1 >= ROULETTE_START:
         u_rr = sample_1d(kind, pkey[p], spp, index[p], base + D.ROULETTE)
-        cont[p] = roulette(u_rr, br, bg, bb)     # applied where the next ray arrives
+        paths.cont[p] = roulette(u_rr, br, bg, bb)     # applied where the next ray arrives
     if not (max(br, bg, bb) > 0.0 and pdf > 0.0):
         return ns, nn
-    beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb     # phase / pdf = 1
+    paths.beta[p, 0], paths.beta[p, 1], paths.beta[p, 2] = br, bg, bb     # phase / pdf = 1
     if bounce[p] == 0:
         tl.left_first(tally, p, VOLUME_SHARES)
     bounce[p] += 1
     vbounce[p] += 1
-    ray_bits[p] = DIFFUSE_BIT
-    keep_receiver(prev_pos, p, recv)
-    prev_pdf[p] = pdf
+    paths.ray_bits[p] = DIFFUSE_BIT
+    keep_receiver(paths.prev_pos, p, recv)
+    paths.prev_pdf[p] = pdf
     return ns, ray_queues.push_next(nexts, nn, p, px, py, pz, wx, wy, wz)
 
 
@@ -122,9 +124,8 @@ def distance_weight(lights, k, recv, time, dx, dy, dz, segment):
 
 
 @kernel(allocates=False)
-def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, t_max,
-                      br, bg, bb, channels, method, bounce, vbounce, tally, lights, vol, stacks,
-                      shadows, ns):
+def equiangular_light(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, br, bg, bb,
+                      channels, method, tally, lights, vol, shadows, ns):
     """The equiangular half of a homogeneous segment's direct light: path p (throughput
     b before the segment, roulette applied) travels o + t d, t in [0, t_max], through its
     medium, whose distance sampling picked the channels with weights `channels` (RGB),
@@ -133,6 +134,9 @@ def equiangular_light(depth, cfg, pkey, index, p, time, ox, oy, oz, dx, dy, dz, 
     its position and a point on it from there, and queues the shadow ray (returned count
     ns). Its weight against phase sampling takes the light's pick probability for that
     point, as a scattering there would pick it."""
+    pkey, index, time, bounce, vbounce = paths.key, paths.index, paths.time[p], \
+        paths.bounce, paths.vbounce
+    stacks = paths.stacks
     kind, spp = cfg.sampler, cfg.spp
     mode = cfg.mis_mode
     if lt.n_entries(lights) == 0:

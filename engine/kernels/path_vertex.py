@@ -6,7 +6,7 @@ The estimator, at each surface vertex:
      discs (escaped rays) and emissive triangles (hit by the ray cast), each weighted
      against light sampling by the power heuristic with the pdf light sampling would have
      had for that direction; camera rays and specular bounces (pdf = inf) see emission
-     with weight 1;
+     with weight 1 (lamps and the world: found_light.py);
   2. next-event estimation: one light entry (lamp or emissive triangle) picked in
      proportion to its power, one point on it, one shadow ray, weighted against BSDF
      sampling by the power heuristic;
@@ -44,8 +44,9 @@ from . import lights as lt
 from .bsdf import principled as bsdf
 from .bsdf.state import S_WALTER
 from . import ray_queues
-from .frame import dot, length, to_local, to_world
+from .frame import dot, to_local, to_world
 from .jit import kernel
+from .found_light import escaped, lamps_in_front
 from . import light_tally as tl
 from .pass_shares import NO_SHARES, bounce_shares, light_shares, lobe_colours
 from .medium_vertex import equiangular_light, scatter
@@ -53,7 +54,7 @@ from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
                            TRANSMISSION_BIT, _INF, continues, hit_weight, holdout_share,
                            keep_receiver, nee_weight, previous_receiver, roulette, uncovered)
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
-from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium, passed,
+from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium,
                      sample_method, segment, stack_cross, volume_dim)
 from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA, P_HOLDOUT, P_SETS_NORMAL
 from .surface import hit_uv, offset_origin, surface_at
@@ -96,52 +97,53 @@ def prepare_closures(cfg, row, min_pdf, ray_bit):
 
 
 @kernel
-def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_pos, ray_bits,
-          min_pdf, cont, path_time, live, ro, rd, rt, hits, stopped,
-          geometry, params, emission, textures, tables, lights, world, media,
-          shadows, nexts, path_info,
+def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shadows, nexts,
           programs, volumes, het, sss):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`
-    (engine.accel.HitArrays: t, prim, inst, u, v per ray; prim -1 where missed).
+    (engine.accel.HitArrays: t, prim, inst, u, v per ray; prim -1 where missed); stopped:
+    rays that ended at the transparent bounce limit. Writes the shadow rays to `shadows`
+    (ray_queues.ShadowQueue; their contributions before the clamp, which
+    light_tally.add_transmitted applies) and the continuing paths' next rays to `nexts`
+    (ray_queues.NextQueue); returns (shadow count, next count).
 
     cfg: the render's engine.kernels.path_config.PathConfig (see `prepare_closures`).
-    geometry: (vertex positions, each triangle's corners as rows of them, the static
-    scene's centre, material, corner_normals, holdout, corner_uvs, moving objects,
-    triangle objects, object table, corner tangents, corner colours, camera, terminator
-    cutoffs) of every triangle (corner normals, holdout, UVs, objects, tangents, colours
-    and cutoffs may be empty; see `surface.surface_at` and engine.nodes.shading).
-    textures: the packed textures and shader programs (engine.nodes.pack.pack_shading);
-    a material with a program runs it at each hit, and its outputs replace the
-    parameters they drive. path_time: each path's shutter time (its moving triangles are
-    placed at that time). alpha: each path's film coverage, or
-    empty when the film is opaque. stopped: rays that ended at the transparent bounce
-    limit. ray_bits: the kind of each path's current ray (engine.visibility: CAMERA,
-    then the bit of the lobe it left by), which decides the lamps it sees; next-event
-    estimation evaluates only the lobes the light is seen by and skips the shadow ray
-    of a light that casts no shadow. min_pdf: the smallest BSDF pdf along each path so
-    far (Filter Glossy, `prepare_closures`). cont: each path's Russian roulette verdict
-    for the vertex its ray finds (`path_weights.roulette`: 1 none, q it survived with
-    probability q, 0 it ends there after the emission found). Writes the shadow rays to
-    `shadows` (ray_queues.ShadowQueue; their contributions before the clamp, which
-    light_tally.add_transmitted applies) and the continuing paths' next rays to `nexts`
-    (ray_queues.NextQueue); returns (shadow count, next count). beta,
-    counts, alpha, prev_pdf, prev_pos are per-path state, updated in place. tally:
-    where the light goes (engine.kernels.light_tally: Combined, and the light passes and
-    light groups when the render asks for them).
-    path_info: (transparent bounces per path, ray cone per path (n, 2): footprint at the
-    ray's origin and spread, see engine.nodes.differentials), what shader programs read
-    of the path; the cone moves on to the next ray's origin.
-
-    media: (bounce, volume bounces, VOL, stacks, heterogeneous count): each path's
-    bounces so far (depth counts the wavefront's steps, which include crossings of
-    volume boundaries) and volume scatterings, the volume table and the paths' volume
-    stacks (engine.kernels.volume; empty when the scene has no media; the shadow queue
-    keeps each shadow ray's copy) and a (1,) int64 counter of
-    the shader program runs inside heterogeneous media. A ray in a medium first travels
-    through it (`volume.segment`, or `medium_density.tracked_segment` when a medium of
-    its stack is heterogeneous): it may scatter there (`medium_vertex.scatter` shades that
-    point), emission along it is added, and what it reaches beyond is weighted by its
-    transmittance. A hit on a volume's boundary surface is crossed without a bounce.
+    tally: where the light goes (engine.kernels.light_tally: Combined, and the light
+    passes and light groups when the render asks for them).
+    paths: every path's state (engine.kernels.path_state.PathState), updated in place:
+      - time: its shutter time (its moving triangles are placed at that time);
+      - alpha: its film coverage (no rows on an opaque film);
+      - ray_bits: the kind of its current ray (engine.visibility: CAMERA, then the bit of
+        the lobe it left by), which decides the lamps it sees; next-event estimation
+        evaluates only the lobes the light is seen by and skips the shadow ray of a light
+        that casts no shadow;
+      - min_pdf: the smallest BSDF pdf along it (Filter Glossy, `prepare_closures`);
+      - cont: its Russian roulette verdict for the vertex its ray finds
+        (`path_weights.roulette`: 1 none, q it survived with probability q, 0 it ends
+        there after the emission found);
+      - used and cone: its transparent bounces and ray cone (footprint at the ray's origin
+        and spread, engine.nodes.differentials), what shader programs read of it (the
+        cone moves on to the next ray's origin);
+      - bounce and vbounce: its bounces so far (depth counts the wavefront's steps, which
+        include crossings of volume boundaries) and volume scatterings; stacks: its
+        volume stack (engine.kernels.volume; no rows without media; the shadow queue
+        keeps each shadow ray's copy).
+    scene: engine.kernels.path_state.TracedScene:
+      - geometry: (vertex positions, each triangle's corners as rows of them, the static
+        scene's centre, material, corner_normals, holdout, corner_uvs, moving objects,
+        triangle objects, object table, corner tangents, corner colours, camera,
+        terminator cutoffs) of every triangle (corner normals, holdout, UVs, objects,
+        tangents, colours and cutoffs may be empty; see `surface.surface_at` and
+        engine.nodes.shading);
+      - textures: the packed textures and shader programs
+        (engine.nodes.pack.pack_shading); a material with a program runs it at each hit,
+        and its outputs replace the parameters they drive;
+      - vol: the volume table; het_count: a (1,) int64 counter of the shader program runs
+        inside heterogeneous media.
+    A ray in a medium first travels through it (`volume.segment`, or
+    `medium_density.tracked_segment` when a medium of its stack is heterogeneous): it may
+    scatter there (`medium_vertex.scatter` shades that point), emission along it is
+    added, and what it reaches beyond is weighted by its transmittance. A hit on a
+    volume's boundary surface is crossed without a bounce.
 
     programs, volumes, het, sss: what the scene uses, each None when it does not (Numba then
     compiles this kernel without that code, and never compiles what only it calls: a
@@ -152,7 +154,15 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
     scene for rays cast inside a kernel (engine.kernels.subsurface.local_hit) when a
     material scatters below its surface: a sampled subsurface lobe then walks there
     (engine.kernels.subsurface_vertex), queueing one more shadow ray for its exit."""
-    bounce, vbounce, vol, stacks, het_count = media
+    pkey, index, beta, counts = paths.key, paths.index, paths.beta, paths.counts
+    bounce, ray_bits, min_pdf = paths.bounce, paths.ray_bits, paths.min_pdf
+    cont, prev_pdf, prev_pos, path_time = paths.cont, paths.prev_pdf, paths.prev_pos, \
+        paths.time
+    alpha, stacks, path_info = paths.alpha, paths.stacks, (paths.used, paths.cone)
+    geometry, params, emission, textures = scene.geometry, scene.params, scene.emission, \
+        scene.textures
+    tables, lights, world, vol, het_count = scene.tables, scene.lights, scene.world, \
+        scene.vol, scene.het_count
     hit_t, hit_prim, hit_inst, hit_u, hit_v = hits.t, hits.prim, hits.inst, hits.u, hits.v
     het_scene = has_heterogeneous(vol)
     vhit = np.zeros(N_HIT)
@@ -163,7 +173,6 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
     clamp_direct, clamp_indirect, mode = cfg.clamp_direct, cfg.clamp_indirect, cfg.mis_mode
     scene_radius = cfg.scene_radius
     n_lights = lt.n_entries(lights)
-    n_lamps = lt.n_lamps(lights)
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
     hit_row = np.zeros(N_HIT)
@@ -222,43 +231,23 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
                     # the segment's direct light at an equiangular distance (the roulette
                     # verdict on this ray applies, as at a scattering)
                     ns_out = equiangular_light(
-                        depth, cfg, pkey, index, p, path_time[p], ox, oy, oz, dx, dy, dz,
-                        t_geom, b0r / cont[p], b0g / cont[p], b0b / cont[p], (wcr, wcg, wcb),
-                        method, bounce, vbounce, tally, lights, vol, stacks, shadows, ns_out)
+                        depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_geom, b0r / cont[p],
+                        b0g / cont[p], b0b / cont[p], (wcr, wcg, wcb), method, tally,
+                        lights, vol, shadows, ns_out)
             tl.found(tally, p, b, er, eg, eb, clamp_hit, False, -1)   # a medium's: no group
-        # 1a. area and sphere lamps in front of the geometry: the ray passes through
-        # lamps (as in Cycles) and finds every one before what it hits
-        for k_l in range(n_lamps):
-            t_l, lr, lg, lb = lt.lamp_hit(lights, k_l, ox, oy, oz, dx, dy, dz, ray_bits[p],
-                                          path_time[p])
-            if not t_l < t_end:
-                continue
-            if vmode == 3:
-                # (the heterogeneous medium's factor is taken at the nearest lamp)
-                fr, fg, fb = mfr, mfg, mfb
-            else:
-                fr, fg, fb = passed(vmode, str_, stg, stb, wcr, wcg, wcb, t_l)
-            if vol.shape[0] > 0:
-                # the ray may start past volume boundaries: the lamp's distance is from
-                # the path's last vertex
-                t_l = length(ox + dx * t_l - prev_pos[p, 0], oy + dy * t_l - prev_pos[p, 1],
-                             oz + dz * t_l - prev_pos[p, 2])
-            lpdf = lt.lamp_pdf(lights, k_l, previous_receiver(prev_pos, p), dx, dy, dz, t_l,
-                               path_time[p])
-            w = hit_weight(mode, prev_pdf[p], lpdf)
-            tl.found(tally, p, b, b0r * fr * lr * w, b0g * fg * lg * w, b0b * fb * lb * w,
-                     clamp_hit, False, tl.entry_group(tally, k_l))
+        # 1a. area and sphere lamps in front of the geometry
+        lamps_in_front(tally, lights, paths, p, b, ox, oy, oz, dx, dy, dz, t_end,
+                       (vmode, str_, stg, stb, wcr, wcg, wcb, mfr, mfg, mfb),
+                       vol.shape[0] > 0, mode, b0r, b0g, b0b, clamp_hit)
         if volumes is not None and scattered:
             q = continues(cont, p)             # the roulette, after the emission found
             if q == 0.0:
                 continue
             br, bg, bb = br / q, bg / q, bb / q
             cone_moves(path_info[1], p, t_end)
-            ns_out, nn_out = scatter(depth, cfg, pkey, index, p, path_time[p], ox + dx * t_end,
-                                     oy + dy * t_end, oz + dz * t_end, dx, dy, dz, br, bg, bb,
-                                     g_phase, bounce, vbounce, beta, cont, prev_pdf, prev_pos,
-                                     ray_bits, tally, lights, vol, stacks, shadows, ns_out,
-                                     nexts, nn_out, segment_mis)
+            ns_out, nn_out = scatter(depth, cfg, paths, p, ox + dx * t_end, oy + dy * t_end,
+                                     oz + dz * t_end, dx, dy, dz, br, bg, bb, g_phase, tally,
+                                     lights, vol, shadows, ns_out, nexts, nn_out, segment_mis)
             continue
         # 1b. escaped rays: the world and sun discs (or, for camera rays on a transparent
         # film, no colour and the coverage left)
@@ -266,32 +255,8 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
             if b == 0 and film_transparent:
                 alpha[p] = uncovered(br, bg, bb)
                 continue
-            recv = previous_receiver(prev_pos, p)
-            er, eg, eb, epdf = lt.world_escaped(lights, world, ray_bits[p], dx, dy, dz, recv,
-                                                path_time[p])
-            w = hit_weight(mode, prev_pdf[p], epdf)
-            er, eg, eb = er * w, eg * w, eb * w
-            wr, wg, wb = er, eg, eb               # the world's own part (light groups)
-            for s in range(lt.n_suns(lights)):
-                sr, sg, sb, spdf = lt.sun_escaped(lights, s, dx, dy, dz, recv, path_time[p])
-                w = hit_weight(mode, prev_pdf[p], spdf)
-                er += sr * w
-                eg += sg * w
-                eb += sb * w
-            # (what a camera ray sees here, sun discs included, is the Environment pass)
-            world_only = wr == er and wg == eg and wb == eb
-            kr, kg, kb = tl.found(tally, p, b, br * er, bg * eg, bb * eb, clamp_hit, True,
-                                  tally.world_group[0] if world_only else -1)
-            if tl.grouped(tally) and not world_only:
-                # each source to its group, with the clamp's factor of the whole
-                tl.to_group(tally, p, tally.world_group[0], br * wr * kr, bg * wg * kg,
-                            bb * wb * kb)
-                for s in range(lt.n_suns(lights)):
-                    sr, sg, sb, spdf = lt.sun_escaped(lights, s, dx, dy, dz, recv,
-                                                      path_time[p])
-                    w = hit_weight(mode, prev_pdf[p], spdf)
-                    tl.to_group(tally, p, tl.entry_group(tally, lt.sun_entry(lights, s)),
-                                br * sr * w * kr, bg * sg * w * kg, bb * sb * w * kb)
+            escaped(tally, lights, world, paths, p, b, dx, dy, dz, mode, br, bg, bb,
+                    clamp_hit)
             continue
         if stopped[j]:
             continue                      # past the transparent bounce limit
@@ -454,12 +419,10 @@ def shade(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_po
                     tl.left_first(tally, p, tl.one_class(tl.DIFFUSE_CLASS))
                 cone_moves(path_info[1], p, t_geom)
                 ns_out, nn_out = scatter_below(
-                    cfg, walk_key(pkey[p], index[p], depth), p, path_time[p], sss, f_ray,
-                    w_ray, geometry, row, prim, hit_inst[j], px, py, pz, gx, gy, gz, nx, ny,
-                    nz, scale, dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, bounce, counts,
-                    beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, tally, lights, stacks,
-                    shadows, ns_out, nexts, nn_out, programs, params, path_info, hit_row,
-                    regs)
+                    cfg, walk_key(pkey[p], index[p], depth), p, paths, sss, f_ray, w_ray,
+                    geometry, row, prim, hit_inst[j], px, py, pz, gx, gy, gz, nx, ny, nz,
+                    scale, dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, tally, lights,
+                    shadows, ns_out, nexts, nn_out, programs, params, hit_row, regs)
             continue
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
         if bent and ad and not sdelta and spdf > 0.0:

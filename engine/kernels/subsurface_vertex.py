@@ -95,19 +95,22 @@ def walk_params(row):
 
 
 @kernel(allocates=False)
-def scatter_below(cfg, key, p, time, rays, f, w, geometry, row, prim, inst, px, py, pz,
-                  gx, gy, gz, nx, ny, nz, scale, dx, dy, dz, u1, u2, br, bg, bb, bounce,
-                  counts, beta, cont, prev_pdf, prev_pos, ray_bits, min_pdf, tally, lights,
-                  stacks, shadows, ns, nexts, nn, programs, params, path_info, hit_row,
-                  regs):
+def scatter_below(cfg, key, p, paths, rays, f, w, geometry, row, prim, inst, px, py, pz,
+                  gx, gy, gz, nx, ny, nz, scale, dx, dy, dz, u1, u2, br, bg, bb, tally,
+                  lights, shadows, ns, nexts, nn, programs, params, hit_row, regs):
     """Path p (throughput b, the lobe's weight included) enters the surface it hit at p
     (triangle prim of instance inst; geometric normal g and shading normal n facing the
     ray along d), walks, and leaves: queues at most one shadow ray (count ns) and one
     next ray (count nn), as path_vertex.shade does. key: the walk's stream
     (subsurface.walk_key); rays: the scene for rays cast here (subsurface.local_hit);
     f, w: a ray record (engine.embree.rays). programs (None in a scene without shader
-    programs), params, path_info, hit_row, regs: what the exit's material program reads
-    and writes (path_vertex.shade's), run there for the normal it bends."""
+    programs), params, hit_row, regs: what the exit's material program reads and writes
+    (path_vertex.shade's), run there for the normal it bends. paths: the paths' state
+    (path_state.PathState), updated for path p."""
+    time, bounce, counts, beta = paths.time[p], paths.bounce, paths.counts, paths.beta
+    cont, prev_pdf, prev_pos, ray_bits = paths.cont, paths.prev_pdf, paths.prev_pos, \
+        paths.ray_bits
+    min_pdf, stacks, path_info = paths.min_pdf, paths.stacks, (paths.used, paths.cone)
     ex_dx, ex_dy, ex_dz, ok = entry_direction(row, dx, dy, dz, nx, ny, nz, u1, u2)
     if not ok or dot(ex_dx, ex_dy, ex_dz, gx, gy, gz) >= 0.0:
         return ns, nn

@@ -76,17 +76,21 @@ def mirror_row(row):
 
 
 @kernel
-def shade_whitted(depth, cfg, pkey, index, beta, counts, tally, alpha, prev_pdf, prev_pos,
-                  ray_bits, min_pdf, cont, path_time, live, ro, rd, rt, hits,
-                  stopped, geometry, params, emission, textures, tables,
-                  lights, world, media, shadows, nexts, path_info, programs, volumes, het, sss):
+def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shadows,
+                  nexts, programs, volumes, het, sss):
     """Whitted's bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`.
     The arguments are `path_vertex.shade`'s (read its docstring); this kernel reads no
-    roulette verdict, MIS state or volume (min_pdf, cont, prev_pdf, prev_pos, volumes,
-    het and sss are unused: subsurface scattering is its diffuse lobe here), and queues
-    up to `lamp_rays(lights)` shadow rays per path, so the shadow queue must hold that
-    many times the live paths. Returns (shadow count, next count)."""
-    bounce, stacks = media[0], media[3]
+    roulette verdict, MIS state or volume (the paths' min_pdf, cont, prev_pdf, prev_pos;
+    volumes, het and sss are unused: subsurface scattering is its diffuse lobe here), and
+    queues up to `lamp_rays(lights)` shadow rays per path, so the shadow queue must hold
+    that many times the live paths. Returns (shadow count, next count)."""
+    pkey, index, beta, counts = paths.key, paths.index, paths.beta, paths.counts
+    bounce, stacks, ray_bits, path_time = paths.bounce, paths.stacks, paths.ray_bits, \
+        paths.time
+    alpha, path_info = paths.alpha, (paths.used, paths.cone)
+    geometry, params, emission, textures = scene.geometry, scene.params, scene.emission, \
+        scene.textures
+    tables, lights, world = scene.tables, scene.lights, scene.world
     hit_t, hit_prim, hit_inst, hit_u, hit_v = hits.t, hits.prim, hits.inst, hits.u, hits.v
     tri_material, holdout, corner_uvs = geometry[3], geometry[5], geometry[6]
     film_transparent = cfg.film_transparent and alpha.shape[0] > 0
