@@ -134,13 +134,16 @@ def write(rows, lifted, seconds, drt, cycles):
         "count as Diffuse; a glass's reflection as Glossy, its refraction as "
         "Transmission), Direct being the light sampled at the first surface and what its "
         "bounce finds, Indirect the rest; divided by that kind's Color, as Cycles writes "
-        "them. Where several lobes share a direction, each gets its part of the BSDF's "
-        "value there.",
+        "them (a channel whose Color is 0 takes the other channels' ratio, as Cycles' film "
+        "does, so a pass under a saturated colour stays grey). Where several lobes share a "
+        "direction, each gets its part of the BSDF's value there.",
         "- **Diffuse, Glossy, Transmission Color**: what the first surface's lobes of that "
         "kind weigh at the view (their albedo estimates, as Cycles' closure weights).",
         "- **Volume Direct / Indirect**: paths that first scattered in a medium.",
         "- **Emission**: what camera rays see emitted: lamps, emissive surfaces, media.",
-        "- **Environment**: the world seen by camera rays.",
+        "- **Environment**: the world seen by camera rays (through transparent surfaces, "
+        "and on a transparent film too, where Combined leaves it out but the world's light "
+        "group keeps it, as in Cycles).",
         "- **Combined_<group>**: the light of the lamps, emissive objects and world of a "
         "light group (Object > Shading > Light Group, World > Settings > Light Group).",
         "",
@@ -177,9 +180,6 @@ def write(rows, lifted, seconds, drt, cycles):
         "- **Glossy Color of metals**: DRT takes the metal lobe's Fresnel at the view "
         "angle, Cycles a table of the rough lobe's albedo (F82-tint): the passes differ by "
         "a few percent on rough metals; Glossy Direct x Glossy Color, the light, does not.",
-        "- **Environment with Film > Transparent**: Cycles still writes the world there and "
-        "counts it in the world's light group; DRT's Environment pass has it, its light "
-        "group does not.",
         "- **A medium's own emission** belongs to no light group in DRT (Cycles: its "
         "object's).",
         "- The Distribution and Whitted integrators write no light passes (Combined only); "

@@ -55,6 +55,20 @@ def enabled(view_layer) -> list:
     return [name for name, (_, _, on) in LIGHT_PASSES.items() if on(view_layer)]
 
 
+def splits(view_layer) -> bool:
+    """Whether the path tracer splits its light: a light pass or Environment is asked
+    for (Environment is the path tracer's too, every sample, as Cycles writes it)."""
+    return bool(enabled(view_layer)) or bool(getattr(view_layer, "use_pass_environment",
+                                                     False))
+
+
+def environment(film):
+    """Cycles' Environment pass, (h, w, 3) row 0 at the top: the world and sun discs
+    camera rays see, through transparent surfaces, on a transparent film too."""
+    from .engine_link import engine
+    return import_module(engine.__name__ + ".light_passes").images(film, ())["environment"]
+
+
 def group_passes(view_layer) -> list:
     """Combined_<name> of each of the view layer's light groups, as Cycles names them."""
     from .export import light_groups

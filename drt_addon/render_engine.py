@@ -250,7 +250,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             description.light_groups = ()
         else:
             # the path tracer splits its light only when a light pass is asked for
-            settings.light_passes = bool(light_passes.enabled(view_layer))
+            settings.light_passes = light_passes.splits(view_layer)
         try:
             settings.validate()
         except ValueError as e:
@@ -391,6 +391,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         if not wanted and not aovs and not lights:
             return
         images = light_passes.images(film, description.light_groups, lights)
+        if ENVIRONMENT_PASS in wanted:
+            images[ENVIRONMENT_PASS] = light_passes.environment(film)
         wanted += lights
         if any(n in wanted for n in FIRST_HIT):
             self.update_stats("", "DRT: first-hit passes")
@@ -401,7 +403,6 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                            "Mist": first.mist, "Position": first.position, "UV": first.uv,
                            OBJECT_INDEX_PASS: first.object_index,
                            MATERIAL_INDEX_PASS: first.material_index,
-                           ENVIRONMENT_PASS: first.environment,
                            AO_PASS: first.ambient_occlusion})
         if aovs:
             self.update_stats("", "DRT: shader AOVs")

@@ -20,7 +20,8 @@ layer (Properties > View Layer > Passes):
   named IndexOB and IndexMA before Blender 5.0, as Cycles names them): the Pass Index of the object and of the material the
   pixel's first camera sample hits, as Cycles writes them (sample 0 alone).
 - Environment (`use_pass_environment`; Env before Blender 5.0): the world as camera rays
-  that hit nothing see it, as Cycles' Environment pass.
+  see it, through transparent surfaces, on a transparent film too, as Cycles' Environment
+  pass: from the path tracer's own samples (drt_addon.light_passes).
 - Ambient Occlusion (`use_pass_ambient_occlusion`; AO before Blender 5.0): Cycles' AO
   pass, from the first hits (engine.ambient_occlusion).
 - Vector (`use_pass_vector`): Cycles' motion vectors for Vector Blur, from the pixel
@@ -36,8 +37,8 @@ layer (Properties > View Layer > Passes):
   (engine.cryptomatte).
 - Noisy Image (when Render > Denoise and the view layer's Denoising are on, Cycles'
   settings): the render before denoising; Combined is then denoised (drt_addon.denoise).
-Depth, Normal, Mist, Position, UV, the index passes, Cryptomatte and the denoising passes
-come from engine.aov (a first-hit query on the same camera samples), not from the path
+Depth, Normal, Mist, Position, UV, the index passes, AO, Cryptomatte and the denoising
+passes come from engine.aov (a first-hit query on the same camera samples), not from the path
 tracer."""
 from __future__ import annotations
 
@@ -65,7 +66,7 @@ PASSES = {
     "Vector": (4, "XYZW", "VECTOR", lambda vl: vl.use_pass_vector),
 }
 FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position",
-             "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, ENVIRONMENT_PASS, AO_PASS)
+             "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, AO_PASS)
 
 
 CRYPTOMATTE = {"object": "Object", "material": "Material", "asset": "Asset"}

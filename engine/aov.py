@@ -24,10 +24,6 @@ intersection each, no shading), with Cycles' meanings:
 - object_index, material_index: the Pass Index of the object and of the material that
   the pixel's first camera sample hits (0 where it hits nothing), not averaged: Cycles
   writes its Object Index and Material Index passes from sample 0 alone;
-- environment: what camera rays that hit nothing see of the world (Cycles'
-  Environment pass: the background seen directly, as the camera sees it), averaged the
-  same way; 0 where a sample hits a surface (through a transparent one too, which
-  Cycles looks through);
 - ambient_occlusion, when asked for: Cycles' AO pass from the same hits
   (engine.ambient_occlusion);
 - shader_aovs, when asked for: the view layer's AOV passes, what the materials' AOV
@@ -80,7 +76,6 @@ class FirstHitPasses:
     uv: np.ndarray = None        # (h, w, 3) float64: u, v, coverage
     object_index: np.ndarray = None    # (h, w) float64
     material_index: np.ndarray = None  # (h, w) float64
-    environment: np.ndarray = None     # (h, w, 3) float64
     ambient_occlusion: np.ndarray = None  # (h, w, 3) float64, when asked for
     shader_aovs: dict = None     # {AOV name: (h, w, 4) RGBA or (h, w, 1)}, when asked for
 
@@ -100,15 +95,6 @@ def _intersect(ctx, o, d, tmax, time):
 
 def _build(ctx, hits, index, o, d, time):
     return ctx.surfaces.build(hits, index, d, time=time, origins=o)
-
-
-def _world_seen(ctx, directions) -> np.ndarray:
-    """What camera rays along `directions` see of the world (the integrator's packed
-    world light, engine.kernels.lights)."""
-    from .kernels.lights.batch import world_escaped_batch
-    from .visibility import CAMERA
-    integ = ctx.integrator
-    return world_escaped_batch(integ.lights, integ.world, directions, CAMERA)[0]
 
 
 def _corner_lerp(corners: np.ndarray, prim: np.ndarray, bary: np.ndarray) -> np.ndarray:
@@ -249,16 +235,11 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
     material_pass = np.array([float(getattr(m, "pass_index", 0)) for m in scene.materials]
                              or [0.0])
     ortho = scene.camera.kind == "ORTHO"
-    environment = np.zeros((n_pix, 3))
     occluded = np.zeros((n_pix, 3)) if ao is not None else None
     aov_sums = {p.name: np.zeros((n_pix, p.width)) for p in aov_passes}
     m = ao.rays_per_sample(ctx.settings.samples, k) if ao is not None else 0
     for pixel, index, hit, si, directions, time in sample_hits(ctx, k, max(1, chunk // m)
                                                                if m else chunk):
-        missed = np.ones(len(pixel), bool)
-        missed[hit] = False
-        if missed.any():
-            _add(environment, pixel[missed], _world_seen(ctx, directions[missed]))
         if si is None:
             continue
         if ao is not None:
@@ -289,7 +270,6 @@ def first_hit_passes(ctx, samples: int = AOV_SAMPLES, chunk: int = 1 << 16,
                           (mist_sum / k).reshape(height, width), (uv / k).reshape(shape),
                           object_index.reshape(height, width),
                           material_index.reshape(height, width),
-                          (environment / k).reshape(shape),
                           None if ao is None else (occluded / k).reshape(shape),
                           {name: (v / k).reshape(height, width, -1)
                            for name, v in aov_sums.items()} if aov_passes else None)

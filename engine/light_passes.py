@@ -87,9 +87,30 @@ def images(film, groups: tuple) -> dict:
 
 def divide_by_colour(light: np.ndarray, colour: np.ndarray) -> np.ndarray:
     """Cycles' Direct and Indirect passes: the light divided by the Color pass, per
-    channel, 0 where the colour is 0."""
+    channel, as Cycles' film divides them (its safe_divide_even_color): where a channel's
+    colour is 0, that channel takes the other channels' ratio (their mean when both have
+    one), so a saturated colour's pass stays grey; 0 where every channel's is."""
+    light = np.asarray(light, np.float64)
+    colour = np.asarray(colour, np.float64)
+    zero = colour == 0.0
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(colour != 0.0, light / np.where(colour != 0.0, colour, 1.0), 0.0)
+        ratio = np.where(zero, 0.0, light / np.where(zero, 1.0, colour))
+    x, y, z = ratio[..., 0].copy(), ratio[..., 1].copy(), ratio[..., 2].copy()
+    zx, zy, zz = zero[..., 0], zero[..., 1], zero[..., 2]
+    # the order of Cycles' cases: a zero x first, then a zero y, then a zero z
+    xy = zx & zy
+    xz = zx & ~zy & zz
+    x_only = zx & ~zy & ~zz
+    yz = ~zx & zy & zz
+    y_only = ~zx & zy & ~zz
+    z_only = ~zx & ~zy & zz
+    x, y = np.where(xy, z, x), np.where(xy, z, y)
+    x, z = np.where(xz, y, x), np.where(xz, y, z)
+    x = np.where(x_only, 0.5 * (y + z), x)
+    y, z = np.where(yz, x, y), np.where(yz, x, z)
+    y = np.where(y_only, 0.5 * (x + z), y)
+    z = np.where(z_only, 0.5 * (x + y), z)
+    return np.stack([x, y, z], axis=-1)
 
 
 def per_sample(tally, n: int, k: int) -> np.ndarray:

@@ -90,6 +90,46 @@ def test_plane_under_a_uniform_world_has_the_world_as_diffuse_direct(albedo, sky
     np.testing.assert_allclose(img["group:sky"], film.mean(), rtol=1e-12)
 
 
+def test_transparent_film_keeps_the_background_in_environment_and_its_group():
+    """As Cycles: on a transparent film Combined has no background (alpha 0 there), but
+    the Environment pass and the world's light group still hold it."""
+    sky = (0.2, 0.3, 0.5)
+    plane = quad((0, 0, 0), (0.5, 0, 0), (0, 0.5, 0), "plane")     # the middle of the view
+    cam = Camera(look_at((0.0, 0.0, 3.0), (0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0)), lens=50.0)
+    scene = Scene(cam, 16, 16, [plane], [Material("grey", (0.5,) * 3)], [], World(sky),
+                  film_transparent=True, light_groups=("sky",))
+    scene.world.lightgroup = "sky"
+    film, img = _images(scene, samples=16)
+    alpha = film.mean_alpha()
+    background = alpha == 0.0
+    assert background.sum() > 100 and (alpha == 1.0).sum() > 4
+    assert not film.mean()[background].any()
+    np.testing.assert_allclose(img["environment"][background], np.tile(sky, (background.sum(), 1)),
+                               rtol=1e-12)
+    np.testing.assert_allclose(img["group:sky"][background],
+                               np.tile(sky, (background.sum(), 1)), rtol=1e-12)
+    # on the plane the world lights it: its group holds that light, Combined the same
+    covered = alpha == 1.0
+    np.testing.assert_allclose(img["group:sky"][covered], film.mean()[covered], rtol=1e-9)
+    assert not img["environment"][covered].any()
+
+
+@pytest.mark.parametrize("colour, expected", [
+    ((1.0, 0.5, 1.0), (1.0, 4.0, 3.0)),      # no zero: light / colour per channel
+    ((1.0, 0.0, 1.0), (1.0, 2.0, 3.0)),      # one zero: the mean of the others' ratios
+    ((0.0, 0.0, 1.0), (3.0, 3.0, 3.0)),      # two zeros: the third's ratio
+    ((2.0, 1.0, 0.0), (0.5, 2.0, 1.25)),
+    ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),      # no colour: no pass
+])
+def test_direct_and_indirect_divide_by_colour_as_cycles_film_does(colour, expected):
+    """Cycles' safe_divide_even_color (its film's read of Diffuse Direct and the like):
+    a channel whose colour is 0 takes the other channels' ratio, so a pass under a
+    saturated colour (a missing texture's magenta, a pure red) stays grey."""
+    light = np.array([[1.0, 2.0, 3.0]])
+    out = light_passes.divide_by_colour(light, np.array([colour]))
+    np.testing.assert_allclose(out[0], expected, rtol=1e-12)
+
+
 def test_film_keeps_extra_channels_through_shipping_and_merging():
     from engine.film import Film
     film = Film(2, 1, extra=3)

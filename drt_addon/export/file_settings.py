@@ -149,8 +149,8 @@ SETTINGS: list[FileSetting] = [
        "written: the Pass Index of the object the pixel's first sample hits (Cycles' "
        "IndexOB)"),
     _s("view_layer.use_pass_environment", "Passes > Environment", READ,
-       "written: the world as camera rays that hit nothing see it (Cycles' Environment; "
-       "a sample through a transparent surface adds nothing)"),
+       "written: the world as camera rays see it, through transparent surfaces and on a "
+       "transparent film too, every sample (Cycles' Environment)"),
     *[_s(f"view_layer.use_pass_{kind}_{part}", f"Passes > {kind.title()} {part.title()}",
          READ, f"written: the light of paths that first scattered off a {kind} lobe "
          f"({_PART_HOW[part]}), divided by {kind.title()} Color as Cycles writes it")

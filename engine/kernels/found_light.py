@@ -71,3 +71,21 @@ def escaped(tally, lights, world, paths, p, b, dx, dy, dz, mode, br, bg, bb, cla
             w = hit_weight(mode, prev_pdf, spdf)
             tl.to_group(tally, p, tl.entry_group(tally, lt.sun_entry(lights, s)),
                         br * sr * w * kr, bg * sg * w * kg, bb * sb * w * kb)
+
+
+@kernel(allocates=False)
+def background(tally, lights, world, paths, p, dx, dy, dz, br, bg, bb):
+    """A camera ray on a transparent film escaped (throughput b): no colour in Combined,
+    but what it sees of the world and sun discs is the Environment pass and the light of
+    their groups, as Cycles writes them (only when those are asked for)."""
+    if not (tl.on(tally) or tl.grouped(tally)):
+        return
+    recv = previous_receiver(paths.prev_pos, p)
+    time = paths.time[p]
+    wr, wg, wb, _ = lt.world_escaped(lights, world, paths.ray_bits[p], dx, dy, dz, recv,
+                                     time)
+    tl.hidden(tally, p, br * wr, bg * wg, bb * wb, tally.world_group[0])
+    for s in range(lt.n_suns(lights)):
+        sr, sg, sb, _ = lt.sun_escaped(lights, s, dx, dy, dz, recv, time)
+        tl.hidden(tally, p, br * sr, bg * sg, bb * sb,
+                  tl.entry_group(tally, lt.sun_entry(lights, s)))

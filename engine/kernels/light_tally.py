@@ -9,7 +9,8 @@ Every contribution a path adds is one of two kinds:
 
 Light passes (slots of `LightTally.passes`, Cycles' pass names):
   - found by a camera ray (bounce 0; through transparent surfaces too): Emission, or
-    Environment for the world (sun discs of the world's sky included);
+    Environment for the world and sun discs (on a transparent film too, where Combined
+    has none of it: `hidden`);
   - anything else is split over the kind of the path's first scattering: Diffuse,
     Glossy, Transmission or Volume, each Direct (next-event estimation at the first
     vertex, and light found by the ray leaving it) or Indirect (the rest). The split is
@@ -24,7 +25,9 @@ Light passes (slots of `LightTally.passes`, Cycles' pass names):
     `colours`). Blender's Diffuse Direct is the slot divided by Diffuse Color (the
     add-on divides, as Cycles' film does).
 Light groups (`LightTally.groups`): each contribution also goes to the group of the
-light it came from (a lamp's, an emissive object's, the world's; -1: none). Emission of
+light it came from (a lamp's, an emissive object's, the world's; -1: none); so does
+the background a transparent film leaves out of Combined (Cycles': the groups then
+exceed Combined there). Emission of
 a medium belongs to no group (docs/passes.md names this gap).
 
 With passes and groups off (`LightTally.passes` and `.groups` with no rows) every
@@ -55,7 +58,8 @@ SLOT_NAMES = ("diffuse_direct", "diffuse_indirect", "glossy_direct", "glossy_ind
               "transmission_direct", "transmission_indirect", "volume_direct",
               "volume_indirect", "emission", "environment", "diffuse_color",
               "glossy_color", "transmission_color")
-# the slots whose sum is Combined (the colours are weights, not light)
+# the slots whose sum is Combined (the colours are weights, not light; on a transparent
+# film Environment also holds the background Combined leaves out)
 LIGHT_SLOTS = tuple(range(10))
 
 
@@ -181,6 +185,17 @@ def found(t, p, b, r, g, bl, limit, world, group):
             _split(t.passes, p, t.shares, p, b > 1, ar, ag, ab)
     to_group(t, p, group, ar, ag, ab)
     return _factor(ar, r), _factor(ag, g), _factor(ab, bl)
+
+
+@kernel(allocates=False)
+def hidden(t, p, r, g, bl, group):
+    """The background a camera ray sees on a transparent film: not in Combined, but in
+    the Environment pass and its light group, as Cycles keeps it."""
+    if t.passes.shape[0] > 0:
+        t.passes[p, ENVIRONMENT, 0] += r
+        t.passes[p, ENVIRONMENT, 1] += g
+        t.passes[p, ENVIRONMENT, 2] += bl
+    to_group(t, p, group, r, g, bl)
 
 
 @kernel(allocates=False)

@@ -46,7 +46,7 @@ from .bsdf.state import S_WALTER
 from . import ray_queues
 from .frame import dot, to_local, to_world
 from .jit import kernel
-from .found_light import escaped, lamps_in_front
+from .found_light import background, escaped, lamps_in_front
 from . import light_tally as tl
 from .pass_shares import NO_SHARES, bounce_shares, light_shares, lobe_colours
 from .medium_vertex import equiangular_light, scatter
@@ -254,6 +254,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         if not hit:
             if b == 0 and film_transparent:
                 alpha[p] = uncovered(br, bg, bb)
+                background(tally, lights, world, paths, p, dx, dy, dz, br, bg, bb)
                 continue
             escaped(tally, lights, world, paths, p, b, dx, dy, dz, mode, br, bg, bb,
                     clamp_hit)
