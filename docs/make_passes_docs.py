@@ -177,9 +177,12 @@ def write(rows, lifted, seconds, drt, cycles):
         "",
         *lift_table,
         "",
-        "- **Glossy Color of metals**: DRT takes the metal lobe's Fresnel at the view "
-        "angle, Cycles a table of the rough lobe's albedo (F82-tint): the passes differ by "
-        "a few percent on rough metals; Glossy Direct x Glossy Color, the light, does not.",
+        "- **Glossy Color of metals**: both take the lobe's albedo, Schlick's Fresnel "
+        "averaged over it times its single-scattering albedo and multiscatter factor; DRT "
+        "averages the Fresnel by a 16-point quadrature of the visible normals, Cycles reads "
+        "a table. On a near-black metal the Color passes differ by up to 9 % "
+        "([public_passes.md](public_passes.md)); Glossy Direct moves the other way, and "
+        "their product, the light, agrees.",
         "- **A medium's own emission** belongs to no light group in DRT (Cycles: its "
         "object's).",
         "- The Distribution and Whitted integrators write no light passes (Combined only); "

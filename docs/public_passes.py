@@ -91,9 +91,9 @@ def write(source, results) -> None:
              "`objects` (every object) and `sky` (the world). Differences are relative to "
              "Cycles' Combined mean. DRT's identities: the passes recompose Combined and the "
              "groups sum to it (largest difference per pixel). Known difference: Glossy Color "
-             "of metals (DRT: the Fresnel at the view, Cycles: a table of the lobe's albedo), "
-             "which moves Glossy Direct the other way; their product, the light, agrees "
-             "([passes.md](passes.md)).", ""]
+             "of metals (the lobe's albedo: DRT averages Schlick's Fresnel over the visible "
+             "normals by quadrature, Cycles reads a table), which moves Glossy Direct the "
+             "other way; their product, the light, agrees ([passes.md](passes.md)).", ""]
     for name, m in results.items():
         t_drt, t_cycles = m["seconds"]
         lines += [f"## {name}", "",

@@ -63,7 +63,8 @@ def test_asking_changes_nothing_in_combined_and_not_asking_costs_nothing():
     scene = _cornell(groups=())
     film_on, _ = _images(scene, passes=True)
     film_off, img_off = _images(scene, passes=False)
-    assert np.array_equal(film_on.mean(), film_off.mean())
+    # (the same arithmetic on Combined either way; a tolerance, not bits, for other CPUs)
+    np.testing.assert_allclose(film_on.mean(), film_off.mean(), rtol=1e-12, atol=1e-15)
     assert film_on.extra_sum.shape[1] == len(SLOT_NAMES)
     # not asked: the film keeps no channel and the paths' tally no row
     assert film_off.extra_sum.shape[1] == 0 and img_off == {}

@@ -10,12 +10,15 @@ principled.eval_seen restricted to that kind. Where a Normal Map bends the norma
 diffuse part is path_vertex's bent_diffuse, as the light itself is."""
 from __future__ import annotations
 
+import math
+
 from .bsdf import fresnel, layers
 from .bsdf import principled as bsdf
 from .bsdf.principled import GLOSSY
-from .bsdf.reflection_lobes import metal_fresnel
-from .bsdf.state import (S_DIFFUSE, S_E_SPEC, S_ETA_GLASS, S_LAYERED, S_MS_METAL,
-                         S_REFRACT_ONLY, S_SSS, S_TINT, S_W_GLASS, S_W_METAL, S_W_SPEC)
+from .bsdf import microfacet as mf
+from .bsdf.state import (S_ALPHA, S_DIFFUSE, S_E_SPEC, S_ETA_GLASS, S_LAYERED, S_METAL_CONST,
+                         S_METAL_F0, S_MS_E, S_MS_METAL, S_REFRACT_ONLY, S_SSS, S_TINT,
+                         S_W_GLASS, S_W_METAL, S_W_SPEC)
 from .jit import kernel
 from .light_tally import DIFFUSE_CLASS, GLOSSY_CLASS, TRANSMISSION_CLASS, one_class, \
     surface_shares
@@ -81,17 +84,37 @@ def lobe_colours(state, woz):
     tuples: diffuse, glossy, transmission), the Color passes' values. Cycles writes each
     closure's weight times its albedo estimate at the view: the diffuse colour under the
     specular layer (and sheen, translucency and subsurface), the specular layer's albedo,
-    the metal's Fresnel at the view, a glass's Fresnel reflectance and its tinted
-    transmittance 1 - F; a coat's albedo on top, every base lobe dimmed by the layers."""
-    d0, g0, t0 = _channel_colours(state, woz, 0)
-    d1, g1, t1 = _channel_colours(state, woz, 1)
-    d2, g2, t2 = _channel_colours(state, woz, 2)
+    the metal's albedo (Schlick's Fresnel over its lobe, E and the multiscatter factor),
+    a glass's Fresnel reflectance and its tinted transmittance 1 - F; a coat's albedo on
+    top, every base lobe dimmed by the layers."""
+    s = schlick_share(woz, state[S_ALPHA]) if state[S_W_METAL] > 0.0 else 0.0
+    d0, g0, t0 = _channel_colours(state, woz, s, 0)
+    d1, g1, t1 = _channel_colours(state, woz, s, 1)
+    d2, g2, t2 = _channel_colours(state, woz, s, 2)
     return (d0, d1, d2), (g0, g1, g2), (t0, t1, t2)
 
 
 @kernel(allocates=False)
-def _channel_colours(state, woz, c):
-    """lobe_colours in channel c: (diffuse, glossy, transmission)."""
+def schlick_share(woz, alpha):
+    """s = the mean of (1 - wo.h)^5 over GGX's visible normals at the view (Heitz 2018),
+    so that mix(F0, 1, s) is Schlick's Fresnel averaged over the lobe, as Cycles'
+    albedo estimate of a metal takes it; a 4 x 4 stratified quadrature (only when the
+    Color passes are asked for)."""
+    cos_o = min(max(woz, 0.0), 1.0)
+    sin_o = math.sqrt(max(1.0 - cos_o * cos_o, 0.0))
+    total = 0.0
+    for i in range(4):
+        for j in range(4):
+            hx, hy, hz = mf.sample_visible_normal(sin_o, 0.0, cos_o, alpha, (i + 0.5) / 4.0,
+                                                  (j + 0.5) / 4.0)
+            k = 1.0 - min(max(sin_o * hx + cos_o * hz, 0.0), 1.0)
+            total += k * k * k * k * k
+    return total / 16.0
+
+
+@kernel(allocates=False)
+def _channel_colours(state, woz, s, c):
+    """lobe_colours in channel c: (diffuse, glossy, transmission); s: schlick_share."""
     cos_o = min(max(woz, 0.0), 1.0)
     layered = state[S_LAYERED] != 0.0
     m = state[S_W_METAL]
@@ -104,7 +127,13 @@ def _channel_colours(state, woz, c):
     if layered:
         d += state[layers.S_SHEEN_W + c] + state[layers.S_TRANS + c]
         coat = state[layers.S_EST_COAT]
-    metal = m * metal_fresnel(state, c, cos_o) * state[S_MS_METAL + c] if m > 0.0 else 0.0
+    metal = 0.0
+    if m > 0.0:
+        # the lobe's albedo: Fresnel over the lobe (a Glossy BSDF's is its colour) times
+        # the single-scattering albedo E and the multiscatter factor (Cycles' estimate)
+        f0 = state[S_METAL_F0 + c]
+        f = f0 if state[S_METAL_CONST] != 0.0 else f0 + (1.0 - f0) * s
+        metal = m * f * state[S_MS_E] * state[S_MS_METAL + c]
     g = scale * (state[S_W_SPEC] * state[S_E_SPEC] + metal + refl) + coat
     t = scale * w_glass * (1.0 - F) * state[S_TINT + c]
     return d, g, t
