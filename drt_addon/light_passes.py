@@ -21,6 +21,7 @@ from __future__ import annotations
 from importlib import import_module
 
 import bpy
+import numpy as np
 
 FIVE = bpy.app.version >= (5, 0, 0)
 
@@ -66,7 +67,10 @@ def environment(film):
     """Cycles' Environment pass, (h, w, 3) row 0 at the top: the world and sun discs
     camera rays see, through transparent surfaces, on a transparent film too."""
     from .engine_link import engine
-    return import_module(engine.__name__ + ".light_passes").images(film, ())["environment"]
+    slots = import_module(engine.__name__ + ".light_passes").images(film, ())
+    if "environment" not in slots:          # a render that kept no light passes
+        return np.zeros((film.height, film.width, 3))
+    return slots["environment"]
 
 
 def group_passes(view_layer) -> list:
@@ -83,6 +87,9 @@ def images(film, scene_groups: tuple, names) -> dict:
     slots = split.images(film, tuple(scene_groups))
     out = {}
     for name in names:
+        if not slots:                       # a render that kept no light passes
+            out[name] = np.zeros((film.height, film.width, 3))
+            continue
         if name.startswith("Combined_"):
             out[name] = slots["group:" + name[len("Combined_"):]]
             continue

@@ -249,7 +249,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             settings = preview_settings(settings)
             description.light_groups = ()
         else:
-            # the path tracer splits its light only when a light pass is asked for
+            # the path tracer splits its light only when a light pass or Environment is
+            # asked for
             settings.light_passes = light_passes.splits(view_layer)
         try:
             settings.validate()

@@ -116,6 +116,8 @@ def divide_by_colour(light: np.ndarray, colour: np.ndarray) -> np.ndarray:
 def per_sample(tally, n: int, k: int) -> np.ndarray:
     """The film's extra channels (n, k, 3) of a batch's LightTally: its slots (zeros
     without light passes), then its groups."""
+    if tally.passes.shape[0] and not tally.groups.shape[0] and k == N_SLOTS:
+        return tally.passes                  # the slots alone: no copy
     out = np.zeros((n, k, 3))
     if tally.passes.shape[0]:
         out[:, :N_SLOTS] = tally.passes
