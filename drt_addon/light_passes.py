@@ -34,21 +34,24 @@ def _cycles(prop):
     return lambda vl: bool(getattr(getattr(vl, "cycles", None), prop, False))
 
 
-# Blender's name: (engine.light_passes slot, its Color slot or None, enabled)
-LIGHT_PASSES = {}
-for _kind, _short, _long in (("diffuse", "Diff", "Diffuse"), ("glossy", "Gloss", "Glossy"),
-                             ("transmission", "Trans", "Transmission")):
-    for _part, _abbr in (("direct", "Dir"), ("indirect", "Ind")):
-        _name = f"{_long} {_part.title()}" if FIVE else f"{_short}{_abbr}"
-        LIGHT_PASSES[_name] = (f"{_kind}_{_part}", f"{_kind}_color",
-                               _vl(f"use_pass_{_kind}_{_part}"))
-    LIGHT_PASSES[f"{_long} Color" if FIVE else f"{_short}Col"] = (
-        f"{_kind}_color", None, _vl(f"use_pass_{_kind}_color"))
-LIGHT_PASSES["Volume Direct" if FIVE else "VolumeDir"] = (
-    "volume_direct", None, _cycles("use_pass_volume_direct"))
-LIGHT_PASSES["Volume Indirect" if FIVE else "VolumeInd"] = (
-    "volume_indirect", None, _cycles("use_pass_volume_indirect"))
-LIGHT_PASSES["Emission" if FIVE else "Emit"] = ("emission", None, _vl("use_pass_emit"))
+def _table() -> dict:
+    """Blender's name: (engine.light_passes slot, its Color slot or None, enabled)."""
+    table = {}
+    for kind, short, long in (("diffuse", "Diff", "Diffuse"), ("glossy", "Gloss", "Glossy"),
+                              ("transmission", "Trans", "Transmission")):
+        for part, abbr in (("direct", "Dir"), ("indirect", "Ind")):
+            name = f"{long} {part.title()}" if FIVE else f"{short}{abbr}"
+            table[name] = (f"{kind}_{part}", f"{kind}_color", _vl(f"use_pass_{kind}_{part}"))
+        table[f"{long} Color" if FIVE else f"{short}Col"] = (
+            f"{kind}_color", None, _vl(f"use_pass_{kind}_color"))
+    for part, abbr in (("direct", "Dir"), ("indirect", "Ind")):
+        table[f"Volume {part.title()}" if FIVE else f"Volume{abbr}"] = (
+            f"volume_{part}", None, _cycles(f"use_pass_volume_{part}"))
+    table["Emission" if FIVE else "Emit"] = ("emission", None, _vl("use_pass_emit"))
+    return table
+
+
+LIGHT_PASSES = _table()
 
 
 def enabled(view_layer) -> list:
