@@ -268,3 +268,20 @@ def test_the_tree_pays_on_a_street_of_64_lamps():
     diff = tree_mean.mean(0) - power_mean.mean(0)
     print("means", tree_mean.mean(0), power_mean.mean(0), "se", se)
     assert np.all(np.abs(diff) < 4 * se)
+
+
+@pytest.mark.parametrize("direction", [(1.0, 0.0, -1.0), (0.7071067811865476, 0.0,
+                                                           -0.7071067811865476)])
+def test_a_delta_sun_is_inside_its_own_cone_whatever_its_rounding(direction):
+    """A sun of no angle has a cone of no width: its direction towards the light, t, and
+    its emission axis, -t, meet at cos = |t|^2, which is 1 - 2e-16 for a unit vector an
+    ulp short ((1, 0, -1) normalised). The tree still gives it its share under a world
+    and beside a lamp (it once gave it none: the sun was missing from such renders)."""
+    from engine.scene import SunLight, World
+    from engine.world_light import world_model
+    sun = SunLight(direction, (3.0, 3.0, 3.0))
+    ls = LightSet([sun, PointLight((0.0, 0.0, 3.0), (50.0, 50.0, 50.0))], 15.0,
+                  world=world_model(World((0.1, 0.2, 0.3))))
+    L = pack_lights(ls, tree=True)
+    up = (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, ONE_SIDED, 0.0)
+    assert select_pdf(L, 0, up, 0.0) > 0.1

@@ -96,6 +96,9 @@ def _bounded(x):
     return min(x, HUGE)
 
 
+ON_AXIS = 1.0 - 1e-14      # cosines above this are the axis (angles under 1.5e-7 rad)
+
+
 @kernel(allocates=False)
 def importance(recv, tx, ty, tz, cos_u, ax, ay, az, cos_o, sin_o, cos_oe, cos_eo, d_max,
                d_min, energy, theta_d):
@@ -119,6 +122,11 @@ def importance(recv, tx, ty, tz, cos_u, ax, ay, az, cos_o, sin_o, cos_oe, cos_eo
             return 0.0, 0.0           # wholly below an opaque surface
         cos_in_max = max(ci * cos_u - si * sin_u, 0.0)
     cos_t = min(1.0, max(-1.0, -(ax * tx + ay * ty + az * tz)))
+    if cos_t > ON_AXIS:
+        # on the axis but for rounding: a delta sun (theta_o = theta_e = 0) whose unit
+        # direction is an ulp short has cos_t = |t|^2 < 1 = cos_o, and would be outside
+        # its own cone; bounds that err on the inclusive side bias nothing
+        cos_t = 1.0
     sin_t = _sin(cos_t)
     cos_t_minus_u = cos_t * cos_u + sin_t * sin_u
     if cos_t >= cos_u or cos_t_minus_u >= cos_o:
