@@ -27,6 +27,7 @@ import threading
 import time
 from dataclasses import dataclass, replace
 
+from . import shadow_catcher
 from .batch_report import FrameResult
 from .frame_output import frame_rgba, save_pixels
 from .overrides import Overrides, apply_overrides
@@ -182,8 +183,16 @@ def render_part(blend: str, stamp, frame: int, overrides: Overrides, sample_star
     t0 = time.perf_counter()
     exported = _export_frame(blend, stamp, frame, overrides)
     settings = replace(exported.settings, threads=1)
-    film, stats = engine.render(exported.description, settings, sample_start=sample_start,
-                                sample_end=sample_end)
+    ctx = engine.RenderContext(exported.description, settings)
+    try:
+        film, stats = engine.render(exported.description, settings, context=ctx,
+                                    sample_start=sample_start, sample_end=sample_end)
+    finally:
+        ctx.close()
+    # what the frame's Combined needs of a scene with shadow catchers
+    catcher = (ctx.catcher is not None,
+               shadow_catcher.pass_on(_import_bpy().context.view_layer),
+               bool(exported.description.film_transparent))
     try:
         from distributed import get_worker
         where = get_worker().address
@@ -193,7 +202,7 @@ def render_part(blend: str, stamp, frame: int, overrides: Overrides, sample_star
             "width": film.width, "height": film.height, "film": film.statistics(),
             "region": exported.region, "crop": exported.crop, "paths": stats.paths,
             "seconds": time.perf_counter() - t0, "worker": where,
-            "warnings": exported.warnings}
+            "warnings": exported.warnings, "catcher": catcher}
 
 
 # ----------------------------------------------------------------- on the client
@@ -263,8 +272,8 @@ def render_frames(client, bpy, scene, blend: str, jobs, overrides: Overrides,
 def _write_frame(bpy, scene, frame_parts, path, progress) -> FrameResult:
     film = merge_parts(frame_parts)
     p0 = frame_parts[0]
-    save_pixels(bpy, scene, frame_rgba(film.mean(), film.mean_alpha(), p0["region"],
-                                       p0["crop"]), path)
+    rgb, alpha = shadow_catcher.of_film(film, *p0.get("catcher", (False, False, False)))
+    save_pixels(bpy, scene, frame_rgba(rgb, alpha, p0["region"], p0["crop"]), path)
     result = FrameResult(p0["frame"], path, seconds=sum(p["seconds"] for p in frame_parts),
                          samples=int(max(p["end"] for p in frame_parts)),
                          paths=sum(p["paths"] for p in frame_parts),

@@ -19,7 +19,7 @@ import bpy
 import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
-from . import denoise, light_passes
+from . import denoise, light_passes, shadow_catcher
 from .blender_compat import (AO_PASS, ENVIRONMENT_PASS, MATERIAL_INDEX_PASS,
                              OBJECT_INDEX_PASS, set_pass_pixels)
 from .render_passes import (CRYPTOMATTE, FIRST_HIT, PASSES, FirstHit, cryptomatte_passes,
@@ -277,7 +277,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 if last_render.get("first_sample_seconds") is None:
                     # depsgraph to first sample: export, BVH build, first pass
                     last_render["first_sample_seconds"] = time.perf_counter() - t0
-                set_pass_pixels(combined, _rgba_bottom_up(film.mean(), film.mean_alpha()))
+                set_pass_pixels(combined, _rgba_bottom_up(*shadow_catcher.combined(
+                    ctx, film, view_layer)))
                 self.update_result(result)
                 self.update_progress(fraction)
                 last_render["progress"].append((stats.samples_done, fraction))
@@ -312,7 +313,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             film, stats = engine.render(description, settings, context=ctx, progress=progress,
                                         cancelled=lambda: self._polled("tracing"),
                                         compiling=compiling)
-            image, alpha = film.mean(), film.mean_alpha()
+            image, alpha = shadow_catcher.combined(ctx, film, view_layer)
             first_hit = FirstHit(ctx, render_world(scene, view_layer), description,
                                  ambient_occlusion=AO_PASS in enabled_passes(view_layer),
                                  aovs=shader_aov_passes(view_layer))
@@ -412,6 +413,8 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 v = first.shader_aovs[name]          # (h, w, 4) RGBA or (h, w, 1)
                 images[name] = v[..., 0] if channels == 1 else v
                 wanted.append(name)
+        if shadow_catcher.PASS in wanted:
+            images[shadow_catcher.PASS] = shadow_catcher.shadow_pass(ctx, film)
         if "DRT Noise" in wanted:
             images["DRT Noise"] = np.sqrt(film.variance_of_mean())
         if "Vector" in wanted:

@@ -35,6 +35,9 @@ layer (Properties > View Layer > Passes):
   coverage) pairs of the names each pixel shows, with the manifest in the render
   result's metadata, so that Blender's Cryptomatte node picks mattes by name
   (engine.cryptomatte).
+- Shadow Catcher (Cycles' `use_pass_shadow_catcher`): what the other objects do to the
+  shadow catcher objects, 1 where nothing does; Combined is then the matte alone, as
+  Cycles writes them (drt_addon.shadow_catcher, engine.shadow_catcher).
 - Noisy Image (when Render > Denoise and the view layer's Denoising are on, Cycles'
   settings): the render before denoising; Combined is then denoised (drt_addon.denoise).
 Depth, Normal, Mist, Position, UV, the index passes, AO, Cryptomatte and the denoising
@@ -46,7 +49,9 @@ from importlib import import_module
 
 import numpy as np
 
+from . import shadow_catcher
 from .blender_compat import AO_PASS, ENVIRONMENT_PASS, MATERIAL_INDEX_PASS, OBJECT_INDEX_PASS
+from .shadow_catcher import PASS as SHADOW_CATCHER_PASS
 
 
 # (name, channels, channel ids, type) of each pass DRT can write, and when it is enabled.
@@ -64,6 +69,7 @@ PASSES = {
     ENVIRONMENT_PASS: (3, "RGB", "COLOR", lambda vl: vl.use_pass_environment),
     AO_PASS: (3, "RGB", "COLOR", lambda vl: vl.use_pass_ambient_occlusion),
     "Vector": (4, "XYZW", "VECTOR", lambda vl: vl.use_pass_vector),
+    SHADOW_CATCHER_PASS: (3, "RGB", "COLOR", shadow_catcher.pass_on),
 }
 FIRST_HIT = ("Depth", "Normal", "Denoising Normal", "Denoising Albedo", "Mist", "Position",
              "UV", OBJECT_INDEX_PASS, MATERIAL_INDEX_PASS, AO_PASS)

@@ -37,6 +37,7 @@ from importlib import import_module
 
 import numpy as np
 
+from . import shadow_catcher
 from .engine_link import engine
 from .export.memo import ExportMemo
 from .viewport_camera import ViewportView, view_of
@@ -286,7 +287,7 @@ class ViewportSession:
             self._publish(run, film, 0, step, None)
             step //= 2
         ctx = run.ctx.view(camera, w, h)
-        film, done, size = film_mod.Film(w, h), 0, 1
+        film, done, size = film_mod.Film(w, h, extra=ctx.film_channels()), 0, 1
         guides = None
         while done < run.settings.samples and not self._stale(run):
             size = min(size, run.settings.samples - done)
@@ -314,7 +315,8 @@ class ViewportSession:
         return (first.albedo, normal)
 
     def _publish(self, run, film, samples, step, guides) -> None:
-        image = film.mean()
+        # shadow catchers as Cycles' viewport shows them: the shadow laid in
+        image, alpha = shadow_catcher.combined(run.ctx, film, None)
         if guides is not None:
             denoiser = import_module(engine.__name__ + ".denoiser")
             try:
@@ -324,7 +326,7 @@ class ViewportSession:
         h, w = image.shape[:2]
         rgba = np.empty((h, w, 4), np.float32)
         rgba[..., :3] = image[::-1]            # bottom-up, as textures are
-        rgba[..., 3] = film.mean_alpha()[::-1]
+        rgba[..., 3] = alpha[::-1]
         with self.lock:
             if self._stale(run):
                 return

@@ -4,7 +4,8 @@ Never imports bpy. The input is an `engine.scene.Scene`, the output an `engine.f
 """
 from .curves import HairCurves
 from .film import Film
-from .render import RenderContext, RenderStats, render
+from .render import RenderContext, render
+from .render_stats import RenderStats
 from .scene import (AreaLight, Camera, Instances, Material, ObjectInfo, PointLight, Scene,
                     SunLight, TriangleMesh, Volume, World)
 from .settings import RenderSettings

@@ -75,8 +75,8 @@ def images(film, groups: tuple) -> dict:
     """The film's light passes as (height, width, 3) means, row 0 at the top: the slots
     by SLOT_NAMES and each group as 'group:<name>'. The Direct and Indirect slots hold
     light, not yet divided by their Color (the add-on divides, as Cycles' film does)."""
-    if film.extra_sum.shape[1] == 0:
-        return {}
+    if film.extra_sum.shape[1] < N_SLOTS + len(groups):
+        return {}                # kept none (a film may keep the shadow catcher's alone)
     c = np.maximum(film.count, 1)[:, None, None]
     mean = (film.extra_sum / c).reshape(film.height, film.width, -1, 3)
     out = {name: mean[:, :, i] for i, name in enumerate(SLOT_NAMES)}

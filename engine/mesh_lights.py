@@ -98,11 +98,12 @@ class EmissiveTriangles:
             setattr(self, name, getattr(self, name)[first])
 
     @classmethod
-    def from_scene(cls, scene, accel, emission=None) -> "EmissiveTriangles":
+    def from_scene(cls, scene, accel, emission=None, only=None) -> "EmissiveTriangles":
         """The emissive triangles of `scene`, with the global ids of `accel`
         (engine.accel.Accelerator: static triangles first, ids 0..len(accel.triangles)-1).
         `emission`: (materials, 3) radiance table, by default the materials' `emission`;
-        the renderer passes the one its integrator adds at hits, so both agree."""
+        the renderer passes the one its integrator adds at hits, so both agree. `only`:
+        a flag per global triangle, the ones that may be lights (None: all)."""
         tri = accel.triangles
         if not len(tri) or not scene.materials:
             return cls(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
@@ -119,6 +120,8 @@ class EmissiveTriangles:
         static_meshes = ordered[:getattr(accel, "static_meshes", len(ordered))]
         mat = np.concatenate([m.material_indices for m in static_meshes])
         emissive = np.nonzero((emission.max(axis=1) > 0)[mat])[0]
+        if only is not None:
+            emissive = emissive[np.asarray(only, bool)[emissive]]
         p = accel.positions
         t = tri[emissive]
         return cls(p[t[:, 0]], p[t[:, 1]], p[t[:, 2]], emission[mat[emissive]], emissive,

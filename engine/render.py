@@ -20,7 +20,7 @@ import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 from concurrent.futures import TimeoutError as FutureTimeout
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
@@ -29,7 +29,7 @@ from .adaptive_sampling import AdaptiveSampling
 from .bsdf.material_table import MaterialTable
 from .camera import CameraModel, CameraRays
 from .film import Film
-from . import instancing, light_passes
+from . import instancing, light_passes, shadow_catcher
 from .integrators import make_integrator
 from .kernels.camera_rays import generate as generate_camera_rays
 from .kernels.camera_rays import pack_camera
@@ -42,47 +42,13 @@ from .sampling import dimensions as D
 from .sampling import make_sampler
 from .sampling.dispatch import pixel_keys
 from .scene import Scene
+from .render_stats import RenderStats
 from .settings import RenderSettings
 from .surface import SurfaceBuilder
 from .world_light import world_model
 
 
 POLL = 0.25      # seconds between looks at cancel and compile progress while units run
-
-
-@dataclass
-class RenderStats:
-    samples_done: int = 0
-    paths: int = 0
-    nonfinite_samples: int = 0
-    seconds: float = 0.0
-    cancelled: bool = False
-    units_done: int = 0
-    units_running_at_cancel: int = 0   # finished after the cancel (at most the thread count)
-    time_limited: bool = False         # stopped by settings.time_limit
-    active_pixels: int = -1            # pixels still sampled after the last pass (adaptive)
-    pixel_samples: int = 0             # samples taken over all pixels
-    compile_seconds: float = 0.0       # spent compiling kernels (a first render only)
-    kernels_compiled: int = 0          # kernels compiled, of kernels_reachable
-    kernels_reachable: int = 0
-
-    def sampling_seconds(self) -> float:
-        """Seconds spent rendering, the kernels' one-time compile left out."""
-        return max(self.seconds - self.compile_seconds, 0.0)
-
-    def paths_per_second(self) -> float:
-        seconds = self.sampling_seconds()
-        return self.paths / seconds if seconds > 0 else 0.0
-
-    def status(self, samples: int, n_pixels: int) -> str:
-        """The stats line: samples, adaptive sampling's share of converged pixels, the
-        time limit."""
-        text = f"Sample {self.samples_done}/{samples}"
-        if self.active_pixels >= 0:
-            text += f" | {100.0 * (1 - self.active_pixels / max(n_pixels, 1)):.0f}% converged"
-        if self.time_limited:
-            text += " | time limit reached"
-        return text
 
 
 class RenderContext:
@@ -110,8 +76,21 @@ class RenderContext:
         self._light(scene, EmissiveTriangles.from_scene(scene, self.accel,
                                                         self.materials.emission))
         self.integrator = make_integrator(settings.integrator, self)
+        self.catcher = self._catcher_run()
         # A camera that does not move gets its rays from one compiled kernel.
         self.camera_kernel = None if self.has_motion else pack_camera(self.camera, self.filter)
+
+    def _catcher_run(self):
+        """The shadow catcher's second run (engine.shadow_catcher), or None in a scene
+        without a catcher object."""
+        catcher = shadow_catcher.catcher_triangles(self.accel)
+        return None if catcher is None else shadow_catcher.CatcherRun(self, catcher)
+
+    def film_channels(self) -> int:
+        """The RGB channels the film keeps per pixel besides Combined: the light passes
+        and groups (engine.light_passes), then the shadow catcher's."""
+        return light_passes.channels(self) + (shadow_catcher.CHANNELS
+                                              if self.catcher is not None else 0)
 
     def _light(self, scene: Scene, mesh_lights, world=None) -> None:
         """The scene radius, the world model and the light set of `scene` (its lamps, a
@@ -146,6 +125,7 @@ class RenderContext:
                                                                        self.filter)
         other._light(scene, self.lights.mesh)
         other.integrator = make_integrator(self.settings.integrator, other)
+        other.catcher = other._catcher_run()
         return other
 
     def view(self, camera, width: int, height: int) -> "RenderContext":
@@ -165,6 +145,7 @@ class RenderContext:
         if _scene_radius(other.scene, self.accel) > self.scene_radius * (1.0 + 1e-9):
             other._light(other.scene, self.lights.mesh, self.world)
         other.integrator = make_integrator(self.settings.integrator, other)
+        other.catcher = other._catcher_run()
         return other
 
     def entry_kernels(self) -> list:
@@ -173,6 +154,9 @@ class RenderContext:
         from .embree import rays
         found = [generate_camera_rays, pixel_keys, rays.intersect_batch, rays.occluded_batch]
         found += self.integrator.entry_kernels()
+        if self.catcher is not None:
+            from .kernels.lights.batch import _world_rows
+            found.append(_world_rows)
         if self.accel.moving:
             from . import accel
             found += [v for v in vars(accel).values() if isinstance(v, Kernel)]
@@ -241,21 +225,28 @@ def camera_rays(ctx: RenderContext, pixel: np.ndarray, index: np.ndarray):
 def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sample_end: int):
     """Radiance of samples [sample_start, sample_end) of each pixel in `pixels`.
     Returns (pixel ids, sample indices, radiance (n, 3) float64, alpha (n,) or None when
-    the film is opaque, the light passes and groups (n, k, 3) of engine.light_passes or
-    None when the render asks for none)."""
+    the film is opaque, the film's other channels (n, ctx.film_channels(), 3): the light
+    passes and groups of engine.light_passes, then the shadow catcher's; None when it
+    keeps none)."""
     k = sample_end - sample_start
     pixel = np.repeat(pixels.astype(np.int64), k)
     index = np.tile(np.arange(sample_start, sample_end, dtype=np.int64), len(pixels))
     rays, time = camera_rays(ctx, pixel, index)
-    alpha = np.ones(len(pixel)) if ctx.scene.needs_alpha() else None
-    if not light_passes.channels(ctx):
-        radiance = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions,
-                                           rays.tmax, time=time, alpha_out=alpha)
+    n = len(pixel)
+    alpha = np.ones(n) if ctx.scene.needs_alpha() else None
+    lights = light_passes.channels(ctx)
+    first = np.empty(n, np.int64) if ctx.catcher is not None else None
+    found = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
+                                    time=time, alpha_out=alpha, split=bool(lights),
+                                    first_out=first)
+    radiance = found.L if lights else found
+    if not ctx.film_channels():
         return pixel, index, radiance, alpha, None
-    tally = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
-                                    time=time, alpha_out=alpha, split=True)
-    return pixel, index, tally.L, alpha, light_passes.per_sample(tally, len(pixel),
-                                                                 light_passes.channels(ctx))
+    parts = [light_passes.per_sample(found, n, lights)] if lights else []
+    if ctx.catcher is not None:
+        parts.append(ctx.catcher.samples(pixel, index, rays, time, radiance, alpha, first))
+    return pixel, index, radiance, alpha, (parts[0] if len(parts) == 1
+                                           else np.concatenate(parts, axis=1))
 
 
 def plan_passes(total: int, first: int = 1, growth: float = 2.0, largest: int = 64):
@@ -286,7 +277,8 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
     sample_end = settings.samples if sample_end is None else sample_end
     if not (0 <= sample_start < sample_end):
         raise ValueError(f"empty or negative sample range [{sample_start}, {sample_end})")
-    film = Film(scene.width, scene.height, extra=light_passes.channels(ctx))
+    film = Film(scene.width, scene.height, extra=ctx.film_channels())
+    lights = light_passes.channels(ctx)
     stats = RenderStats()
     n_pixels = scene.width * scene.height
     threads = settings.threads or min(os.cpu_count() or 1, 8)
@@ -313,14 +305,18 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
             with lock:
                 running[0] -= 1
         bad = ~np.isfinite(rad).all(axis=1)
+        if extra is not None:
+            bad |= ~np.isfinite(extra).all(axis=(1, 2))
         if bad.any():
             rad[bad] = 0.0
             if extra is not None:
                 extra[bad] = 0.0
         if settings.film_exposure != 1.0:
             rad *= settings.film_exposure      # Film > Exposure, on the way into the film
-            if extra is not None:
-                light_passes.scale_light(extra, settings.film_exposure)
+            if lights:
+                light_passes.scale_light(extra[:, :lights], settings.film_exposure)
+            if ctx.catcher is not None:
+                shadow_catcher.scale(extra[:, lights:], settings.film_exposure)
         with lock:
             if abandoned.is_set():             # finished after render() returned
                 return 0

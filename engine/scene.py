@@ -298,6 +298,9 @@ class TriangleMesh:
     instances: Optional[Instances] = None
     pass_index: int = 0            # Blender's object Pass Index (IndexOB pass)
     lightgroup: str = ""           # its emission's light group (Scene.light_groups)
+    # Object > Visibility > Shadow Catcher (engine.shadow_catcher): the shadows and light
+    # other objects cast on it become a pass of their own, the object itself a hole
+    shadow_catcher: bool = False
     # the names Cryptomatte gives its hits (engine.cryptomatte): the Blender object's and
     # its topmost parent's ("": the mesh's name, and the object name)
     object_name: str = ""
@@ -356,6 +359,7 @@ class PointLight:
     visibility: int = 31           # the ray kinds that see it (engine.visibility)
     motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
     lightgroup: str = ""           # its light group's name (Scene.light_groups; "": none)
+    shadow_catcher: bool = True    # the lamp lights shadow catchers (Blender's default)
 
 
 @dataclass
@@ -369,6 +373,7 @@ class SunLight:
     visibility: int = 31           # the ray kinds that see it (engine.visibility)
     motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
     lightgroup: str = ""           # its light group's name (Scene.light_groups; "": none)
+    shadow_catcher: bool = True    # the lamp lights shadow catchers (Blender's default)
 
 
 @dataclass
@@ -389,6 +394,7 @@ class AreaLight:
     visibility: int = 31           # the ray kinds that see it (engine.visibility)
     motion_slices: Optional[list] = None   # this light at K shutter-slice middles (moving)
     lightgroup: str = ""           # its light group's name (Scene.light_groups; "": none)
+    shadow_catcher: bool = True    # the lamp lights shadow catchers (Blender's default)
 
 
 @dataclass

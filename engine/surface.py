@@ -12,6 +12,7 @@ whole scene is far from the world origin.
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -157,6 +158,21 @@ class SurfaceBuilder:
             from .nodes.context import O_INDEX
             out[placed] = self.objects[inst[placed], O_INDEX]
         return out
+
+    def seen_by_catcher_paths(self, catcher: np.ndarray) -> "SurfaceBuilder":
+        """These surfaces as Cycles' shadow catcher paths see them (engine.shadow_catcher):
+        the triangles flagged in `catcher` as they are; the others only by camera rays,
+        which end there with nothing (as at a holdout), and by no other ray."""
+        from . import visibility
+        other = copy.copy(self)
+        catcher = np.asarray(catcher, bool)
+        seen = (self.visibility if self.visibility is not None
+                else np.full(len(catcher), visibility.ALL, np.uint8))
+        other.visibility = np.where(catcher, seen, seen & visibility.CAMERA).astype(np.uint8)
+        held = self.holdout if self.holdout is not None else np.zeros(len(catcher), bool)
+        other.holdout = held | ~catcher
+        other._geometry = None
+        return other
 
     def geometry(self, camera=None) -> tuple:
         """The primitives as the compiled kernels read them (engine.kernels.surface,

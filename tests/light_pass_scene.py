@@ -49,7 +49,9 @@ def _add(bpy, op, mat, **kw):
     return obj
 
 
-def build(bpy, size=(64, 48), samples=64, fog=True):
+def empty_scene(bpy, size, samples, world_color):
+    """Blender's empty factory scene at `size` and `samples` in both engines (Cycles: no
+    denoising, no adaptive sampling, seed 1) under a world of one colour."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     scene.render.resolution_x, scene.render.resolution_y = size
@@ -60,9 +62,14 @@ def build(bpy, size=(64, 48), samples=64, fog=True):
     scene.cycles.seed = 1
     scene.drt.samples = samples
     scene.world = bpy.data.worlds.new("sky")
-    scene.world.color = (0.05, 0.07, 0.1)
+    scene.world.color = world_color
     if bpy.app.version < (5, 0, 0):
         scene.world.use_nodes = False
+    return scene
+
+
+def build(bpy, size=(64, 48), samples=64, fog=True):
+    scene = empty_scene(bpy, size, samples, (0.05, 0.07, 0.1))
     grey = _principled(bpy, "grey", **{"Base Color": (0.6, 0.6, 0.6, 1.0)})
     _add(bpy, "primitive_plane_add", grey, size=8.0)
     wall = _add(bpy, "primitive_plane_add", grey, size=8.0, location=(0.0, 2.0, 4.0))
@@ -112,9 +119,10 @@ def build(bpy, size=(64, 48), samples=64, fog=True):
     return scene
 
 
-def cycles_passes(bpy, scene, names):
+def cycles_passes(bpy, scene, names, channels=3):
     """Render `scene` and read its passes `names` (Blender 5's File Output node, one
-    OpenEXR per pass), as (h, w, 3) float arrays, row 0 at the top."""
+    OpenEXR per pass), as (h, w, channels) float arrays (RGB; 4: with alpha), row 0 at
+    the top."""
     tree = bpy.data.node_groups.new("Comp", "CompositorNodeTree")
     layers = tree.nodes.new("CompositorNodeRLayers")
     layers.scene = scene
@@ -135,7 +143,8 @@ def cycles_passes(bpy, scene, names):
         img = bpy.data.images.load(glob.glob(os.path.join(folder, f"p_{name}*.exr"))[0])
         px = np.empty(len(img.pixels), np.float32)
         img.pixels.foreach_get(px)
-        images[name] = px.reshape(img.size[1], img.size[0], -1)[::-1, :, :3].astype(float)
+        images[name] = px.reshape(img.size[1], img.size[0], -1)[::-1, :, :channels].astype(
+            float)
         bpy.data.images.remove(img)
     return images
 

@@ -323,6 +323,42 @@ def test_viewport_denoises_as_its_settings_ask(scene):
         s.free()
 
 
+def test_viewport_shows_a_shadow_catcher_as_the_final_render(scene):
+    """A shadow catcher floor in the viewport: the image and alpha are Cycles' matte with
+    the shadow laid in (its viewport form), exactly what a fresh export's film gives."""
+    bpy = scene
+    import engine
+    from dataclasses import replace
+    from drt_addon import shadow_catcher
+    from drt_addon.export import Reporter, export_scene
+    from drt_addon.viewport import ViewportSession, viewport_settings
+    bpy.data.objects["Plane"].is_shadow_catcher = True
+    bpy.context.scene.render.film_transparent = True
+    s = ViewportSession(lambda: None)
+    try:
+        s.context = _context(_camera_view(bpy, bpy.context.scene.camera))
+        s.sync(bpy.context.evaluated_depsgraph_get(), s.context, Reporter())
+        published = _wait(s, SAMPLES)[1][::-1].astype(np.float64)
+        view = s.view
+        d = export_scene(bpy.context.evaluated_depsgraph_get(),
+                         view=(view.camera, view.width, view.height))
+        settings = replace(viewport_settings(bpy.context.scene), samples=SAMPLES)
+        ctx = engine.RenderContext(d, settings)
+        try:
+            film, _ = engine.render(d, settings, context=ctx)
+            rgb, alpha = shadow_catcher.combined(ctx, film, None)
+        finally:
+            ctx.close()
+        _same(published[..., :3], rgb)
+        np.testing.assert_allclose(published[..., 3], alpha, atol=1e-6)
+        # the floor is a hole but for the cube's shadow on it
+        assert 0.2 < (alpha < 0.05).mean() < 0.95 and (alpha > 0.5).mean() > 0.05
+    finally:
+        s.free()
+        bpy.data.objects["Plane"].is_shadow_catcher = False
+        bpy.context.scene.render.film_transparent = False
+
+
 def test_free_stops_the_render_threads(session):
     """Leaving Rendered mode frees the engine: no viewport thread is left tracing."""
     session.free()

@@ -205,8 +205,9 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             seen = _instance_visibility(inst, obj)
             programmed = any(_runs_program(materials[i]) for i in slots)
             color, pass_index, texspace = object_values(obj)
+            catcher = _is_shadow_catcher(inst, obj)
             source = Source(groups.group(local, slots, name, holdout, offset, seen,
-                                         programmed, texspace, _lightgroup(obj)),
+                                         programmed, texspace, _lightgroup(obj), catcher),
                             color, pass_index, holdout, crypto_names(inst, obj))
             if tracker is None:
                 # without motion blur, repeated geometry becomes instances (export.instances)
@@ -223,6 +224,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             meshes[-1].visibility = seen
             meshes[-1].pass_index = int(getattr(obj, "pass_index", 0))
             meshes[-1].lightgroup = _lightgroup(obj)
+            meshes[-1].shadow_catcher = catcher
             meshes[-1].object_name, meshes[-1].asset_name = crypto_names(inst, obj)
             tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
             # with motion blur, each place is a mesh of its own until the shutter is
@@ -234,6 +236,9 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             light = export_light(obj, inst.matrix_world.copy(), reporter)
             if light is not None:
                 light.lightgroup = _lightgroup(obj)
+                # a lamp lights the shadow catchers' copies of paths unless its object
+                # is no shadow catcher (on by default for lamps, as Cycles reads it)
+                light.shadow_catcher = bool(getattr(obj, "is_shadow_catcher", True))
                 lights.append(light)
                 if tracker is not None:
                     tracker.note_light(inst, obj, len(lights) - 1)
@@ -279,6 +284,14 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
 def light_groups(view_layer) -> tuple:
     """The view layer's light groups (View Layer > Light Groups), by name."""
     return tuple(g.name for g in getattr(view_layer, "lightgroups", ()) if g.name)
+
+
+def _is_shadow_catcher(inst, obj) -> bool:
+    """Object > Visibility > Shadow Catcher, of the object or of its instancer."""
+    if getattr(obj, "is_shadow_catcher", False):
+        return True
+    parent = inst.parent if inst.is_instance else None
+    return bool(parent is not None and getattr(parent, "is_shadow_catcher", False))
 
 
 def _lightgroup(id_block) -> str:

@@ -71,8 +71,8 @@ _NULL_SCATTERING = ("DRT renders volumes without ray marching steps: homogeneous
 _SIMPLIFY = ("scene.render.use_simplify", (True,))
 _ADAPTIVE = ("scene.cycles.use_adaptive_sampling", (True,))
 WRITTEN_PASSES = ("Combined, Depth, Mist, Normal, Position, UV, Vector, Object Index, "
-                  "Material Index, Environment, Ambient Occlusion, Cryptomatte, Denoising "
-                  "Data and DRT Noise")
+                  "Material Index, Environment, Ambient Occlusion, Shadow Catcher, "
+                  "Cryptomatte, Denoising Data and DRT Noise")
 _PASSES_HOW = f"not written (DRT writes {WRITTEN_PASSES})"
 
 # Render passes DRT does not write, as (path, label).
@@ -86,7 +86,6 @@ _UNWRITTEN_PASSES = [
     ("view_layer.cycles.use_pass_volume_transmit", "Volume Transmit"),
     ("view_layer.cycles.use_pass_volume_majorant", "Volume Majorant"),
     ("view_layer.use_pass_shadow", "Shadow"),
-    ("view_layer.cycles.use_pass_shadow_catcher", "Shadow Catcher"),
     ("view_layer.cycles.denoising_store_passes", "Denoising Data (Cycles')"),
     ("view_layer.cycles.pass_debug_sample_count", "Sample Count"),
     ("view_layer.cycles.pass_render_time", "Render Time"),
@@ -162,6 +161,10 @@ SETTINGS: list[FileSetting] = [
     *[_s(f"view_layer.cycles.use_pass_volume_{part}", f"Passes > Volume {part.title()}",
          READ, "written: the light of paths that first scattered in a medium")
       for part in ("direct", "indirect")],
+    _s("view_layer.cycles.use_pass_shadow_catcher", "Passes > Shadow Catcher", READ,
+       "written: what other objects do to shadow catcher objects (1: nothing), and "
+       "Combined becomes the matte alone, as Cycles' (off: the shadow is laid into "
+       "Combined, Cycles' approximation)"),
     _s("view_layer.use_pass_emit", "Passes > Emission", READ,
        "written: what camera rays see emitted (lamps, emissive surfaces and media)"),
     _s("view_layer.use_pass_vector", "Passes > Vector", READ,

@@ -40,6 +40,7 @@ class Group:
     with_info: bool                  # its materials run shader programs
     texspace: tuple                  # (location, size) Generated coordinates map from
     lightgroup: str = ""             # Object > Shading > Light Group (its emission's)
+    shadow_catcher: bool = False     # Object > Visibility > Shadow Catcher
     matrices: list = field(default_factory=list)      # mathutils matrices, one a place
     random_ids: list = field(default_factory=list)    # Blender's random id of each place
     colors: list = field(default_factory=list)        # Object Info colour of each place
@@ -82,15 +83,15 @@ class InstanceGroups:
 
     def group(self, local: LocalMesh, slots, name: str, holdout: bool,
               terminator_offset: float, visibility: int, with_info: bool,
-              texspace, lightgroup: str = "") -> Group:
+              texspace, lightgroup: str = "", shadow_catcher: bool = False) -> Group:
         """The group of places with this mesh, materials and settings."""
         key = (id(local), tuple(slots), holdout, terminator_offset, visibility, with_info,
-               lightgroup)
+               lightgroup, shadow_catcher)
         found = self._groups.get(key)
         if found is None:
             found = self._groups[key] = Group(local, tuple(slots), name, holdout,
                                               terminator_offset, visibility, with_info,
-                                              texspace, lightgroup)
+                                              texspace, lightgroup, shadow_catcher)
         return found
 
     def place(self, source: Source, matrix_world, random_id: int) -> None:
@@ -145,6 +146,7 @@ def _settings(mesh, g: Group):
     mesh.terminator_offset = g.terminator_offset
     mesh.visibility = g.visibility
     mesh.lightgroup = g.lightgroup
+    mesh.shadow_catcher = g.shadow_catcher
     return mesh
 
 

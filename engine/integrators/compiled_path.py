@@ -208,10 +208,13 @@ class CompiledPathIntegrator:
         return trans
 
     def radiance(self, pixel, index, origins, dirs, tmax, time=None, alpha_out=None,
-                 split=False):
+                 split=False, first_out=None):
         """Radiance (n, 3) of the camera rays (origins, dirs, tmax) of samples `index` of
         pixels `pixel`; with `split`, the whole LightTally (engine.kernels.light_tally),
-        with the light passes and groups this integrator was asked for."""
+        with the light passes and groups this integrator was asked for. first_out: (n,)
+        int64 to fill with the global triangle each camera ray found (through
+        transparent layers and surfaces it does not see; -1: none), which decides where
+        Cycles' shadow catcher splits a path (engine.shadow_catcher)."""
         if self._mode not in _MODE_IDS:
             raise ValueError(f"mis_mode must be one of {MIS_MODES}, got {self._mode!r}")
         ctx, s = self.ctx, self.ctx.settings
@@ -259,6 +262,8 @@ class CompiledPathIntegrator:
                     depth, (pkey, index), live, paths.used, paths.ray_bits, path_time,
                     ray_time, o, d, tm, hits)
                 paths.beta[live] *= factor
+            if depth == 0 and first_out is not None:
+                first_out[:] = found.prim
             ns, nn = self.vertex(depth, self.cfg, paths, tally, live, o, d, tm, found, stopped,
                                  self.scene, shadows, nexts, *self.features)
             if ns:
