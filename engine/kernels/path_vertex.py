@@ -417,7 +417,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         if skind == SUBSURFACE:
             if sss is not None:
                 if b == 0:
-                    tl.left_first(tally, p, tl.one_class(tl.DIFFUSE_CLASS))
+                    tl.left_first(tally, p, tl.DIFFUSE_SHARES)
                 cone_moves(path_info[1], p, t_geom)
                 ns_out, nn_out = scatter_below(
                     cfg, walk_key(pkey[p], index[p], depth), p, paths, sss, f_ray, w_ray,
