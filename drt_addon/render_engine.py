@@ -222,6 +222,17 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         if self._polled(phase):
             raise RenderCancelled(phase)
 
+    def bake(self, depsgraph, obj, pass_type, pass_filter, width, height):
+        """Blender's bake operator, with DRT as the render engine (drt_addon.bake)."""
+        from .bake import BakeError, bake
+        from .export import ExportError, Reporter
+        try:
+            bake(self, depsgraph, obj, pass_type, pass_filter, width, height,
+                 Reporter(self.report))
+        except (BakeError, ExportError) as e:
+            self.report({"ERROR"}, str(e))
+            raise
+
     def _fail(self, message):
         last_render.update(ok=False, error=message)
         self.report({"ERROR"}, message)

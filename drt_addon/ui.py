@@ -155,8 +155,50 @@ class DRT_PT_passes(DRTPanel, bpy.types.Panel):
             col.prop(drt, "use_pass_noise")
 
 
+class DRT_PT_bake(DRTPanel, bpy.types.Panel):
+    """Render > Bake: Cycles' bake type and Blender's bake settings, which DRT bakes with
+    (drt_addon.bake); the button runs Blender's bake operator."""
+    bl_label = "Bake"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    @classmethod
+    def poll(cls, context):
+        return super().poll(context) and hasattr(context.scene, "cycles")
+
+    def draw(self, context):
+        cycles, bake = context.scene.cycles, context.scene.render.bake
+        col = self.layout.column()
+        col.use_property_split = True
+        col.operator("object.bake", icon="RENDER_STILL").type = cycles.bake_type
+        col.prop(cycles, "bake_type")
+        kind = cycles.bake_type
+        if kind in ("COMBINED", "DIFFUSE", "GLOSSY", "TRANSMISSION"):
+            sub = col.column(heading="Lighting", align=True)
+            sub.prop(bake, "use_pass_direct")
+            sub.prop(bake, "use_pass_indirect")
+            if kind == "COMBINED":
+                sub = col.column(heading="Contributions", align=True)
+                for name in ("diffuse", "glossy", "transmission", "emit"):
+                    sub.prop(bake, f"use_pass_{name}")
+            else:
+                sub.prop(bake, "use_pass_color")
+        elif kind == "NORMAL":
+            col.prop(bake, "normal_space", text="Space")
+            sub = col.column(align=True)
+            sub.prop(bake, "normal_r", text="Swizzle R")
+            sub.prop(bake, "normal_g", text="G")
+            sub.prop(bake, "normal_b", text="B")
+        col.prop(bake, "use_selected_to_active")
+        if bake.use_selected_to_active:
+            col.prop(bake, "cage_extrusion")
+            col.prop(bake, "max_ray_distance")
+        col.prop(bake, "target")
+        col.prop(bake, "margin")
+        col.prop(bake, "use_clear", text="Clear Image")
+
+
 CLASSES = (DRT_PT_sampling, DRT_PT_denoise, DRT_PT_viewport, DRT_PT_light_paths, DRT_PT_film,
-           DRT_PT_passes)
+           DRT_PT_passes, DRT_PT_bake)
 
 # Blender's generic panels for what Cycles draws in panels of its own add-on: depth of
 # field, light type/colour/power, spot shape, the material slots and node surfaces.

@@ -59,7 +59,7 @@ def crypto_names(inst, obj) -> tuple:
 def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
                  region: RenderRegion | None = None, stats: dict | None = None,
                  render_engine=None, check_cancel=None, memo=None,
-                 view=None, motion=None) -> "engine.Scene":
+                 view=None, motion=None, alone=None) -> "engine.Scene":
     """The scene as DRT's description.
 
     region: the pixels to render (default: Blender's render size and border, see
@@ -82,7 +82,10 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
     materials are reused from the last export unless an update dropped them.
 
     `motion` (an export.motion.MotionSettings) exports the scene with that shutter whatever
-    the file's motion blur says: the Vector pass's scene over frames f - 1 to f + 1."""
+    the file's motion blur says: the Vector pass's scene over frames f - 1 to f + 1.
+
+    `alone`, an object's name: that object becomes a mesh of its own, never an instance
+    of a mesh it shares (a bake finds its triangles there: drt_addon.bake)."""
     reporter = reporter or Reporter()
     check_file_settings(depsgraph.scene, depsgraph.view_layer, reporter)
     for message in missing_library_messages():
@@ -90,14 +93,14 @@ def export_scene(depsgraph, reporter: Reporter | None = None, size=None,
     blur = motion or (read_settings(depsgraph.scene) if view is None else None)
     if blur is None:
         return _export_scene(depsgraph, reporter, size, region, stats, None, check_cancel,
-                             memo, view)
+                             memo, view, alone)
     with MotionExport(depsgraph, blur, reporter, render_engine) as tracker:
         return _export_scene(depsgraph, reporter, size, region, stats,
                              tracker if tracker.usable else None, check_cancel)
 
 
 def _export_scene(depsgraph, reporter, size, region, stats, tracker,
-                  check_cancel=None, memo=None, view=None) -> "engine.Scene":
+                  check_cancel=None, memo=None, view=None, alone=None) -> "engine.Scene":
     t0 = time.perf_counter()
     scene = depsgraph.scene
     if view is not None:
@@ -207,7 +210,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             color, pass_index, texspace = object_values(obj)
             catcher = _is_shadow_catcher(inst, obj)
             source = Source(groups.group(local, slots, name, holdout, offset, seen,
-                                         programmed, texspace, _lightgroup(obj), catcher),
+                                         programmed, texspace, _lightgroup(obj), catcher,
+                                         alone=not inst.is_instance and obj.name == alone),
                             color, pass_index, holdout, crypto_names(inst, obj))
             if tracker is None:
                 # without motion blur, repeated geometry becomes instances (export.instances)

@@ -83,10 +83,12 @@ class InstanceGroups:
 
     def group(self, local: LocalMesh, slots, name: str, holdout: bool,
               terminator_offset: float, visibility: int, with_info: bool,
-              texspace, lightgroup: str = "", shadow_catcher: bool = False) -> Group:
-        """The group of places with this mesh, materials and settings."""
+              texspace, lightgroup: str = "", shadow_catcher: bool = False,
+              alone: bool = False) -> Group:
+        """The group of places with this mesh, materials and settings (`alone`: a group
+        of its own, whatever it shares)."""
         key = (id(local), tuple(slots), holdout, terminator_offset, visibility, with_info,
-               lightgroup, shadow_catcher)
+               lightgroup, shadow_catcher, name if alone else None)
         found = self._groups.get(key)
         if found is None:
             found = self._groups[key] = Group(local, tuple(slots), name, holdout,

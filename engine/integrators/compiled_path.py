@@ -208,13 +208,15 @@ class CompiledPathIntegrator:
         return trans
 
     def radiance(self, pixel, index, origins, dirs, tmax, time=None, alpha_out=None,
-                 split=False, first_out=None):
+                 split=False, first_out=None, first_hits=None):
         """Radiance (n, 3) of the camera rays (origins, dirs, tmax) of samples `index` of
         pixels `pixel`; with `split`, the whole LightTally (engine.kernels.light_tally),
         with the light passes and groups this integrator was asked for. first_out: (n,)
         int64 to fill with the global triangle each camera ray found (through
         transparent layers and surfaces it does not see; -1: none), which decides where
-        Cycles' shadow catcher splits a path (engine.shadow_catcher)."""
+        Cycles' shadow catcher splits a path (engine.shadow_catcher). first_hits: the
+        camera rays' hits (engine.accel.Hits) to take instead of intersecting them (a
+        bake's rays, which hit their texel's point: engine.bake)."""
         if self._mode not in _MODE_IDS:
             raise ValueError(f"mis_mode must be one of {MIS_MODES}, got {self._mode!r}")
         ctx, s = self.ctx, self.ctx.settings
@@ -255,7 +257,8 @@ class CompiledPathIntegrator:
             if live.size == 0:
                 break
             ray_time = path_time[live] if moving else None
-            hits = ctx.accel.intersect(o, d, tm, ray_time)
+            hits = (first_hits if depth == 0 and first_hits is not None
+                    else ctx.accel.intersect(o, d, tm, ray_time))
             found, stopped = hits.arrays(), no_stop
             if self.any_transparent or self.skips_hits:
                 found, factor, stopped = self._through_transparent(
