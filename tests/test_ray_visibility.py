@@ -15,7 +15,7 @@ tests/test_scenes_vs_cycles.py (scene `ray_visibility`) and test_export.py.
 import numpy as np
 
 from engine import RenderSettings, render, visibility as V
-from engine.kernels import path_weights
+from engine.kernels import path_vertex
 from engine.scene import Camera, Material, PointLight, Scene, World
 from engine_scenes import box, look_at, quad
 
@@ -50,8 +50,8 @@ def _render(scene, spp=64, bounces=0, seed=3):
 
 
 def test_kernel_bits_are_the_engine_bits():
-    assert (path_weights.DIFFUSE_BIT, path_weights.GLOSSY_BIT, path_weights.TRANSMISSION_BIT,
-            path_weights.SHADOW_BIT) == (V.DIFFUSE, V.GLOSSY, V.TRANSMISSION, V.SHADOW)
+    assert (path_vertex.DIFFUSE_BIT, path_vertex.GLOSSY_BIT, path_vertex.TRANSMISSION_BIT,
+            path_vertex.SHADOW_BIT) == (V.DIFFUSE, V.GLOSSY, V.TRANSMISSION, V.SHADOW)
     assert V.from_flags(camera=False, shadow=False) == V.DIFFUSE | V.GLOSSY | V.TRANSMISSION
 
 

@@ -7,9 +7,9 @@ The estimator, at each surface vertex:
      against light sampling by the power heuristic with the pdf light sampling would have
      had for that direction; camera rays and specular bounces (pdf = inf) see emission
      with weight 1 (lamps and the world: found_light.py);
-  2. next-event estimation (surface_light.py): one light entry (lamp or emissive
-     triangle) picked for the point (the light tree, or in proportion to its power), one
-     point on it, one shadow ray, weighted against BSDF sampling by the power heuristic;
+  2. next-event estimation: one light entry (lamp or emissive triangle) picked in
+     proportion to its power, one point on it, one shadow ray, weighted against BSDF
+     sampling by the power heuristic;
   3. BSDF sampling over the lobes whose bounce budget (Cycles' diffuse, glossy,
      transmission and total limits) is not used up; Cycles' Russian roulette: the ray
      leaves with a verdict (survival probability q = min(sqrt(max throughput), 1), or
@@ -42,30 +42,32 @@ from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
 from .bsdf import principled as bsdf
+from .bsdf.state import S_WALTER
 from . import ray_queues
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from .found_light import background, escaped, lamps_in_front
 from . import light_tally as tl
-from .pass_shares import bounce_shares, lobe_colours
+from .pass_shares import NO_SHARES, bounce_shares, light_shares, lobe_colours
 from .medium_vertex import equiangular_light, scatter
-from .path_weights import (DIFFUSE_BIT, ROULETTE_START, _INF, continues, hit_weight,
-                           holdout_share, keep_receiver, previous_receiver, roulette,
-                           uncovered)
+from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
+                           TRANSMISSION_BIT, _INF, continues, hit_weight, holdout_share,
+                           keep_receiver, nee_weight, previous_receiver, roulette, uncovered)
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium,
                      sample_method, segment, stack_cross, volume_dim)
 from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA, P_HOLDOUT, P_SETS_NORMAL
 from .surface import hit_uv, offset_origin, surface_at
+from .terminator import shadow_origin
 from .surface_hit import material_row, run_program, surface_emission
 from .subsurface import walk_key
 from .subsurface_vertex import scatter_below
-from .surface_light import ShadingFrame, SurfacePoint, next_event
 from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import bent_diffuse, may_emit, valid_reflection_normal
+from ..nodes.shading import (bent_diffuse, bump_rejects, may_emit,
+                             valid_reflection_normal)
 
 @kernel
 def prepare_closures(cfg, row, min_pdf, ray_bit):
@@ -169,6 +171,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
     kind, spp = cfg.sampler, cfg.spp
     max_bounces = cfg.max_bounces
     clamp_direct, clamp_indirect, mode = cfg.clamp_direct, cfg.clamp_indirect, cfg.mis_mode
+    scene_radius = cfg.scene_radius
     n_lights = lt.n_entries(lights)
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
@@ -339,12 +342,70 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         at = room and counts[p, 2] < cfg.transmission_bounces and keep_t
         # 2. next-event estimation: one light entry, one point, one shadow ray
         if n_lights > 0:
-            point = SurfacePoint(px, py, pz, gx, gy, gz, scale, prim, hit_inst[j], hit_u[j],
-                                 hit_v[j], front, m)
-            frame = ShadingFrame(nx, ny, nz, rx, ry, rz, s0x, s0y, s0z, bent, correct)
-            ns_out = next_event(cfg, paths, p, b, base, tally, lights, recv, state,
-                                (wox, woy, woz), frame, point, (keep_g, keep_t, ad, ag, at),
-                                (br, bg, bb), geometry, vol, shadows, ns_out)
+            # (one light: nothing to pick, and no number drawn for it)
+            u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK) \
+                if n_lights > 1 else 0.0
+            u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
+            k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
+                lights, recv, u_pick, u1, u2, path_time[p])
+            lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
+            # a uniform world, which Cycles never samples (its escaping rays find it):
+            # refraction towards it on Walter's pairs, as those rays see it
+            state[S_WALTER] = 1.0 if lt.is_uniform_world(lights, k) else 0.0
+            seen = lt.entry_visibility(lights, k)
+            see_d = (seen & DIFFUSE_BIT) != 0
+            see_g = (seen & GLOSSY_BIT) != 0 and keep_g
+            see_t = (seen & TRANSMISSION_BIT) != 0 and keep_t
+            cosine = abs(lz)
+            if bent:
+                # a Normal Map's normal: specular lobes on its valid-reflection frame,
+                # the diffuse lobe on the raw normal with bump shadowing (Cycles)
+                fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, False, see_g,
+                                            see_t)
+                if bump_rejects(s0x, s0y, s0z, nx, ny, nz, wx, wy, wz):
+                    cosine = 0.0
+                fr, fg, fb = fr * cosine, fg * cosine, fb * cosine
+                if see_d:
+                    dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry,
+                                              rz, wx, wy, wz, correct)
+                    fr, fg, fb = fr + dr, fg + dg, fb + db
+                cosine = 1.0
+            else:
+                fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, see_d, see_g,
+                                            see_t)
+            # as in Cycles, the lobes alone decide (on the shading normals): a light
+            # under the triangle's own plane but above its smooth normal lights it, its
+            # shadow ray leaving from the curved surface the normals describe
+            if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0:
+                sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[4],
+                                              geometry[13], geometry[9], prim, hit_inst[j],
+                                              hit_u[j], hit_v[j], px, py, pz, gx, gy, gz,
+                                              s0x, s0y, s0z, scale, wx, wy, wz)
+                sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy,
+                                                         wz, dist, margin, scene_radius)
+                bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
+                                     see_d, see_g, see_t)
+                w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine
+                shares = NO_SHARES
+                if b == 0 and tl.on(tally):
+                    shares = light_shares(state, wox, woy, woz, lx, ly, lz, see_d, see_g,
+                                          see_t, bent, fr, fg, fb, s0x, s0y, s0z, rx, ry,
+                                          rz, wx, wy, wz, correct)
+                group = tl.entry_group(tally, k)
+                if not seen & SHADOW_BIT:        # a light casting no shadow: no shadow ray
+                    tl.lit(tally, p, b, br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w,
+                           clamp_direct if b == 0 else clamp_indirect, shares, group)
+                else:
+                    ns_out = ray_queues.push(shadows, ns_out, p, b, sox, soy, soz, sdx, sdy,
+                                             sdz, far, br * fr * lr * w, bg * fg * lg * w,
+                                             bb * fb * lb * w, stacks)
+                    tl.queued(tally, ns_out - 1, p, b, shares, group)
+                    if (vol.shape[0] > 0 and vol[m, V_HAS] != 0.0
+                            and dot(wx, wy, wz, gx, gy, gz) < 0.0):
+                        # towards a light through the surface: the shadow ray enters or
+                        # leaves the material's volume there, as the refracted path does
+                        stack_cross(shadows.stack, ns_out - 1, m, front)
+            state[S_WALTER] = 0.0
         # 3. continue by BSDF sampling
         if not (ad or ag or at):
             continue
