@@ -48,7 +48,7 @@ from .surface import SurfaceBuilder
 from .world_light import world_model
 
 
-POLL = 0.25      # seconds between looks at cancel and compile progress while units run
+POLL = 0.05      # seconds between looks at cancel and compile progress while units run
 
 
 class RenderContext:
@@ -222,12 +222,14 @@ def camera_rays(ctx: RenderContext, pixel: np.ndarray, index: np.ndarray):
     return ctx.camera.generate(film_xy, lens_u, time), time
 
 
-def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sample_end: int):
+def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sample_end: int,
+                stop=None):
     """Radiance of samples [sample_start, sample_end) of each pixel in `pixels`.
     Returns (pixel ids, sample indices, radiance (n, 3) float64, alpha (n,) or None when
     the film is opaque, the film's other channels (n, ctx.film_channels(), 3): the light
     passes and groups of engine.light_passes, then the shadow catcher's; None when it
-    keeps none)."""
+    keeps none). stop: a threading.Event that, once set, ends the unit's paths at their
+    next bounce (a cancelled render: its result is then not to be used)."""
     k = sample_end - sample_start
     pixel = np.repeat(pixels.astype(np.int64), k)
     index = np.tile(np.arange(sample_start, sample_end, dtype=np.int64), len(pixels))
@@ -238,7 +240,7 @@ def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sampl
     first = np.empty(n, np.int64) if ctx.catcher is not None else None
     found = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
                                     time=time, alpha_out=alpha, split=bool(lights),
-                                    first_out=first)
+                                    first_out=first, stop=stop)
     radiance = found.L if lights else found
     if not ctx.film_channels():
         return pixel, index, radiance, alpha, None
@@ -300,10 +302,12 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
                 return 0
             running[0] += 1
         try:
-            pix, index, rad, alpha, extra = render_unit(ctx, pixels, a, b)
+            pix, index, rad, alpha, extra = render_unit(ctx, pixels, a, b, stop)
         finally:
             with lock:
                 running[0] -= 1
+        if stop.is_set():
+            return 0                           # cut short by a cancel: not a sample
         bad = ~np.isfinite(rad).all(axis=1)
         if extra is not None:
             bad |= ~np.isfinite(extra).all(axis=(1, 2))
@@ -344,12 +348,12 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
         with watch:
             for a, b in passes:
                 a, b = a + sample_start, b + sample_start
-                # Pixels per unit: two units per thread, but no unit over chunk_paths
-                # paths (memory) nor under 8192 (smaller arrays cost more in per-call
-                # overhead, which holds the GIL, than the threads win).
+                # Pixels per unit: two units per thread, none over chunk_paths paths
+                # (memory) nor under 8192 (per-call overhead holds the GIL) unless that
+                # leaves a thread idle (the viewport's coarse images)
                 k = b - a
                 most = max(1, settings.chunk_paths // k)
-                least = -(-8192 // k)
+                least = min(-(-8192 // k), -(-len(active) // threads))
                 per_unit = min(most, max(least, -(-len(active) // (2 * threads))))
                 futures = [pool.submit(run, active[start:start + per_unit], a, b)
                            for start in range(0, len(active), per_unit)]

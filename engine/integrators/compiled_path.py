@@ -208,7 +208,7 @@ class CompiledPathIntegrator:
         return trans
 
     def radiance(self, pixel, index, origins, dirs, tmax, time=None, alpha_out=None,
-                 split=False, first_out=None, first_hits=None):
+                 split=False, first_out=None, first_hits=None, stop=None):
         """Radiance (n, 3) of the camera rays (origins, dirs, tmax) of samples `index` of
         pixels `pixel`; with `split`, the whole LightTally (engine.kernels.light_tally),
         with the light passes and groups this integrator was asked for. first_out: (n,)
@@ -216,7 +216,8 @@ class CompiledPathIntegrator:
         transparent layers and surfaces it does not see; -1: none), which decides where
         Cycles' shadow catcher splits a path (engine.shadow_catcher). first_hits: the
         camera rays' hits (engine.accel.Hits) to take instead of intersecting them (a
-        bake's rays, which hit their texel's point: engine.bake)."""
+        bake's rays, which hit their texel's point: engine.bake). stop: a
+        threading.Event that, once set, ends every path at its next bounce (a cancel)."""
         if self._mode not in _MODE_IDS:
             raise ValueError(f"mis_mode must be one of {MIS_MODES}, got {self._mode!r}")
         ctx, s = self.ctx, self.ctx.settings
@@ -254,7 +255,7 @@ class CompiledPathIntegrator:
         # one step per bounce, and per crossing of a volume's boundary
         steps = self.max_bounces + 1 + (VOLUME_BOUNDS_MAX if self.has_volumes else 0)
         for depth in range(steps):
-            if live.size == 0:
+            if live.size == 0 or (stop is not None and stop.is_set()):
                 break
             ray_time = path_time[live] if moving else None
             hits = (first_hits if depth == 0 and first_hits is not None
