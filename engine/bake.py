@@ -85,11 +85,19 @@ def _whole(kind: str, filt: int) -> bool:
     return kind == "COMBINED" and filt & ALL_LIGHT == ALL_LIGHT
 
 
+def _first_hit_only(kind: str, filt: int) -> bool:
+    """Whether a pass is read at the first hit alone (Emit; a colour with no light)."""
+    return kind == "EMIT" or (kind in ("DIFFUSE", "GLOSSY", "TRANSMISSION")
+                              and not filt & (DIRECT | INDIRECT))
+
+
 def settings_for(settings, kind: str, filt: int = -1):
     """The render settings a bake of `kind` with filter `filt` traces with: the light
-    passes on where a pass is made of their slots."""
-    return replace(settings, light_passes=not _whole(kind, filt) and kind in (
+    passes on where a pass is made of their slots, no bounce where it is read at the
+    first hit alone."""
+    out = replace(settings, light_passes=not _whole(kind, filt) and kind in (
         "COMBINED", "DIFFUSE", "GLOSSY", "TRANSMISSION", "EMIT"))
+    return replace(out, max_bounces=0) if _first_hit_only(kind, filt) else out
 
 
 def jittered(ctx, texel, index, u, v, footprint):
@@ -119,13 +127,13 @@ def bake(ctx, prim, u, v, kind: str, filt: int = -1, samples: int | None = None,
     prim = np.ascontiguousarray(prim, np.int64)
     bu, bv = np.asarray(u, np.float64), np.asarray(v, np.float64)
     footprint = None if footprint is None else np.asarray(footprint, np.float64)
-    pts = points(ctx, prim, bu, bv)
-    n = len(pts.normal)
+    n = len(prim)
     if kind == "NORMAL":
-        return pts.normal.copy()
+        return points(ctx, prim, bu, bv).normal
     samples = int(samples or ctx.settings.samples)
     if kind == "AO":
         from .ambient_occlusion import AmbientOcclusion, occlusion
+        pts = points(ctx, prim, bu, bv)
         si = ctx.surfaces.build(pts.hits, np.arange(n), pts.directions, origins=pts.origins)
         ao = AmbientOcclusion(distance=ao_distance, max_rays=samples)
         return occlusion(ctx, ao, np.arange(n), np.zeros(n, np.int64), si, None, samples)
@@ -151,15 +159,16 @@ def bake(ctx, prim, u, v, kind: str, filt: int = -1, samples: int | None = None,
             found = ctx.integrator.radiance(texel, index, at.origins, at.directions,
                                             np.full(len(texel), np.inf), split=not whole,
                                             first_hits=at.hits)
+            # each unit owns its texels (no two threads add to one row), each texel's
+            # k samples one after the other
             if whole:
-                np.add.at(total, texel, found)
+                total[texels] += found.reshape(-1, k, 3).sum(axis=1)
                 continue
             got = found.passes
-            # each unit owns its texels: no two threads add to one row
-            np.add.at(total, texel, sum((got[:, slot[s]] for s in names),
-                                        np.zeros((len(texel), 3))))
+            value = sum((got[:, slot[s]] for s in names), np.zeros((len(texel), 3)))
+            total[texels] += value.reshape(-1, k, 3).sum(axis=1)
             if colour_slot is not None:
-                np.add.at(colour, texel, got[:, colour_slot])
+                colour[texels] += got[:, colour_slot].reshape(-1, k, 3).sum(axis=1)
 
     threads = ctx.settings.threads or min(os.cpu_count() or 1, 8)
     units = np.array_split(np.arange(n, dtype=np.int64), max(1, min(n, 2 * threads)))

@@ -80,9 +80,11 @@ class RenderContext:
         # A camera that does not move gets its rays from one compiled kernel.
         self.camera_kernel = None if self.has_motion else pack_camera(self.camera, self.filter)
 
-    def _catcher_run(self):
-        """The shadow catcher's second run (engine.shadow_catcher), or None in a scene
-        without a catcher object."""
+    def _catcher_run(self, like=None):
+        """The shadow catcher's second run (engine.shadow_catcher; None without a catcher
+        object), reusing `like`'s, a run on the same geometry, where given."""
+        if like is not None:
+            return shadow_catcher.CatcherRun(self, like.catcher, like)
         catcher = shadow_catcher.catcher_triangles(self.accel)
         return None if catcher is None else shadow_catcher.CatcherRun(self, catcher)
 
@@ -125,7 +127,7 @@ class RenderContext:
                                                                        self.filter)
         other._light(scene, self.lights.mesh)
         other.integrator = make_integrator(self.settings.integrator, other)
-        other.catcher = other._catcher_run()
+        other.catcher = None if self.catcher is None else other._catcher_run(self.catcher)
         return other
 
     def view(self, camera, width: int, height: int) -> "RenderContext":
@@ -145,7 +147,7 @@ class RenderContext:
         if _scene_radius(other.scene, self.accel) > self.scene_radius * (1.0 + 1e-9):
             other._light(other.scene, self.lights.mesh, self.world)
         other.integrator = make_integrator(self.settings.integrator, other)
-        other.catcher = other._catcher_run()
+        other.catcher = None if self.catcher is None else other._catcher_run(self.catcher)
         return other
 
     def entry_kernels(self) -> list:
@@ -237,7 +239,7 @@ def render_unit(ctx: RenderContext, pixels: np.ndarray, sample_start: int, sampl
     n = len(pixel)
     alpha = np.ones(n) if ctx.scene.needs_alpha() else None
     lights = light_passes.channels(ctx)
-    first = np.empty(n, np.int64) if ctx.catcher is not None else None
+    first = np.full(n, -1, np.int64) if ctx.catcher is not None else None
     found = ctx.integrator.radiance(pixel, index, rays.origins, rays.directions, rays.tmax,
                                     time=time, alpha_out=alpha, split=bool(lights),
                                     first_out=first, stop=stop)

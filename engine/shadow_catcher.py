@@ -54,7 +54,10 @@ class CatcherRun:
     """The second run of a render's integrator that traces the shadow catcher's copies of
     the paths that split (see the module's docstring)."""
 
-    def __init__(self, ctx, catcher: np.ndarray):
+    def __init__(self, ctx, catcher: np.ndarray, like: "CatcherRun | None" = None):
+        """The run of `ctx` for the triangles flagged in `catcher`; `like`: the run of a
+        context on the same geometry and materials (RenderContext.view and relit), whose
+        catcher-path surfaces and emissive triangles are reused, not made again."""
         from .integrators import make_integrator
         from .mesh_lights import EmissiveTriangles
         self.catcher = np.asarray(catcher, bool)
@@ -64,9 +67,14 @@ class CatcherRun:
         # a transparent film: a copy's camera ray that escapes adds nothing
         run.scene = replace(ctx.scene, lights=lamps, film_transparent=True, light_groups=())
         run.settings = replace(ctx.settings, light_passes=False)
-        run.surfaces = ctx.surfaces.seen_by_catcher_paths(self.catcher)
-        run._light(run.scene, EmissiveTriangles.from_scene(
-            ctx.scene, ctx.accel, ctx.materials.emission, only=self.catcher), ctx.world)
+        if like is None:
+            self.surfaces = ctx.surfaces.seen_by_catcher_paths(self.catcher)
+            self.mesh_lights = EmissiveTriangles.from_scene(
+                ctx.scene, ctx.accel, ctx.materials.emission, only=self.catcher)
+        else:
+            self.surfaces, self.mesh_lights = like.surfaces, like.mesh_lights
+        run.surfaces = self.surfaces
+        run._light(run.scene, self.mesh_lights, ctx.world)
         run.catcher = None
         self.integrator = make_integrator(ctx.settings.integrator, run)
         # the main run's lights and world: what an escaped camera ray sees
