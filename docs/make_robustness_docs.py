@@ -123,20 +123,22 @@ brighter light.
 How: Embree traces in float32, whose spacing at 1e5 is 0.008. DRT keeps geometry in
 float64, rebuilds hit points in float64, and uploads the static scene to Embree relative
 to its median vertex, moving every ray origin by the same amount in float64 before
-rounding; the ray offset that prevents self-intersection (2^-17 of the coordinate
-magnitude) is measured from that point too. So a compact scene far from the origin keeps
+rounding. A ray leaving a surface starts on it and names the triangle it leaves, which
+Embree's filter passes (`engine/embree/self_hits.py`, as Cycles starts its rays): there
+is no offset to grow with the coordinates. So a compact scene far from the origin keeps
 the precision it has at the origin. The limit that remains is the distance of detail from
 the median vertex: the rows "with specks" add, out of view, twice as many vertices as the
 box has (1 cm triangles) that far away, which moves the median vertex there; where they
-fail, the box's 2 m of detail has become too fine for float32 at that distance (offsets
-of 2^-17 of it, and float32 spacing, against a 2 m box). A few far vertices do not move
-the median (a vertex at 3.4e38 in `tests/test_degenerate_input.py`).
-Moving objects (motion blur) are traced in their own object spaces and keep the
-world-space offset.
+fail, the box's 2 m of detail has become too fine for float32 at that distance (float32
+spacing against a 2 m box). A few far vertices do not move the median (a vertex at
+3.4e38 in `tests/test_degenerate_input.py`). Moving objects (motion blur) are traced in
+their own object spaces.
 
 Acne and leaks at every scale (`tests/test_robustness.py`, scales 1e-3, 1, 1e2, 1e4):
 a plane under a sun at 85 degrees has no self-shadowed pixel; a closed box with walls 1%
-or 0.01% of its size thick lets no light in; a sheet 1e-4 above a table leaves it black.
+or 0.01% of its size thick lets no light in; a sheet 1e-4 or 2e-6 of its size above a
+table leaves it black (2e-6 leaked before 2026-11-30, when rays started 2^-17 of the
+coordinates' magnitude off the surface).
 The plane and a box with walls 1e-3 thick also 1e5 and 1e7 from the origin
 (`tests/test_extremes_scale.py`; before the median-vertex origin, the box let light in
 at 1e5 and 37.5% of the plane's pixels were self-shadowed at 1e7).

@@ -2,8 +2,9 @@
 (`engine.embree`: scenes on shared NumPy buffers, queries in compiled kernels).
 
 Batches of rays are traced by one compiled call each (`engine.embree.rays`), at tnear 0:
-ray origins are offset by the caller (`engine.surface.offset_origin`); batches are split
-over threads (every kernel releases the GIL). Everything is one Embree scene, in world
+a ray that leaves a surface starts on it and names the primitive it leaves (`skip`),
+which Embree's filter passes (engine.embree.self_hits); batches are split over threads
+(every kernel releases the GIL). Everything is one Embree scene, in world
 space relative to `center`:
 - static triangles: one geometry (the only one a scene without motion or instances
   builds, so static scenes pay nothing for motion blur);
@@ -51,7 +52,7 @@ import numpy as np
 
 from .curves import pack_curves
 from .embree.library import GEOMETRY_ROUND_CATMULL_ROM_CURVE
-from .embree.rays import intersect_batch, occluded_batch
+from .embree.rays import intersect_batch, occluded_batch, target
 from .embree.scene import Scene as EmbreeScene
 from .instancing import is_instanced
 from .kernels.motion import pack_motion
@@ -60,6 +61,8 @@ from .scene import TriangleMesh
 
 MISS = -1
 _NO_F64 = np.zeros(0)
+_NO_SKIP = np.zeros((0, 2), np.int64)
+_NO_SKIP_SHADOW = np.zeros((0, 4), np.int64)
 _MIN_SPLIT = 4096      # below this many rays, one thread is faster than two
 
 
@@ -102,6 +105,16 @@ class Hits:
     @property
     def hit(self) -> np.ndarray:
         return self.prim >= 0
+
+
+def _skips(skip, n: int, columns: int) -> np.ndarray:
+    """skip as (n, columns) int64 rows, -1 in the columns it lacks."""
+    skip = np.asarray(skip, np.int64)
+    if skip.shape == (n, columns):
+        return np.ascontiguousarray(skip)
+    out = np.full((n, columns), -1, np.int64)
+    out[:, :skip.shape[1]] = skip
+    return out
 
 
 @dataclass
@@ -245,14 +258,15 @@ class Accelerator:
         object-table row of its first place (-1: not an instanced mesh)."""
         scene = EmbreeScene()
         ids = []
+        curve_geom = -1
         if len(self.triangles):
             ids.append((scene.add_triangles(self.positions, self.triangles, self.center),
                         0, -1))
         if self.curves:
             C = self.packed_curves
-            ids.append((scene.add_curves(C.points, C.first, GEOMETRY_ROUND_CATMULL_ROM_CURVE,
-                                         self.center, cull_back_faces=True),
-                        self.curve_start, -1))
+            curve_geom = scene.add_curves(C.points, C.first, GEOMETRY_ROUND_CATMULL_ROM_CURVE,
+                                          self.center, cull_back_faces=True)
+            ids.append((curve_geom, self.curve_start, -1))
         for proto in self.prototypes:
             places = proto.mesh.instances.matrices[:, :3, :].copy()
             places[:, :, 3] -= self.center
@@ -272,19 +286,21 @@ class Accelerator:
             self._geom_base[g], self._geom_row[g] = base, row
         # whether a hit's ids need mapping (anything beside the static triangles)
         self._remaps = len(ids) > 1 or (len(ids) == 1 and ids[0][1:] != (0, -1))
-        return scene.commit()
+        scene.commit()
+        self.target = target(scene.handle, self.center, self._geom_base, self._geom_row,
+                             curve_geom)
+        return scene
 
     def kernel_rays(self) -> tuple:
         """What a kernel needs to cast rays itself and name what they hit as the queries
-        here do (engine.kernels.subsurface.local_hit): (Embree scene handle, centre,
-        geometry id -> first global triangle, geometry id -> first object-table row, each
-        ordered mesh's first global triangle and the total); None without triangles."""
+        here do (engine.kernels.subsurface.local_hit): (the scene's
+        engine.embree.rays.Target, each ordered mesh's first global triangle and the
+        total); None without triangles."""
         if self._scene is None:
             return None
         counts = [len(m.triangles) for m in self.ordered_meshes]
         starts = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-        return (int(self._scene.handle), np.asarray(self.center, np.float64),
-                self._geom_base, self._geom_row, starts)
+        return self.target, starts
 
     def close(self):
         if self._pool is not None:
@@ -292,29 +308,32 @@ class Accelerator:
             self._pool = None
 
     # -- queries ---------------------------------------------------------------------
-    def _query(self, origins, dirs, tmax, time, query):
+    def _query(self, origins, dirs, tmax, time, query, skip=None):
         """Embree on float64 rays whose origins are moved by -center before rounding to
-        float32 (engine.embree.rays), split over the pool for large batches. Returns
-        blocked (n,) for OCCLUDED; Hits for INTERSECT."""
+        float32 (engine.embree.rays), split over the pool for large batches; skip: what
+        each ray must not hit (see `intersect` and `occluded`). Returns blocked (n,) for
+        OCCLUDED; Hits for INTERSECT."""
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(dirs, dtype=np.float64)
         n = len(o)
         far = np.array(np.broadcast_to(tmax, (n,)), dtype=np.float64)
         tm = _NO_F64 if time is None else np.array(np.broadcast_to(time, (n,)), np.float64)
-        scene, center = self._scene.handle, self.center
+        tg = self.target
         if query == "OCCLUDED":
             out = (np.zeros(n, bool),)
+            sk = _NO_SKIP_SHADOW if skip is None else _skips(skip, n, 4)
 
             def run(a, b):
-                occluded_batch(scene, center, o[a:b], d[a:b], far[a:b],
-                               tm[a:b] if len(tm) else tm, out[0][a:b])
+                occluded_batch(tg, o[a:b], d[a:b], far[a:b], tm[a:b] if len(tm) else tm,
+                               sk[a:b] if len(sk) else sk, out[0][a:b])
         else:
             out = (np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64),
                    np.empty(n, np.int64), np.empty(n), np.empty(n), np.empty(n))
+            sk = _NO_SKIP if skip is None else _skips(skip, n, skip.shape[1])
 
             def run(a, b):
-                intersect_batch(scene, center, o[a:b], d[a:b], far[a:b],
-                                tm[a:b] if len(tm) else tm, *(x[a:b] for x in out))
+                intersect_batch(tg, o[a:b], d[a:b], far[a:b], tm[a:b] if len(tm) else tm,
+                                sk[a:b] if len(sk) else sk, *(x[a:b] for x in out))
         if self._pool is None or n < _MIN_SPLIT:
             run(0, n)
         else:
@@ -337,7 +356,7 @@ class Accelerator:
         inst = np.where(row >= 0, row + element, -1)
         return Hits(t, prim, u, v, inst)
 
-    def _run(self, origins, dirs, tmax, time, query):
+    def _run(self, origins, dirs, tmax, time, query, skip=None):
         """One batch of queries, counted (and recorded for a benchmark's replay)."""
         n = len(origins)
         if self.moving and time is None:
@@ -349,27 +368,34 @@ class Accelerator:
                                       np.array(dirs, np.float64),
                                       np.array(np.broadcast_to(tmax, (n,)), np.float64),
                                       None if time is None else np.array(
-                                          np.broadcast_to(time, (n,)), np.float64)))
-        return self._query(origins, dirs, tmax, time if self.moving else None, query)
+                                          np.broadcast_to(time, (n,)), np.float64),
+                                      None if skip is None else np.array(skip, np.int64)))
+        return self._query(origins, dirs, tmax, time if self.moving else None, query, skip)
 
     def replay(self, batches) -> None:
         """Recorded batches through bare Embree (a benchmark's reference: the same
         queries, without DRT's work around them)."""
-        for query, o, d, far, time in batches:
-            self._query(o, d, far, time, query)
+        for query, o, d, far, time, skip in batches:
+            self._query(o, d, far, time, query, skip)
 
     def intersect(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
-                  time: np.ndarray | None = None) -> Hits:
+                  time: np.ndarray | None = None, skip: np.ndarray | None = None) -> Hits:
+        """The closest hit of each ray within [0, tmax]. skip (n, 2) int64: the global
+        primitive each ray leaves and its place (Hits.prim and Hits.inst of the hit it
+        starts on; -1: none), which it does not hit again; (n, 4): and a second pair,
+        the emissive triangle a shadow ray goes to."""
         n = len(origins)
         if n == 0 or self._scene is None:
             return Hits(np.full(n, np.inf), np.full(n, MISS, np.int64), np.zeros(n),
                         np.zeros(n), np.full(n, -1, np.int64))
-        return self._run(origins, dirs, tmax, time, "INTERSECT")
+        return self._run(origins, dirs, tmax, time, "INTERSECT", skip)
 
     def occluded(self, origins: np.ndarray, dirs: np.ndarray, tmax: np.ndarray,
-                 time: np.ndarray | None = None) -> np.ndarray:
-        """True where something lies on the segment [0, tmax) of each ray."""
+                 time: np.ndarray | None = None, skip: np.ndarray | None = None) -> np.ndarray:
+        """True where something lies on the segment [0, tmax) of each ray. skip (n, 4)
+        int64: the global primitive and place each ray leaves and the emissive triangle
+        and place it goes to (-1: none), which do not block it."""
         n = len(origins)
         if n == 0 or self._scene is None:
             return np.zeros(n, dtype=bool)
-        return self._run(origins, dirs, tmax, time, "OCCLUDED")
+        return self._run(origins, dirs, tmax, time, "OCCLUDED", skip)

@@ -24,7 +24,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .sampling import dimensions as D
-from .surface import offset_origin
 from .warp import cosine_hemisphere, to_world
 
 DEFAULT_DISTANCE = 10.0      # Cycles' AO distance when the scene has no world
@@ -69,24 +68,28 @@ def occlusion(ctx, ao: AmbientOcclusion, pixel: np.ndarray, index: np.ndarray, s
         passed[above] = 1.0             # nothing lies within no distance (as in Cycles)
     elif above.any():
         r = np.nonzero(above)[0]
-        o = offset_origin(si.position[rows[r]], si.geometric_normal[rows[r]],
-                          si.scale[rows[r]], d[r])
+        # each ray starts on its surface and names the triangle it leaves (Cycles')
+        prim = np.ascontiguousarray(si.prim[rows[r]], np.int64)
+        inst = (np.full(len(r), -1, np.int64) if si.inst is None
+                else np.ascontiguousarray(si.inst[rows[r]], np.int64))
+        o = si.position[rows[r]]
         far = np.full(len(r), ao.distance)
         t = None if time is None else np.asarray(time)[rows[r]]
         passed[r] = _transmitted(ctx, o, np.ascontiguousarray(d[r]), far, t,
-                                 pixels[r], sample[r])
+                                 pixels[r], sample[r], np.stack([prim, inst], 1))
     return passed.reshape(n, m, 3).mean(axis=1)
 
 
-def _transmitted(ctx, o, d, far, time, pixel, sample) -> np.ndarray:
+def _transmitted(ctx, o, d, far, time, pixel, sample, skip) -> np.ndarray:
     """(n, 3) what each ray carries to `far`: 1 or 0 against opaque surfaces, the
     transmittance of transparent layers and volumes as the path tracer's shadow rays
-    take it (engine.integrators.compiled_path)."""
+    take it (engine.integrators.compiled_path); skip (n, 2): the triangle and place each
+    ray leaves."""
     integ = ctx.integrator
     transparent = getattr(integ, "any_transparent", False) or \
         getattr(integ, "skips_shadows", False) or getattr(integ, "has_volumes", False)
     if not transparent:
-        blocked = ctx.accel.occluded(o, d, far, time)
+        blocked = ctx.accel.occluded(o, d, far, time, skip)
         return np.repeat((~blocked).astype(np.float64)[:, None], 3, axis=1)
     from .kernels.medium_density import shadow_keys
     from .kernels.volume import STACK
@@ -101,4 +104,4 @@ def _transmitted(ctx, o, d, far, time, pixel, sample) -> np.ndarray:
         pkey = pixel_keys(np.uint64(ctx.sampler.seed), np.asarray(pixel, np.int64))
         keys = shadow_keys(pkey, np.asarray(sample, np.int64), np.arange(n, dtype=np.int64),
                            0)
-    return integ.shadow_transmittance(o, d, far, time, stacks, keys)
+    return integ.shadow_transmittance(o, d, far, time, stacks, keys, skip)

@@ -1,14 +1,12 @@
-"""Surface interactions: what a ray hit, rebuilt in float64, and safe ray origins.
+"""Surface interactions: what a ray hit, rebuilt in float64.
 
 Hit points come from the triangle's float64 vertices and Embree's barycentrics, so their
 error is a few float32 ulps of the vertex coordinates whatever the ray length. A new ray
-leaving the surface starts at the hit point pushed along the geometric normal, to the
-side it leaves from, by an amount proportional to the magnitude of the coordinates
-involved: that bounds the float32 rounding Embree applies to origins and triangles, so
-there is no self-intersection (acne) and, the offset being relative, no leaking through
-thin geometry at any scene scale from 1e-3 to 1e4. The magnitude is measured from the
-centre Embree sees the static scene around (engine.accel), so it does not grow when the
-whole scene is far from the world origin.
+leaving the surface starts at the hit point itself and names the triangle it leaves,
+which Embree's filter then passes (engine.kernels.ray_origin, engine.embree.self_hits),
+as Cycles starts its rays: no offset, so no acne and no leaking through thin geometry at
+any scene scale. `scale`, each hit's largest coordinate magnitude relative to the centre
+Embree sees the static scene around (engine.accel), bounds its float32 error.
 """
 from __future__ import annotations
 
@@ -19,9 +17,8 @@ import numpy as np
 
 from .accel import Accelerator, Hits
 
-# Relative offset: 2**-17 ~ 7.6e-6 of the coordinate magnitude, i.e. 64 float32 ulps,
-# comfortably above Embree's watertight-test error and the float32 rounding of vertices
-# and origins, and small enough not to skip geometry thinner than 1e-5 of the scene size.
+# 2**-17 ~ 7.6e-6 of a coordinate's magnitude (64 float32 ulps): how far short of a
+# sampled point on an emissive triangle its shadow ray stops (engine.mesh_lights)
 RELATIVE_OFFSET = 2.0 ** -17
 
 
@@ -32,7 +29,7 @@ class SurfaceHit:
     shading_normal: np.ndarray   # (n, 3) unit, same hemisphere as geometric_normal
     front_facing: np.ndarray     # (n,) bool: the ray hit the triangle's front side
     material: np.ndarray         # (n,) int64 index into Scene.materials
-    scale: np.ndarray            # (n,) float64 magnitude used for ray offsets
+    scale: np.ndarray            # (n,) float64 coordinate magnitude (float32 error bound)
     uv: np.ndarray | None = None   # (n, 2) texture coordinates, None if no mesh has UVs
     prim: np.ndarray | None = None       # (n,) the triangles hit
     direction: np.ndarray | None = None  # (n, 3) the rays' directions
@@ -328,11 +325,3 @@ def _corner_normals(v0, v1, v2):
     n[ok] /= length[ok, None]
     n[~ok] = (0.0, 0.0, 1.0)                     # never hit by Embree anyway
     return n
-
-
-def offset_origin(position: np.ndarray, normal: np.ndarray, scale: np.ndarray,
-                  direction: np.ndarray) -> np.ndarray:
-    """Move origins off the surface to the side `direction` leaves towards."""
-    side = np.where((normal * direction).sum(1) >= 0.0, 1.0, -1.0)[:, None]
-    eps = (RELATIVE_OFFSET * np.maximum(scale, 1e-30))[:, None]
-    return position + normal * (eps * side)

@@ -4,8 +4,8 @@ Glossy 1, caustics on): a grey floor and back wall, a rough metal sphere, a glas
 a diffuse cube in a thin fog, an emissive panel the camera sees, an area lamp, a point
 lamp and a world colour; light groups key (the area lamp), panel (the emissive panel)
 and sky (the world), the point lamp in none. The glass cube rests on the floor, as an
-artist leaves it (a named gap: docs/passes.md); the fog box floats 5 cm above it, since
-resting there it shows the same coplanar gap a second time."""
+artist leaves it (rays leaving the floor meet its coplanar bottom face, in DRT as in
+Cycles); the fog box floats 5 cm above it."""
 from __future__ import annotations
 
 import glob

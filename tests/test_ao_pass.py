@@ -29,9 +29,7 @@ W, H = 32, 24
 def _between_planes(h: float) -> Scene:
     """A 10 m floor at z = 0 under a 10 m ceiling at z = h (its front side down), the
     camera between them looking down at the floor: every AO ray (at most 1.2 m long)
-    that leaves the floor's visible part below the ceiling's height meets the ceiling.
-    (Not 2 km: rays leave a surface 2^-17 of its vertices' magnitude above it,
-    engine.surface.RELATIVE_OFFSET, 7.6 mm there.)"""
+    that leaves the floor's visible part below the ceiling's height meets the ceiling."""
     meshes = [quad((0, 0, 0), (5, 0, 0), (0, 5, 0), "floor"),
               quad((0, 0, h), (0, 5, 0), (5, 0, 0), "ceiling")]
     cam = Camera(look_at((0.0, -0.3 * h, 0.6 * h), (0.0, 0.0, 0.0)), lens=35.0)

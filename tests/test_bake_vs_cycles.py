@@ -7,10 +7,10 @@ Glossy, Emit, Normal (tangent space) and Ambient Occlusion, both engines at 64 s
 Held to (measured: the printed lines, docs/bake.md): the image's mean within 0.02 of
 Cycles' (relative to Cycles' mean) and its worst 8 x 8 block within 0.08; Glossy, a
 faint pass here (mean 0.014), within 0.03 and 0.25; Emit, Normal and Diffuse Color,
-which carry no light, within 0.002 and 0.01. Named gap (docs/bake.md): the cube rests
-on the floor, as an artist leaves it, and DRT's rays leave the floor past the cube's
-coplanar bottom face where Cycles' find it (issue 26's ray origins): the floor's
-indirect light is 9 % below Cycles' (Diffuse mean -0.004); lifted 1 cm it matches."""
+which carry no light, within 0.002 and 0.01. The cube rests on the floor, as an artist
+leaves it: DRT's rays, like Cycles', start on the floor and meet the cube's coplanar
+bottom face (engine.embree.self_hits); until 2026-11-30 they passed it and the floor's
+indirect light was 9 % below Cycles' (Diffuse mean -0.004; since: -0.0011)."""
 import numpy as np
 import pytest
 

@@ -12,28 +12,37 @@ import numpy as np
 import pytest
 
 from engine.embree import library as L
-from engine.embree.rays import intersect_batch, occluded_batch
+from engine.embree.rays import intersect_batch, occluded_batch, target
 from engine.embree.scene import Scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 F32 = np.finfo(np.float32).eps
 
 
+def scene_target(scene, center=np.zeros(3)):
+    """The Target of a bare Scene (geometry ids as global ids, no instance rows)."""
+    k = len(scene.kinds)
+    return target(scene.handle, center, np.zeros(k, np.int64), np.full(k, -1, np.int64),
+                  scene.kinds.index("curves") if "curves" in scene.kinds else -1)
+
+
 def trace(scene, o, d, tmax=None, time=None, center=np.zeros(3)):
     n = len(o)
     out = [np.empty(n, np.int64) for _ in range(4)] + [np.empty(n) for _ in range(3)]
-    intersect_batch(scene.handle, center, np.ascontiguousarray(o, np.float64),
+    intersect_batch(scene_target(scene, center), np.ascontiguousarray(o, np.float64),
                     np.ascontiguousarray(d, np.float64),
                     np.full(n, np.inf) if tmax is None else np.asarray(tmax, np.float64),
-                    np.zeros(0) if time is None else np.asarray(time, np.float64), *out)
+                    np.zeros(0) if time is None else np.asarray(time, np.float64),
+                    np.zeros((0, 2), np.int64), *out)
     return dict(zip(("geom", "prim", "inst", "element", "t", "u", "v"), out))
 
 
 def blocked(scene, o, d, tmax, time=None):
     b = np.zeros(len(o), bool)
-    occluded_batch(scene.handle, np.zeros(3), np.ascontiguousarray(o, np.float64),
+    occluded_batch(scene_target(scene), np.ascontiguousarray(o, np.float64),
                    np.ascontiguousarray(d, np.float64), np.asarray(tmax, np.float64),
-                   np.zeros(0) if time is None else np.asarray(time, np.float64), b)
+                   np.zeros(0) if time is None else np.asarray(time, np.float64),
+                   np.zeros((0, 4), np.int64), b)
     return b
 
 

@@ -132,7 +132,9 @@ def test_needle_duplicate_and_tiny_triangles():
 
 def test_mesh_without_faces_and_objects_scaled_to_zero():
     """A mesh with vertices but no faces and a cube scaled to a point change nothing; a
-    cube scaled to zero height renders as the square it has become."""
+    cube scaled to zero height renders as the two coincident squares it has become: as
+    in Cycles, a ray leaving one meets the other at distance 0, so the lit square is
+    darker, speckled by its own shadow (tests/test_coincident_faces_vs_cycles.py)."""
     empty = TriangleMesh("no faces", np.random.default_rng(0).random((5, 3)),
                          np.zeros((0, 3), np.int32), np.zeros(0))
     from engine_scenes import box
@@ -149,7 +151,8 @@ def test_mesh_without_faces_and_objects_scaled_to_zero():
     square = _render(_lit_floor_scene([quad((0, 0, 1.0), (0.2, 0, 0), (0, 0.2, 0))]))
     print(f"squashed cube vs square: mean {squashed.mean():.5f} vs {square.mean():.5f}, "
           f"base {base.mean():.5f}")
-    assert abs(squashed.mean() / square.mean() - 1) < 0.01
+    assert np.isfinite(squashed).all() and squashed.min() >= 0.0
+    assert 0.8 < squashed.mean() / square.mean() < 1.0
     assert np.abs(squashed - base).max() > 0.05          # and it is there
 
 

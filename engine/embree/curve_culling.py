@@ -16,9 +16,11 @@ from __future__ import annotations
 import ctypes
 
 import numpy as np
-from numba import carray, cfunc, njit, types
-from numba.core import cgutils, config
+from numba import carray, njit, types
+from numba.core import cgutils
 from numba.extending import intrinsic
+
+from ..kernels.jit import filter_address as jit_filter_address
 
 # RTCFilterFunctionNArguments: int* valid, void* geometryUserPtr, context, RTCRayN* ray,
 # RTCHitN* hit, unsigned int N (each a 64-bit word here)
@@ -73,20 +75,7 @@ def _cull_python(args):
             _view(words[_HIT], 3 * n, ctypes.c_float), n)
 
 
-_FILTER = None
-
-
 def filter_address() -> int:
-    """The address of the compiled filter (RTCFilterFunctionN), compiled on first use (a
-    ctypes callback of the plain Python when kernels run uncompiled)."""
-    global _FILTER
-    if _FILTER is None:
-        if config.DISABLE_JIT:
-            proto = ctypes.CFUNCTYPE(None, ctypes.POINTER(ctypes.c_uint64))
-            _FILTER = proto(_cull_python)
-        else:
-            _FILTER = cfunc(types.void(types.CPointer(types.uint64)), cache=True,
-                            nopython=True)(_cull)
-    if config.DISABLE_JIT:
-        return ctypes.cast(_FILTER, ctypes.c_void_p).value
-    return _FILTER.address
+    """The address of the compiled filter (RTCFilterFunctionN), compiled on first use
+    (engine.kernels.jit.filter_address)."""
+    return jit_filter_address(_cull, _cull_python)

@@ -92,8 +92,10 @@ class Scene:
         self._device = device()
         self.handle = self._lib.rtcNewScene(self._device)
         check("rtcNewScene")
-        flags = (L.SCENE_FLAG_ROBUST if robust else 0) | (L.SCENE_FLAG_COMPACT if compact
-                                                          else 0)
+        # every scene takes the filter a query passes (engine.embree.self_hits)
+        flags = (L.SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS
+                 | (L.SCENE_FLAG_ROBUST if robust else 0)
+                 | (L.SCENE_FLAG_COMPACT if compact else 0))
         self._lib.rtcSetSceneFlags(self.handle, flags)
         self._lib.rtcSetSceneBuildQuality(self.handle, quality)
         self._keep: list = []          # every array Embree shares, and instanced scenes

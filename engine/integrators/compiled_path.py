@@ -28,7 +28,7 @@ from ..kernels.camera_rays import pack_camera
 from ..kernels.jit import Kernel
 from ..kernels.path_config import path_config
 from ..kernels.path_state import TracedScene, new_paths
-from ..kernels.ray_queues import NextQueue, ShadowQueue
+from ..kernels.ray_queues import next_queue, shadow_queue
 from ..kernels.path_vertex import shade
 from ..kernels.light_tally import add_transmitted, add_unoccluded, new_tally
 from ..kernels.path_weights import BSDF_ONLY, LIGHT_ONLY, MIS
@@ -156,7 +156,9 @@ class CompiledPathIntegrator:
                              d, tm, hits):
         """Closest hits seen through transparent layers and surfaces the rays do not see
         (engine.kernels.transparency); time: the rays' shutter times (None when nothing
-        moves). Returns (the hits (HitArrays), throughput factor (m, 3), stopped (m,))."""
+        moves). A ray going on beyond a layer starts on it, naming it (Accelerator.
+        intersect's skip). Returns (the hits (HitArrays), throughput factor (m, 3),
+        stopped (m,))."""
         m = len(live)
         found = HitArrays(hits.t.copy(), hits.prim.copy(), hits.inst.copy(), hits.u.copy(),
                           hits.v.copy())
@@ -165,6 +167,7 @@ class CompiledPathIntegrator:
         rows = np.arange(m, dtype=np.int64)
         cur = hits.arrays()
         out_rows, out_org, out_far = np.empty(m, np.int64), np.empty((m, 3)), np.empty(m)
+        out_skip = np.empty((m, 4), np.int64)
         cfg = self.cfg
         layer = 0
         seg_org = np.ascontiguousarray(o, np.float64)    # where the hits cur are measured from
@@ -172,38 +175,47 @@ class CompiledPathIntegrator:
             k = alpha_pass(depth, layer, self.transparent_limit, cfg.sampler, cfg.spp,
                            paths[0], paths[1], live, used, ray_bits, path_time, rows, seg_org,
                            d, tm, cur, travelled, factor, stopped,
-                           self.geometry, self.materials, out_rows, out_org, out_far)
+                           self.geometry, self.materials, out_rows, out_org, out_far,
+                           out_skip)
             if k == 0:
                 break
             rows = out_rows[:k].copy()
             seg_org = out_org[:k].copy()
             cur = self.ctx.accel.intersect(seg_org, d[rows], out_far[:k],
-                                           None if time is None else time[rows]).arrays()
+                                           None if time is None else time[rows],
+                                           out_skip[:k, :2]).arrays()
             merge_layer(rows, travelled, cur, found)
             layer += 1
         return found, factor, stopped
 
-    def shadow_transmittance(self, org, dirs, far, time, stacks, keys):
+    def shadow_transmittance(self, org, dirs, far, time, stacks, keys, skip=None):
         """Transmittance (n, 3) of shadow rays through transparent layers and volumes
         (stacks: each ray's volume stack, updated as it crosses boundaries; (0, STACK)
         without volumes); time: their shutter times (None when nothing moves); keys:
-        their random streams in heterogeneous media (empty without)."""
+        their random streams in heterogeneous media (empty without); skip (n, 2) or (n, 4):
+        what each ray must not hit (Accelerator.occluded's), None: nothing."""
         n = len(org)
         trans = np.ones((n, 3))
         rows = np.arange(n, dtype=np.int64)
         o, remaining = org, far
+        cur_skip = np.full((n, 4), -1, np.int64)
+        if skip is not None:
+            cur_skip[:, :skip.shape[1]] = skip
         out_rows, out_org, out_far = np.empty(n, np.int64), np.empty((n, 3)), np.empty(n)
+        out_skip = np.empty((n, 4), np.int64)
         ray_time = np.zeros(n) if time is None else np.ascontiguousarray(time, np.float64)
         layer = 0
         while rows.size:
             h = self.ctx.accel.intersect(o, dirs[rows], remaining,
-                                         None if time is None else time[rows])
+                                         None if time is None else time[rows],
+                                         cur_skip)
             k = shadow_pass(layer, self.transparent_limit, rows, o, dirs, ray_time,
                             remaining, h.arrays(), trans, self.geometry,
                             self.materials, self.vol, stacks, (keys, self.het_runs),
-                            out_rows, out_org, out_far)
+                            cur_skip, out_rows, out_org, out_far, out_skip)
             rows = out_rows[:k].copy()
             o, remaining = out_org[:k].copy(), out_far[:k].copy()
+            cur_skip = out_skip[:k].copy()
             layer += 1
         return trans
 
@@ -240,11 +252,8 @@ class CompiledPathIntegrator:
         tally = new_tally(n, ns_max, split and self.light_passes,
                           len(self.light_groups) if split else 0, self.group_tables)
         # the shadow rays a bounce queues (a copy of the volume stack each), the next rays
-        shadows = ShadowQueue(np.empty(ns_max, np.int64), np.empty((ns_max, 3)),
-                              np.empty((ns_max, 3)), np.empty(ns_max), np.empty((ns_max, 3)),
-                              np.empty(ns_max, np.int64),
-                              np.full((ns_max if k else 0, STACK), -1, np.int32))
-        nexts = NextQueue(np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 3)))
+        shadows = shadow_queue(ns_max, k > 0, STACK)
+        nexts = next_queue(n)
         no_keys = np.zeros(0, np.uint64)
         o = np.ascontiguousarray(origins, dtype=np.float64)
         d = np.ascontiguousarray(dirs, dtype=np.float64)
@@ -252,6 +261,7 @@ class CompiledPathIntegrator:
         # Numba, and load a second copy of the shading kernel (15 MB, 0.1 s per process)
         tm = np.array(np.broadcast_to(tmax, (n,)), dtype=np.float64)
         no_stop = np.zeros(n, bool)
+        skip = None                  # what the rays leave (camera rays: nothing)
         # one step per bounce, and per crossing of a volume's boundary
         steps = self.max_bounces + 1 + (VOLUME_BOUNDS_MAX if self.has_volumes else 0)
         for depth in range(steps):
@@ -259,7 +269,7 @@ class CompiledPathIntegrator:
                 break
             ray_time = path_time[live] if moving else None
             hits = (first_hits if depth == 0 and first_hits is not None
-                    else ctx.accel.intersect(o, d, tm, ray_time))
+                    else ctx.accel.intersect(o, d, tm, ray_time, skip))
             found, stopped = hits.arrays(), no_stop
             if self.any_transparent or self.skips_hits:
                 found, factor, stopped = self._through_transparent(
@@ -279,13 +289,15 @@ class CompiledPathIntegrator:
                             if self.heterogeneous else no_keys)
                     trans = self.shadow_transmittance(sh.org[:ns], sh.dir[:ns], sh.far[:ns],
                                                       sh_time,
-                                                      sh.stack[:ns] if k else sh.stack, keys)
+                                                      sh.stack[:ns] if k else sh.stack, keys,
+                                                      sh.skip[:ns])
                     add_transmitted(tally, sh.path[:ns], sh.contrib[:ns], trans, *clamps)
                 else:
                     blocked = ctx.accel.occluded(sh.org[:ns], sh.dir[:ns], sh.far[:ns],
-                                                 sh_time)
+                                                 sh_time, sh.skip[:ns])
                     add_unoccluded(tally, sh.path[:ns], sh.contrib[:ns], blocked, *clamps)
             live = nexts.path[:nn].copy()
             o, d = nexts.org[:nn].copy(), nexts.dir[:nn].copy()
+            skip = nexts.skip[:nn].copy()
             tm = np.full(nn, np.inf)
         return tally if split else tally.L

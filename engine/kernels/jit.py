@@ -372,6 +372,43 @@ def kernel(fn=None, *, allocates=True, **options):
     return compiled if fn is None else compiled(fn)
 
 
+def callback(py_func, sig):
+    """py_func as a C callback (Numba's cfunc, nopython), for Embree to call (its filter
+    functions: engine.embree.self_hits, curve_culling), loaded from or saved to the
+    engine's cache like every kernel: relocatable to any name of the engine package, and
+    read from the kernels an extension zip ships (Numba's own cfunc cache would pickle
+    the module's name and write beside the shipped kernels)."""
+    from numba.core import sigutils
+    from numba.core.ccallback import CFunc
+    made = CFunc(py_func, sigutils.normalize_signature(sig), locals={},
+                 options=dict(nopython=True))
+    if LOADS:
+        made._cache = EngineFunctionCache(py_func, ".cfunc")
+    made.compile()
+    return made
+
+
+_FILTERS: dict = {}
+
+
+def filter_address(py_func, plain) -> int:
+    """The address of an Embree filter function (RTCFilterFunctionN: one pointer to its
+    arguments): py_func as a `callback`, made once per process; when kernels run as plain
+    Python (NUMBA_DISABLE_JIT=1), a ctypes callback of `plain`, which reads the
+    arguments through ctypes."""
+    import ctypes
+    from numba.core import config
+    if py_func not in _FILTERS:
+        if config.DISABLE_JIT:
+            proto = ctypes.CFUNCTYPE(None, ctypes.POINTER(ctypes.c_uint64))
+            made = proto(plain)
+            _FILTERS[py_func] = (made, ctypes.cast(made, ctypes.c_void_p).value)
+        else:
+            made = callback(py_func, types.void(types.CPointer(types.uint64)))
+            _FILTERS[py_func] = (made, made.address)
+    return _FILTERS[py_func][1]
+
+
 def holds_array(ty) -> bool:
     """Whether a Numba type is, or is a tuple holding, an array."""
     if isinstance(ty, types.ArrayCompatible):

@@ -37,7 +37,6 @@ import math
 import numpy as np
 
 from .bsdf.principled import SUBSURFACE, TRANSMISSION
-from ..embree.rays import new_ray_record
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
@@ -57,7 +56,7 @@ from .medium_density import has_heterogeneous, heterogeneous_in, path_key, track
 from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium,
                      sample_method, segment, stack_cross, volume_dim)
 from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA, P_HOLDOUT, P_SETS_NORMAL
-from .surface import hit_uv, offset_origin, surface_at
+from .surface import hit_uv, surface_at
 from .terminator import shadow_origin
 from .surface_hit import material_row, run_program, surface_emission
 from .subsurface import walk_key
@@ -179,7 +178,9 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
     regs = np.zeros(max(textures[NREGS][0], 1))
     ns_out, nn_out = 0, 0
     base = D.FIRST_BOUNCE + depth * D.PER_BOUNCE
-    f_ray, w_ray = new_ray_record()           # for rays cast here (a subsurface walk)
+    # what shadow rays' origins read (terminator), taken out of the tuple once
+    positions, corners, corner_normals, objects, cutoff = (
+        geometry[0], geometry[1], geometry[4], geometry[9], geometry[13])
     for j in range(live.shape[0]):
         p = live[j]
         ox, oy, oz = ro[j, 0], ro[j, 1], ro[j, 2]
@@ -266,7 +267,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
             if alpha.shape[0] > 0:        # Cycles' holdout: a hole, for camera rays only
                 alpha[p] = uncovered(br, bg, bb)
             continue
-        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = surface_at(
+        px, py, pz, gx, gy, gz, nx, ny, nz, front, _ = surface_at(
             geometry, prim, hit_inst[j], hit_u[j], hit_v[j], ox, oy, oz, hit_t[j], dx, dy,
             dz, path_time[p])
         m = tri_material[prim]
@@ -275,8 +276,8 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
             stack_cross(stacks, p, m, front)
             cone_moves(path_info[1], p, t_geom)
             beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb
-            nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
-            nn_out = ray_queues.push_next(nexts, nn_out, p, nox, noy, noz, dx, dy, dz)
+            nn_out = ray_queues.push_next(nexts, nn_out, p, px, py, pz, dx, dy, dz, prim,
+                                          hit_inst[j])
             continue
         if cont[p] == 0.0 and not may_emit(textures, emission, m):
             continue                      # ended by the roulette, and nothing to find here
@@ -377,10 +378,9 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
             # under the triangle's own plane but above its smooth normal lights it, its
             # shadow ray leaving from the curved surface the normals describe
             if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and max(fr, fg, fb) > 0.0:
-                sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[4],
-                                              geometry[13], geometry[9], prim, hit_inst[j],
-                                              hit_u[j], hit_v[j], px, py, pz, gx, gy, gz,
-                                              s0x, s0y, s0z, scale, wx, wy, wz)
+                sox, soy, soz, own = shadow_origin(
+                    positions, corners, corner_normals, cutoff, objects, prim, hit_inst[j],
+                    hit_u[j], hit_v[j], px, py, pz, gx, gy, gz, s0x, s0y, s0z, wx, wy, wz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy,
                                                          wz, dist, margin, scene_radius)
                 bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
@@ -398,7 +398,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                 else:
                     ns_out = ray_queues.push(shadows, ns_out, p, b, sox, soy, soz, sdx, sdy,
                                              sdz, far, br * fr * lr * w, bg * fg * lg * w,
-                                             bb * fb * lb * w, stacks)
+                                             bb * fb * lb * w, stacks, own, hit_inst[j])
                     tl.queued(tally, ns_out - 1, p, b, shares, group)
                     if (vol.shape[0] > 0 and vol[m, V_HAS] != 0.0
                             and dot(wx, wy, wz, gx, gy, gz) < 0.0):
@@ -420,9 +420,9 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                     tl.left_first(tally, p, tl.DIFFUSE_SHARES)
                 cone_moves(path_info[1], p, t_geom)
                 ns_out, nn_out = scatter_below(
-                    cfg, walk_key(pkey[p], index[p], depth), p, paths, sss, f_ray, w_ray,
+                    cfg, walk_key(pkey[p], index[p], depth), p, paths, sss,
                     geometry, row, prim, hit_inst[j], px, py, pz, gx, gy, gz, nx, ny, nz,
-                    scale, dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, tally, lights,
+                    dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, tally, lights,
                     shadows, ns_out, nexts, nn_out, programs, params, hit_row, regs)
             continue
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
@@ -458,9 +458,9 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         ray_bits[p] = DIFFUSE_BIT << skind     # diffuse, glossy, transmission: 2, 4, 8
         if not sdelta:
             min_pdf[p] = min(min_pdf[p], spdf)
-        nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
         cone_moves(path_info[1], p, t_geom)
-        nn_out = ray_queues.push_next(nexts, nn_out, p, nox, noy, noz, wx, wy, wz)
+        nn_out = ray_queues.push_next(nexts, nn_out, p, px, py, pz, wx, wy, wz, prim,
+                                      hit_inst[j])
         keep_receiver(prev_pos, p, recv)
         prev_pdf[p] = _INF if sdelta else spdf
     return ns_out, nn_out

@@ -1,7 +1,9 @@
 """The rays the shading stages queue for the next Embree queries: the shadow rays of
-next-event estimation, from a surface point (its origin offset off the surface) or a
-point in a volume towards a sampled light point or direction, and each continuing
-path's next ray; the caller traces them after the stage."""
+next-event estimation, from a surface point or a point in a volume towards a sampled
+light point or direction, and each continuing path's next ray; the caller traces them
+after the stage. A ray leaving a surface starts on it (engine.kernels.ray_origin) and
+names what it must not hit (engine.embree.self_hits): the global primitive and place
+it leaves (-1, -1 from a point in a volume)."""
 from __future__ import annotations
 
 import math
@@ -34,7 +36,9 @@ def towards(sox, soy, soz, px, py, pz, wx, wy, wz, dist, margin, scene_radius):
 class ShadowQueue(NamedTuple):
     """The shadow rays one bounce queues: each one's path, origin, direction, length,
     contribution if unoccluded, the bounce of the vertex it left (the clamp that applies)
-    and a copy of the path's volume stack (no rows without media)."""
+    and a copy of the path's volume stack (no rows without media); skip: the primitive
+    and place it leaves, and the emissive triangle and place it goes to (n, 4; -1:
+    none)."""
     path: np.ndarray
     org: np.ndarray
     dir: np.ndarray
@@ -42,21 +46,40 @@ class ShadowQueue(NamedTuple):
     contrib: np.ndarray
     bounce: np.ndarray
     stack: np.ndarray
+    skip: np.ndarray
 
 
 class NextQueue(NamedTuple):
-    """The continuing paths' next rays: each one's path, origin and direction."""
+    """The continuing paths' next rays: each one's path, origin and direction, and the
+    primitive and place it leaves (n, 2; -1: none)."""
     path: np.ndarray
     org: np.ndarray
     dir: np.ndarray
+    skip: np.ndarray
+
+
+def shadow_queue(n: int, stacks: bool, stack_size: int) -> ShadowQueue:
+    """An empty ShadowQueue for n rays (volume stacks copied only if `stacks`)."""
+    return ShadowQueue(np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 3)),
+                       np.empty(n), np.empty((n, 3)), np.empty(n, np.int64),
+                       np.full((n if stacks else 0, stack_size), -1, np.int32),
+                       np.empty((n, 4), np.int64))
+
+
+def next_queue(n: int) -> NextQueue:
+    """An empty NextQueue for n rays."""
+    return NextQueue(np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 3)),
+                     np.empty((n, 2), np.int64))
 
 
 @kernel(allocates=False)
-def push(q, n, p, b, ox, oy, oz, dx, dy, dz, far, cr, cg, cb, stacks):
+def push(q, n, p, b, ox, oy, oz, dx, dy, dz, far, cr, cg, cb, stacks, prim=-1, inst=-1):
     """Write shadow ray n of path p at its bounce b (contribution c if unoccluded; the
-    clamp that applies depends on b) to the ShadowQueue q, with a copy of the path's
-    volume stack when the scene has volumes. Returns n + 1."""
+    clamp that applies depends on b), leaving primitive prim of place inst (-1: none),
+    to the ShadowQueue q, with a copy of the path's volume stack when the scene has
+    volumes. Returns n + 1."""
     q.path[n] = p
+    q.skip[n, 0], q.skip[n, 1], q.skip[n, 2], q.skip[n, 3] = prim, inst, -1, -1
     q.bounce[n] = b
     q.org[n, 0], q.org[n, 1], q.org[n, 2] = ox, oy, oz
     q.dir[n, 0], q.dir[n, 1], q.dir[n, 2] = dx, dy, dz
@@ -69,9 +92,11 @@ def push(q, n, p, b, ox, oy, oz, dx, dy, dz, far, cr, cg, cb, stacks):
 
 
 @kernel(allocates=False)
-def push_next(q, n, p, ox, oy, oz, dx, dy, dz):
-    """Write next ray n to the NextQueue q: path p goes on from o along d. Returns n + 1."""
+def push_next(q, n, p, ox, oy, oz, dx, dy, dz, prim=-1, inst=-1):
+    """Write next ray n to the NextQueue q: path p goes on from o along d, leaving
+    primitive prim of place inst (-1: none). Returns n + 1."""
     q.path[n] = p
+    q.skip[n, 0], q.skip[n, 1] = prim, inst
     q.org[n, 0], q.org[n, 1], q.org[n, 2] = ox, oy, oz
     q.dir[n, 0], q.dir[n, 1], q.dir[n, 2] = dx, dy, dz
     return n + 1

@@ -146,17 +146,19 @@ def object_of(mesh_start, prim):
 
 
 @kernel(allocates=False)
-def local_hit(rays, f, w, mesh, inst, ox, oy, oz, dx, dy, dz, tmax, time):
+def local_hit(rays, rec, mesh, inst, ox, oy, oz, dx, dy, dz, tmax, time, skip=-1):
     """The first hit within tmax of the surface of mesh `mesh` placed as instance `inst`
-    (-1: not instanced) along o + t d, passing other objects' triangles. rays: (Embree
-    scene handle, centre, geometry id -> first global triangle, geometry id -> first
-    object-table row, each mesh's first global triangle). Returns (prim, inst, t, u, v);
-    prim -1 when nothing is hit."""
-    handle, center, geom_base, geom_row, mesh_start = rays
+    (-1: not instanced) along o + t d, passing other objects' triangles and triangle
+    `skip` of the mesh (the one the ray leaves; -1: none). rays: (the scene's
+    engine.embree.rays.Target, each mesh's first global triangle); rec: a RayRecord of
+    it. Returns (prim, inst, t, u, v); prim -1 when nothing is hit."""
+    tg, mesh_start = rays
+    center, geom_base, geom_row = tg.center, tg.geom_base, tg.geom_row
     tnear = 0.0
     for _ in range(MAX_SKIPS):
-        g, pr, k, e, t, u, v = intersect1(handle, f, w, ox - center[0], oy - center[1],
-                                          oz - center[2], dx, dy, dz, tnear, tmax, time)
+        g, pr, k, e, t, u, v = intersect1(tg.handle, rec, ox - center[0], oy - center[1],
+                                          oz - center[2], dx, dy, dz, tnear, tmax, time,
+                                          skip, inst)
         if g < 0:
             return -1, -1, math.inf, 0.0, 0.0
         owner = k if k >= 0 else g
@@ -191,10 +193,11 @@ def _from_cosine(nx, ny, nz, cos_theta, u):
 
 
 @kernel(allocates=False)
-def walk(rays, f, w, key, time, mesh, inst, px, py, pz, dx, dy, dz, nx, ny, nz, albedo,
-         radius, g, beta, guided_walk):
-    """Walk from p (just inside the surface) along d, the surface's normal at the entry
-    being n (outward). albedo, radius (walk_radius), beta: per channel (3-tuples); g the
+def walk(rays, rec, key, time, mesh, inst, entry, px, py, pz, dx, dy, dz, nx, ny, nz,
+         albedo, radius, g, beta, guided_walk):
+    """Walk from p along d into the surface, the surface's normal at the entry being n
+    (outward); the first ray names the triangle `entry` it leaves (-1: none, p is
+    inside already). albedo, radius (walk_radius), beta: per channel (3-tuples); g the
     anisotropy (clamped to [0, 0.9]); guided_walk False: the classic walk alone (a test's
     second estimator). Returns (left, prim, inst, u, v, dx, dy, dz, throughput r, g, b):
     the exit hit and the direction it was reached along."""
@@ -263,8 +266,9 @@ def walk(rays, f, w, key, time, mesh, inst, px, py, pz, dx, dy, dz, nx, ny, nz, 
                 sample_st *= back_stretch if backward else fwd_stretch
         t = -math.log(max(1.0 - stream_uniform(key, step, 5), 1e-300)) / sample_st
         reach = max(t, 10.0 / min(e0, min(e1, e2))) if step == 0 else t
-        k_prim, k_inst, t_hit, k_u, k_v = local_hit(rays, f, w, mesh, inst, ox, oy, oz,
-                                                    dx, dy, dz, reach, time)
+        k_prim, k_inst, t_hit, k_u, k_v = local_hit(rays, rec, mesh, inst, ox, oy, oz,
+                                                    dx, dy, dz, reach, time,
+                                                    entry if step == 0 else -1)
         hit = k_prim >= 0
         if step == 0 and hit:
             # the first ray looks ten mean free paths ahead for the opposite side
@@ -323,10 +327,10 @@ def walk_batch(rays, keys, mesh, start, direction, normal, albedo, radius, g, gu
     key, for tests: out (n, 5) gets (left, throughput r, g, b, exit triangle) per walk,
     the path's throughput on entry the albedo (as the lobe's weight makes it), so the
     mean throughput is the reflectance."""
-    f, w = new_ray_record()
+    rec = new_ray_record(rays[0])
     for i in range(keys.shape[0]):
         left, prim, _, _, _, _, _, _, tr, tg, tb = walk(
-            rays, f, w, keys[i], 0.0, mesh, -1, start[0], start[1], start[2], direction[0],
+            rays, rec, keys[i], 0.0, mesh, -1, -1, start[0], start[1], start[2], direction[0],
             direction[1], direction[2], normal[0], normal[1], normal[2], albedo, radius, g,
             albedo, guided_walk)
         out[i, 0] = 1.0 if left else 0.0

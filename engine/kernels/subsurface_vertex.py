@@ -39,7 +39,8 @@ from ..sampling.hashing import stream_uniform
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, keep_receiver,
                            nee_weight, roulette)
 from .subsurface import MAX_BOUNCES, object_of, walk, walk_radius
-from .surface import hit_uv, offset_origin, rebuild_at_time
+from ..embree.rays import new_ray_record
+from .surface import hit_uv, rebuild_at_time
 from .surface_hit import run_program
 from .terminator import shadow_origin
 from .warp import INV_PI, cosine_hemisphere
@@ -95,15 +96,16 @@ def walk_params(row):
 
 
 @kernel(allocates=False)
-def scatter_below(cfg, key, p, paths, rays, f, w, geometry, row, prim, inst, px, py, pz,
-                  gx, gy, gz, nx, ny, nz, scale, dx, dy, dz, u1, u2, br, bg, bb, tally,
+def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, pz,
+                  gx, gy, gz, nx, ny, nz, dx, dy, dz, u1, u2, br, bg, bb, tally,
                   lights, shadows, ns, nexts, nn, programs, params, hit_row, regs):
     """Path p (throughput b, the lobe's weight included) enters the surface it hit at p
     (triangle prim of instance inst; geometric normal g and shading normal n facing the
-    ray along d), walks, and leaves: queues at most one shadow ray (count ns) and one
-    next ray (count nn), as path_vertex.shade does. key: the walk's stream
-    (subsurface.walk_key); rays: the scene for rays cast here (subsurface.local_hit);
-    f, w: a ray record (engine.embree.rays). programs (None in a scene without shader
+    ray along d), walks from p, its first ray naming prim
+    (as Cycles' walk starts), and leaves: queues at most one shadow ray (count ns) and
+    one next ray (count nn), as path_vertex.shade does. key: the walk's stream
+    (subsurface.walk_key); rays: the scene for rays cast here (subsurface.local_hit).
+    programs (None in a scene without shader
     programs), params, hit_row, regs: what the exit's material program reads and writes
     (path_vertex.shade's), run there for the normal it bends. paths: the paths' state
     (path_state.PathState), updated for path p."""
@@ -115,15 +117,14 @@ def scatter_below(cfg, key, p, paths, rays, f, w, geometry, row, prim, inst, px,
     if not ok or dot(ex_dx, ex_dy, ex_dz, gx, gy, gz) >= 0.0:
         return ns, nn
     albedo, radius, g = walk_params(row)
-    sx, sy, sz = offset_origin(px, py, pz, gx, gy, gz, scale, ex_dx, ex_dy, ex_dz)
-    mesh = object_of(rays[4], prim)
+    mesh = object_of(rays[1], prim)
     left, prim2, inst2, u, v, wdx, wdy, wdz, tr, tg, tb = walk(
-        rays, f, w, key, time, mesh, inst, sx, sy, sz, ex_dx, ex_dy, ex_dz, nx, ny, nz,
-        albedo, radius, g, (br, bg, bb), True)
+        rays, new_ray_record(rays[0]), key, time, mesh, inst, prim, px, py, pz, ex_dx,
+        ex_dy, ex_dz, nx, ny, nz, albedo, radius, g, (br, bg, bb), True)
     if not left or not max(tr, tg, tb) > 0.0:
         return ns, nn
     # the exit, seen from outside along the walk's last direction reversed
-    qx, qy, qz, hx, hy, hz, mx, my, mz, front2, escale = rebuild_at_time(
+    qx, qy, qz, hx, hy, hz, mx, my, mz, front2, _ = rebuild_at_time(
         geometry, prim2, inst2, u, v, -wdx, -wdy, -wdz, time)
     b = bounce[p]
     n0x, n0y, n0z = mx, my, mz          # the surface's own normal (shadow rays leave by it)
@@ -164,14 +165,13 @@ def scatter_below(cfg, key, p, paths, rays, f, w, geometry, row, prim, inst, px,
                 clamp = cfg.clamp_direct if b == 0 else cfg.clamp_indirect
                 tl.lit(tally, p, b, cr, cg, cb, clamp, DIFFUSE_SHARES, tl.entry_group(tally, k))
             else:
-                sox, soy, soz = shadow_origin(geometry[0], geometry[1], geometry[4],
-                                              geometry[13], geometry[9], prim2, inst2, u, v,
-                                              qx, qy, qz, hx, hy, hz, n0x, n0y, n0z,
-                                              escale, lx, ly, lz)
+                sox, soy, soz, own = shadow_origin(
+                    geometry[0], geometry[1], geometry[4], geometry[13], geometry[9], prim2,
+                    inst2, u, v, qx, qy, qz, hx, hy, hz, n0x, n0y, n0z, lx, ly, lz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, qx, qy, qz, lx, ly,
                                                          lz, dist, margin, cfg.scene_radius)
-                ns = ray_queues.push(shadows, ns, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr, cg,
-                                      cb, stacks)
+                ns = ray_queues.push(shadows, ns, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr,
+                                     cg, cb, stacks, own, inst2)
                 tl.queued(tally, ns - 1, p, b, DIFFUSE_SHARES, tl.entry_group(tally, k))
     if not goes_on:
         return ns, nn
@@ -197,5 +197,4 @@ def scatter_below(cfg, key, p, paths, rays, f, w, geometry, row, prim, inst, px,
     min_pdf[p] = min(min_pdf[p], pdf)
     keep_receiver(prev_pos, p, recv)
     prev_pdf[p] = pdf
-    nox, noy, noz = offset_origin(qx, qy, qz, hx, hy, hz, escale, ox, oy, oz)
-    return ns, ray_queues.push_next(nexts, nn, p, nox, noy, noz, ox, oy, oz)
+    return ns, ray_queues.push_next(nexts, nn, p, qx, qy, qz, ox, oy, oz, prim2, inst2)

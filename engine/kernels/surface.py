@@ -1,15 +1,14 @@
-"""Surface interactions rebuilt in float64 from Embree's hit, and safe ray origins: the
-compiled form of `engine.surface` (same formulas, one hit at a time), for static
-triangles (`rebuild`), and for triangles of instanced meshes placed by their instance
-and of moving objects placed at the ray's time (`rebuild_at_time`). See that module for why hit points come from barycentrics and why
-the ray offset is relative to the coordinates' magnitude."""
+"""Surface interactions rebuilt in float64 from Embree's hit: the compiled form of
+`engine.surface`, for static triangles (`rebuild`), and for triangles of instanced meshes
+placed by their instance and of moving objects placed at the ray's time
+(`rebuild_at_time`). See that module for why hit points come from barycentrics; where
+rays leaving them start: engine.kernels.ray_origin."""
 from __future__ import annotations
 
 import math
 
 import numpy as np
 
-from ..surface import RELATIVE_OFFSET
 from .curve_hit import curve_surface, is_curve
 from .frame import cross, dot
 from .jit import kernel
@@ -22,11 +21,11 @@ from ..nodes.context import O_TO_OBJECT, O_TO_WORLD
 def rebuild(positions, corners, center, corner_normals, prim, u, v, dx, dy, dz):
     """The hit of a ray with direction d on static triangle `prim` at barycentrics (u, v):
     its corners are rows corners[prim] of positions (engine.surface.SurfaceBuilder), its
-    unit normal and offset scale computed here as SurfaceBuilder computes them (the
+    unit normal and error scale computed here as SurfaceBuilder computes them (the
     scale relative to the static scene's centre `center`).
     corner_normals is (T, 3, 3) float32, or empty for flat shading everywhere.
     Returns (position, geometric normal facing the ray, shading normal on that side,
-    front_facing, offset scale)."""
+    front_facing, error scale)."""
     w = 1.0 - u - v
     i0, i1, i2 = corners[prim, 0], corners[prim, 1], corners[prim, 2]
     p0x, p0y, p0z = positions[i0, 0], positions[i0, 1], positions[i0, 2]
@@ -139,7 +138,7 @@ def surface_at(geometry, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz, time):
     """The hit of the ray o + t d on primitive `prim` at (u, v): a triangle's
     (`rebuild_at_time`, which needs only d) or a hair strand's (engine.kernels.curve_hit,
     geometry[15], whose point comes from the ray). Returns (position, geometric normal
-    facing the ray, shading normal, front_facing, offset scale)."""
+    facing the ray, shading normal, front_facing, error scale)."""
     C = geometry[15]
     if is_curve(C, prim):
         return curve_surface(C, geometry[2], prim, u, ox, oy, oz, t, dx, dy, dz)
@@ -159,7 +158,7 @@ def _between(verts, a, b, f):
 def _rebuild_placed(positions, corners, center, corner_normals, o, prim, u, v, dx, dy, dz):
     """`rebuild` for triangle prim of an instanced mesh (object-space rows of positions)
     at the place of object row o (engine.nodes.context: O_TO_WORLD its matrix, O_TO_OBJECT
-    the inverse, whose transpose places normals). The offset scale bounds both the world
+    the inverse, whose transpose places normals). The error scale bounds both the world
     corners' distance from `center` and the float32 error of the object-space corners
     Embree intersects, carried into the world by the matrix. A mirroring place
     (determinant < 0) turns the placed triangle's winding over; its geometric normal is
@@ -247,7 +246,7 @@ def rebuild_batch(geometry, prim, inst, u, v, o, t, d, time, position, geometric
                   front, scale):
     """`surface_at` for n hits of the rays o + t d (time may be empty: 0): writes the hit
     points, the geometric and shading normals facing the rays (n, 3), front (n,) and the
-    offset scales (n,). What engine.surface.SurfaceBuilder.build returns, compiled once."""
+    error scales (n,). What engine.surface.SurfaceBuilder.build returns, compiled once."""
     timed = time.shape[0] > 0
     for i in range(prim.shape[0]):
         px, py, pz, gx, gy, gz, sx, sy, sz, fr, sc = surface_at(
@@ -265,14 +264,6 @@ def _place(verts, row, a00, a01, a02, a10, a11, a12, a20, a21, a22, tx, ty, tz):
     x, y, z = verts[row, 0], verts[row, 1], verts[row, 2]
     return (a00 * x + a01 * y + a02 * z + tx, a10 * x + a11 * y + a12 * z + ty,
             a20 * x + a21 * y + a22 * z + tz)
-
-
-@kernel(allocates=False)
-def offset_origin(px, py, pz, nx, ny, nz, scale, dx, dy, dz):
-    """The origin of a ray leaving p along d: p pushed along n to d's side."""
-    side = 1.0 if dot(nx, ny, nz, dx, dy, dz) >= 0.0 else -1.0
-    eps = RELATIVE_OFFSET * max(scale, 1e-30) * side
-    return px + nx * eps, py + ny * eps, pz + nz * eps
 
 
 @kernel(allocates=False)

@@ -12,8 +12,8 @@ edges), bounded by each corner's tangent plane. The lift fades in as the light n
 triangle's plane: fully when the light is under it, not at all once the cosine to the
 plane exceeds the object's Shadow Terminator > Geometry Offset (0.1 by default; 0 turns
 it off). A shadow ray lifted towards a light under the plane may still hit its own
-triangle (Cycles then does not skip it); one towards a light above is pushed off the
-triangle as every ray is (`surface.offset_origin`).
+triangle (Cycles then does not name it); any other starts on its triangle and names
+it, as every ray does (engine.embree.self_hits).
 
 `cutoff` holds each triangle's Geometry Offset, 0 where there is nothing to lift: flat
 shading, a moving object's triangles (their corners are placed per ray elsewhere), an
@@ -28,7 +28,6 @@ import numpy as np
 from ..nodes.context import O_NORMAL, to_world_direction
 from .frame import dot
 from .jit import kernel
-from .surface import offset_origin
 
 
 @kernel(inline="always")
@@ -95,12 +94,13 @@ def _placed_lift(positions, corners, c, o, prim, u, v, fx, fy, fz):
 
 @kernel(allocates=False)
 def shadow_origin(positions, corners, corner_normals, cutoff, objects, prim, inst, u, v, px,
-                  py, pz, gx, gy, gz, nx, ny, nz, scale, wx, wy, wz):
+                  py, pz, gx, gy, gz, nx, ny, nz, wx, wy, wz):
     """The origin of a shadow ray from hit p (barycentrics (u, v) of triangle prim, whose
     corners are rows corners[prim] of positions (engine.surface.SurfaceBuilder);
     geometric normal g and the surface's own shading normal n, both facing the incoming
-    ray) towards the light direction w (unit). inst: the hit's instance, its row of
-    `objects` (-1: a mesh in world space)."""
+    ray) towards the light direction w (unit), and the primitive it names (prim, or -1
+    when it may hit its own triangle). inst: the hit's instance, its row of `objects`
+    (-1: a mesh in world space)."""
     off = cutoff[prim] if cutoff.shape[0] > 0 else 0.0
     if off > 0.0:
         nl = dot(nx, ny, nz, wx, wy, wz)
@@ -121,5 +121,5 @@ def shadow_origin(positions, corners, corner_normals, cutoff, objects, prim, ins
                                           prim, u, v, fx, fy, fz)
             px, py, pz = px + lx * amount, py + ly * amount, pz + lz * amount
             if not ngl > 0.0:
-                return px, py, pz    # the light is under the plane: its own triangle counts
-    return offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
+                return px, py, pz, -1    # the light is under the plane: its own triangle counts
+    return px, py, pz, prim

@@ -21,7 +21,12 @@ time of the ray's path (`path_time` per path, `ray_time` per shadow ray).
 
 The same passes skip the surfaces a ray does not see (Ray Visibility): a camera or bounce
 ray goes on through a triangle lacking its kind's bit, a shadow ray through one lacking
-SHADOW, untinted and without counting a transparent bounce."""
+SHADOW, untinted and without counting a transparent bounce.
+
+A ray going on beyond a surface starts on it and names it, so that the next query passes
+it (engine.embree.self_hits); a shadow ray keeps naming the
+emissive triangle it goes to. The rays that go on are written to `out`: (row, origin
+(n, 3), remaining distance, what it names (n, 4))."""
 from __future__ import annotations
 
 import numpy as np
@@ -29,7 +34,7 @@ import numpy as np
 from .. import visibility
 from ..sampling.dispatch import sample_1d
 from .jit import kernel
-from .surface import hit_uv, offset_origin, surface_at
+from .surface import hit_uv, surface_at
 from .textures import alpha_at
 from .medium_density import attenuate_tracked, has_heterogeneous, heterogeneous_in
 from .volume import V_BOUNDARY, attenuate, stack_cross
@@ -56,7 +61,7 @@ def _hit_alpha(geometry, materials, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz,
     vertex), its material and its surface point."""
     tri_material, corner_uvs = geometry[3], geometry[6]
     _, _, alpha_table, _, T, _ = materials
-    px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = surface_at(
+    px, py, pz, gx, gy, gz, nx, ny, nz, front, _ = surface_at(
         geometry, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz, time)
     uu, vv = hit_uv(corner_uvs, prim, u, v)
     m = tri_material[prim]
@@ -67,47 +72,49 @@ def _hit_alpha(geometry, materials, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz,
         program_hit(T, geometry, m, prim, inst, u, v, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
                     dx, dy, dz, front, ray, depth, length, hit, regs)
         a = program_alpha(T, m, regs, a)
-    return a, m, px, py, pz, gx, gy, gz, scale
+    return a, m, px, py, pz, gx, gy, gz
 
 
 @kernel(allocates=False)
-def _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, dx, dy, dz,
-          far):
-    """Entry n_out of out_*: ray r goes on from just beyond the surface point p (geometric
-    normal g), for a remaining distance `far`."""
-    ox, oy, oz = offset_origin(px, py, pz, gx, gy, gz, scale, dx, dy, dz)
+def _emit(out, n_out, r, prim, inst, px, py, pz, far, light):
+    """Entry n_out of `out`: ray r goes on from the surface point p of primitive prim of
+    place inst, naming it and `light` (the emissive triangle and place a shadow ray goes
+    to), for a remaining distance `far`."""
+    out_rows, out_org, out_far, out_skip = out
     out_rows[n_out] = r
-    out_org[n_out, 0], out_org[n_out, 1], out_org[n_out, 2] = ox, oy, oz
+    out_org[n_out, 0], out_org[n_out, 1], out_org[n_out, 2] = px, py, pz
     out_far[n_out] = max(far, 0.0)
+    out_skip[n_out, 0], out_skip[n_out, 1] = prim, inst
+    out_skip[n_out, 2], out_skip[n_out, 3] = light
 
 
 @kernel(allocates=False)
-def _pass_through(geometry, prim, inst, u, v, ox, oy, oz, t, d, r, time, far, out_rows,
-                  out_org, out_far, n_out):
+def _pass_through(geometry, prim, inst, u, v, ox, oy, oz, t, d, r, time, far, out, n_out,
+                  light):
     """Ray r (origin o, direction d[r]) goes on, unchanged, beyond the surface it hit at
     t; returns whether it hit the surface's front."""
     dx, dy, dz = d[r, 0], d[r, 1], d[r, 2]
-    px, py, pz, gx, gy, gz, _, _, _, front, scale = surface_at(
+    px, py, pz, _, _, _, _, _, _, front, _ = surface_at(
         geometry, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz, time)
-    _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale, dx, dy, dz,
-          far)
+    _emit(out, n_out, r, prim, inst, px, py, pz, far, light)
     return front
 
 
 @kernel
 def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits, path_time,
                rows, ro, rd, tmax, cur, travelled, factor, stopped,
-               geometry, materials, out_rows, out_org, out_far):
+               geometry, materials, out_rows, out_org, out_far, out_skip):
     """One transparent layer for the camera or bounce rays `rows` (indices into the
     wavefront `live`) whose current closest hits are cur_*: each ray whose hit surface
     lets it through (a sampler number >= alpha) goes on beyond it, tinted, counting one
     transparent bounce of its path (`used`, per path); past `limit` such bounces the
     path stops. A ray whose kind (ray_bits, per path) does not see the hit triangle goes
     on beyond it as it is. ro: the origins the hits cur_* are measured from (row i's at
-    ro[i]). Writes the rays that go on (row, origin, remaining distance);
+    ro[i]). Writes the rays that go on (row, origin, remaining distance, what they name);
     returns their count."""
     tri_material, maybe_transparent, _, tcolor, _, tri_vis = materials
     cur_t, cur_prim, cur_inst, cur_u, cur_v = cur.t, cur.prim, cur.inst, cur.u, cur.v
+    out = (out_rows, out_org, out_far, out_skip)
     n_out = 0
     for i in range(rows.shape[0]):
         r = rows[i]
@@ -118,14 +125,14 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
             travelled[r] += cur_t[i]
             _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], ro[i, 0],
                           ro[i, 1], ro[i, 2], cur_t[i], rd, r, path_time[live[r]],
-                          tmax[r] - travelled[r], out_rows, out_org, out_far, n_out)
+                          tmax[r] - travelled[r], out, n_out, (-1, -1))
             n_out += 1
             continue
         if not maybe_transparent[tri_material[prim]]:
             continue
         dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
         p = live[r]
-        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(
+        a, m, px, py, pz, gx, gy, gz = _hit_alpha(
             geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], ro[i, 0], ro[i, 1],
             ro[i, 2], cur_t[i], dx, dy, dz, path_time[p],
             ray_bits[p], depth, travelled[r] + cur_t[i])
@@ -139,15 +146,15 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
         factor[r, 2] *= tcolor[m, 2]
         used[p] += 1
         travelled[r] += cur_t[i]
-        _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale,
-              dx, dy, dz, tmax[r] - travelled[r])
+        _emit(out, n_out, r, prim, cur_inst[i], px, py, pz, tmax[r] - travelled[r], (-1, -1))
         n_out += 1
     return n_out
 
 
 @kernel
-def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geometry, materials, vol, stacks, tracking, out_rows, out_org,
-                out_far):
+def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geometry,
+                materials, vol, stacks, tracking, skip, out_rows, out_org, out_far,
+                out_skip):
     """One layer of transparent shadows for the shadow rays `rows`: an opaque surface (or
     one past `limit` transparent layers) blocks; a transparent one multiplies the
     transmittance by (1 - alpha) x its transparent colour and the ray goes on; through a
@@ -156,10 +163,12 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
     and a volume's boundary is crossed (the stack updated) without counting a layer.
     so: the rows' origins (row i's at so[i]). tracking: (each shadow ray's random key,
     the heterogeneous program-run counter; engine.kernels.medium_density), used by the
-    rays whose media include a heterogeneous one (ratio tracking)."""
+    rays whose media include a heterogeneous one (ratio tracking). skip: what the rows
+    name (row i's at skip[i]: the layer it left, the emissive triangle it goes to)."""
     tri_material, maybe_transparent, _, tcolor, T, tri_vis = materials
     keys, het_count = tracking
     cur_t, cur_prim, cur_inst, cur_u, cur_v = cur.t, cur.prim, cur.inst, cur.u, cur.v
+    out = (out_rows, out_org, out_far, out_skip)
     het_scene = stacks.shape[0] > 0 and has_heterogeneous(vol)
     hit = np.zeros(N_HIT if het_scene else 0)
     regs = np.zeros(max(T[NREGS][0], 1) if het_scene else 0)
@@ -177,10 +186,11 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
             attenuate(vol, stacks, r, trans, remaining[i] if reached else cur_t[i])
         if reached:
             continue
+        light = (skip[i, 2], skip[i, 3])
         if vol.shape[0] > 0 and vol[tri_material[prim], V_BOUNDARY] != 0.0:
             front = _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], so[i, 0],
                                   so[i, 1], so[i, 2], cur_t[i], sd, r, ray_time[r],
-                                  remaining[i] - cur_t[i], out_rows, out_org, out_far, n_out)
+                                  remaining[i] - cur_t[i], out, n_out, light)
             n_out += 1
             if stacks.shape[0] > 0:
                 stack_cross(stacks, r, tri_material[prim], front)
@@ -188,14 +198,14 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
         if tri_vis.shape[0] > 0 and not tri_vis[prim] & SHADOW_BIT:
             _pass_through(geometry, prim, cur_inst[i], cur_u[i], cur_v[i], so[i, 0], so[i, 1],
                           so[i, 2], cur_t[i], sd, r, ray_time[r],
-                          remaining[i] - cur_t[i], out_rows, out_org, out_far, n_out)
+                          remaining[i] - cur_t[i], out, n_out, light)
             n_out += 1
             continue
         if not maybe_transparent[tri_material[prim]] or layer >= limit:
             trans[r, 0] = trans[r, 1] = trans[r, 2] = 0.0
             continue
         dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
-        a, m, px, py, pz, gx, gy, gz, scale = _hit_alpha(
+        a, m, px, py, pz, gx, gy, gz = _hit_alpha(
             geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], so[i, 0], so[i, 1],
             so[i, 2], cur_t[i], dx, dy, dz, ray_time[r],
             SHADOW_BIT, 0, cur_t[i])
@@ -204,8 +214,7 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
         trans[r, 2] *= (1.0 - a) * tcolor[m, 2]
         if not max(trans[r, 0], trans[r, 1], trans[r, 2]) > 0.0:
             continue
-        _emit(out_rows, out_org, out_far, n_out, r, px, py, pz, gx, gy, gz, scale,
-              dx, dy, dz, remaining[i] - cur_t[i])
+        _emit(out, n_out, r, prim, cur_inst[i], px, py, pz, remaining[i] - cur_t[i], light)
         n_out += 1
     return n_out
 

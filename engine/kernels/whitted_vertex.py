@@ -40,7 +40,7 @@ from .jit import kernel
 from .lights.light_set import sample_lamp_at
 from .lights.pack import C_TYPE, LAMPS, T_ENV, T_ENV_MAP
 from .path_weights import DIFFUSE_BIT, SHADOW_BIT, _add, holdout_share, uncovered
-from .surface import hit_uv, offset_origin, surface_at
+from .surface import hit_uv, surface_at
 from .surface_hit import material_row, run_program, surface_emission
 from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
@@ -140,7 +140,7 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
             if alpha.shape[0] > 0:        # Cycles' holdout: a hole, for camera rays only
                 alpha[p] = uncovered(br, bg, bb)
             continue
-        px, py, pz, gx, gy, gz, nx, ny, nz, front, scale = surface_at(
+        px, py, pz, gx, gy, gz, nx, ny, nz, front, _ = surface_at(
             geometry, prim, hit_inst[j], hit_u[j], hit_v[j], ox, oy, oz, hit_t[j], dx, dy,
             dz, path_time[p])
         m = tri_material[prim]
@@ -197,11 +197,10 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
             if not seen & SHADOW_BIT:            # a lamp casting no shadow
                 _add(tally.L, p, cr, cg, cb, clamp)
                 continue
-            sox, soy, soz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
-            sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy, wz,
+            sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz,
                                                      dist, 0.0, scene_radius)
-            ns_out = ray_queues.push(shadows, ns_out, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr,
-                                      cg, cb, stacks)
+            ns_out = ray_queues.push(shadows, ns_out, p, b, px, py, pz, sdx, sdy, sdz, far,
+                                     cr, cg, cb, stacks, prim, hit_inst[j])
         # 3. one ray of Whitted's tree: mirror reflection or refraction
         if b >= max_bounces:
             continue
@@ -227,7 +226,7 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
         counts[p, skind] += 1
         bounce[p] = b + 1
         ray_bits[p] = DIFFUSE_BIT << skind
-        nox, noy, noz = offset_origin(px, py, pz, gx, gy, gz, scale, wx, wy, wz)
         cone_moves(path_info[1], p, t_geom)
-        nn_out = ray_queues.push_next(nexts, nn_out, p, nox, noy, noz, wx, wy, wz)
+        nn_out = ray_queues.push_next(nexts, nn_out, p, px, py, pz, wx, wy, wz, prim,
+                                      hit_inst[j])
     return ns_out, nn_out
