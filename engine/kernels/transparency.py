@@ -24,8 +24,7 @@ ray goes on through a triangle lacking its kind's bit, a shadow ray through one 
 SHADOW, untinted and without counting a transparent bounce.
 
 A ray going on beyond a surface starts on it and names it, so that the next query passes
-it (engine.embree.self_hits); a shadow ray keeps naming the
-emissive triangle it goes to. The rays that go on are written to `out`: (row, origin
+it (engine.embree.self_hits); a shadow ray keeps naming the emissive triangle it goes to. The rays that go on are written to `out`: (row, origin
 (n, 3), remaining distance, what it names (n, 4))."""
 from __future__ import annotations
 
@@ -72,7 +71,7 @@ def _hit_alpha(geometry, materials, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz,
         program_hit(T, geometry, m, prim, inst, u, v, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
                     dx, dy, dz, front, ray, depth, length, hit, regs)
         a = program_alpha(T, m, regs, a)
-    return a, m, px, py, pz, gx, gy, gz
+    return a, m, px, py, pz
 
 
 @kernel(allocates=False)
@@ -132,7 +131,7 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
             continue
         dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
         p = live[r]
-        a, m, px, py, pz, gx, gy, gz = _hit_alpha(
+        a, m, px, py, pz = _hit_alpha(
             geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], ro[i, 0], ro[i, 1],
             ro[i, 2], cur_t[i], dx, dy, dz, path_time[p],
             ray_bits[p], depth, travelled[r] + cur_t[i])
@@ -205,7 +204,7 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
             trans[r, 0] = trans[r, 1] = trans[r, 2] = 0.0
             continue
         dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
-        a, m, px, py, pz, gx, gy, gz = _hit_alpha(
+        a, m, px, py, pz = _hit_alpha(
             geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], so[i, 0], so[i, 1],
             so[i, 2], cur_t[i], dx, dy, dz, ray_time[r],
             SHADOW_BIT, 0, cur_t[i])
