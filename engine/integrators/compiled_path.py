@@ -298,6 +298,7 @@ class CompiledPathIntegrator:
                     add_unoccluded(tally, sh.path[:ns], sh.contrib[:ns], blocked, *clamps)
             live = nexts.path[:nn].copy()
             o, d = nexts.org[:nn].copy(), nexts.dir[:nn].copy()
-            skip = nexts.skip[:nn].copy()
+            # a view: only the next query reads it, before shade writes the queue again
+            skip = nexts.skip[:nn]
             tm = np.full(nn, np.inf)
         return tally if split else tally.L
