@@ -62,6 +62,10 @@ class Material:
                   the coat, dimming what is below by its albedo; sheen_layered False: a
                   Sheen BSDF node's, added beside the rest (weight 1, tint its colour);
       translucent_color   a Translucent BSDF (diffuse transmission), its weight included;
+      hair_reflection, hair_transmission   a Hair BSDF node's Reflection and
+                  Transmission colours (weight included; black: none), beside the other
+                  lobes, with their _roughness (RoughnessU, RoughnessV) and _offset (the
+                  node's Offset, radians; it applies on strands only, as in Cycles);
       refraction_only     the glass lobe refracts without reflecting (Refraction BSDF).
 
     Subsurface scattering (compiled path tracer; Cycles' random walk,
@@ -109,6 +113,12 @@ class Material:
     sheen_tint: tuple = (1.0, 1.0, 1.0)
     sheen_layered: bool = True
     translucent_color: tuple = (0.0, 0.0, 0.0)
+    hair_reflection: tuple = (0.0, 0.0, 0.0)
+    hair_reflection_roughness: tuple = (0.1, 1.0)
+    hair_reflection_offset: float = 0.0
+    hair_transmission: tuple = (0.0, 0.0, 0.0)
+    hair_transmission_roughness: tuple = (0.1, 1.0)
+    hair_transmission_offset: float = 0.0
     refraction_only: bool = False
     bump_correction: bool = True
     sets_normal: bool = False            # the program's normal becomes the surface's own

@@ -48,15 +48,18 @@ class _Comp:
 
 NULL_COMP = _Comp(base=BLACK, spec=0.0)     # absorbs: an Emission shader's "no BSDF"
 
+HAIR_PARTS = ("hair_reflection", "hair_transmission")
 LAYER_FIELDS = ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",
-                "sheen_roughness", "sheen_tint", "sheen_layered", "translucent_color")
+                "sheen_roughness", "sheen_tint", "sheen_layered", "translucent_color") + \
+    tuple(p + k for p in HAIR_PARTS for k in ("", "_roughness", "_offset"))
 
 
 @dataclass
 class _Layers:
     """A closure's lobes beyond the Principled base, as engine.scene.Material fields:
     Principled's coat and sheen (layered over the base), a Sheen BSDF node's sheen
-    (sheen_layered False: beside the other closures) and a Translucent BSDF's colour."""
+    (sheen_layered False: beside the other closures), a Translucent BSDF's colour and a
+    Hair BSDF's components (colour, RoughnessU / V, Offset), beside the rest."""
     coat_weight: float = 0.0
     coat_roughness: float = 0.03
     coat_ior: float = 1.5
@@ -66,6 +69,12 @@ class _Layers:
     sheen_tint: tuple = WHITE
     sheen_layered: bool = True
     translucent_color: tuple = BLACK
+    hair_reflection: tuple = BLACK
+    hair_reflection_roughness: tuple = (0.1, 1.0)
+    hair_reflection_offset: float = 0.0
+    hair_transmission: tuple = BLACK
+    hair_transmission_roughness: tuple = (0.1, 1.0)
+    hair_transmission_offset: float = 0.0
 
 
 def _blend_layers(comps, ctx):
@@ -107,6 +116,15 @@ def _blend_layers(comps, ctx):
                       "layers the mixture's coat and sheen over all of them")
     out.translucent_color = _plain(sum(c * np.asarray(L.translucent_color, float)
                                        for c, L in with_layers))
+    for part in HAIR_PARTS:
+        # colours summed; roughness and offset averaged by the colours' weight
+        hw = [(c * max(getattr(L, part)), L) for c, L in with_layers
+              if max(getattr(L, part)) > 0]
+        setattr(out, part, _plain(sum(c * np.asarray(getattr(L, part), float)
+                                      for c, L in with_layers)))
+        if hw:
+            for name in (part + "_roughness", part + "_offset"):
+                setattr(out, name, avg(hw, name))
     return out
 
 
@@ -191,6 +209,8 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
             L = p["layers"] = replace(p["layers"])
             L.coat_weight, L.sheen_weight = L.coat_weight * total, L.sheen_weight * total
             L.translucent_color = _scale(L.translucent_color, total)
+            for part in HAIR_PARTS:
+                setattr(L, part, _scale(getattr(L, part), total))
     # emitted by the shaded part (probability W / total)
     emission = _scale(cl.emission, total / W)
     alpha_tex = cl.alpha_texture

@@ -159,6 +159,15 @@ class MaterialTable:
         self.sheen_roughness = scalar("sheen_roughness", 0.5)
         self.sheen_tint = colour("sheen_tint", (1.0, 1.0, 1.0))
         self.translucent_color = np.maximum(colour("translucent_color", (0.0, 0.0, 0.0)), 0.0)
+        # a Hair BSDF node's two components (engine/kernels/bsdf/hair.py)
+        for part in ("reflection", "transmission"):
+            name = "hair_" + part
+            setattr(self, name, np.maximum(colour(name, (0.0, 0.0, 0.0)), 0.0))
+            setattr(self, name + "_offset", scalar(name + "_offset", 0.0))
+            setattr(self, name + "_roughness", np.array(
+                [tuple(getattr(m, name + "_roughness", (0.1, 1.0)))[:2] for m in materials],
+                np.float64).reshape(-1, 2))
+        self.hair = (self.hair_reflection.max(1) > 0.0) | (self.hair_transmission.max(1) > 0.0)
         self.refraction_only = np.array([bool(getattr(m, "refraction_only", False))
                                          for m in materials], bool)
         self.sheen_layered = np.array([bool(getattr(m, "sheen_layered", True))
@@ -173,9 +182,13 @@ class MaterialTable:
              else float(np.clip(getattr(m, "holdout_weight", 0.0), 0.0, 1.0))
              for m in materials], np.float64)
         self.layered = ((self.coat_weight > 1e-5) | (self.sheen_weight > 1e-5)
-                        | (self.translucent_color.max(1) > 0.0) | self.refraction_only)
+                        | (self.translucent_color.max(1) > 0.0) | self.refraction_only
+                        | self.hair)
         for name in ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",
-                     "sheen_roughness", "sheen_tint", "translucent_color"):
+                     "sheen_roughness", "sheen_tint", "translucent_color", "hair_reflection",
+                     "hair_reflection_offset", "hair_reflection_roughness",
+                     "hair_transmission", "hair_transmission_offset",
+                     "hair_transmission_roughness"):
             _require_finite(materials, name, getattr(self, name))
 
     def _subsurface_params(self, materials):

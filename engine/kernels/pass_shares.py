@@ -5,7 +5,8 @@ what the first surface's lobes of each kind weigh (`lobe_colours`, the Color pas
 
 A share is the lobe kind's part of the BSDF's value f(wo, wi), per channel: its diffuse
 lobes (Lambert, sheen, translucency), its glossy reflection (specular, metal, coat, a
-glass's reflection) and its transmission (a glass's refraction), evaluated by
+glass's reflection, hair R) and its transmission (a glass's refraction, hair TT),
+evaluated by
 principled.eval_seen restricted to that kind. Where a Normal Map bends the normal, the
 diffuse part is path_vertex's bent_diffuse, as the light itself is."""
 from __future__ import annotations
@@ -124,9 +125,12 @@ def _channel_colours(state, woz, s, c):
     scale = state[layers.S_BASE_SCALE + c] if layered else 1.0
     d = state[S_DIFFUSE + c] + state[S_SSS + c]
     coat = 0.0
+    hair_r = hair_tt = 0.0
     if layered:
         d += state[layers.S_SHEEN_W + c] + state[layers.S_TRANS + c]
         coat = state[layers.S_EST_COAT]
+        # a Hair BSDF's colour (Cycles' albedo of its closures is their weight)
+        hair_r, hair_tt = state[layers.S_HAIR_R + c], state[layers.S_HAIR_TT + c]
     metal = 0.0
     if m > 0.0:
         # the lobe's albedo: Fresnel over the lobe (a Glossy BSDF's is its colour) times
@@ -134,6 +138,6 @@ def _channel_colours(state, woz, s, c):
         f0 = state[S_METAL_F0 + c]
         f = f0 if state[S_METAL_CONST] != 0.0 else f0 + (1.0 - f0) * s
         metal = m * f * state[S_MS_E] * state[S_MS_METAL + c]
-    g = scale * (state[S_W_SPEC] * state[S_E_SPEC] + metal + refl) + coat
-    t = scale * w_glass * (1.0 - F) * state[S_TINT + c]
+    g = scale * (state[S_W_SPEC] * state[S_E_SPEC] + metal + refl) + coat + hair_r
+    t = scale * w_glass * (1.0 - F) * state[S_TINT + c] + hair_tt
     return d, g, t

@@ -41,7 +41,8 @@ from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
 from .bsdf import principled as bsdf
-from .bsdf.state import S_WALTER
+from .bsdf.state import S_ANY_SIDE, S_WALTER
+from . import hair_tangent
 from . import ray_queues
 from .frame import dot, to_local, to_world
 from .jit import kernel
@@ -55,7 +56,8 @@ from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
 from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
 from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium,
                      sample_method, segment, stack_cross, volume_dim)
-from .bsdf.params import P_BUMP_CORRECTION, P_FILTER_ALPHA, P_HOLDOUT, P_SETS_NORMAL
+from .bsdf.params import (P_BUMP_CORRECTION, P_FILTER_ALPHA, P_HAIR, P_HOLDOUT,
+                          P_SETS_NORMAL)
 from .surface import hit_uv, surface_at
 from .terminator import shadow_origin
 from .surface_hit import material_row, run_program, surface_emission
@@ -328,15 +330,19 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         br, bg, bb = br / q, bg / q, bb / q
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
         material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)
+        if row[P_HAIR] != 0.0:           # a Hair BSDF: the fibre's direction at the hit
+            hair_tangent.write(geometry, prim, hit_inst[j], hit_u[j], hit_v[j], path_time[p],
+                               nx, ny, nz, row)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
         if b == 0 and tl.on(tally):
             d_col, g_col, t_col = lobe_colours(state, woz)
             tl.colours(tally, p, br, bg, bb, d_col, g_col, t_col)
-        # the point lights are picked for (lights/tree.py): light from below the surface
-        # counts where it transmits, or where a bent normal makes "below" uncertain
-        recv = lt.receiver(px, py, pz, nx, ny, nz,
-                           lt.TWO_SIDED if bent or bsdf.transmits(state) else lt.ONE_SIDED)
+        # the point lights are picked for (lights/tree.py), as Cycles' tree picks them:
+        # on the surface's own normal (sd->N, not a lobe's bent one), light from below it
+        # counting only where the surface transmits
+        recv = lt.receiver(px, py, pz, s0x, s0y, s0z,
+                           lt.TWO_SIDED if bsdf.transmits(state) else lt.ONE_SIDED)
         room = b < max_bounces
         ad = room and counts[p, 0] < cfg.diffuse_bounces
         ag = room and counts[p, 1] < cfg.glossy_bounces and keep_g
@@ -438,8 +444,10 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
             wg = max(wg + (dg - fd_g * c) / spdf, 0.0)
             wb = max(wb + (db - fd_b * c) / spdf, 0.0)
         side = dot(wx, wy, wz, gx, gy, gz)
-        if (side >= 0.0) if skind == TRANSMISSION else (side <= 0.0):
-            continue       # reflection leaves on the geometric normal's side, refraction through
+        if state[S_ANY_SIDE] == 0.0 and ((side >= 0.0) if skind == TRANSMISSION
+                                          else (side <= 0.0)):
+            continue       # reflection leaves on the geometric normal's side, refraction
+            #                through (a hair lobe's direction on either, as in Cycles)
         if b == 0 and tl.on(tally):
             tl.left_first(tally, p, bounce_shares(state, wox, woy, woz, ix, iy, iz, skind,
                                                   sdelta, bent, s0x, s0y, s0z, rx, ry, rz,

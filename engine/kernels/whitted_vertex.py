@@ -33,7 +33,9 @@ from ..sampling.dispatch import sample_1d
 from . import lights as lt
 from . import ray_queues
 from .bsdf import principled as bsdf
-from .bsdf.params import (P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_HOLDOUT, P_ROUGHNESS,
+from . import hair_tangent
+from .bsdf.state import S_ANY_SIDE
+from .bsdf.params import (P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_HAIR, P_HOLDOUT, P_ROUGHNESS,
                           P_SETS_NORMAL, P_SSS_WEIGHT, P_TRANSLUCENT)
 from .frame import dot, to_local, to_world
 from .jit import kernel
@@ -166,6 +168,9 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
         _add(tally.L, p, br * er, bg * eg, bb * eb, clamp_hit)
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
         material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)
+        if row[P_HAIR] != 0.0:           # a Hair BSDF: the fibre's direction at the hit
+            hair_tangent.write(geometry, prim, hit_inst[j], hit_u[j], hit_v[j], path_time[p],
+                               nx, ny, nz, row)
         row[P_SSS_WEIGHT] = 0.0          # Whitted's model: subsurface light is diffuse
         # 2. direct light: one shadow ray to each lamp's fixed point, on the lobes that
         # are not followed (diffuse, sheen, translucency)
@@ -217,8 +222,10 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
             continue
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
         side = dot(wx, wy, wz, gx, gy, gz)
-        if (side >= 0.0) if skind == TRANSMISSION else (side <= 0.0):
-            continue       # reflection leaves on the geometric normal's side, refraction through
+        if state[S_ANY_SIDE] == 0.0 and ((side >= 0.0) if skind == TRANSMISSION
+                                          else (side <= 0.0)):
+            continue       # reflection leaves on the geometric normal's side, refraction
+            #                through (a hair lobe's direction on either, as in Cycles)
         br, bg, bb = br * wr, bg * wg, bb * wb
         if not max(br, bg, bb) > 0.0 or not (br < np.inf and bg < np.inf and bb < np.inf):
             continue

@@ -13,7 +13,7 @@ from ...engine_link import engine
 from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _Layers, _sum
 from ..material_params import TOL, NodeParam, _is_tex, _lin, _mean, _same, _scale
 from .links import _link
-from . import metallic, subsurface
+from . import hair, metallic, subsurface
 
 lobes = importlib.import_module(engine.__name__ + ".kernels.bsdf.lobe_batch")
 
@@ -355,6 +355,8 @@ def _closure(socket, ctx, depth=0) -> _Closure:
         return _translucent(node, ctx)
     if kind == "ShaderNodeSubsurfaceScattering":
         return _scattering(node, ctx)
+    if kind == "ShaderNodeBsdfHair":
+        return hair.hair_bsdf(node, ctx, _constant)
     if kind == "ShaderNodeEmission":
         return _emission(node, ctx)
     if kind == "ShaderNodeBsdfTransparent":

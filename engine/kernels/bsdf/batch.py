@@ -96,17 +96,17 @@ def setup_batch(rows, front, wo, tables, walter=False):
 
 @kernel
 def selection_batch(rows, front, wo, allowed, tables, walter=False):
-    """Lobe probabilities (n, 8) of `principled.selection` (diffuse, specular, metal,
-    glass; coat, sheen, translucent; subsurface)."""
+    """Lobe probabilities (n, 10) of `principled.selection` (diffuse, specular, metal,
+    glass; coat, sheen, translucent, hair R, hair TT; subsurface)."""
     n = wo.shape[0]
-    out = np.zeros((n, 8))
+    out = np.zeros((n, 10))
     state = np.empty(P.NSTATE)
     for k in range(n):
         P.setup(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state)
         if walter:
             state[S_WALTER] = 1.0
         q = P.selection(state, allowed[k, 0], allowed[k, 1], allowed[k, 2])
-        for j in range(8):
+        for j in range(10):
             out[k, j] = q[j]
     return out
 
@@ -190,7 +190,7 @@ class Principled:
         return setup_batch(self.rows, self.front, self._dirs(wo), self.tables, self.walter)
 
     def selection(self, wo, allowed=None):
-        """The probabilities (n, 8) with which `sample` picks each lobe at wo."""
+        """The probabilities (n, 10) with which `sample` picks each lobe at wo."""
         return selection_batch(self.rows, self.front, self._dirs(wo),
                                self._allowed(allowed), self.tables, self.walter)
 

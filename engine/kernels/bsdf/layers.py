@@ -5,7 +5,10 @@
     coat         (coat.py)         under the sheen, dimming and tinting what is below;
     base         (principled.py)   diffuse, specular, metal, glass: scaled per channel by
                                    `S_BASE_SCALE`, the product of the layers' factors;
-    translucent  (translucent.py)  a Translucent BSDF mixed in beside them (no layering).
+    translucent  (translucent.py)  a Translucent BSDF mixed in beside them (no layering);
+    hair R, TT   (hair.py)         a Hair BSDF node's Reflection and Transmission, beside
+                                   them, about the fibre's tangent that the integrator
+                                   writes into the row per hit (P_HAIR_T).
 
 A material row uses them only where P_LAYERS is 1; then principled.setup calls `setup`
 here, which fills the slots below and returns nothing else, and principled's eval, pdf
@@ -15,16 +18,21 @@ and sample add this module's lobes. A row with P_LAYERS = 0 never reads a slot h
 Lobe kinds: coat GLOSSY; sheen DIFFUSE (Cycles labels it diffuse reflection); translucent
 TRANSMISSION for the bounce that follows it (it leaves through the surface) and seen by
 lights as diffuse, as Cycles classifies it; it is sampled only while both the diffuse
-and the transmission bounce budgets last (Cycles counts it against both).
+and the transmission bounce budgets last (Cycles counts it against both); hair R
+GLOSSY, hair TT TRANSMISSION (Cycles' closure classes, which the lights' visibility and
+the passes follow). A sampled hair direction is kept on either side of the surface, as
+Cycles keeps it (`hair_sample`; principled.sample weighs it with the density drawn).
 """
 from __future__ import annotations
 
 from ..jit import kernel
-from . import coat, sheen, translucent
+from . import coat, hair, sheen, translucent
 from . import microfacet as mf
 from .params import (P_COAT_IOR, P_COAT_ROUGHNESS, P_COAT_TINT, P_COAT_WEIGHT,
-                     P_FILTER_ALPHA, P_SHEEN_LAYERED, P_SHEEN_ROUGHNESS, P_SHEEN_TINT,
-                     P_SHEEN_WEIGHT, P_TRANSLUCENT)
+                     P_FILTER_ALPHA, P_HAIR_CURVE, P_HAIR_R, P_HAIR_R_OFFSET,
+                     P_HAIR_R_ROUGH, P_HAIR_T, P_HAIR_TT, P_HAIR_TT_OFFSET, P_HAIR_TT_ROUGH,
+                     P_SHEEN_LAYERED, P_SHEEN_ROUGHNESS, P_SHEEN_TINT, P_SHEEN_WEIGHT,
+                     P_TRANSLUCENT)
 
 WEIGHT_CUTOFF = 1e-5            # Cycles' CLOSURE_WEIGHT_CUTOFF
 MIN_SELECTION = 0.02            # principled.MIN_SELECTION
@@ -43,7 +51,14 @@ S_TRANS = 46                    # 3: the translucent colour
 S_EST_COAT = 49                 # selection estimates of the three lobes
 S_EST_SHEEN = 50
 S_EST_TRANS = 51
-NSTATE = 52
+S_HAIR_T = 52                   # 3: the fibre's tangent, local
+S_HAIR_R = 55                   # 3: the hair reflection's colour
+S_HAIR_TT = 58                  # 3: the hair transmission's colour
+S_HAIR_R_LOBE = 61              # 3: its offset (0 off a strand), r1, r2 (clamped)
+S_HAIR_TT_LOBE = 64             # 3: the same for the transmission
+S_EST_HAIR_R = 67               # selection estimates of the two hair lobes
+S_EST_HAIR_TT = 68
+NSTATE = 69
 
 
 @kernel(allocates=False)
@@ -101,6 +116,25 @@ def setup(row, wox, woy, woz, tables, state):
         state[S_TRANS + c] = max(row[P_TRANSLUCENT + c], 0.0)
         t_max = max(t_max, state[S_TRANS + c])
     state[S_EST_TRANS] = t_max
+    # hair: each lobe's f cos integrates to at most 1, so its colour estimates its albedo
+    r_max = 0.0
+    tt_max = 0.0
+    for c in range(3):
+        state[S_HAIR_R + c] = max(row[P_HAIR_R + c], 0.0)
+        state[S_HAIR_TT + c] = max(row[P_HAIR_TT + c], 0.0)
+        r_max = max(r_max, state[S_HAIR_R + c])
+        tt_max = max(tt_max, state[S_HAIR_TT + c])
+        state[S_HAIR_T + c] = row[P_HAIR_T + c]
+    state[S_EST_HAIR_R] = r_max
+    state[S_EST_HAIR_TT] = tt_max
+    if r_max > 0.0 or tt_max > 0.0:
+        on_strand = row[P_HAIR_CURVE] != 0.0        # Cycles: no offset on a mesh
+        state[S_HAIR_R_LOBE] = row[P_HAIR_R_OFFSET] if on_strand else 0.0
+        state[S_HAIR_R_LOBE + 1] = hair.clamp_roughness(row[P_HAIR_R_ROUGH])
+        state[S_HAIR_R_LOBE + 2] = hair.clamp_roughness(row[P_HAIR_R_ROUGH + 1])
+        state[S_HAIR_TT_LOBE] = row[P_HAIR_TT_OFFSET] if on_strand else 0.0
+        state[S_HAIR_TT_LOBE + 1] = hair.clamp_roughness(row[P_HAIR_TT_ROUGH])
+        state[S_HAIR_TT_LOBE + 2] = hair.clamp_roughness(row[P_HAIR_TT_ROUGH + 1])
 
 
 @kernel(allocates=False)
@@ -109,9 +143,9 @@ def base_scale_max(state):
 
 
 @kernel(allocates=False)
-def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g):
-    """f (1/sr) of the sheen, coat and translucent lobes that a light of the given kinds
-    sees (principled.eval_seen adds the scaled base)."""
+def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
+    """f (1/sr) of the sheen, coat, translucent and hair lobes that a light of the given
+    kinds sees (principled.eval_seen adds the scaled base)."""
     fr = fg = fb = 0.0
     if see_d and state[S_EST_SHEEN] > 0.0 and woz > 0.0:
         s = sheen.shape(wix, wiy, wiz, state[S_SHEEN_CX], state[S_SHEEN_CY],
@@ -130,21 +164,53 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g):
         fr += state[S_TRANS] * t
         fg += state[S_TRANS + 1] * t
         fb += state[S_TRANS + 2] * t
+    if see_g and state[S_EST_HAIR_R] > 0.0 and wiz > 0.0:
+        v = hair_pdf(state, wox, woy, woz, wix, wiy, wiz, False) / wiz
+        fr += state[S_HAIR_R] * v
+        fg += state[S_HAIR_R + 1] * v
+        fb += state[S_HAIR_R + 2] * v
+    if see_t and state[S_EST_HAIR_TT] > 0.0 and wiz < 0.0:
+        v = hair_pdf(state, wox, woy, woz, wix, wiy, wiz, True) / -wiz
+        fr += state[S_HAIR_TT] * v
+        fg += state[S_HAIR_TT + 1] * v
+        fb += state[S_HAIR_TT + 2] * v
     return fr, fg, fb
 
 
 @kernel(allocates=False)
-def selection(state, allow_d, allow_g, allow_t):
-    """Unnormalised selection weights (coat, sheen, translucent) over the allowed kinds."""
-    wc = state[S_EST_COAT] if allow_g else 0.0
-    ws = state[S_EST_SHEEN] if allow_d else 0.0
-    wt = state[S_EST_TRANS] if (allow_d and allow_t) else 0.0
-    return wc, ws, wt
+def hair_pdf(state, wox, woy, woz, wix, wiy, wiz, transmission):
+    """The hair R (or TT) lobe's evaluation pdf, f cos per unit colour (hair.pdf)."""
+    k = S_HAIR_TT_LOBE if transmission else S_HAIR_R_LOBE
+    return hair.pdf(state[S_HAIR_T], state[S_HAIR_T + 1], state[S_HAIR_T + 2], state[k],
+                    state[k + 1], state[k + 2], transmission, wox, woy, woz, wix, wiy, wiz)
 
 
 @kernel(allocates=False)
-def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt):
-    """sum q_i pdf_i over the coat, sheen and translucent lobes."""
+def hair_sample(state, wox, woy, woz, transmission, u1, u2):
+    """A direction from the hair R (or TT) lobe, on either side: (wi, its pdf, colour)."""
+    k = S_HAIR_TT_LOBE if transmission else S_HAIR_R_LOBE
+    x, y, z, p = hair.sample(state[S_HAIR_T], state[S_HAIR_T + 1], state[S_HAIR_T + 2],
+                             state[k], state[k + 1], state[k + 2], transmission, wox, woy,
+                             woz, u1, u2)
+    c = S_HAIR_TT if transmission else S_HAIR_R
+    return x, y, z, p, state[c], state[c + 1], state[c + 2]
+
+
+@kernel(allocates=False)
+def selection(state, allow_d, allow_g, allow_t):
+    """Unnormalised selection weights (coat, sheen, translucent, hair R, hair TT) over
+    the allowed kinds."""
+    wc = state[S_EST_COAT] if allow_g else 0.0
+    ws = state[S_EST_SHEEN] if allow_d else 0.0
+    wt = state[S_EST_TRANS] if (allow_d and allow_t) else 0.0
+    whr = state[S_EST_HAIR_R] if allow_g else 0.0
+    wht = state[S_EST_HAIR_TT] if allow_t else 0.0
+    return wc, ws, wt, whr, wht
+
+
+@kernel(allocates=False)
+def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht):
+    """sum q_i pdf_i over the coat, sheen, translucent and hair lobes (evaluation's)."""
     p = 0.0
     if qc > 0.0:
         p += qc * mf.reflection_pdf(wox, woy, woz, wix, wiy, wiz, state[S_COAT_ALPHA])
@@ -153,6 +219,10 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt):
                             state[S_SHEEN_A], state[S_SHEEN_B])
     if qt > 0.0:
         p += qt * translucent.pdf(woz, wiz)
+    if qhr > 0.0:
+        p += qhr * hair_pdf(state, wox, woy, woz, wix, wiy, wiz, False)
+    if qht > 0.0:
+        p += qht * hair_pdf(state, wox, woy, woz, wix, wiy, wiz, True)
     return p
 
 

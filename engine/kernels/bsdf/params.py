@@ -52,7 +52,18 @@ P_SETS_NORMAL = 48       # 0 / 1: the program's normal becomes the surface's (Cy
 #                          shadowed against the smooth normal it bends
 P_HOLDOUT = 49           # the share of hits that are a Holdout shader (a hole for the
 #                          camera, black to other rays); 1 for a Holdout alone
-NPARAM = 50
+# Cycles' Hair BSDF node (hair.py), beside the other lobes: read only where P_LAYERS is 1
+P_HAIR = 50              # 0 / 1: the integrator writes P_HAIR_T and P_HAIR_CURVE per hit
+P_HAIR_R = 51            # 3 columns: the Reflection component's colour (weight included)
+P_HAIR_R_OFFSET = 54     # its Offset as Cycles keeps it (minus the node's), radians
+P_HAIR_R_ROUGH = 55      # 2 columns: its RoughnessU, RoughnessV
+P_HAIR_TT = 57           # 3 columns: the Transmission component's colour
+P_HAIR_TT_OFFSET = 60
+P_HAIR_TT_ROUGH = 61     # 2 columns
+P_HAIR_T = 63            # per hit, 3 columns: the fibre's tangent in the shading frame
+#                          (a strand's direction, a triangle's second edge: Cycles' dPdv)
+P_HAIR_CURVE = 66        # per hit, 0 / 1: the hit is on a strand (the Offset applies)
+NPARAM = 67
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -100,4 +111,11 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_SSS_SKIN] = table.subsurface_skin
     rows[:, P_METAL_CONSTANT] = table.metal_constant
     rows[:, P_SPEC_TINT:P_SPEC_TINT + 3] = table.specular_tint
+    rows[:, P_HAIR] = table.hair
+    rows[:, P_HAIR_R:P_HAIR_R + 3] = table.hair_reflection
+    rows[:, P_HAIR_R_OFFSET] = -table.hair_reflection_offset
+    rows[:, P_HAIR_R_ROUGH:P_HAIR_R_ROUGH + 2] = table.hair_reflection_roughness
+    rows[:, P_HAIR_TT:P_HAIR_TT + 3] = table.hair_transmission
+    rows[:, P_HAIR_TT_OFFSET] = -table.hair_transmission_offset
+    rows[:, P_HAIR_TT_ROUGH:P_HAIR_TT_ROUGH + 2] = table.hair_transmission_roughness
     return rows

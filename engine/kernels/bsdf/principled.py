@@ -65,7 +65,7 @@ from .albedo import specular_albedo
 from .compensation import compensate
 from .reflection_lobes import (f82_setup, metal_fresnel, reflection_eval, reflection_pdf,
                                reflection_sample)
-from .state import (NSTATE, S_ALPHA, S_BECKMANN, S_BLINN, S_DIFFUSE,  # noqa: F401
+from .state import (NSTATE, S_ALPHA, S_ANY_SIDE, S_BECKMANN, S_BLINN, S_DIFFUSE,  # noqa: F401
                     S_EST, S_ETA_GLASS, S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH,
                     S_GLASS_TINTED, S_LAYERED, S_METAL_CONST, S_METAL_F0, S_METAL_F82,
                     S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY,
@@ -219,29 +219,29 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
 @kernel(allocates=False)
 def transmits(state):
     """True where light from behind the surface can contribute (glass, translucency)."""
-    return state[S_W_GLASS] > 0.0 or (state[S_LAYERED] != 0.0
-                                      and state[layers.S_EST_TRANS] > 0.0)
+    return state[S_W_GLASS] > 0.0 or (state[S_LAYERED] != 0.0 and (
+        state[layers.S_EST_TRANS] > 0.0 or state[layers.S_EST_HAIR_TT] > 0.0))
 
 
 @kernel(allocates=False)
 def selection(state, allow_d, allow_g, allow_t):
-    """Lobe probabilities (diffuse, specular, metal, glass; coat, sheen, translucent of
-    layers.py; subsurface) over the allowed kinds. The subsurface lobe may be chosen
+    """Lobe probabilities (diffuse, specular, metal, glass; coat, sheen, translucent,
+    hair R, hair TT of layers.py; subsurface) over the allowed kinds. The subsurface lobe may be chosen
     while any kind may continue: it leaves as a diffuse surface, which is then lit
     directly even where no diffuse bounce is left (Cycles: the walk is no bounce)."""
     w0 = state[S_EST] if allow_d else 0.0
     w1 = state[S_EST + 1] if allow_g else 0.0
     w2 = state[S_EST + 2] if allow_g else 0.0
     w3 = (state[S_EST + 3] if allow_g else 0.0) + (state[S_EST + 4] if allow_t else 0.0)
-    wc = ws = wt = 0.0
+    wc = ws = wt = whr = wht = 0.0
     if state[S_LAYERED] != 0.0:
-        wc, ws, wt = layers.selection(state, allow_d, allow_g, allow_t)
+        wc, ws, wt, whr, wht = layers.selection(state, allow_d, allow_g, allow_t)
     wu = state[S_EST_SSS] if (allow_d or allow_g or allow_t) else 0.0
-    total = w0 + w1 + w2 + w3 + wc + ws + wt + wu
+    total = w0 + w1 + w2 + w3 + wc + ws + wt + whr + wht + wu
     if not total > 0.0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     return (w0 / total, w1 / total, w2 / total, w3 / total, wc / total, ws / total,
-            wt / total, wu / total)
+            wt / total, whr / total, wht / total, wu / total)
 
 
 @kernel(allocates=False)
@@ -263,7 +263,7 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
     if state[S_LAYERED] == 0.0:
         return fr + gr, fg + gg, fb + gb
     s = layers.S_BASE_SCALE
-    lr, lg, lb = layers.eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g)
+    lr, lg, lb = layers.eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t)
     return (fr + gr * state[s] + lr, fg + gg * state[s + 1] + lg,
             fb + gb * state[s + 2] + lb)
 
@@ -324,7 +324,7 @@ def eval_f(state, wox, woy, woz, wix, wiy, wiz):
 def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
     """sum_i q_i pdf_i over the lobes, for the selection probabilities q (`selection`;
     the subsurface lobe's has no density here)."""
-    q0, q1, q2, q3, qc, qs, qt, qu = q
+    q0, q1, q2, q3, qc, qs, qt, qhr, qht, qu = q
     p = 0.0
     if wiz > 0.0:
         p += q0 * (wiz * INV_PI)
@@ -336,8 +336,8 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
                                        state[S_ALPHA], allow_g and state[S_REFRACT_ONLY] == 0.0,
                                        allow_t, state[S_WALTER] != 0.0,
                                        state[S_BECKMANN] != 0.0)
-    if qc > 0.0 or qs > 0.0 or qt > 0.0:
-        p += layers.mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt)
+    if qc > 0.0 or qs > 0.0 or qt > 0.0 or qhr > 0.0 or qht > 0.0:
+        p += layers.mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht)
     return p
 
 
@@ -353,15 +353,17 @@ def pdf_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t,
              see_d, see_g, see_t):
     """The part of `pdf` (same allow flags) due to the lobes of the kinds a light is seen
     by: the density with which BSDF sampling reaches that light through wi."""
-    q0, q1, q2, q3, qc, qs, qt, qu = selection(state, allow_d, allow_g, allow_t)
+    q0, q1, q2, q3, qc, qs, qt, qhr, qht, qu = selection(state, allow_d, allow_g, allow_t)
     if not see_d:
         q0 = qs = qt = 0.0
     if not see_g:
-        q1 = q2 = qc = 0.0
+        q1 = q2 = qc = qhr = 0.0
+    if not see_t:
+        qht = 0.0
     if not (see_g if wiz > 0.0 else see_t):
         q3 = 0.0
     return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz,
-                       (q0, q1, q2, q3, qc, qs, qt, qu), allow_g, allow_t)
+                       (q0, q1, q2, q3, qc, qs, qt, qhr, qht, qu), allow_g, allow_t)
 
 
 @kernel(allocates=False)
@@ -370,12 +372,14 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     picks a glass reflection or refraction). Returns
     (wix, wiy, wiz, weight_r, weight_g, weight_b, pdf, kind, delta, valid): weight is
     f |cos| / pdf (zero where invalid), pdf the mixture pdf over the allowed lobes (inf
-    for the delta choices of a smooth glass, with delta True)."""
+    for the delta choices of a smooth glass, with delta True). state[S_ANY_SIDE] says
+    whether the direction may leave on either side of the surface (a hair lobe's)."""
     q = selection(state, allow_d, allow_g, allow_t)
+    state[S_ANY_SIDE] = 0.0
     lobe = 0
     lo = 0.0
     total = 0.0
-    for k in range(8):
+    for k in range(10):
         if k > 0 and u_lobe >= total and q[k] > 0.0:
             lobe, lo = k, total
         total += q[k]
@@ -387,14 +391,23 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     ok = total > 0.0 and q_sel > 0.0
     if not ok:
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
-    if lobe == 7:                       # below the surface: the caller walks it
+    if lobe == 9:                       # below the surface: the caller walks it
         return (wix, wiy, wiz, state[S_SSS] / q_sel, state[S_SSS + 1] / q_sel,
                 state[S_SSS + 2] / q_sel, math.inf, SUBSURFACE, True, True)
+    hair_d = 0.0                        # a hair lobe's sampled pdf less its evaluated one
+    hr = hg = hb = 0.0
     if lobe == 0:
         wix, wiy, wiz = cosine_hemisphere(u1, u2)
     elif lobe == 1 or lobe == 2:
         wix, wiy, wiz, ok = reflection_sample(state, wox, woy, woz, u1, u2)
         kind = GLOSSY
+    elif lobe > 6:                      # hair R, TT: on either side, with their own pdf
+        tt = lobe == 8
+        wix, wiy, wiz, ps, hr, hg, hb = layers.hair_sample(state, wox, woy, woz, tt, u1, u2)
+        ok = ps > 0.0
+        kind = TRANSMISSION if tt else GLOSSY
+        hair_d = ps - layers.hair_pdf(state, wox, woy, woz, wix, wiy, wiz, tt)
+        state[S_ANY_SIDE] = 1.0
     elif lobe > 3:                      # coat, sheen, translucent
         wix, wiy, wiz, ok = layers.sample(state, wox, woy, woz, lobe - 4, u1, u2)
         kind = (GLOSSY, DIFFUSE, TRANSMISSION)[lobe - 4]
@@ -435,7 +448,14 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     # a path that picks it ends)
     fr, fg, fb = eval_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t)
     p = mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t)
+    c = abs(wiz)
+    if hair_d != 0.0:
+        # as Cycles: the sampled hair lobe counts with the value and density its
+        # sampling gave (f cos = pdf, on either side), the other lobes as evaluated
+        fr, fg, fb = fr * c + hr * hair_d, fg * c + hg * hair_d, fb * c + hb * hair_d
+        p += q_sel * hair_d
+        c = 1.0
     if not (p > 0.0 and p < math.inf):
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
-    s = abs(wiz) / p
+    s = c / p
     return wix, wiy, wiz, fr * s, fg * s, fb * s, p, kind, False, True

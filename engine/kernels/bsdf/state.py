@@ -34,4 +34,6 @@ S_GLASS_F0 = layers.NSTATE + 15      # 3: ... its tinted F0 per channel
 S_SSS = layers.NSTATE + 18          # 3: the subsurface lobe's weight (subsurface_lobe.py)
 S_EST_SSS = layers.NSTATE + 21      # its selection estimate
 S_E_SPEC = layers.NSTATE + 22       # the specular layer's albedo at wo (the Glossy Color pass)
-NSTATE = layers.NSTATE + 23
+S_ANY_SIDE = layers.NSTATE + 23     # 1: principled.sample's last direction may leave on
+#                                     either side of the surface (a hair lobe's, as Cycles)
+NSTATE = layers.NSTATE + 24

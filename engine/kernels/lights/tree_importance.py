@@ -5,9 +5,12 @@ its distance and the best cosines its box and cone allow (`importance`, Cycles'
 `light_tree_importance`). tree.py picks lights with it.
 
 The receiver is a tuple (px, py, pz, nx, ny, nz, mode, t): the shading point, its
-shading normal and what the surface does with light from below it (`mode`):
-  ONE_SIDED  an opaque surface: lights wholly below its plane get no importance;
-  TWO_SIDED  a surface that transmits, or whose normal a bump bends: |cos|, none lost;
+shading normal (Cycles' sd->N: the surface's, not a lobe's bent one) and what the
+surface does with light from below it (`mode`):
+  ONE_SIDED  an opaque surface: lights wholly below its plane get no importance (a lobe
+             on a bent normal that reaches under it finds them by its own rays, at
+             full weight, as in Cycles);
+  TWO_SIDED  a surface that transmits: |cos|, none lost;
   OMNI       a point in a volume: no normal, no cosine;
   SEGMENT    a ray segment o + s d, s in [0, t], through a volume (p = o, n = d):
              Cycles' volume form (tree_segment.py); suns and the world, which no
