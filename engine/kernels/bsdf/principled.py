@@ -44,6 +44,7 @@ slots: state.py. Tests reach these kernels over arrays through batch.py.
 Use, per hit:
     setup(row, front_facing, wox, woy, woz, tables, state)   # fills state[:NSTATE]
     eval_f(state, wo..., wi...)      -> (r, g, b)   the whole BSDF, every lobe
+                                     (eval_f, eval_seen: principled_eval.py)
     pdf(state, wo..., wi..., allow_d, allow_g, allow_t) -> mixture pdf of `sample`
     sample(state, wo..., u_lobe, u1, u2, allow_d, allow_g, allow_t)
         -> (wix, wiy, wiz, weight_r, weight_g, weight_b, pdf, kind, delta, valid)
@@ -63,8 +64,7 @@ from . import microfacet as mf
 from . import multiscatter as ms
 from .albedo import specular_albedo
 from .compensation import compensate
-from .reflection_lobes import (f82_setup, metal_fresnel, reflection_eval, reflection_pdf,
-                               reflection_sample)
+from .reflection_lobes import f82_setup, metal_fresnel, reflection_pdf, reflection_sample
 from .state import (NSTATE, S_ALPHA, S_ANY_SIDE, S_BECKMANN, S_BLINN, S_DIFFUSE,  # noqa: F401
                     S_EST, S_ETA_GLASS, S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH,
                     S_GLASS_TINTED, S_LAYERED, S_METAL_CONST, S_METAL_F0, S_METAL_F82,
@@ -78,6 +78,7 @@ from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX,  # noqa: F
                      P_REFRACT_ONLY, P_ROUGHNESS, P_SPEC_LEVEL, P_TRANSMISSION,
                      pack_materials)
 from .tables import kernel_tables  # noqa: F401  (re-exported)
+from .principled_eval import base_glossy, eval_f, eval_seen  # noqa: F401  (re-exported)
 from ..warp import INV_PI, cosine_hemisphere
 
 DIFFUSE, GLOSSY, TRANSMISSION = 0, 1, 2    # lobe kinds
@@ -242,82 +243,6 @@ def selection(state, allow_d, allow_g, allow_t):
         return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     return (w0 / total, w1 / total, w2 / total, w3 / total, wc / total, ws / total,
             wt / total, whr / total, wht / total, wu / total)
-
-
-@kernel(allocates=False)
-def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
-    """f(wo, wi) in 1/sr of the lobes of the kinds a light is seen by (see_d: diffuse,
-    see_g: glossy reflection, see_t: transmission; engine.visibility), delta parts
-    excluded."""
-    fr = 0.0
-    fg = 0.0
-    fb = 0.0
-    # Lambert under the specular layer; as Cycles' diffuse closure it asks only that the
-    # light be above the shading normal, not the view (which a smooth mesh's silhouette
-    # can put under it)
-    if see_d and wiz > 0.0:
-        fr = state[S_DIFFUSE] * INV_PI
-        fg = state[S_DIFFUSE + 1] * INV_PI
-        fb = state[S_DIFFUSE + 2] * INV_PI
-    gr, gg, gb = base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t)
-    if state[S_LAYERED] == 0.0:
-        return fr + gr, fg + gg, fb + gb
-    s = layers.S_BASE_SCALE
-    lr, lg, lb = layers.eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t)
-    return (fr + gr * state[s] + lr, fg + gg * state[s + 1] + lg,
-            fb + gb * state[s + 2] + lb)
-
-
-@kernel(allocates=False)
-def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
-    """f (1/sr) of the specular, metal and glass lobes a light of these kinds sees."""
-    fr = 0.0
-    fg = 0.0
-    fb = 0.0
-    w_spec = state[S_W_SPEC]
-    w_metal = state[S_W_METAL]
-    if see_g and (w_spec > 0.0 or w_metal > 0.0):
-        base, hx, hy, hz = reflection_eval(state, wox, woy, woz, wix, wiy, wiz)
-        cos_oh = min(max(mf.dot(wox, woy, woz, hx, hy, hz), 0.0), 1.0)
-        if w_spec > 0.0 and state[S_SPEC_TINTED] != 0.0:
-            bw = base * w_spec
-            fr += specular_tint.reflectance(state, 0, cos_oh, state[S_ETA_SPEC]) * bw
-            fg += specular_tint.reflectance(state, 1, cos_oh, state[S_ETA_SPEC]) * bw
-            fb += specular_tint.reflectance(state, 2, cos_oh, state[S_ETA_SPEC]) * bw
-        elif w_spec > 0.0:
-            F = fresnel.dielectric(cos_oh, state[S_ETA_SPEC])
-            v = F * (base * w_spec) * state[S_MS_SPEC]
-            fr += v
-            fg += v
-            fb += v
-        if w_metal > 0.0:
-            bw = base * w_metal
-            fr += metal_fresnel(state, 0, cos_oh) * bw * state[S_MS_METAL]
-            fg += metal_fresnel(state, 1, cos_oh) * bw * state[S_MS_METAL + 1]
-            fb += metal_fresnel(state, 2, cos_oh) * bw * state[S_MS_METAL + 2]
-    w_glass = state[S_W_GLASS]
-    if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0 and (see_g if wiz > 0.0 else see_t):
-        f_r, f_t, F = dielectric.rough_eval_lobes(wox, woy, woz, wix, wiy, wiz,
-                                               state[S_ETA_GLASS], state[S_ALPHA],
-                                               state[S_REFRACT_ONLY] != 0.0,
-                                               state[S_WALTER] != 0.0,
-                                               state[S_BECKMANN] != 0.0)
-        k0 = k1 = k2 = 1.0
-        if state[S_GLASS_TINTED] != 0.0:        # Specular Tint: per channel F_c for F
-            refl = f_r > 0.0
-            k0 = specular_tint.glass_factor(state, 0, F, state[S_ETA_GLASS], refl)
-            k1 = specular_tint.glass_factor(state, 1, F, state[S_ETA_GLASS], refl)
-            k2 = specular_tint.glass_factor(state, 2, F, state[S_ETA_GLASS], refl)
-        fr += (f_r + f_t * state[S_TINT]) * k0 * w_glass * state[S_MS_GLASS]
-        fg += (f_r + f_t * state[S_TINT + 1]) * k1 * w_glass * state[S_MS_GLASS + 1]
-        fb += (f_r + f_t * state[S_TINT + 2]) * k2 * w_glass * state[S_MS_GLASS + 2]
-    return fr, fg, fb
-
-
-@kernel(allocates=False)
-def eval_f(state, wox, woy, woz, wix, wiy, wiz):
-    """The whole BSDF f(wo, wi) in 1/sr, every lobe (delta parts excluded)."""
-    return eval_seen(state, wox, woy, woz, wix, wiy, wiz, True, True, True)
 
 
 @kernel(allocates=False)
