@@ -138,7 +138,11 @@ Acne and leaks at every scale (`tests/test_robustness.py`, scales 1e-3, 1, 1e2, 
 a plane under a sun at 85 degrees has no self-shadowed pixel; a closed box with walls 1%
 or 0.01% of its size thick lets no light in; a sheet 1e-4 or 2e-6 of its size above a
 table leaves it black (2e-6 leaked before 2026-11-30, when rays started 2^-17 of the
-coordinates' magnitude off the surface).
+coordinates' magnitude off the surface); an opaque sheet 2e-6 of its size under an
+emissive panel leaves the table under them black (shadow rays towards an emitting
+triangle name it, as Cycles' do, and stop 2^-21 of the point's magnitude over the cosine
+short of it; until 2026-11-30 they stopped 2^-17 short, before the sheet, and lit the
+table at every scale).
 The plane and a box with walls 1e-3 thick also 1e5 and 1e7 from the origin
 (`tests/test_extremes_scale.py`; before the median-vertex origin, the box let light in
 at 1e5 and 37.5% of the plane's pixels were self-shadowed at 1e7).

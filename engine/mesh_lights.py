@@ -46,7 +46,6 @@ from __future__ import annotations
 import numpy as np
 
 from .luminance import luminance
-from .surface import RELATIVE_OFFSET, triangle_scale
 
 
 def _coincident_copies(v0, v1, v2, radiance):
@@ -70,7 +69,7 @@ def _coincident_copies(v0, v1, v2, radiance):
 
 
 class EmissiveTriangles:
-    def __init__(self, v0, v1, v2, radiance, prim_ids, n_prims_total: int, center=None):
+    def __init__(self, v0, v1, v2, radiance, prim_ids, n_prims_total: int):
         v0, v1, v2 = (np.asarray(v, dtype=np.float64).reshape(-1, 3) for v in (v0, v1, v2))
         radiance = np.asarray(radiance, dtype=np.float64).reshape(-1, 3)
         prim_ids = np.asarray(prim_ids, dtype=np.int64).reshape(-1)
@@ -86,15 +85,11 @@ class EmissiveTriangles:
         self.radiance = radiance[keep]
         self.power = power[keep]
         self.prim = prim_ids[keep]
-        # the offset scale relative to the static scene's centre (engine.accel, surface)
-        c = np.zeros(3) if center is None else np.asarray(center, np.float64)
-        self.tri_scale = triangle_scale(v0, v1, v2, c)[keep]
         first, copy_of = _coincident_copies(v0[keep], v1[keep], v2[keep],
                                               self.radiance)
         self.entry = np.full(max(int(n_prims_total), 1), -1, dtype=np.int64)
         self.entry[self.prim] = copy_of
-        for name in ("v0", "e1", "e2", "normal", "area", "radiance", "power", "tri_scale",
-                     "prim"):
+        for name in ("v0", "e1", "e2", "normal", "area", "radiance", "power", "prim"):
             setattr(self, name, getattr(self, name)[first])
 
     @classmethod
@@ -125,7 +120,7 @@ class EmissiveTriangles:
         p = accel.positions
         t = tri[emissive]
         return cls(p[t[:, 0]], p[t[:, 1]], p[t[:, 2]], emission[mat[emissive]], emissive,
-                   len(tri), getattr(accel, "center", None))
+                   len(tri))
 
     def __len__(self):
         return len(self.area)

@@ -83,7 +83,7 @@ def map_sample(L, u, up=None):
     """Directions (n, 3) sampled from the world light with u (n, 2), and their pdfs."""
     n = len(u)
     up = np.full(n, 0.5) if up is None else up
-    k, wi, dist, rad, pdf, delta, _ = sample_batch(L, np.zeros((n, 3)), up,
+    k, wi, dist, rad, pdf, delta, _, _ = sample_batch(L, np.zeros((n, 3)), up,
                                                    np.ascontiguousarray(u, np.float64))
     return wi, pdf, rad, k
 

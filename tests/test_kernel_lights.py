@@ -233,7 +233,8 @@ def consistency(L, ls, p, up, u, shift=1.0, normals=None, mode=OMNI):
     there; `shift` scales p for that second evaluation (the negative control). Returns
     a dict of (what, mismatched rows, rows checked, rows at a uniform's edge among the
     mismatched)."""
-    k, wi, dist, rad, pdf, delta, margin = sample_batch(L, p, up, u, None, normals, mode)
+    k, wi, dist, rad, pdf, delta, light_prim, margin = sample_batch(L, p, up, u, None, normals,
+                                                                    mode)
     n_lamps = ls.n_lamps
     edge = np.any((u == 0.0) | (u == ONE_MINUS), axis=1)
     q = p * shift
@@ -378,7 +379,8 @@ def test_empty_set():
     L = pack_lights(ls)
     assert n_entries(L) == 0 and n_suns(L) == 0
     recv = (0.0, 0.0, 0.0, 0.0, 0.0, 1.0, ONE_SIDED, 0.0)
-    k, wx, wy, wz, dist, r, g, b, pdf, delta, margin = sample(L, recv, 0.3, 0.5, 0.5, 0.0)
+    k, wx, wy, wz, dist, r, g, b, pdf, delta, light_prim, margin = sample(
+        L, recv, 0.3, 0.5, 0.5, 0.0)
     assert k == -1 and pdf == 0.0 and not delta and (r, g, b) == (0.0, 0.0, 0.0)
     assert hit_lamps(L, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 7.0, 31, 0.0) == (7.0, -1, 0.0, 0.0, 0.0)
     assert environment_pdf(L, 0.0, 0.0, 1.0, recv, 0.0) == 0.0
@@ -437,8 +439,8 @@ def test_a_moving_lamp_is_its_slice_at_the_rays_time():
             ratio = L[SELECT_PDF][0] / still[SELECT_PDF][0]
             for t in (j / K, (j + 0.5) / K, (j + 1) / K - 1e-9):
                 time = np.full(64, t)
-                k, wi, dist, rad, pdf, delta, _ = sample_batch(L, p, up * 0.0, u, time)
-                k1, wi1, dist1, rad1, pdf1, _, _ = sample_batch(still, p, up * 0.0, u)
+                k, wi, dist, rad, pdf, delta, _, _ = sample_batch(L, p, up * 0.0, u, time)
+                k1, wi1, dist1, rad1, pdf1, _, _, _ = sample_batch(still, p, up * 0.0, u)
                 assert np.all(k == 0) and np.all(k1 == 0), name
                 assert np.array_equal(wi, wi1) and np.array_equal(rad, rad1), (name, t)
                 np.testing.assert_allclose(pdf, pdf1 * ratio, rtol=1e-12)

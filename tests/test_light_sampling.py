@@ -179,6 +179,7 @@ class Samples(NamedTuple):
     radiance: np.ndarray
     pdf: np.ndarray
     delta: np.ndarray
+    light_prim: np.ndarray
     margin: np.ndarray
 
 
@@ -767,6 +768,10 @@ def test_emissive_triangles_stay_finite_on_and_in_the_plane():
         s = kernel_sample(L, P, rng.random((len(P), 2)), rng.random(len(P)))
         assert np.all(np.isfinite(s.wi)) and np.all(np.isfinite(s.pdf))
         assert np.all(np.isfinite(s.radiance)) and np.all(np.isfinite(s.margin))
+        # each sample names the emissive triangle it lies on (its shadow ray skips it)
+        ok = s.entry >= 0
+        assert ok.any() and np.all(s.light_prim[ok] == mesh.prim[s.entry[ok]])
+        assert np.all(s.light_prim[~ok] == -1)
     tiny = EmissiveTriangles([[0, 0, 0]], [[1e-7, 0, 0]], [[0, 1e-7, 0]], [[1, 1, 1]], [0], 1)
     huge = EmissiveTriangles([[0, 0, 0]], [[1e4, 0, 0]], [[0, 1e4, 0]], [[1, 1, 1]], [0], 1)
     for m in (tiny, huge):

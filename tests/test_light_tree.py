@@ -168,7 +168,7 @@ def test_no_light_that_reaches_the_receiver_is_lost(name):
             for k in range(n):
                 prob = select_pdf(L, k, recv, 0.0)
                 for u in rng.random((6, 2)):
-                    wx, wy, wz, dist, r, g, b, pdf, delta, _ = sample_entry(
+                    wx, wy, wz, dist, r, g, b, pdf, delta, _, _ = sample_entry(
                         L, k, recv[0], recv[1], recv[2], u[0], u[1], 0.0)
                     if not (pdf > 0 and max(r, g, b) > 0):
                         continue
@@ -218,7 +218,7 @@ def test_segment_picks_are_a_distribution_that_loses_no_light(name):
             x = o + s * d
             for kk in set(range(n)) - distant:
                 for u in rng.random((3, 2)):
-                    *_, r, g, b, p_point, _, _ = sample_entry(L, kk, *x, u[0], u[1], 0.0)
+                    *_, r, g, b, p_point, _, _, _ = sample_entry(L, kk, *x, u[0], u[1], 0.0)
                     if p_point > 0 and max(r, g, b) > 0:
                         checked += 1
                         assert pdf[kk] > 0, (name, kk, seg, s)

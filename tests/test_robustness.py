@@ -148,3 +148,29 @@ def test_no_leak_under_a_sheet_lying_on_a_table(s, gap):
                                            filter_width=0.1))
     img = film.mean()[..., 0]
     assert img.max() == 0.0, f"{(img > 0).sum()} leaking pixels"
+
+
+@pytest.mark.parametrize("s", SCALES)
+def test_no_leak_through_a_sheet_under_a_light_panel(s):
+    """An emissive panel with an opaque sheet 2e-6 (relative) under it, over a table: the
+    table must be black. A shadow ray towards the panel names its triangle and runs to the
+    sampled point, as Cycles' run to ls->P naming ls->prim; until 2026-11-30 they stopped
+    2^-17 of the coordinates' magnitude short of it, before the sheet, and lit the table
+    through it."""
+    table = quad((0, 0, 0), (s, 0, 0), (0, s, 0), "table")
+    panel = quad((0, 0, s), (0.3 * s, 0, 0), (0, -0.3 * s, 0), "panel", material=1)
+    sheet = quad((0, 0, s * (1.0 - 2e-6)), (0.5 * s, 0, 0), (0, 0.5 * s, 0), "sheet")
+    m = np.eye(4)
+    m[:3, 3] = (0, 0, 0.5 * s)
+    cam = Camera(m, kind="ORTHO", ortho_scale=1.0 * s, clip_start=1e-3 * s, clip_end=s)
+    mats = [Material("m", (0.8,) * 3, specular_ior_level=0.0),
+            Material("light", (0.0,) * 3, specular_ior_level=0.0, emission=(10.0,) * 3)]
+    scene = Scene(cam, 20, 20, [table, panel, sheet], mats, [])
+    film, _ = render(scene, RenderSettings(samples=4, diffuse_bounces=0, filter_type="BOX",
+                                           filter_width=0.1))
+    img = film.mean()[..., 0]
+    assert img.max() == 0.0, f"{(img > 0).sum()} leaking pixels"
+    # the control: without the sheet the panel lights the table
+    lit, _ = render(Scene(cam, 20, 20, [table, panel], mats, []),
+                    RenderSettings(samples=4, diffuse_bounces=0))
+    assert lit.mean()[..., 0].min() > 0.0

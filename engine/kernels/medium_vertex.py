@@ -59,7 +59,7 @@ def scatter(depth, cfg, paths, p, px, py, pz, dx, dy, dz, br, bg, bb, g, tally, 
     if lt.n_entries(lights) > 0:
         u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK)
         u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
-        k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
+        k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, lprim, margin = lt.sample(
             lights, recv, u_pick, u1, u2, time)
         seen = lt.entry_visibility(lights, k)
         if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0:
@@ -76,7 +76,7 @@ def scatter(depth, cfg, paths, p, px, py, pz, dx, dy, dz, br, bg, bb, g, tally, 
                 sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz,
                                                          dist, margin, cfg.scene_radius)
                 ns = ray_queues.push(shadows, ns, p, bounce[p], px, py, pz, sdx, sdy, sdz,
-                                     far, cr, cg, cb, paths.stacks)
+                                     far, cr, cg, cb, paths.stacks, -1, -1, lprim)
                 tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))
     if not goes_on:
         return ns, nn
@@ -159,7 +159,7 @@ def equiangular_light(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, br, b
     pd = distance_pdf(str_, stg, stb, wr, wg, wb, t)
     px, py, pz = ox + dx * t, oy + dy * t, oz + dz * t
     u1, u2 = sample_2d(kind, pkey[p], spp, index[p], volume_dim(depth, 4))
-    wx, wy, wz, dist, lr, lg, lb, ppoint, delta, margin = lt.sample_entry(
+    wx, wy, wz, dist, lr, lg, lb, ppoint, delta, lprim, margin = lt.sample_entry(
         lights, k, px, py, pz, u1, u2, time)
     seen = lt.entry_visibility(lights, k)
     if not (ppoint > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0):
@@ -179,9 +179,9 @@ def equiangular_light(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, br, b
         clamp = cfg.clamp_direct if bounce[p] == 0 else cfg.clamp_indirect
         tl.lit(tally, p, bounce[p], cr, cg, cb, clamp, VOLUME_SHARES, tl.entry_group(tally, k))
         return ns
-    sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz, dist, margin,
-                                             cfg.scene_radius)
+    sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz, dist,
+                                             margin, cfg.scene_radius)
     ns = ray_queues.push(shadows, ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr, cg,
-                         cb, stacks)
+                         cb, stacks, -1, -1, lprim)
     tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))
     return ns

@@ -353,7 +353,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
             u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK) \
                 if n_lights > 1 else 0.0
             u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
-            k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
+            k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, lprim, margin = lt.sample(
                 lights, recv, u_pick, u1, u2, path_time[p])
             lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
             # a uniform world, which Cycles never samples (its escaping rays find it):
@@ -404,7 +404,8 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                 else:
                     ns_out = ray_queues.push(shadows, ns_out, p, b, sox, soy, soz, sdx, sdy,
                                              sdz, far, br * fr * lr * w, bg * fg * lg * w,
-                                             bb * fb * lb * w, stacks, own, hit_inst[j])
+                                             bb * fb * lb * w, stacks, own, hit_inst[j],
+                                             lprim)
                     tl.queued(tally, ns_out - 1, p, b, shares, group)
                     if (vol.shape[0] > 0 and vol[m, V_HAS] != 0.0
                             and dot(wx, wy, wz, gx, gy, gz) < 0.0):

@@ -18,7 +18,9 @@ from .jit import kernel
 def towards(sox, soy, soz, px, py, pz, wx, wy, wz, dist, margin, scene_radius):
     """Direction and length of the shadow ray from origin so (for the shading point p)
     towards direction w for `dist` (inf: a sun or the world): to the sampled point,
-    stopping short of it by `margin` (emissive triangles) and a relative 2e-5."""
+    stopping `margin` short of it (a point on an emissive triangle, which the ray also
+    names: push's light_prim, Cycles' ls->prim), or a relative 2e-5 short where margin
+    is 0 (a lamp's)."""
     sdx, sdy, sdz = wx, wy, wz
     if math.isfinite(dist):
         tx = px + wx * dist - sox
@@ -27,7 +29,7 @@ def towards(sox, soy, soz, px, py, pz, wx, wy, wz, dist, margin, scene_radius):
         seg = math.sqrt(tx * tx + ty * ty + tz * tz)
         if seg > 0.0:
             sdx, sdy, sdz = tx / seg, ty / seg, tz / seg
-        far = min(seg * (1.0 - 2e-5), seg - margin)
+        far = seg - margin if margin > 0.0 else seg * (1.0 - 2e-5)
     else:
         far = scene_radius * 4.0
     return sdx, sdy, sdz, max(far, 0.0)
@@ -73,13 +75,15 @@ def next_queue(n: int) -> NextQueue:
 
 
 @kernel(allocates=False)
-def push(q, n, p, b, ox, oy, oz, dx, dy, dz, far, cr, cg, cb, stacks, prim=-1, inst=-1):
+def push(q, n, p, b, ox, oy, oz, dx, dy, dz, far, cr, cg, cb, stacks, prim=-1, inst=-1,
+         light_prim=-1):
     """Write shadow ray n of path p at its bounce b (contribution c if unoccluded; the
-    clamp that applies depends on b), leaving primitive prim of place inst (-1: none),
-    to the ShadowQueue q, with a copy of the path's volume stack when the scene has
-    volumes. Returns n + 1."""
+    clamp that applies depends on b), leaving primitive prim of place inst (-1: none)
+    towards the emissive triangle light_prim (-1: a lamp; emissive triangles are never
+    instanced), to the ShadowQueue q, with a copy of the path's volume stack when the
+    scene has volumes. Returns n + 1."""
     q.path[n] = p
-    q.skip[n, 0], q.skip[n, 1], q.skip[n, 2], q.skip[n, 3] = prim, inst, -1, -1
+    q.skip[n, 0], q.skip[n, 1], q.skip[n, 2], q.skip[n, 3] = prim, inst, light_prim, -1
     q.bounce[n] = b
     q.org[n, 0], q.org[n, 1], q.org[n, 2] = ox, oy, oz
     q.dir[n, 0], q.dir[n, 1], q.dir[n, 2] = dx, dy, dz

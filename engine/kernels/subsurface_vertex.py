@@ -145,11 +145,11 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, p
                     n0x, n0y, n0z = bx, by, bz
     goes_on = b < cfg.max_bounces and counts[p, 0] < cfg.diffuse_bounces
     mode = cfg.mis_mode
-    # next-event estimation on the exit's Lambertian surface (lights picked for it:
-    # one-sided, unless a bump bends its normal)
-    recv = lt.receiver(qx, qy, qz, mx, my, mz, lt.TWO_SIDED if bent else lt.ONE_SIDED)
+    # next-event estimation on the exit's Lambertian surface (lights picked for it as
+    # Cycles' tree picks them: one-sided, on the surface's own normal, sd->N)
+    recv = lt.receiver(qx, qy, qz, n0x, n0y, n0z, lt.ONE_SIDED)
     if lt.n_entries(lights) > 0:
-        k, lx, ly, lz, dist, lr, lg, lb, lpdf, delta, margin = lt.sample(
+        k, lx, ly, lz, dist, lr, lg, lb, lpdf, delta, lprim, margin = lt.sample(
             lights, recv, stream_uniform(key, EXIT_STEP, 0),
             stream_uniform(key, EXIT_STEP, 1), stream_uniform(key, EXIT_STEP, 2), time)
         seen = lt.entry_visibility(lights, k)
@@ -169,9 +169,10 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, p
                     geometry[0], geometry[1], geometry[4], geometry[13], geometry[9], prim2,
                     inst2, u, v, qx, qy, qz, hx, hy, hz, n0x, n0y, n0z, lx, ly, lz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, qx, qy, qz, lx, ly,
-                                                         lz, dist, margin, cfg.scene_radius)
+                                                         lz, dist, margin,
+                                                         cfg.scene_radius)
                 ns = ray_queues.push(shadows, ns, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr,
-                                     cg, cb, stacks, own, inst2)
+                                     cg, cb, stacks, own, inst2, lprim)
                 tl.queued(tally, ns - 1, p, b, DIFFUSE_SHARES, tl.entry_group(tally, k))
     if not goes_on:
         return ns, nn

@@ -31,8 +31,8 @@ Use:
 
     L = pack_lights(light_set)                 # once per scene (NumPy arrays)
     recv = receiver(px, py, pz, nx, ny, nz, mode)   # the shading point (tree.py)
-    k, wix, wiy, wiz, dist, r, g, b, pdf, delta, margin = sample(L, recv, u_pick, u1, u2,
-                                                                 time)
+    k, wix, wiy, wiz, dist, r, g, b, pdf, delta, light_prim, margin = sample(
+        L, recv, u_pick, u1, u2, time)
     t, k, r, g, b = hit_lamps(L, ox, oy, oz, dx, dy, dz, tmax, ray_bit, time)   # nearest
     n_lamps(L);  t, r, g, b = lamp_hit(L, k, ox, oy, oz, dx, dy, dz, ray_bit, time)
     lamp_pdf(L, k, recv, wix, wiy, wiz, t, time)     # recv: the ray's origin's receiver

@@ -40,7 +40,8 @@ def sample_batch(L, p, u_pick, u, time=None, normals=None, mode=OMNI):
 @kernel
 def _sample_rows(L, rc, u_pick, u, time):
     """`light_set.sample` over n points: (k (n,) int64, wi (n, 3), dist (n,), radiance
-    (n, 3), pdf (n,) with the pick probability, delta (n,) bool, margin (n,))."""
+    (n, 3), pdf (n,) with the pick probability, delta (n,) bool, light_prim (n,) int64:
+    the emissive triangle's global id, -1 for lamps, margin (n,))."""
     n = rc.shape[0]
     k_out = np.empty(n, dtype=np.int64)
     wi = np.empty((n, 3))
@@ -48,9 +49,10 @@ def _sample_rows(L, rc, u_pick, u, time):
     rad = np.empty((n, 3))
     pdf = np.empty(n)
     delta = np.empty(n, dtype=np.bool_)
+    light_prim = np.empty(n, dtype=np.int64)
     margin = np.empty(n)
     for i in range(n):
-        k, wx, wy, wz, d, r, g, b, pd, dl, m = sample(L, _recv(rc, i), u_pick[i], u[i, 0],
+        k, wx, wy, wz, d, r, g, b, pd, dl, m, mg = sample(L, _recv(rc, i), u_pick[i], u[i, 0],
                                                       u[i, 1], time[i])
         k_out[i] = k
         wi[i, 0], wi[i, 1], wi[i, 2] = wx, wy, wz
@@ -58,8 +60,9 @@ def _sample_rows(L, rc, u_pick, u, time):
         rad[i, 0], rad[i, 1], rad[i, 2] = r, g, b
         pdf[i] = pd
         delta[i] = dl
-        margin[i] = m
-    return k_out, wi, dist, rad, pdf, delta, margin
+        light_prim[i] = m
+        margin[i] = mg
+    return k_out, wi, dist, rad, pdf, delta, light_prim, margin
 
 
 def hit_lamps_batch(L, o, d, tmax, time=None):

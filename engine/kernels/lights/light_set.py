@@ -126,32 +126,33 @@ def pick_entry(L, recv, u_pick, time):
 @kernel(allocates=False)
 def sample_entry(L, k, px, py, pz, u1, u2, time):
     """Entry k sampled from p with (u1, u2), its pick probability not included: (wix,
-    wiy, wiz, dist, r, g, b, pdf, delta, margin) as `sample` returns them."""
+    wiy, wiz, dist, r, g, b, pdf, delta, light_prim, margin) as `sample` returns them."""
     n_lamps = L[LAMPS].shape[0]
     if k < n_lamps:
         wx, wy, wz, dist, r, g, b, pdf, delta = sample_lamp_at(L, k, px, py, pz, u1, u2,
                                                                time)
-        return wx, wy, wz, dist, r, g, b, pdf, delta, 0.0
-    wx, wy, wz, dist, r, g, b, pdf, margin = sample_triangle(L, k - n_lamps, px, py, pz,
-                                                             u1, u2)
-    return wx, wy, wz, dist, r, g, b, pdf, False, margin
+        return wx, wy, wz, dist, r, g, b, pdf, delta, -1, 0.0
+    wx, wy, wz, dist, r, g, b, pdf, prim, margin = sample_triangle(L, k - n_lamps, px, py,
+                                                                   pz, u1, u2)
+    return wx, wy, wz, dist, r, g, b, pdf, False, prim, margin
 
 
 @kernel(allocates=False)
 def sample(L, recv, u_pick, u1, u2, time):
     """Light sampling for one receiver (tree.py: the shading point p, its normal and
     mode) at shutter time `time`: pick an entry with u_pick, sample it with (u1, u2).
-    Returns (k, wix, wiy, wiz, dist, r, g, b, pdf, delta, margin): k the entry (-1 when
-    there is none, or none lights the receiver), dist inf for suns and the world, pdf in
-    solid angle including the pick probability (0 = no sample), delta for points and
-    zero-angle suns, margin the shadow-ray stop before dist for emissive triangles (0 for
-    lamps)."""
+    Returns (k, wix, wiy, wiz, dist, r, g, b, pdf, delta, light_prim, margin): k the
+    entry (-1 when there is none, or none lights the receiver), dist inf for suns and
+    the world, pdf in solid angle including the pick probability (0 = no sample), delta
+    for points and zero-angle suns, light_prim the emissive triangle's global id (-1 for
+    lamps), which the shadow ray names, and margin how far short of the point it stops
+    (0: a lamp, ray_queues.towards' relative stop)."""
     k, select = pick_entry(L, recv, u_pick, time)
     if k < 0:
-        return k, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, 0.0
-    wx, wy, wz, dist, r, g, b, pdf, delta, margin = sample_entry(L, k, recv[0], recv[1],
-                                                                 recv[2], u1, u2, time)
-    return k, wx, wy, wz, dist, r, g, b, pdf * select, delta, margin
+        return k, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, False, -1, 0.0
+    wx, wy, wz, dist, r, g, b, pdf, delta, prim, margin = sample_entry(
+        L, k, recv[0], recv[1], recv[2], u1, u2, time)
+    return k, wx, wy, wz, dist, r, g, b, pdf * select, delta, prim, margin
 
 
 @kernel(allocates=False)

@@ -13,7 +13,9 @@ every scene):
   L[TRI_V0], L[TRI_E1], L[TRI_E2], L[TRI_NORMAL]   float64 (n_tri, 3): the emissive
                  triangles (`EmissiveTriangles` v0, e1 = v1 - v0, e2 = v2 - v0, unit normal);
                  triangle j is entry n_lamps + j. Empty when the set has no mesh lights.
-  L[TRI_AREA], L[TRI_SCALE]   float64 (n_tri,): area; largest |coordinate| of its vertices.
+  L[TRI_AREA]    float64 (n_tri,): area.
+  L[TRI_PRIM]    int64 (n_tri,): its global triangle id (the first of coincident copies),
+                 which shadow rays towards it name (engine.embree.self_hits).
   L[TRI_RADIANCE]  float64 (n_tri, 3): emitted radiance (two-sided).
   L[TRI_ENTRY]   int64 (n_prims,): global triangle id -> triangle entry j, or -1
                  (`EmissiveTriangles.entry`; empty without mesh lights).
@@ -67,7 +69,8 @@ TRI_E1 = 5
 TRI_E2 = 6
 TRI_NORMAL = 7
 TRI_AREA = 8
-TRI_SCALE = 9
+TRI_PRIM = 9        # (the tuple keeps its size: each array more in L, which the vertex
+#                     kernels pass everywhere, cost 18 % of a Cornell box's time)
 TRI_RADIANCE = 10
 TRI_ENTRY = 11
 ENV = 12
@@ -237,12 +240,13 @@ def pack_lights(light_set, tri_visibility=None, timed=True, tree=True) -> tuple:
     if mesh is not None and len(mesh):
         tri = (_f64(mesh.v0, (-1, 3)), _f64(mesh.e1, (-1, 3)), _f64(mesh.e2, (-1, 3)),
                _f64(mesh.normal, (-1, 3)), _f64(mesh.area, (-1,)),
-               _f64(mesh.tri_scale, (-1,)), _f64(mesh.radiance, (-1, 3)),
+               np.array(mesh.prim, dtype=np.int64, order="C", copy=True),
+               _f64(mesh.radiance, (-1, 3)),
                np.array(mesh.entry, dtype=np.int64, order="C", copy=True))
     else:
         z3 = np.zeros((0, 3))
-        tri = (z3, z3.copy(), z3.copy(), z3.copy(), np.zeros(0), np.zeros(0), z3.copy(),
-               np.zeros(0, dtype=np.int64))
+        tri = (z3, z3.copy(), z3.copy(), z3.copy(), np.zeros(0), np.zeros(0, np.int64),
+               z3.copy(), np.zeros(0, dtype=np.int64))
     env = np.zeros(6)
     env[0] = -1.0
     env[5] = getattr(light_set.world, "seen_by", 31)

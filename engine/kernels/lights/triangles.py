@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import math
 
-from ...surface import RELATIVE_OFFSET
 from ..jit import kernel
-from .pack import (TRI_AREA, TRI_E1, TRI_E2, TRI_ENTRY, TRI_NORMAL, TRI_RADIANCE,
-                   TRI_SCALE, TRI_V0)
+from .pack import (TRI_AREA, TRI_E1, TRI_E2, TRI_ENTRY, TRI_NORMAL, TRI_PRIM, TRI_RADIANCE,
+                   TRI_V0)
 
+
+# Shadow rays stop this far (relative to the sampled point's largest coordinate, over
+# the cosine at the light) short of it: 8 float32 ulps, past the float32 rounding of
+# a coincident copy of the emitter, which would otherwise block half of them.
+REACH = 2.0 ** -21
 
 # A point this close to a triangle's plane (|cos| at the triangle) gets none of its light:
 # its cosine is rounding there (a point on a coplanar emitter), and the light it would
@@ -27,7 +31,10 @@ def square_to_triangle(u0, u1):
 @kernel(allocates=False)
 def sample_triangle(L, j, px, py, pz, u0, u1):
     """A uniform point of triangle entry j, seen from p (pick probability NOT included):
-    (wix, wiy, wiz, dist, r, g, b, pdf, margin)."""
+    (wix, wiy, wiz, dist, r, g, b, pdf, prim, margin), prim the triangle's global id,
+    which the shadow ray towards the point names (engine.embree.self_hits) so that it
+    does not meet the light itself, as Cycles' shadow rays name ls->prim, and margin how
+    far short of the point it stops (REACH)."""
     v0, e1, e2, nrm = L[TRI_V0], L[TRI_E1], L[TRI_E2], L[TRI_NORMAL]
     b1, b2 = square_to_triangle(u0, u1)
     qx = v0[j, 0] + b1 * e1[j, 0] + b2 * e2[j, 0]
@@ -41,13 +48,11 @@ def sample_triangle(L, j, px, py, pz, u0, u1):
         wx, wy, wz = 0.0, 0.0, 1.0
     cos_l = abs(wx * nrm[j, 0] + wy * nrm[j, 1] + wz * nrm[j, 2])
     if not (dist > 0.0 and cos_l > GRAZING):
-        return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0, 0.0
+        return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0, L[TRI_PRIM][j], 0.0
     pdf = dist * dist / (L[TRI_AREA][j] * cos_l)
     rad = L[TRI_RADIANCE]
-    # shadow rays stop this far before q (engine.mesh_lights: float32 self-occlusion)
-    # (the triangle's scale, relative to the static scene's centre, bounds q's)
-    margin = RELATIVE_OFFSET * L[TRI_SCALE][j] / cos_l
-    return wx, wy, wz, dist, rad[j, 0], rad[j, 1], rad[j, 2], pdf, margin
+    margin = REACH * max(abs(qx), abs(qy), abs(qz)) / cos_l
+    return wx, wy, wz, dist, rad[j, 0], rad[j, 1], rad[j, 2], pdf, L[TRI_PRIM][j], margin
 
 
 @kernel(allocates=False)
