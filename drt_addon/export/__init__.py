@@ -179,6 +179,11 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         if obj.type in GEOMETRY_TYPES:
             if not inst.is_instance and not inst.show_self:
                 continue
+            if obj.type != "CURVES" and (obj.data is None
+                                         or obj.data.bl_rna.identifier != "Mesh"):
+                # a curve, text, surface or metaball object itself: Blender hands its
+                # mesh on as an instance of it, which is drawn (Cycles' object_is_geometry)
+                continue
             key = source_key(inst, obj) if tracker is None else None
             source = groups.known.get(key) if key is not None else None
             if source is not None:               # a place of a source worked out before
