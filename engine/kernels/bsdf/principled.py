@@ -219,7 +219,8 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
 
 @kernel(allocates=False)
 def transmits(state):
-    """True where light from behind the surface can contribute (glass, translucency)."""
+    """True where light from behind the surface can contribute (glass, translucency, a
+    Hair BSDF's transmission)."""
     return state[S_W_GLASS] > 0.0 or (state[S_LAYERED] != 0.0 and (
         state[layers.S_EST_TRANS] > 0.0 or state[layers.S_EST_HAIR_TT] > 0.0))
 
@@ -227,9 +228,10 @@ def transmits(state):
 @kernel(allocates=False)
 def selection(state, allow_d, allow_g, allow_t):
     """Lobe probabilities (diffuse, specular, metal, glass; coat, sheen, translucent,
-    hair R, hair TT of layers.py; subsurface) over the allowed kinds. The subsurface lobe may be chosen
-    while any kind may continue: it leaves as a diffuse surface, which is then lit
-    directly even where no diffuse bounce is left (Cycles: the walk is no bounce)."""
+    hair R, hair TT of layers.py; subsurface) over the allowed kinds. The subsurface
+    lobe may be chosen while any kind may continue: it leaves as a diffuse surface,
+    which is then lit directly even where no diffuse bounce is left (Cycles: the walk is
+    no bounce)."""
     w0 = state[S_EST] if allow_d else 0.0
     w1 = state[S_EST + 1] if allow_g else 0.0
     w2 = state[S_EST + 2] if allow_g else 0.0
