@@ -106,7 +106,7 @@ def main():
         "  the triangle edge, Cycles' default).",
         "- On a mesh with a mirroring transform (negative scale) DRT swaps two corners of",
         "  each triangle to keep its normal, so the fibre direction is the other edge.",
-        "- The Principled Hair BSDF (Chiang, Huang) falls back with a warning.",
+        "- The Principled Hair BSDF: [principled_hair.md](principled_hair.md).",
         "",
         f"Written by `docs/make_hair_bsdf_docs.py` on {platform.machine()}, "
         f"{os.cpu_count()} cores, Python {platform.python_version()}.",

@@ -4,6 +4,7 @@ Never imports bpy. The input is an `engine.scene.Scene`, the output an `engine.f
 """
 from .curves import HairCurves
 from .film import Film
+from .principled_hair import PrincipledHair
 from .render import RenderContext, render
 from .render_stats import RenderStats
 from .scene import (AreaLight, Camera, Instances, Material, ObjectInfo, PointLight, Scene,
@@ -13,5 +14,5 @@ from . import visibility  # noqa: E402  (the Ray Visibility bits, for exporters)
 from . import sky_texture  # noqa: E402  (Blender's Sky Texture node, for exporters)
 
 __all__ = ["AreaLight", "Camera", "Film", "HairCurves", "Instances", "Material", "ObjectInfo",
-           "PointLight", "RenderContext", "RenderSettings", "RenderStats", "Scene", "SunLight",
+           "PointLight", "PrincipledHair", "RenderContext", "RenderSettings", "RenderStats", "Scene", "SunLight",
            "TriangleMesh", "Volume", "World", "render"]

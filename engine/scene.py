@@ -66,6 +66,8 @@ class Material:
                   Transmission colours (weight included; black: none), beside the other
                   lobes, with their _roughness (RoughnessU, RoughnessV) and _offset (the
                   node's Offset, radians; it applies on strands only, as in Cycles);
+      principled_hair     a Principled Hair BSDF (engine.PrincipledHair, Chiang model),
+                  beside the other lobes;
       refraction_only     the glass lobe refracts without reflecting (Refraction BSDF).
 
     Subsurface scattering (compiled path tracer; Cycles' random walk,
@@ -119,6 +121,7 @@ class Material:
     hair_transmission: tuple = (0.0, 0.0, 0.0)
     hair_transmission_roughness: tuple = (0.1, 1.0)
     hair_transmission_offset: float = 0.0
+    principled_hair: object = None       # an engine.PrincipledHair (None: none)
     refraction_only: bool = False
     bump_correction: bool = True
     sets_normal: bool = False            # the program's normal becomes the surface's own

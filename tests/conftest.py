@@ -163,3 +163,17 @@ def grey_room(bpy, size, grey, world=0.02):
                                      rotation=(math.pi / 2, 0.0, 0.0))
     bpy.context.object.data.materials.append(mat)
     return scene
+
+
+def as_diffuse(bpy, bl_idname, colour):
+    """Every node of type `bl_idname` in every material replaced, in place, by a Diffuse
+    BSDF of colour(material, node) (RGB): the controls of the comparisons of shader
+    nodes, what DRT rendered before it supported them."""
+    for mat in bpy.data.materials:
+        nt = mat.node_tree
+        for node in [n for n in nt.nodes if n.bl_idname == bl_idname]:
+            diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
+            diffuse.inputs["Color"].default_value = (*colour(mat, node)[:3], 1.0)
+            for link in list(node.outputs[0].links):
+                nt.links.new(diffuse.outputs[0], link.to_socket)
+            nt.nodes.remove(node)

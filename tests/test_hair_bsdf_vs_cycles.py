@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from conftest import grey_room, render_current, use_engine
+from conftest import as_diffuse, grey_room, render_current, use_engine
 from test_multiscatter_vs_cycles import assert_matches, compare
 
 
@@ -102,14 +102,8 @@ def _scene(bpy):
 
 def _as_diffuse(bpy):
     """Every Hair BSDF replaced by a Diffuse BSDF of its colour, in place."""
-    for mat in bpy.data.materials:
-        nt = mat.node_tree
-        for node in [n for n in nt.nodes if n.bl_idname == "ShaderNodeBsdfHair"]:
-            diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
-            diffuse.inputs["Color"].default_value = node.inputs["Color"].default_value
-            for link in list(node.outputs[0].links):
-                nt.links.new(diffuse.outputs[0], link.to_socket)
-            nt.nodes.remove(node)
+    as_diffuse(bpy, "ShaderNodeBsdfHair",
+               lambda mat, node: tuple(node.inputs["Color"].default_value))
 
 
 def test_hair_bsdf_on_strands_and_meshes_matches_cycles(bpy_drt):

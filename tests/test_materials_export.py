@@ -442,7 +442,7 @@ def test_unsupported_nodes_warn_once_per_material_and_render(bpy_drt):
     _camera_and_sun(bpy, scene, size=(8, 8))
     mat, nt = _material(bpy, "Weird")
     toon = nt.nodes.new("ShaderNodeBsdfToon")
-    hair = nt.nodes.new("ShaderNodeBsdfHairPrincipled")
+    hair = nt.nodes.new("ShaderNodeBsdfRayPortal")
     mix = nt.nodes.new("ShaderNodeMixShader")
     nt.links.new(toon.outputs[0], mix.inputs[1])
     nt.links.new(hair.outputs[0], mix.inputs[2])
@@ -455,7 +455,7 @@ def test_unsupported_nodes_warn_once_per_material_and_render(bpy_drt):
     assert last["ok"], last["error"]
     mine = [w for w in last["warnings"] if "'Weird'" in w]
     assert len(mine) == 1, last["warnings"]
-    assert "Toon" in mine[0] and "Principled Hair" in mine[0] and "viewport colour" in mine[0]
+    assert "Toon" in mine[0] and "Ray Portal" in mine[0] and "viewport colour" in mine[0]
     assert not any("'Fine'" in w for w in last["warnings"])
     assert np.isfinite(last["pixels"]).all() and last["pixels"].max() > 0
 

@@ -50,7 +50,8 @@ NULL_COMP = _Comp(base=BLACK, spec=0.0)     # absorbs: an Emission shader's "no 
 
 HAIR_PARTS = ("hair_reflection", "hair_transmission")
 LAYER_FIELDS = ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",
-                "sheen_roughness", "sheen_tint", "sheen_layered", "translucent_color") + \
+                "sheen_roughness", "sheen_tint", "sheen_layered", "translucent_color",
+                "principled_hair") + \
     tuple(p + k for p in HAIR_PARTS for k in ("", "_roughness", "_offset"))
 
 
@@ -59,7 +60,8 @@ class _Layers:
     """A closure's lobes beyond the Principled base, as engine.scene.Material fields:
     Principled's coat and sheen (layered over the base), a Sheen BSDF node's sheen
     (sheen_layered False: beside the other closures), a Translucent BSDF's colour and a
-    Hair BSDF's components (colour, RoughnessU / V, Offset), beside the rest."""
+    Hair BSDF's components (colour, RoughnessU / V, Offset) and a Principled Hair BSDF
+    (engine.PrincipledHair, its weight colour included), beside the rest."""
     coat_weight: float = 0.0
     coat_roughness: float = 0.03
     coat_ior: float = 1.5
@@ -75,6 +77,21 @@ class _Layers:
     hair_transmission: tuple = BLACK
     hair_transmission_roughness: tuple = (0.1, 1.0)
     hair_transmission_offset: float = 0.0
+    principled_hair: object = None
+
+
+def _blend_hair(with_layers, ctx):
+    """The Principled Hair of a mixture: weights summed (scaled by the mix), the inputs
+    of the heaviest (reported where they differ)."""
+    hairs = [(c, L.principled_hair) for c, L in with_layers if L.principled_hair is not None]
+    if not hairs:
+        return None
+    weight = tuple(float(sum(c * h.weight[k] for c, h in hairs)) for k in range(3))
+    _, heaviest = max(hairs, key=lambda ch: ch[0] * max(ch[1].weight))
+    if len({replace(h, weight=(1.0, 1.0, 1.0)) for _, h in hairs}) > 1:
+        ctx.issue("mixed Principled Hair BSDFs have different inputs; DRT uses the "
+                  "heaviest one's")
+    return replace(heaviest, weight=weight)
 
 
 def _blend_layers(comps, ctx):
@@ -125,6 +142,7 @@ def _blend_layers(comps, ctx):
         if hw:
             for name in (part + "_roughness", part + "_offset"):
                 setattr(out, name, avg(hw, name))
+    out.principled_hair = _blend_hair(with_layers, ctx)
     return out
 
 
@@ -211,6 +229,8 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
             L.translucent_color = _scale(L.translucent_color, total)
             for part in HAIR_PARTS:
                 setattr(L, part, _scale(getattr(L, part), total))
+            if L.principled_hair is not None:
+                L.principled_hair = L.principled_hair.scaled(total)
     # emitted by the shaded part (probability W / total)
     emission = _scale(cl.emission, total / W)
     alpha_tex = cl.alpha_texture

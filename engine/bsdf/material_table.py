@@ -167,7 +167,9 @@ class MaterialTable:
             setattr(self, name + "_roughness", np.array(
                 [tuple(getattr(m, name + "_roughness", (0.1, 1.0)))[:2] for m in materials],
                 np.float64).reshape(-1, 2))
-        self.hair = (self.hair_reflection.max(1) > 0.0) | (self.hair_transmission.max(1) > 0.0)
+        self._chiang_params(materials)
+        self.hair = ((self.hair_reflection.max(1) > 0.0) | (self.hair_transmission.max(1) > 0.0)
+                     | (self.chiang_weight.max(1) > 0.0))
         self.refraction_only = np.array([bool(getattr(m, "refraction_only", False))
                                          for m in materials], bool)
         self.sheen_layered = np.array([bool(getattr(m, "sheen_layered", True))
@@ -189,6 +191,31 @@ class MaterialTable:
                      "hair_reflection_offset", "hair_reflection_roughness",
                      "hair_transmission", "hair_transmission_offset",
                      "hair_transmission_roughness"):
+            _require_finite(materials, name, getattr(self, name))
+
+    def _chiang_params(self, materials):
+        """A Principled Hair BSDF's inputs (engine.principled_hair; hair_chiang.py)."""
+        from ..principled_hair import PARAMETRIZATIONS, PrincipledHair
+        hair = [getattr(m, "principled_hair", None) for m in materials]
+        plain = PrincipledHair(weight=(0.0, 0.0, 0.0))
+        hair = [plain if h is None else h for h in hair]
+        self.chiang_weight = np.maximum(np.array([h.weight for h in hair],
+                                                 np.float64).reshape(-1, 3), 0.0)
+        self.chiang_mode = np.array([PARAMETRIZATIONS.index(h.parametrization)
+                                     for h in hair], np.float64)
+        self.chiang_colour = np.array([h.mode_colour() for h in hair],
+                                      np.float64).reshape(-1, 3)
+        self.chiang_melanin = np.array([(h.melanin, h.melanin_redness) for h in hair],
+                                       np.float64).reshape(-1, 2)
+        self.chiang_roughness = np.array([(h.roughness, h.radial_roughness, h.coat)
+                                          for h in hair], np.float64).reshape(-1, 3)
+        self.chiang_ior = np.array([h.ior for h in hair], np.float64)
+        self.chiang_offset = np.array([h.offset for h in hair], np.float64)
+        self.chiang_random = np.array([(h.random_color, h.random_roughness, h.random)
+                                       for h in hair], np.float64).reshape(-1, 3)
+        self.chiang_own_random = np.array([h.strand_random for h in hair], np.float64)
+        for name in ("chiang_weight", "chiang_colour", "chiang_melanin", "chiang_roughness",
+                     "chiang_ior", "chiang_offset", "chiang_random"):
             _require_finite(materials, name, getattr(self, name))
 
     def _subsurface_params(self, materials):

@@ -131,6 +131,8 @@ def _channel_colours(state, woz, s, c):
         coat = state[layers.S_EST_COAT]
         # a Hair BSDF's colour (Cycles' albedo of its closures is their weight)
         hair_r, hair_tt = state[layers.S_HAIR_R + c], state[layers.S_HAIR_TT + c]
+        # a Principled Hair's: its weight times Cycles' albedo estimate, glossy
+        hair_r += state[layers.S_CHIANG_W + c] * state[layers.S_CHIANG_ALBEDO + c]
     metal = 0.0
     if m > 0.0:
         # the lobe's albedo: Fresnel over the lobe (a Glossy BSDF's is its colour) times

@@ -330,7 +330,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         br, bg, bb = br / q, bg / q, bb / q
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
         material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)
-        if row[P_HAIR] != 0.0:           # a Hair BSDF: the fibre's direction at the hit
+        if row[P_HAIR] != 0.0:           # a hair closure: the fibre's direction at the hit
             hair_tangent.write(geometry, prim, hit_inst[j], hit_u[j], hit_v[j], path_time[p],
                                nx, ny, nz, row)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])

@@ -168,7 +168,7 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
         _add(tally.L, p, br * er, bg * eg, bb * eb, clamp_hit)
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
         material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)
-        if row[P_HAIR] != 0.0:           # a Hair BSDF: the fibre's direction at the hit
+        if row[P_HAIR] != 0.0:           # a hair closure: the fibre's direction at the hit
             hair_tangent.write(geometry, prim, hit_inst[j], hit_u[j], hit_v[j], path_time[p],
                                nx, ny, nz, row)
         row[P_SSS_WEIGHT] = 0.0          # Whitted's model: subsurface light is diffuse

@@ -1,9 +1,11 @@
 """Hair shader nodes to closures: the Hair BSDF node (Cycles' HairBsdfNode: a Reflection
 or a Transmission component about the fibre's direction), rendered by
-engine/kernels/bsdf/hair.py beside the material's other lobes."""
+engine/kernels/bsdf/hair.py, and the Principled Hair BSDF (engine.principled_hair,
+rendered by engine/kernels/bsdf/hair_chiang.py), beside the material's other lobes."""
 from __future__ import annotations
 
 from ...blender_compat import node_input
+from ...engine_link import engine
 from ..closures import BLACK, _Closure, _Comp, _Layers
 from .links import _link
 
@@ -27,4 +29,55 @@ def hair_bsdf(node, ctx, constant) -> _Closure:
     else:
         layers = _Layers(hair_reflection=color, hair_reflection_roughness=rough,
                          hair_reflection_offset=offset)
+    return _Closure([(1.0, _Comp(base=BLACK, spec=0.0, layers=layers))])
+
+
+def _from_hair_random(socket) -> bool:
+    """Whether `socket` is fed by a Hair Info node's Random: what Cycles reads when the
+    socket is unlinked, so it stays per strand."""
+    link = _link(socket)
+    return (link is not None and link[0].bl_idname == "ShaderNodeHairInfo"
+            and link[1].name == "Random")
+
+
+def principled_hair(node, ctx, constant) -> _Closure:
+    """Principled Hair BSDF (Cycles' PrincipledHairBsdfNode, Chiang model): its inputs as
+    the node's parametrization reads them (`constant` reads a socket, a linked one by its
+    average, reported). The Huang model is rendered with Chiang's, reported."""
+    if getattr(node, "model", "CHIANG") != "CHIANG":
+        ctx.issue(f"{node.name!r} uses the Huang hair model; DRT renders it with the Chiang "
+                  f"model (its Aspect Ratio and lobe weights are left out)")
+    mode = getattr(node, "parametrization", "COLOR")
+    if mode not in ("COLOR", "ABSORPTION", "MELANIN"):
+        ctx.issue(f"{node.name!r} has the parametrization {mode!r}; DRT reads its Color")
+        mode = "COLOR"
+    PrincipledHair = engine.PrincipledHair
+    d = PrincipledHair()
+
+    def num(name, default):
+        return float(constant(node, name, ctx, default))
+
+    def col(name, default):
+        return tuple(float(x) for x in constant(node, name, ctx, default, color=True))[:3]
+    kw = {}
+    if mode == "COLOR":
+        kw["color"] = col("Color", d.color)
+    elif mode == "ABSORPTION":
+        kw["absorption"] = col("Absorption Coefficient", d.absorption)
+    else:
+        kw.update(melanin=num("Melanin", d.melanin),
+                  melanin_redness=num("Melanin Redness", d.melanin_redness),
+                  tint=col("Tint", d.tint), random_color=num("Random Color", d.random_color))
+    random = node_input(node, "Random")
+    linked = random is not None and _link(random) is not None
+    own = not linked or _from_hair_random(random)
+    # a mesh reads the unlinked socket's value, Hair Info's Random there is 0
+    value = 0.0 if (linked and own) else num("Random", d.random)
+    hair = PrincipledHair(
+        parametrization=mode, roughness=num("Roughness", d.roughness),
+        radial_roughness=num("Radial Roughness", d.radial_roughness),
+        coat=num("Coat", d.coat), ior=num("IOR", d.ior), offset=num("Offset", d.offset),
+        random_roughness=num("Random Roughness", d.random_roughness),
+        random=value, strand_random=own, **kw)
+    layers = _Layers(principled_hair=hair)
     return _Closure([(1.0, _Comp(base=BLACK, spec=0.0, layers=layers))])

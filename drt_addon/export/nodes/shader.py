@@ -357,6 +357,8 @@ def _closure(socket, ctx, depth=0) -> _Closure:
         return _scattering(node, ctx)
     if kind == "ShaderNodeBsdfHair":
         return hair.hair_bsdf(node, ctx, _constant)
+    if kind == "ShaderNodeBsdfHairPrincipled":
+        return hair.principled_hair(node, ctx, _constant)
     if kind == "ShaderNodeEmission":
         return _emission(node, ctx)
     if kind == "ShaderNodeBsdfTransparent":

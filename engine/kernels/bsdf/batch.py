@@ -96,17 +96,17 @@ def setup_batch(rows, front, wo, tables, walter=False):
 
 @kernel
 def selection_batch(rows, front, wo, allowed, tables, walter=False):
-    """Lobe probabilities (n, 10) of `principled.selection` (diffuse, specular, metal,
-    glass; coat, sheen, translucent, hair R, hair TT; subsurface)."""
+    """Lobe probabilities (n, 11) of `principled.selection` (diffuse, specular, metal,
+    glass; coat, sheen, translucent, hair R, hair TT; subsurface; Principled Hair)."""
     n = wo.shape[0]
-    out = np.zeros((n, 10))
+    out = np.zeros((n, 11))
     state = np.empty(P.NSTATE)
     for k in range(n):
         P.setup(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state)
         if walter:
             state[S_WALTER] = 1.0
         q = P.selection(state, allowed[k, 0], allowed[k, 1], allowed[k, 2])
-        for j in range(10):
+        for j in range(11):
             out[k, j] = q[j]
     return out
 

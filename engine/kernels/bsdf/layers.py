@@ -8,7 +8,10 @@
     translucent  (translucent.py)  a Translucent BSDF mixed in beside them (no layering);
     hair R, TT   (hair.py)         a Hair BSDF node's Reflection and Transmission, beside
                                    them, about the fibre's tangent that the integrator
-                                   writes into the row per hit (P_HAIR_T).
+                                   writes into the row per hit (P_HAIR_T);
+    chiang       (hair_chiang.py)  a Principled Hair BSDF (Chiang), beside them, about
+                                   the fibre's dP/du (P_CHIANG_T), with the geometric
+                                   normal (P_CHIANG_NG), also written per hit.
 
 A material row uses them only where P_LAYERS is 1; then principled.setup calls `setup`
 here, which fills the slots below and returns nothing else, and principled's eval, pdf
@@ -22,14 +25,20 @@ and the transmission bounce budgets last (Cycles counts it against both); hair R
 GLOSSY, hair TT TRANSMISSION (Cycles' closure classes, which the lights' visibility and
 the passes follow). A sampled hair direction is kept on either side of the surface, as
 Cycles keeps it (`hair_sample`; principled.sample weighs it with the density drawn).
+The Principled Hair closure is GLOSSY for the lights and the passes (Cycles' class) and
+may be sampled while the glossy or the transmission budget lasts; the bounce it makes
+counts as GLOSSY for its R lobe and TRANSMISSION for the three through the fibre
+(Cycles' labels), and a lobe past its budget ends the path, as in Cycles.
 """
 from __future__ import annotations
 
 from ..jit import kernel
-from . import coat, hair, sheen, translucent
+from . import coat, hair, hair_chiang, sheen, translucent
 from . import microfacet as mf
-from .params import (P_COAT_IOR, P_COAT_ROUGHNESS, P_COAT_TINT, P_COAT_WEIGHT,
-                     P_FILTER_ALPHA, P_HAIR_CURVE, P_HAIR_R, P_HAIR_R_OFFSET,
+from .params import (P_CHIANG, P_CHIANG_COLOR, P_CHIANG_IOR, P_CHIANG_MELANIN,
+                     P_CHIANG_MODE, P_CHIANG_NG, P_CHIANG_OFFSET, P_CHIANG_RANDOM,
+                     P_CHIANG_ROUGH, P_CHIANG_T, P_COAT_IOR, P_COAT_ROUGHNESS, P_COAT_TINT,
+                     P_COAT_WEIGHT, P_FILTER_ALPHA, P_HAIR_CURVE, P_HAIR_R, P_HAIR_R_OFFSET,
                      P_HAIR_R_ROUGH, P_HAIR_T, P_HAIR_TT, P_HAIR_TT_OFFSET, P_HAIR_TT_ROUGH,
                      P_SHEEN_LAYERED, P_SHEEN_ROUGHNESS, P_SHEEN_TINT, P_SHEEN_WEIGHT,
                      P_TRANSLUCENT)
@@ -58,7 +67,18 @@ S_HAIR_R_LOBE = 61              # 3: its offset (0 off a strand), r1, r2 (clampe
 S_HAIR_TT_LOBE = 64             # 3: the same for the transmission
 S_EST_HAIR_R = 67               # selection estimates of the two hair lobes
 S_EST_HAIR_TT = 68
-NSTATE = 69
+S_CHIANG_W = 69                 # 3: the Principled Hair closure's weight colour
+S_CHIANG_SIGMA = 72             # 3: its absorption
+S_CHIANG_LOBE = 75              # 3: v, s, m0 (hair_chiang.remap, Filter Glossy included)
+S_CHIANG_ALPHA = 78             # the node's Offset
+S_CHIANG_ETA = 79
+S_CHIANG_H = 80
+S_CHIANG_T = 81                 # 3: the fibre's tangent, local
+S_CHIANG_ALBEDO = 84            # 3: Cycles' albedo estimate at wo (the Color passes)
+S_EST_CHIANG = 87               # its selection estimate
+S_CHIANG_MESH = 88              # 1: on a triangle, where lights see Cycles' bump test
+S_CHIANG_AS_SAMPLED = 89        # 1: principled.sample weighs the closure's own direction
+NSTATE = 90
 
 
 @kernel(allocates=False)
@@ -135,6 +155,106 @@ def setup(row, wox, woy, woz, tables, state):
         state[S_HAIR_TT_LOBE] = row[P_HAIR_TT_OFFSET] if on_strand else 0.0
         state[S_HAIR_TT_LOBE + 1] = hair.clamp_roughness(row[P_HAIR_TT_ROUGH])
         state[S_HAIR_TT_LOBE + 2] = hair.clamp_roughness(row[P_HAIR_TT_ROUGH + 1])
+    _chiang_setup(row, wox, woy, woz, state)
+
+
+@kernel(allocates=False)
+def _chiang_setup(row, wox, woy, woz, state):
+    """The Principled Hair closure's slots, as Cycles' svm closure and setup make them:
+    Random Roughness scales both roughnesses by 1 + 2 (random - 1/2) amount."""
+    w_max = 0.0
+    for c in range(3):
+        state[S_CHIANG_W + c] = max(row[P_CHIANG + c], 0.0)
+        state[S_CHIANG_ALBEDO + c] = 0.0
+        w_max = max(w_max, state[S_CHIANG_W + c])
+    state[S_EST_CHIANG] = w_max
+    state[S_CHIANG_AS_SAMPLED] = 0.0
+    if not w_max > 0.0:
+        return
+    state[S_CHIANG_MESH] = 0.0 if row[P_HAIR_CURVE] != 0.0 else 1.0
+    random = row[P_CHIANG_RANDOM + 2]
+    k = 1.0 + 2.0 * (random - 0.5) * row[P_CHIANG_RANDOM + 1]
+    rough = row[P_CHIANG_ROUGH] * k
+    radial = row[P_CHIANG_ROUGH + 1] * k
+    cr, cg, cb = row[P_CHIANG_COLOR], row[P_CHIANG_COLOR + 1], row[P_CHIANG_COLOR + 2]
+    sr, sg, sb = hair_chiang.absorption(int(row[P_CHIANG_MODE]), cr, cg, cb,
+                                        row[P_CHIANG_MELANIN], row[P_CHIANG_MELANIN + 1],
+                                        cr, cg, cb, row[P_CHIANG_RANDOM], random, radial)
+    state[S_CHIANG_SIGMA] = sr
+    state[S_CHIANG_SIGMA + 1] = sg
+    state[S_CHIANG_SIGMA + 2] = sb
+    v, s, m0 = hair_chiang.remap(rough, radial, row[P_CHIANG_ROUGH + 2], row[P_FILTER_ALPHA])
+    state[S_CHIANG_LOBE] = v
+    state[S_CHIANG_LOBE + 1] = s
+    state[S_CHIANG_LOBE + 2] = m0
+    state[S_CHIANG_ALPHA] = row[P_CHIANG_OFFSET]
+    eta = max(row[P_CHIANG_IOR], 1e-3)
+    state[S_CHIANG_ETA] = eta
+    # a hit on the back of a triangle: Cycles turns Ng to the view and negates dPdu
+    tx, ty, tz = row[P_CHIANG_T], row[P_CHIANG_T + 1], row[P_CHIANG_T + 2]
+    gx, gy, gz = row[P_CHIANG_NG], row[P_CHIANG_NG + 1], row[P_CHIANG_NG + 2]
+    if gx * wox + gy * woy + gz * woz < 0.0:
+        gx, gy, gz, tx, ty, tz = -gx, -gy, -gz, -tx, -ty, -tz
+    h = hair_chiang.offset_h(gx, gy, gz, tx, ty, tz, wox, woy, woz)
+    state[S_CHIANG_H] = h
+    state[S_CHIANG_T], state[S_CHIANG_T + 1], state[S_CHIANG_T + 2] = tx, ty, tz
+    ar, ag, ab = hair_chiang.albedo(tx, ty, tz, h, sr, sg, sb, v, eta, wox, woy, woz)
+    state[S_CHIANG_ALBEDO] = ar
+    state[S_CHIANG_ALBEDO + 1] = ag
+    state[S_CHIANG_ALBEDO + 2] = ab
+
+
+@kernel(allocates=False)
+def _bump_shadowed(state, wox, woy, woz, wix, wiy, wiz):
+    """Cycles' bump_shadowing_term for the closure evaluated on a triangle: its normal
+    (Y = X x wo, hair_chiang's frame) is not the surface's, so light is refused where
+    N.wi, N.Y and Y.wi do not agree in sign (N, the shading normal, is local z). Not on
+    strands, and not for the closure's own sampled direction (Cycles' bsdf_sample)."""
+    if state[S_CHIANG_MESH] == 0.0 or state[S_CHIANG_AS_SAMPLED] != 0.0:
+        return False
+    tx, ty, tz = state[S_CHIANG_T], state[S_CHIANG_T + 1], state[S_CHIANG_T + 2]
+    yx = ty * woz - tz * woy
+    yy = tz * wox - tx * woz
+    yz = tx * woy - ty * wox
+    return wiz * yz * (yx * wix + yy * wiy + yz * wiz) < 0.0
+
+
+@kernel(allocates=False)
+def chiang_eval(state, wox, woy, woz, wix, wiy, wiz):
+    """The Principled Hair closure's (F_r, F_g, F_b, pdf) (hair_chiang.evaluate), its
+    weight included in F: f |cos|, as Cycles' bsdf_eval (zero where `_bump_shadowed`)."""
+    if _bump_shadowed(state, wox, woy, woz, wix, wiy, wiz):
+        return 0.0, 0.0, 0.0, 0.0
+    T, L = S_CHIANG_T, S_CHIANG_LOBE
+    Fr, Fg, Fb, p = hair_chiang.evaluate(
+        state[T], state[T + 1], state[T + 2], state[S_CHIANG_H], state[S_CHIANG_SIGMA],
+        state[S_CHIANG_SIGMA + 1], state[S_CHIANG_SIGMA + 2], state[L], state[L + 1],
+        state[L + 2], state[S_CHIANG_ALPHA], state[S_CHIANG_ETA], wox, woy, woz, wix, wiy,
+        wiz)
+    W = S_CHIANG_W
+    return Fr * state[W], Fg * state[W + 1], Fb * state[W + 2], p
+
+
+@kernel(allocates=False)
+def chiang_sample(state, wox, woy, woz, u_p, u1, u2):
+    """A direction from the Principled Hair closure: (wi, F (weight included), pdf, p),
+    p 0 for its reflection, 1..3 through the fibre. Until `chiang_sampled_done`,
+    chiang_eval gives this direction its value without Cycles' bump test, as Cycles'
+    sample does."""
+    state[S_CHIANG_AS_SAMPLED] = 1.0
+    T, L = S_CHIANG_T, S_CHIANG_LOBE
+    x, y, z, Fr, Fg, Fb, p, lobe = hair_chiang.sample(
+        state[T], state[T + 1], state[T + 2], state[S_CHIANG_H], state[S_CHIANG_SIGMA],
+        state[S_CHIANG_SIGMA + 1], state[S_CHIANG_SIGMA + 2], state[L], state[L + 1],
+        state[L + 2], state[S_CHIANG_ALPHA], state[S_CHIANG_ETA], wox, woy, woz, u_p, u1,
+        u2)
+    W = S_CHIANG_W
+    return x, y, z, Fr * state[W], Fg * state[W + 1], Fb * state[W + 2], p, lobe
+
+
+@kernel(allocates=False)
+def chiang_sampled_done(state):
+    state[S_CHIANG_AS_SAMPLED] = 0.0
 
 
 @kernel(allocates=False)
@@ -174,6 +294,12 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
         fr += state[S_HAIR_TT] * v
         fg += state[S_HAIR_TT + 1] * v
         fb += state[S_HAIR_TT + 2] * v
+    if see_g and state[S_EST_CHIANG] > 0.0 and wiz != 0.0:
+        cr, cg, cb, _ = chiang_eval(state, wox, woy, woz, wix, wiy, wiz)
+        c = abs(wiz)
+        fr += cr / c
+        fg += cg / c
+        fb += cb / c
     return fr, fg, fb
 
 
@@ -198,18 +324,19 @@ def hair_sample(state, wox, woy, woz, transmission, u1, u2):
 
 @kernel(allocates=False)
 def selection(state, allow_d, allow_g, allow_t):
-    """Unnormalised selection weights (coat, sheen, translucent, hair R, hair TT) over
-    the allowed kinds."""
+    """Unnormalised selection weights (coat, sheen, translucent, hair R, hair TT,
+    Principled Hair) over the allowed kinds."""
     wc = state[S_EST_COAT] if allow_g else 0.0
     ws = state[S_EST_SHEEN] if allow_d else 0.0
     wt = state[S_EST_TRANS] if (allow_d and allow_t) else 0.0
     whr = state[S_EST_HAIR_R] if allow_g else 0.0
     wht = state[S_EST_HAIR_TT] if allow_t else 0.0
-    return wc, ws, wt, whr, wht
+    wch = state[S_EST_CHIANG] if (allow_g or allow_t) else 0.0
+    return wc, ws, wt, whr, wht, wch
 
 
 @kernel(allocates=False)
-def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht):
+def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht, qch):
     """sum q_i pdf_i over the coat, sheen, translucent and hair lobes (evaluation's)."""
     p = 0.0
     if qc > 0.0:
@@ -223,6 +350,8 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht):
         p += qhr * hair_pdf(state, wox, woy, woz, wix, wiy, wiz, False)
     if qht > 0.0:
         p += qht * hair_pdf(state, wox, woy, woz, wix, wiy, wiz, True)
+    if qch > 0.0:
+        p += qch * chiang_eval(state, wox, woy, woz, wix, wiy, wiz)[3]
     return p
 
 

@@ -53,7 +53,8 @@ P_SETS_NORMAL = 48       # 0 / 1: the program's normal becomes the surface's (Cy
 P_HOLDOUT = 49           # the share of hits that are a Holdout shader (a hole for the
 #                          camera, black to other rays); 1 for a Holdout alone
 # Cycles' Hair BSDF node (hair.py), beside the other lobes: read only where P_LAYERS is 1
-P_HAIR = 50              # 0 / 1: the integrator writes P_HAIR_T and P_HAIR_CURVE per hit
+P_HAIR = 50              # 0 / 1: the integrator writes the per-hit hair columns
+#                          (engine.kernels.hair_tangent)
 P_HAIR_R = 51            # 3 columns: the Reflection component's colour (weight included)
 P_HAIR_R_OFFSET = 54     # its Offset as Cycles keeps it (minus the node's), radians
 P_HAIR_R_ROUGH = 55      # 2 columns: its RoughnessU, RoughnessV
@@ -63,7 +64,22 @@ P_HAIR_TT_ROUGH = 61     # 2 columns
 P_HAIR_T = 63            # per hit, 3 columns: the fibre's tangent in the shading frame
 #                          (a strand's direction, a triangle's second edge: Cycles' dPdv)
 P_HAIR_CURVE = 66        # per hit, 0 / 1: the hit is on a strand (the Offset applies)
-NPARAM = 67
+# The Principled Hair BSDF, Chiang model (hair_chiang.py): read only where P_LAYERS is 1
+P_CHIANG = 67            # 3 columns: the closure's weight colour (black: none)
+P_CHIANG_MODE = 70       # hair_chiang.ABSORPTION, MELANIN or COLOR
+P_CHIANG_COLOR = 71      # 3 columns: Absorption Coefficient, Tint or Color, by the mode
+P_CHIANG_MELANIN = 74    # 2 columns: Melanin, Melanin Redness
+P_CHIANG_ROUGH = 76      # 3 columns: Roughness, Radial Roughness, Coat
+P_CHIANG_IOR = 79
+P_CHIANG_OFFSET = 80     # the node's Offset, radians
+P_CHIANG_RANDOM = 81     # 3 columns: Random Color, Random Roughness, Random (per hit: a
+#                          strand's own Random where P_CHIANG_OWN_RANDOM is 1)
+P_CHIANG_OWN_RANDOM = 84  # 0 / 1: Random is unlinked (Cycles reads the strand's)
+P_CHIANG_T = 85          # per hit, 3 columns: the fibre's tangent in the shading frame
+#                          (Cycles' dPdu: a strand's direction, a triangle's p1 - p0)
+P_CHIANG_NG = 88         # per hit, 3 columns: the geometric normal in the shading frame
+#                          (either side; for h, where across the fibre the view meets it)
+NPARAM = 91
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -118,4 +134,13 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_HAIR_TT:P_HAIR_TT + 3] = table.hair_transmission
     rows[:, P_HAIR_TT_OFFSET] = -table.hair_transmission_offset
     rows[:, P_HAIR_TT_ROUGH:P_HAIR_TT_ROUGH + 2] = table.hair_transmission_roughness
+    rows[:, P_CHIANG:P_CHIANG + 3] = table.chiang_weight
+    rows[:, P_CHIANG_MODE] = table.chiang_mode
+    rows[:, P_CHIANG_COLOR:P_CHIANG_COLOR + 3] = table.chiang_colour
+    rows[:, P_CHIANG_MELANIN:P_CHIANG_MELANIN + 2] = table.chiang_melanin
+    rows[:, P_CHIANG_ROUGH:P_CHIANG_ROUGH + 3] = table.chiang_roughness
+    rows[:, P_CHIANG_IOR] = table.chiang_ior
+    rows[:, P_CHIANG_OFFSET] = table.chiang_offset
+    rows[:, P_CHIANG_RANDOM:P_CHIANG_RANDOM + 3] = table.chiang_random
+    rows[:, P_CHIANG_OWN_RANDOM] = table.chiang_own_random
     return rows

@@ -220,38 +220,38 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
 @kernel(allocates=False)
 def transmits(state):
     """True where light from behind the surface can contribute (glass, translucency, a
-    Hair BSDF's transmission)."""
+    Hair BSDF's transmission, a Principled Hair BSDF)."""
     return state[S_W_GLASS] > 0.0 or (state[S_LAYERED] != 0.0 and (
-        state[layers.S_EST_TRANS] > 0.0 or state[layers.S_EST_HAIR_TT] > 0.0))
+        state[layers.S_EST_TRANS] > 0.0 or state[layers.S_EST_HAIR_TT] > 0.0
+        or state[layers.S_EST_CHIANG] > 0.0))
 
 
 @kernel(allocates=False)
 def selection(state, allow_d, allow_g, allow_t):
     """Lobe probabilities (diffuse, specular, metal, glass; coat, sheen, translucent,
-    hair R, hair TT of layers.py; subsurface) over the allowed kinds. The subsurface
-    lobe may be chosen while any kind may continue: it leaves as a diffuse surface,
-    which is then lit directly even where no diffuse bounce is left (Cycles: the walk is
-    no bounce)."""
+    hair R, hair TT of layers.py; subsurface; Principled Hair) over the allowed kinds.
+    The subsurface lobe may be chosen while any kind may continue: it leaves as a
+    diffuse surface, lit directly even without a diffuse bounce left (Cycles)."""
     w0 = state[S_EST] if allow_d else 0.0
     w1 = state[S_EST + 1] if allow_g else 0.0
     w2 = state[S_EST + 2] if allow_g else 0.0
     w3 = (state[S_EST + 3] if allow_g else 0.0) + (state[S_EST + 4] if allow_t else 0.0)
-    wc = ws = wt = whr = wht = 0.0
+    wc = ws = wt = whr = wht = wch = 0.0
     if state[S_LAYERED] != 0.0:
-        wc, ws, wt, whr, wht = layers.selection(state, allow_d, allow_g, allow_t)
+        wc, ws, wt, whr, wht, wch = layers.selection(state, allow_d, allow_g, allow_t)
     wu = state[S_EST_SSS] if (allow_d or allow_g or allow_t) else 0.0
-    total = w0 + w1 + w2 + w3 + wc + ws + wt + whr + wht + wu
+    total = w0 + w1 + w2 + w3 + wc + ws + wt + whr + wht + wu + wch
     if not total > 0.0:
-        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     return (w0 / total, w1 / total, w2 / total, w3 / total, wc / total, ws / total,
-            wt / total, whr / total, wht / total, wu / total)
+            wt / total, whr / total, wht / total, wu / total, wch / total)
 
 
 @kernel(allocates=False)
 def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
     """sum_i q_i pdf_i over the lobes, for the selection probabilities q (`selection`;
     the subsurface lobe's has no density here)."""
-    q0, q1, q2, q3, qc, qs, qt, qhr, qht, qu = q
+    q0, q1, q2, q3, qc, qs, qt, qhr, qht, qu, qch = q
     p = 0.0
     if wiz > 0.0:
         p += q0 * (wiz * INV_PI)
@@ -263,8 +263,9 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
                                        state[S_ALPHA], allow_g and state[S_REFRACT_ONLY] == 0.0,
                                        allow_t, state[S_WALTER] != 0.0,
                                        state[S_BECKMANN] != 0.0)
-    if qc > 0.0 or qs > 0.0 or qt > 0.0 or qhr > 0.0 or qht > 0.0:
-        p += layers.mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht)
+    if qc > 0.0 or qs > 0.0 or qt > 0.0 or qhr > 0.0 or qht > 0.0 or qch > 0.0:
+        p += layers.mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht,
+                                qch)
     return p
 
 
@@ -280,17 +281,18 @@ def pdf_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t,
              see_d, see_g, see_t):
     """The part of `pdf` (same allow flags) due to the lobes of the kinds a light is seen
     by: the density with which BSDF sampling reaches that light through wi."""
-    q0, q1, q2, q3, qc, qs, qt, qhr, qht, qu = selection(state, allow_d, allow_g, allow_t)
+    q0, q1, q2, q3, qc, qs, qt, qhr, qht, qu, qch = selection(state, allow_d, allow_g,
+                                                              allow_t)
     if not see_d:
         q0 = qs = qt = 0.0
     if not see_g:
-        q1 = q2 = qc = qhr = 0.0
+        q1 = q2 = qc = qhr = qch = 0.0
     if not see_t:
         qht = 0.0
     if not (see_g if wiz > 0.0 else see_t):
         q3 = 0.0
     return mixture_pdf(state, wox, woy, woz, wix, wiy, wiz,
-                       (q0, q1, q2, q3, qc, qs, qt, qhr, qht, qu), allow_g, allow_t)
+                       (q0, q1, q2, q3, qc, qs, qt, qhr, qht, qu, qch), allow_g, allow_t)
 
 
 @kernel(allocates=False)
@@ -306,7 +308,7 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     lobe = 0
     lo = 0.0
     total = 0.0
-    for k in range(10):
+    for k in range(11):
         if k > 0 and u_lobe >= total and q[k] > 0.0:
             lobe, lo = k, total
         total += q[k]
@@ -328,6 +330,14 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     elif lobe == 1 or lobe == 2:
         wix, wiy, wiz, ok = reflection_sample(state, wox, woy, woz, u1, u2)
         kind = GLOSSY
+    elif lobe == 10:                    # Principled Hair: on either side, exact pdf
+        wix, wiy, wiz, _, _, _, ps, p_fibre = layers.chiang_sample(state, wox, woy, woz,
+                                                                   u_re, u1, u2)
+        kind = GLOSSY if p_fibre == 0 else TRANSMISSION
+        ok = ps > 0.0 and (allow_g if p_fibre == 0 else allow_t)
+        state[S_ANY_SIDE] = 1.0
+        if not ok:
+            layers.chiang_sampled_done(state)
     elif lobe > 6:                      # hair R, TT: on either side, with their own pdf
         tt = lobe == 8
         wix, wiy, wiz, ps, hr, hg, hb = layers.hair_sample(state, wox, woy, woz, tt, u1, u2)
@@ -376,6 +386,13 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     fr, fg, fb = eval_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t)
     p = mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t)
     c = abs(wiz)
+    if q[10] > 0.0 and not allow_g and c > 0.0:
+        # the Principled Hair closure is selectable on its transmission budget alone:
+        # its value counts (eval_seen gates it as the glossy closure it is for lights)
+        cr, cg, cb, _ = layers.chiang_eval(state, wox, woy, woz, wix, wiy, wiz)
+        fr, fg, fb = fr + cr / c, fg + cg / c, fb + cb / c
+    if lobe == 10:
+        layers.chiang_sampled_done(state)
     if hair_d != 0.0:
         # as Cycles: the sampled hair lobe counts with the value and density its
         # sampling gave (f cos = pdf, on either side), the other lobes as evaluated
