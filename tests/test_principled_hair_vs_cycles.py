@@ -180,3 +180,60 @@ def test_principled_hair_export(bpy_drt):
     mats, warnings = export()
     assert any("Huang" in w and "auburn" in w for w in warnings), warnings
     assert mats["auburn"].principled_hair.melanin == pytest.approx(0.35)
+
+
+def _textured_scene(bpy):
+    """Two furry balls whose Principled Hair varies per strand and along it: Melanin
+    from Hair Info's Random through a Map Range (0.1 .. 0.9), and a Color Ramp from a
+    dark root to a blond tip on Hair Info's Intercept."""
+    scene = grey_room(bpy, (64, 48), 0.5, world=0.05)
+    mel = _principled_hair(bpy, "random melanin", "MELANIN", **{"Melanin Redness": 0.4})
+    nt = mel.node_tree
+    info = nt.nodes.new("ShaderNodeHairInfo")
+    ranged = nt.nodes.new("ShaderNodeMapRange")
+    ranged.inputs["To Min"].default_value, ranged.inputs["To Max"].default_value = 0.1, 0.9
+    nt.links.new(info.outputs["Random"], ranged.inputs["Value"])
+    nt.links.new(ranged.outputs["Result"], nt.nodes["Principled Hair BSDF"].inputs["Melanin"])
+    _furry_ball(bpy, (-0.45, 0.0, 0.4), mel, count=600)
+    ramp = _principled_hair(bpy, "root to tip", "COLOR")
+    nt = ramp.node_tree
+    info = nt.nodes.new("ShaderNodeHairInfo")
+    cr = nt.nodes.new("ShaderNodeValToRGB")
+    cr.color_ramp.elements[0].color = (0.05, 0.02, 0.01, 1.0)
+    cr.color_ramp.elements[1].color = (0.8, 0.6, 0.35, 1.0)
+    nt.links.new(info.outputs["Intercept"], cr.inputs["Fac"])
+    nt.links.new(cr.outputs["Color"], nt.nodes["Principled Hair BSDF"].inputs["Color"])
+    _furry_ball(bpy, (0.45, 0.0, 0.4), ramp, count=600)
+    bpy.ops.object.light_add(type="POINT", location=(1.0, -1.5, 2.5))
+    bpy.context.object.data.energy = 300.0
+    bpy.context.object.data.shadow_soft_size = 0.3
+    bpy.ops.object.camera_add(location=(0.0, -3.0, 1.0), rotation=(math.radians(82), 0, 0))
+    scene.camera = bpy.context.object
+    return scene
+
+
+def test_principled_hair_inputs_varying_per_strand_match_cycles(bpy_drt):
+    """Melanin and Color driven per strand and along it render per hit (no warning);
+    the control, each replaced by its average (what DRT rendered before, with a
+    warning), must fail the same tolerances."""
+    bpy = bpy_drt
+    scene = _textured_scene(bpy)
+    use_engine(scene, "CYCLES", 512)
+    cycles = render_current(bpy, scene)
+    use_engine(scene, "DRT", 256)
+    drt = render_current(bpy, scene)
+    from drt_addon import render_engine
+    assert not render_engine.last_render["warnings"], render_engine.last_render["warnings"]
+    assert_matches(drt, cycles, 0.02, 0.05)
+    for name, socket, mean in (("random melanin", "Melanin", 0.5),
+                               ("root to tip", "Color", (0.425, 0.31, 0.18, 1.0))):
+        node = bpy.data.materials[name].node_tree.nodes["Principled Hair BSDF"]
+        for link in list(node.inputs[socket].links):
+            node.id_data.links.remove(link)
+        node.inputs[socket].default_value = mean
+    use_engine(scene, "DRT", 64)
+    control = render_current(bpy, scene)
+    rel, block = compare(control, cycles)
+    print(f"control, averaged inputs: mean {np.round(100 * rel, 2)} %, "
+          f"worst block {100 * block:.2f} %")
+    assert block > 0.05, block

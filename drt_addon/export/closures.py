@@ -78,20 +78,24 @@ class _Layers:
     hair_transmission_roughness: tuple = (0.1, 1.0)
     hair_transmission_offset: float = 0.0
     principled_hair: object = None
+    principled_hair_programs: dict = None   # its per-hit inputs: {program output: NodeParam}
 
 
 def _blend_hair(with_layers, ctx):
-    """The Principled Hair of a mixture: weights summed (scaled by the mix), the inputs
-    of the heaviest (reported where they differ)."""
-    hairs = [(c, L.principled_hair) for c, L in with_layers if L.principled_hair is not None]
+    """The Principled Hair of a mixture and its per-hit inputs: weights summed (scaled
+    by the mix), the inputs of the heaviest (reported where they differ)."""
+    hairs = [(c, L) for c, L in with_layers if L.principled_hair is not None]
     if not hairs:
-        return None
-    weight = tuple(float(sum(c * h.weight[k] for c, h in hairs)) for k in range(3))
-    _, heaviest = max(hairs, key=lambda ch: ch[0] * max(ch[1].weight))
-    if len({replace(h, weight=(1.0, 1.0, 1.0)) for _, h in hairs}) > 1:
+        return None, None
+    weight = tuple(float(sum(c * L.principled_hair.weight[k] for c, L in hairs))
+                   for k in range(3))
+    _, heaviest = max(hairs, key=lambda cL: cL[0] * max(cL[1].principled_hair.weight))
+    if len({replace(L.principled_hair, weight=(1.0, 1.0, 1.0)) for _, L in hairs}) > 1 or \
+            any(L.principled_hair_programs for _, L in hairs if L is not heaviest):
         ctx.issue("mixed Principled Hair BSDFs have different inputs; DRT uses the "
                   "heaviest one's")
-    return replace(heaviest, weight=weight)
+    return (replace(heaviest.principled_hair, weight=weight),
+            heaviest.principled_hair_programs)
 
 
 def _blend_layers(comps, ctx):
@@ -142,7 +146,7 @@ def _blend_layers(comps, ctx):
         if hw:
             for name in (part + "_roughness", part + "_offset"):
                 setattr(out, name, avg(hw, name))
-    out.principled_hair = _blend_hair(with_layers, ctx)
+    out.principled_hair, out.principled_hair_programs = _blend_hair(with_layers, ctx)
     return out
 
 
@@ -269,6 +273,8 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
         for k in LAYER_FIELDS:
             v = getattr(p["layers"], k)
             setattr(m, k, tuple(float(x) for x in v) if isinstance(v, tuple) else v)
+        for k, v in (p["layers"].principled_hair_programs or {}).items():
+            program_outputs(m)[k] = v.value       # per hit (hair_chiang's colour, Melanin)
     m.alpha = float(alpha)
     m.transparent_color = tuple(t_color)
     m.holdout_weight = float(holdout)

@@ -25,6 +25,7 @@ from .pack import MIX, OUTS
 
 OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_MIX = range(7)
 OUT_VOL_SA, OUT_VOL_SS, OUT_VOL_EM = 7, 8, 9      # engine.kernels.medium_density
+OUT_HAIR_COLOR, OUT_HAIR_MELANIN = 10, 11          # a Principled Hair's (hair_chiang.py)
 
 
 @kernel(allocates=False)
@@ -96,6 +97,20 @@ def apply_rows(T, m, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS):
     r = outs[m, OUT_ROUGHNESS]
     if r >= 0:
         row[P_ROUGHNESS] = min(max(regs[r], 0.0), 1.0)
+
+
+@kernel(allocates=False)
+def apply_hair(T, m, regs, row, P_COLOR, P_MELANIN):
+    """Write the program's Principled Hair colour and Melanin into the parameter row."""
+    outs = T[OUTS]
+    r = outs[m, OUT_HAIR_COLOR]
+    if r >= 0:
+        row[P_COLOR] = regs[r]
+        row[P_COLOR + 1] = regs[r + 1]
+        row[P_COLOR + 2] = regs[r + 2]
+    r = outs[m, OUT_HAIR_MELANIN]
+    if r >= 0:
+        row[P_MELANIN] = regs[r]
 
 
 @kernel(allocates=False)

@@ -7,6 +7,7 @@ from __future__ import annotations
 from ...blender_compat import node_input
 from ...engine_link import engine
 from ..closures import BLACK, _Closure, _Comp, _Layers
+from ..material_params import _is_tex
 from .links import _link
 
 
@@ -40,10 +41,13 @@ def _from_hair_random(socket) -> bool:
             and link[1].name == "Random")
 
 
-def principled_hair(node, ctx, constant) -> _Closure:
+def principled_hair(node, ctx, constant, value) -> _Closure:
     """Principled Hair BSDF (Cycles' PrincipledHairBsdfNode, Chiang model): its inputs as
-    the node's parametrization reads them (`constant` reads a socket, a linked one by its
-    average, reported). The Huang model is rendered with Chiang's, reported."""
+    the node's parametrization reads them. The colour it reads (Color, Absorption
+    Coefficient or Tint) and Melanin may vary per hit (`value`: a NodeParam, which
+    becomes an output of the material's program); the others are read by `constant`
+    (a linked one by its average, reported). The Huang model is rendered with Chiang's,
+    reported."""
     if getattr(node, "model", "CHIANG") != "CHIANG":
         ctx.issue(f"{node.name!r} uses the Huang hair model; DRT renders it with the Chiang "
                   f"model (its Aspect Ratio and lobe weights are left out)")
@@ -56,28 +60,34 @@ def principled_hair(node, ctx, constant) -> _Closure:
 
     def num(name, default):
         return float(constant(node, name, ctx, default))
+    programs = {}
 
-    def col(name, default):
-        return tuple(float(x) for x in constant(node, name, ctx, default, color=True))[:3]
+    def per_hit(name, default, output, color):
+        v = value(node, name, ctx, color, default)
+        if _is_tex(v):
+            programs[output] = v
+            v = v.mean()
+        return tuple(float(x) for x in v)[:3] if color else float(v)
     kw = {}
     if mode == "COLOR":
-        kw["color"] = col("Color", d.color)
+        kw["color"] = per_hit("Color", d.color, "hair_color", True)
     elif mode == "ABSORPTION":
-        kw["absorption"] = col("Absorption Coefficient", d.absorption)
+        kw["absorption"] = per_hit("Absorption Coefficient", d.absorption, "hair_color", True)
     else:
-        kw.update(melanin=num("Melanin", d.melanin),
+        kw.update(melanin=per_hit("Melanin", d.melanin, "hair_melanin", False),
                   melanin_redness=num("Melanin Redness", d.melanin_redness),
-                  tint=col("Tint", d.tint), random_color=num("Random Color", d.random_color))
+                  tint=per_hit("Tint", d.tint, "hair_color", True),
+                  random_color=num("Random Color", d.random_color))
     random = node_input(node, "Random")
     linked = random is not None and _link(random) is not None
     own = not linked or _from_hair_random(random)
     # a mesh reads the unlinked socket's value, Hair Info's Random there is 0
-    value = 0.0 if (linked and own) else num("Random", d.random)
+    random_value = 0.0 if (linked and own) else num("Random", d.random)
     hair = PrincipledHair(
         parametrization=mode, roughness=num("Roughness", d.roughness),
         radial_roughness=num("Radial Roughness", d.radial_roughness),
         coat=num("Coat", d.coat), ior=num("IOR", d.ior), offset=num("Offset", d.offset),
         random_roughness=num("Random Roughness", d.random_roughness),
-        random=value, strand_random=own, **kw)
-    layers = _Layers(principled_hair=hair)
+        random=random_value, strand_random=own, **kw)
+    layers = _Layers(principled_hair=hair, principled_hair_programs=programs)
     return _Closure([(1.0, _Comp(base=BLACK, spec=0.0, layers=layers))])

@@ -358,7 +358,7 @@ def _closure(socket, ctx, depth=0) -> _Closure:
     if kind == "ShaderNodeBsdfHair":
         return hair.hair_bsdf(node, ctx, _constant)
     if kind == "ShaderNodeBsdfHairPrincipled":
-        return hair.principled_hair(node, ctx, _constant)
+        return hair.principled_hair(node, ctx, _constant, _input)
     if kind == "ShaderNodeEmission":
         return _emission(node, ctx)
     if kind == "ShaderNodeBsdfTransparent":
