@@ -62,10 +62,15 @@ def _scene(bpy):
     bpy.ops.mesh.primitive_cylinder_add(radius=0.25, depth=0.8, location=(0.85, -0.1, 0.4))
     bpy.ops.object.shade_smooth()
     bpy.context.object.data.materials.append(_principled_hair(bpy, "absorbing", "ABSORPTION"))
+    return _lit(bpy, scene, (0.0, -4.0, 1.2))
+
+
+def _lit(bpy, scene, camera):
+    """The scenes' point lamp (300 W, radius 0.3 m) and a camera at `camera`."""
     bpy.ops.object.light_add(type="POINT", location=(1.0, -1.5, 2.5))
     bpy.context.object.data.energy = 300.0
     bpy.context.object.data.shadow_soft_size = 0.3
-    bpy.ops.object.camera_add(location=(0.0, -4.0, 1.2), rotation=(math.radians(82), 0, 0))
+    bpy.ops.object.camera_add(location=camera, rotation=(math.radians(82), 0, 0))
     scene.camera = bpy.context.object
     return scene
 
@@ -204,12 +209,7 @@ def _textured_scene(bpy):
     nt.links.new(info.outputs["Intercept"], cr.inputs["Fac"])
     nt.links.new(cr.outputs["Color"], nt.nodes["Principled Hair BSDF"].inputs["Color"])
     _furry_ball(bpy, (0.45, 0.0, 0.4), ramp, count=600)
-    bpy.ops.object.light_add(type="POINT", location=(1.0, -1.5, 2.5))
-    bpy.context.object.data.energy = 300.0
-    bpy.context.object.data.shadow_soft_size = 0.3
-    bpy.ops.object.camera_add(location=(0.0, -3.0, 1.0), rotation=(math.radians(82), 0, 0))
-    scene.camera = bpy.context.object
-    return scene
+    return _lit(bpy, scene, (0.0, -3.0, 1.0))
 
 
 def test_principled_hair_inputs_varying_per_strand_match_cycles(bpy_drt):
