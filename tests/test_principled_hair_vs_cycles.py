@@ -75,6 +75,21 @@ def _lit(bpy, scene, camera):
     return scene
 
 
+def _matches_cycles(bpy, scene, no_warnings=True):
+    """Render `scene` with Cycles (512 samples) and DRT (256), assert DRT renders
+    without a warning (when `no_warnings`) and within the comparisons' tolerances (2 %
+    per channel mean, 5 % per 8 x 8 block); return Cycles' image."""
+    use_engine(scene, "CYCLES", 512)
+    cycles = render_current(bpy, scene)
+    use_engine(scene, "DRT", 256)
+    drt = render_current(bpy, scene)
+    if no_warnings:
+        from drt_addon import render_engine
+        assert not render_engine.last_render["warnings"], render_engine.last_render["warnings"]
+    assert_matches(drt, cycles, 0.02, 0.05)
+    return cycles
+
+
 def _as_diffuse(bpy):
     """Every Principled Hair replaced by a Diffuse BSDF of a colour near its own."""
     colours = {"blond": (0.75, 0.55, 0.3), "auburn": (0.35, 0.15, 0.08),
@@ -85,13 +100,7 @@ def _as_diffuse(bpy):
 def test_principled_hair_on_strands_and_meshes_matches_cycles(bpy_drt):
     bpy = bpy_drt
     scene = _scene(bpy)
-    use_engine(scene, "CYCLES", 512)
-    cycles = render_current(bpy, scene)
-    use_engine(scene, "DRT", 256)
-    drt = render_current(bpy, scene)
-    from drt_addon import render_engine
-    assert not render_engine.last_render["warnings"], render_engine.last_render["warnings"]
-    assert_matches(drt, cycles, 0.02, 0.05)
+    cycles = _matches_cycles(bpy, scene)
     _as_diffuse(bpy)
     use_engine(scene, "DRT", 64)
     control = render_current(bpy, scene)
@@ -120,11 +129,7 @@ def test_principled_hair_on_a_mesh_matches_cycles(bpy_drt):
     bpy.context.object.data.shadow_soft_size = 0.2
     bpy.ops.object.camera_add(location=(0.0, -2.6, 1.0), rotation=(math.radians(80), 0, 0))
     scene.camera = bpy.context.object
-    use_engine(scene, "CYCLES", 512)
-    cycles = render_current(bpy, scene)
-    use_engine(scene, "DRT", 256)
-    drt = render_current(bpy, scene)
-    assert_matches(drt, cycles, 0.02, 0.05)
+    _matches_cycles(bpy, scene, no_warnings=False)
 
 
 def test_principled_hair_export(bpy_drt):
@@ -218,13 +223,7 @@ def test_principled_hair_inputs_varying_per_strand_match_cycles(bpy_drt):
     warning), must fail the same tolerances."""
     bpy = bpy_drt
     scene = _textured_scene(bpy)
-    use_engine(scene, "CYCLES", 512)
-    cycles = render_current(bpy, scene)
-    use_engine(scene, "DRT", 256)
-    drt = render_current(bpy, scene)
-    from drt_addon import render_engine
-    assert not render_engine.last_render["warnings"], render_engine.last_render["warnings"]
-    assert_matches(drt, cycles, 0.02, 0.05)
+    cycles = _matches_cycles(bpy, scene)
     for name, socket, mean in (("random melanin", "Melanin", 0.5),
                                ("root to tip", "Color", (0.425, 0.31, 0.18, 1.0))):
         node = bpy.data.materials[name].node_tree.nodes["Principled Hair BSDF"]
@@ -271,10 +270,4 @@ def test_principled_hair_on_a_curves_object_matches_cycles(bpy_drt):
         bpy, "curl hair", "MELANIN", Melanin=0.3, **{"Random Color": 0.6, "Roughness": 0.25})
     bpy.data.objects["Sphere"].data.materials[1] = _principled_hair(
         bpy, "fur hair", "COLOR", Color=(0.6, 0.35, 0.15))
-    use_engine(scene, "CYCLES", 512)
-    cycles = render_current(bpy, scene)
-    use_engine(scene, "DRT", 256)
-    drt = render_current(bpy, scene)
-    from drt_addon import render_engine
-    assert not render_engine.last_render["warnings"], render_engine.last_render["warnings"]
-    assert_matches(drt, cycles, 0.02, 0.05)
+    _matches_cycles(bpy, scene)
