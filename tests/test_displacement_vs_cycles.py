@@ -156,28 +156,90 @@ def test_displacement_scene_matches_cycles(bpy_drt):
     assert not _agrees("displacement as Bump Only (control)", control, cycles)
 
 
-def test_adaptive_subdivision_is_named_and_renders_at_the_render_levels(bpy_drt):
-    """Adaptive subdivision (Cycles' dicing) is not modelled: one warning names the
-    object, which renders at its Subdivision modifier's render levels."""
+def _adaptive_plane(bpy, method, levels=2):
+    """The plane at Subdivision render levels `levels`, with Adaptive Subdivision on at
+    Blender's defaults (Pixel space, Pixel Size 1, Dicing Rate 1, Max Subdivisions 12)."""
+    scene, mat = _plane_scene(bpy, method)
+    mod = bpy.data.objects["Plane"].modifiers["Subdivision"]
+    mod.levels = mod.render_levels = levels
+    mod.use_adaptive_subdivision = True
+    return scene, mat, mod
+
+
+def test_adaptive_subdivision_matches_cycles(bpy_drt):
+    """The plane at render levels 2 (4 x 4 quads) with Adaptive Subdivision: Cycles dices
+    it to about a pixel, and so does DRT (DRT and Cycles at 64 samples, of the image
+    mean: means within 1 %, blocks within 3 %). The control, adaptive subdivision off in
+    DRT alone (the render levels, as DRT rendered it before), fails."""
     bpy = bpy_drt
+    scene, mat, mod = _adaptive_plane(bpy, "BOTH")
+    cycles = node_probe.render(bpy, scene, "CYCLES", SAMPLES)
+    drt = node_probe.render(bpy, scene, "DRT", SAMPLES)
+    mean, block = image_errors(drt, cycles)
+    mod.use_adaptive_subdivision = False
+    control = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles)
+    print(f"adaptive subdivision: mean {mean:.2%}, largest block {block:.2%}; at the "
+          f"render levels: mean {control[0]:.2%}, largest block {control[1]:.2%}")
+    assert mean < 0.01 and block < 0.03, (mean, block)
+    assert control[1] > 0.1, control
+
+
+def _export(bpy, view=None):
     from drt_addon.export import Reporter, export_scene
-    scene, _ = _plane_scene(bpy, "DISPLACEMENT")
-    plane = bpy.data.objects["Plane"]
-    reporter = Reporter()
-    flat = export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
-    assert not any("adaptive" in w for w in reporter.warnings)
-    plane.modifiers["Subdivision"].use_adaptive_subdivision = True
-    reporter = Reporter()
-    diced = export_scene(bpy.context.evaluated_depsgraph_get(), reporter)
-    named = [w for w in reporter.warnings if "adaptive subdivision" in w]
-    assert len(named) == 1 and "'Plane'" in named[0], reporter.warnings
-    assert diced.triangle_count() == flat.triangle_count() == 2 * 4 ** 7
+    stats, reporter = {}, Reporter()
+    scene = export_scene(bpy.context.evaluated_depsgraph_get(), reporter, stats=stats,
+                         view=view)
+    return scene, stats, reporter.warnings
 
 
-def test_a_deforming_displaced_mesh_moves_its_displacement_along(bpy_drt):
+def test_adaptive_subdivision_dices_displaced_meshes_alone_by_the_files_settings(bpy_drt):
+    """Only a mesh that its material moves is diced (Bump Only leaves the render levels'
+    32 triangles); its triangles follow the Pixel Size and the Dicing Rate (4 times the
+    segment length: about 16 times fewer), Max Subdivisions caps the segments of an edge
+    of the cage (3 levels: 8, 2 per edge of the level-2 mesh), and in Object space the
+    undisplaced mesh's edges are Edge Length long (a grid's diagonals and the stitches
+    between grids of other factors up to 1.5 times). The Rendered viewport dices
+    to the Viewport rate. No warning names it any more."""
+    bpy = bpy_drt
+    scene, mat, mod = _adaptive_plane(bpy, "BUMP")
+    exported, stats, warnings = _export(bpy)
+    assert stats["diced_meshes"] == 0 and stats["triangles"] == 32
+    mat.displacement_method = "DISPLACEMENT"
+    exported, stats, warnings = _export(bpy)
+    fine = stats["triangles"]
+    assert stats["diced_meshes"] == 1 and fine > 5000, stats
+    assert not any("adaptive" in w for w in warnings), warnings
+    mod.adaptive_pixel_size = 4.0
+    coarse = _export(bpy)[1]["triangles"]
+    assert fine / 32 < coarse < fine / 8, (fine, coarse)
+    mod.adaptive_pixel_size = 1.0
+    scene.cycles.dicing_rate = 4.0
+    assert _export(bpy)[1]["triangles"] == coarse
+    scene.cycles.dicing_rate = 1.0
+    scene.cycles.max_subdivisions = 3
+    assert _export(bpy)[1]["triangles"] == 32 * 4
+    scene.cycles.max_subdivisions = 12
+    mod.adaptive_space = "OBJECT"
+    mod.adaptive_object_edge_length = 0.25
+    exported, stats, _ = _export(bpy)
+    local = exported.meshes[0].undisplaced.astype(np.float64)     # object space
+    longest = np.linalg.norm(local - np.roll(local, -1, axis=1), axis=2).max()
+    assert 0.25 < longest <= 0.25 * 1.5, longest      # the grid's diagonals: 0.35
+    view = (exported.camera, 96, 96)
+    from drt_addon.export.dicing import SceneDicing
+    dicing = SceneDicing(bpy.context.evaluated_depsgraph_get(), view)
+    assert dicing.rate == scene.cycles.preview_dicing_rate == 8.0
+    mod.adaptive_space = "PIXEL"
+    in_view = _export(bpy, view)[1]["triangles"]
+    assert in_view < coarse, (in_view, coarse)            # 8 px in the viewport, not 4
+
+
+@pytest.mark.parametrize("adaptive", [False, True])
+def test_a_deforming_displaced_mesh_moves_its_displacement_along(bpy_drt, adaptive):
     """Motion blur of a mesh that deforms (a shape key) and is displaced: every time step
     carries the same offsets, as Cycles adds them to its motion steps, so the steps differ
-    by the deformation alone (1 m along x over the shutter)."""
+    by the deformation alone (1 m along x over the shutter). Diced by adaptive
+    subdivision, its new vertices follow the deformation too."""
     from engine.motion import DeformMotion
     from test_motion_blender import CUBE, _mesh, _shape_key_motion
     bpy = bpy_drt
@@ -188,6 +250,7 @@ def test_a_deforming_displaced_mesh_moves_its_displacement_along(bpy_drt):
     sub = cube.modifiers.new("Subdivision", "SUBSURF")
     sub.subdivision_type = "SIMPLE"
     sub.levels = sub.render_levels = 3
+    sub.use_adaptive_subdivision = adaptive
     mat, nt = new_material(bpy, "Displaced")
     mat.displacement_method = "DISPLACEMENT"
     noise = nt.nodes.new("ShaderNodeTexNoise")
@@ -200,6 +263,7 @@ def test_a_deforming_displaced_mesh_moves_its_displacement_along(bpy_drt):
     cube.data.materials.append(mat)
     mesh = _mesh(export_scene(bpy.context.evaluated_depsgraph_get()), "Cube")
     assert isinstance(mesh.motion, DeformMotion) and mesh.undisplaced is not None
+    assert (len(mesh.triangles) > 12 * 4 ** 3 * 2) == adaptive      # diced finer
     steps = mesh.motion.positions
     np.testing.assert_allclose(steps[1], mesh.positions, atol=1e-6)
     for k, dx in ((0, -0.5), (2, 0.5)):

@@ -5,7 +5,8 @@ import copy
 import time
 
 from ..engine_link import engine
-from .displaced_mesh import DisplacedMeshes, adaptive_message, adaptive_subdivision
+from .dicing import SceneDicing
+from .displaced_mesh import DisplacedMeshes
 from .camera import RenderRegion, export_camera, render_region, window_camera
 from .errors import ExportError, Reporter
 from .hair import curves_object, hair_systems, particle_hair
@@ -152,8 +153,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
              else MeshCache(reporter, uv_pass=uv_pass, override=override))
     meshes, lights = [], []
     groups = InstanceGroups()
-    displaced = DisplacedMeshes()
-    adaptive = set()                 # objects asking for adaptive subdivision
+    displaced = DisplacedMeshes(SceneDicing(depsgraph, view, aspect), reporter.warn)
     held = []
     left_out = LeftOut()
     holdouts = 0
@@ -197,8 +197,6 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             local = cache.local(obj)
             if local is None:
                 continue
-            if adaptive_subdivision(obj):
-                adaptive.add(obj.name)
             slots = ([material_id(m, k) for m in slot_materials(obj, override)]
                      or [material_id(None)])
             # true displacement moves the mesh once, with its first user (as Cycles)
@@ -254,8 +252,6 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     meshes.extend(groups.meshes())
     if left_out.message():
         reporter.warn(left_out.message(), key="left out")
-    if adaptive:
-        reporter.warn(adaptive_message(adaptive), key="adaptive subdivision")
     if not materials:
         materials.append(engine.Material())
     world_id = render_world(scene, view_layer)
@@ -274,7 +270,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
         stats.update(mesh_evaluations=cache.evaluations, mesh_reuses=cache.reuses,
                      material_exports=(memo.material_exports if memo is not None
                                        else len(material_index)),
-                     displaced_meshes=displaced.displaced,
+                     displaced_meshes=displaced.displaced, diced_meshes=displaced.diced,
                      meshes=len(meshes), lights=len(lights), holdouts=holdouts,
                      triangles=int(sum(len(m.triangles) for m in meshes)),
                      instances=groups.instanced(),

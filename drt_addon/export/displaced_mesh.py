@@ -11,6 +11,7 @@ import importlib
 import numpy as np
 
 from ..engine_link import engine
+from .dicing import dice_local
 from .matrices import to_numpy
 from .object_info import object_values
 
@@ -19,11 +20,16 @@ C = importlib.import_module(engine.__name__ + ".nodes.context")
 
 
 class DisplacedMeshes:
-    """The moved meshes of one export, one per (evaluated mesh, materials)."""
+    """The moved meshes of one export, one per (evaluated mesh, materials); a mesh with
+    Adaptive Subdivision is diced first (export.dicing) by `dicing`, an
+    export.dicing.SceneDicing, as its first user sees it."""
 
-    def __init__(self):
+    def __init__(self, dicing=None, warn=None):
         self._done = {}
         self.displaced = 0            # meshes moved
+        self.diced = 0                # of which diced
+        self.dicing = dicing
+        self.warn = warn
 
     def get(self, local, obj, matrix_world, slots, materials):
         """`local` moved by the displacements of its material slots (indices into
@@ -33,6 +39,13 @@ class DisplacedMeshes:
             return local
         key = (id(local), tuple(slots))
         if key not in self._done:
+            dicing = self.dicing.of(obj) if self.dicing is not None else None
+            if dicing is not None:
+                diced = dice_local(local, dicing, matrix_world,
+                                   lambda m: self.warn and self.warn(
+                                       f"DRT: adaptive subdivision of '{obj.name}' {m}"))
+                self.diced += diced is not local
+                local = diced
             self._done[key] = displace_local(local, obj, matrix_world, displacements)
             self.displaced += 1
         return self._done[key]
@@ -58,21 +71,6 @@ def displace_local(local, obj, matrix_world, displacements):
                                                   corner_normals, local.smooth, normals)
     return dataclasses.replace(local, positions=positions, normals=corner_normals,
                                offset=positions - local.positions)
-
-
-def adaptive_subdivision(obj) -> bool:
-    """Whether the object's Subdivision modifier asks for adaptive subdivision (Cycles'
-    dicing), which DRT renders at the modifier's render levels."""
-    return any(m.type == "SUBSURF" and m.show_render
-               and getattr(m, "use_adaptive_subdivision", False)
-               for m in getattr(obj, "modifiers", ()))
-
-
-def adaptive_message(names) -> str:
-    shown = ", ".join(repr(n) for n in sorted(names)[:5])
-    more = f" and {len(names) - 5} more" if len(names) > 5 else ""
-    return (f"DRT: adaptive subdivision (Cycles' dicing) is not modelled; {shown}{more} "
-            "render at their Subdivision modifier's render levels")
 
 
 def _area_normals(positions, triangles):

@@ -44,6 +44,9 @@ class LocalMesh:
     vertex_normals: Optional[np.ndarray] = None   # (V, 3) float64
     smooth: Optional[np.ndarray] = None           # (T,) bool
     offset: Optional[np.ndarray] = None           # (V, 3) float64
+    # a mesh diced by adaptive subdivision (export.dicing): (the LocalMesh it was diced
+    # from, the engine.dicing.Diced that maps its vertices to the new ones)
+    diced_from: Optional[tuple] = None
 
 
 def _attribute(mesh, name: str, field: str, dtype, domain: str, components: int = 1):

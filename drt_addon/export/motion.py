@@ -57,6 +57,7 @@ from .matrices import to_numpy
 from .mesh import _cache_key, instance_mesh
 
 emotion = import_module(engine.__name__ + ".motion")   # engine.motion, either layout
+interpolate_vertices = import_module(engine.__name__ + ".dicing").interpolate_vertices
 
 CURVE_SAMPLES = 256           # Cycles' RAMP_TABLE_SIZE for the shutter curve
 MOVE_TOLERANCE = 1e-7         # relative change below which a transform or vertex is still
@@ -383,14 +384,17 @@ class MotionExport:
                 if gkey not in per_geometry:
                     per_geometry[gkey] = _positions(obj)
                 got = per_geometry[gkey]
-                kept = tr.local.kept
-                if (got is None or got[0].shape != tr.local.positions.shape
+                # a diced mesh: its vertices follow those it was diced from
+                base, diced = tr.local.diced_from or (tr.local, None)
+                kept = base.kept
+                if (got is None or got[0].shape != base.positions.shape
                         or not np.array_equal(got[1] if kept is None else got[1][kept],
-                                              tr.local.triangles)):
+                                              base.triangles)):
                     tr.topology_changed = True
                 else:        # a displaced mesh moves by its offset at every step (Cycles)
+                    step = got[0] if diced is None else interpolate_vertices(got[0], diced)
                     off = tr.local.offset
-                    tr.positions[i] = got[0] if off is None else got[0] + off
+                    tr.positions[i] = step if off is None else step + off
         cam = self.scene.camera
         if self.camera_steps and cam is not None:
             i = t * (self.camera_steps - 1)
