@@ -23,7 +23,7 @@ class RenderSettings:
     clamp_direct: float = 0.0         # 0 = off, as in Cycles
     clamp_indirect: float = 10.0
     # Cycles' Filter Glossy (`blur_glossy`, 0 = off) and caustics switches
-    # (engine.kernels.path_vertex.prepare_closures)
+    # (engine.kernels.prepare_closures)
     filter_glossy: float = 1.0
     caustics_reflective: bool = True
     caustics_refractive: bool = True

@@ -10,7 +10,19 @@ import numpy as np
 
 class PathState(NamedTuple):
     """Per path (n rows; `stacks` has no rows in a scene without media, `alpha` none on
-    an opaque film)."""
+    an opaque film). What the vertex kernels make of the fields:
+      - ray_bits (engine.visibility: CAMERA, then the bit of the lobe the ray left by)
+        decides the lamps the ray sees; next-event estimation evaluates only the lobes a
+        light is seen by and skips the shadow ray of a light that casts no shadow;
+      - min_pdf: Filter Glossy (engine.kernels.prepare_closures);
+      - cont (path_weights.roulette): 1 none, q survived with probability q, 0 the path
+        ends at the vertex its ray finds, after the emission found there;
+      - used and cone are what shader programs read of the path (the cone, a footprint
+        at the ray's origin and a spread, engine.nodes.differentials, moves on to the
+        next ray's origin);
+      - bounce counts bounces (a wavefront's depth also counts crossings of volume
+        boundaries); stacks: the volume stack (engine.kernels.volume), of which the
+        shadow queue keeps each shadow ray's copy."""
     key: np.ndarray        # (n,) uint64 random stream (engine.sampling.dispatch)
     index: np.ndarray      # (n,) int64 sample index in its pixel
     beta: np.ndarray       # (n, 3) throughput
@@ -30,8 +42,18 @@ class PathState(NamedTuple):
 
 
 class TracedScene(NamedTuple):
-    """What the vertex kernels read of the scene (path_vertex.shade's docstring says what
-    each holds), and the counter of shader program runs in heterogeneous media."""
+    """What the vertex kernels read of the scene:
+      - geometry: (vertex positions, each triangle's corners as rows of them, the static
+        scene's centre, material, corner_normals, holdout, corner_uvs, moving objects,
+        triangle objects, object table, corner tangents, corner colours, camera,
+        terminator cutoffs) of every triangle (corner normals, holdout, UVs, objects,
+        tangents, colours and cutoffs may be empty; see `surface.surface_at` and
+        engine.nodes.shading);
+      - textures: the packed textures and shader programs (engine.nodes.pack.
+        pack_shading); a material with a program runs it at each hit, and its outputs
+        replace the parameters they drive;
+      - vol: the volume table; het_count: a (1,) int64 counter of the shader program
+        runs inside heterogeneous media."""
     geometry: tuple
     params: np.ndarray
     emission: np.ndarray

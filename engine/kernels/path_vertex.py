@@ -22,17 +22,12 @@ only (next-event estimation is kept for delta lights and for directions the BSDF
 sample). All three are unbiased and agree in expectation
 (tests/test_path_estimators.py). Radiance sums are float64.
 
-`shade` runs after the closest-hit query of the bounce. For each live path it adds the
-emission the incoming ray found (lamps hit analytically, the world and sun discs for
-escaped rays, emissive triangles), weighted by multiple importance sampling against
-next-event estimation; it prepares one shadow ray of next-event estimation with its
-unoccluded contribution; and it samples the BSDF for the next ray, with Russian roulette.
-The caller traces the shadow rays (`Accelerator.occluded`), adds the contributions of
-the visible ones, and traces the next rays: the Embree queries stay between the stages.
+`shade` runs after the closest-hit query of the bounce; the caller traces the shadow
+rays it queues (`Accelerator.occluded`), adds the contributions of the visible ones, and
+traces the next rays.
 """
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -49,15 +44,15 @@ from .jit import kernel
 from .found_light import background, escaped, lamps_in_front
 from . import light_tally as tl
 from .pass_shares import NO_SHARES, bounce_shares, light_shares, lobe_colours
-from .medium_vertex import equiangular_light, scatter
+from .medium_vertex import scatter
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
                            TRANSMISSION_BIT, _INF, continues, hit_weight, holdout_share,
                            keep_receiver, nee_weight, previous_receiver, roulette, uncovered)
-from .medium_density import has_heterogeneous, heterogeneous_in, path_key, tracked_segment
-from .volume import (DISTANCE, V_BOUNDARY, V_HAS, distance_pdf, in_medium, medium,
-                     sample_method, segment, stack_cross, volume_dim)
-from .bsdf.params import (P_BUMP_CORRECTION, P_FILTER_ALPHA, P_HAIR, P_HOLDOUT,
-                          P_SETS_NORMAL)
+from .medium_density import has_heterogeneous
+from .medium_segment import NO_SEGMENT, NO_SEGMENT_MIS, along_ray
+from .prepare_closures import prepare_closures
+from .volume import V_BOUNDARY, V_HAS, in_medium, stack_cross
+from .bsdf.params import P_BUMP_CORRECTION, P_HAIR, P_HOLDOUT, P_SETS_NORMAL
 from .surface import hit_uv, surface_at
 from .terminator import shadow_origin
 from .surface_hit import material_row, run_program, surface_emission
@@ -69,33 +64,6 @@ from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
 from ..nodes.shading import (bent_diffuse, bump_rejects, may_emit,
                              valid_reflection_normal)
-
-@kernel
-def prepare_closures(cfg, row, min_pdf, ray_bit):
-    """Cycles' two changes to a hit's BSDF that depend on the path so far (its
-    surface_shader_prepare_closures), applied to the material row before setup:
-
-    Filter Glossy (cfg.filter_glossy, Cycles' `blur_glossy`; 0 = off): after bounces that were
-    unlikely (the smallest BSDF pdf along the path, min_pdf, below blur_glossy), every
-    microfacet lobe is widened to at least GGX alpha = 0.5 sqrt(1 - min_pdf /
-    blur_glossy). A bias that trades sharp caustics and fireflies for blur. As in Cycles,
-    whose closure blur follows the closures' setup, only the lobes widen: the energy
-    compensation and the layering keep the material's alpha (row[P_FILTER_ALPHA]).
-
-    Caustics (cfg.caustics_reflective, cfg.caustics_refractive): with one off, a hit of a
-    ray that left a diffuse bounce has no glossy reflection (resp. refraction) lobes.
-
-    Returns (keep glossy lobes, keep transmission lobes)."""
-    blur = cfg.filter_glossy
-    if blur > 0.0 and min_pdf < _INF:
-        blur_pdf = min_pdf / blur
-        if blur_pdf < 1.0:
-            alpha = 0.5 * math.sqrt(1.0 - blur_pdf)
-            row[P_FILTER_ALPHA] = alpha     # the lobes only (principled.setup)
-    after_diffuse = ray_bit == DIFFUSE_BIT
-    return ((cfg.caustics_reflective or not after_diffuse),
-            (cfg.caustics_refractive or not after_diffuse))
-
 
 @kernel
 def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shadows, nexts,
@@ -110,38 +78,9 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
     cfg: the render's engine.kernels.path_config.PathConfig (see `prepare_closures`).
     tally: where the light goes (engine.kernels.light_tally: Combined, and the light
     passes and light groups when the render asks for them).
-    paths: every path's state (engine.kernels.path_state.PathState), updated in place:
-      - time: its shutter time (its moving triangles are placed at that time);
-      - alpha: its film coverage (no rows on an opaque film);
-      - ray_bits: the kind of its current ray (engine.visibility: CAMERA, then the bit of
-        the lobe it left by), which decides the lamps it sees; next-event estimation
-        evaluates only the lobes the light is seen by and skips the shadow ray of a light
-        that casts no shadow;
-      - min_pdf: the smallest BSDF pdf along it (Filter Glossy, `prepare_closures`);
-      - cont: its Russian roulette verdict for the vertex its ray finds
-        (`path_weights.roulette`: 1 none, q it survived with probability q, 0 it ends
-        there after the emission found);
-      - used and cone: its transparent bounces and ray cone (footprint at the ray's origin
-        and spread, engine.nodes.differentials), what shader programs read of it (the
-        cone moves on to the next ray's origin);
-      - bounce and vbounce: its bounces so far (depth counts the wavefront's steps, which
-        include crossings of volume boundaries) and volume scatterings; stacks: its
-        volume stack (engine.kernels.volume; no rows without media; the shadow queue
-        keeps each shadow ray's copy).
-    scene: engine.kernels.path_state.TracedScene:
-      - geometry: (vertex positions, each triangle's corners as rows of them, the static
-        scene's centre, material, corner_normals, holdout, corner_uvs, moving objects,
-        triangle objects, object table, corner tangents, corner colours, camera,
-        terminator cutoffs) of every triangle (corner normals, holdout, UVs, objects,
-        tangents, colours and cutoffs may be empty; see `surface.surface_at` and
-        engine.nodes.shading);
-      - textures: the packed textures and shader programs
-        (engine.nodes.pack.pack_shading); a material with a program runs it at each hit,
-        and its outputs replace the parameters they drive;
-      - vol: the volume table; het_count: a (1,) int64 counter of the shader program runs
-        inside heterogeneous media.
-    A ray in a medium first travels through it (`volume.segment`, or
-    `medium_density.tracked_segment` when a medium of its stack is heterogeneous): it may
+    paths: every path's state (engine.kernels.path_state.PathState, whose docstring says
+    what each field holds), updated in place; scene: engine.kernels.path_state.TracedScene.
+    A ray in a medium first travels through it (`medium_segment.along_ray`): it may
     scatter there (`medium_vertex.scatter` shades that point), emission along it is
     added, and what it reaches beyond is weighted by its transmittance. A hit on a
     volume's boundary surface is crossed without a bounce.
@@ -199,48 +138,17 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         # 0. the medium along the ray: emission, transmittance, maybe a scattering
         b0r, b0g, b0b = br, bg, bb
         vmode, scattered, t_end = 0, False, t_geom
-        str_ = stg = stb = wcr = wcg = wcb = 0.0
+        seg = NO_SEGMENT
         g_phase = 0.0
-        mfr = mfg = mfb = 1.0                    # a heterogeneous segment's factor at a lamp
-        segment_mis = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)   # no equiangular counterpart
+        segment_mis = NO_SEGMENT_MIS             # no equiangular counterpart
         if volumes is not None and in_medium(stacks, p):
-            if het is not None and het_scene and heterogeneous_in(vol, stacks, p):
-                # null-scattering tracking (engine.kernels.medium_density); the factor
-                # is also taken at the nearest lamp in front of the geometry
-                t_lamp = _INF
-                if n_lights > 0:
-                    t_lamp = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_geom,
-                                          ray_bits[p], path_time[p])[0]
-                vmode = 3
-                scattered, t_end, fr, fg, fb, mfr, mfg, mfb, er, eg, eb, g_phase = \
-                    tracked_segment(vol, stacks, p, textures, geometry[9], geometry[12],
-                                    ox, oy, oz, dx, dy, dz, t_geom, t_lamp, br, bg, bb,
-                                    ray_bits[p], b, path_key(pkey[p], index[p], depth),
-                                    vhit, regs, het_count)
-                br, bg, bb = br * fr, bg * fg, bb * fb
-            else:
-                vmode, scattered, t_end, br, bg, bb, str_, stg, stb, wcr, wcg, wcb, er, eg, \
-                    eb = segment(vol, stacks, p, br, bg, bb, t_geom,
-                                 sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 0)),
-                                 sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 1)))
-                method = sample_method(vol, stacks, p)
-                if scattered:
-                    g_phase = medium(vol, stacks, p)[6]
-                    if method != DISTANCE:
-                        segment_mis = (ox, oy, oz, t_geom, t_end,
-                                       distance_pdf(str_, stg, stb, wcr, wcg, wcb, t_end),
-                                       float(method))
-                if vmode == 2 and method != DISTANCE and n_lights > 0 and cont[p] > 0.0:
-                    # the segment's direct light at an equiangular distance (the roulette
-                    # verdict on this ray applies, as at a scattering)
-                    ns_out = equiangular_light(
-                        depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_geom, b0r / cont[p],
-                        b0g / cont[p], b0b / cont[p], (wcr, wcg, wcb), method, tally,
-                        lights, vol, shadows, ns_out)
-            tl.found(tally, p, b, er, eg, eb, clamp_hit, False, -1)   # a medium's: no group
+            vmode, scattered, t_end, br, bg, bb, seg, g_phase, segment_mis, ns_out = \
+                along_ray(depth, cfg, paths, p, tally, lights, vol, het is not None and
+                          het_scene, textures, geometry, shadows, ns_out, ox, oy, oz, dx,
+                          dy, dz, t_geom, br, bg, bb, clamp_hit, vhit, regs, het_count)
         # 1a. area and sphere lamps in front of the geometry
         lamps_in_front(tally, lights, paths, p, b, ox, oy, oz, dx, dy, dz, t_end,
-                       (vmode, str_, stg, stb, wcr, wcg, wcb, mfr, mfg, mfb),
+                       (vmode,) + seg,
                        vol.shape[0] > 0, mode, b0r, b0g, b0b, clamp_hit)
         if volumes is not None and scattered:
             q = continues(cont, p)             # the roulette, after the emission found
