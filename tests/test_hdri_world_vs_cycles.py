@@ -182,6 +182,67 @@ def test_procedural_world_matches_cycles(bpy_drt):
                       "procedural world, its own colour")
 
 
+def _no_background(kind):
+    """The world's Surface fed without a Background node, as artists' files do: the
+    Environment Texture's Color linked straight into it ('colour'; Cycles converts it
+    to an Emission of strength 1), an Emission node in the Background's place, Strength
+    1.5 ('emission'), a value (the procedural sky's Noise Fac) straight into it
+    ('value', an Emission of white at that strength); or shaders mixed: a Mix Shader by
+    a Light Path's Is Camera Ray of the image's Background and a grey one, which the
+    camera sees ('mix'), an Add Shader of the Background at 0.7 and a blue Emission
+    ('add')."""
+    def setup(scene):
+        nt = scene.world.node_tree
+        bg = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeBackground")
+        env = next(n for n in nt.nodes if n.bl_idname == "ShaderNodeTexEnvironment")
+        surface = nt.nodes["World Output"].inputs["Surface"]
+        if kind == "colour":
+            nt.links.new(env.outputs["Color"], surface)
+        elif kind == "emission":
+            emission = nt.nodes.new("ShaderNodeEmission")
+            emission.inputs["Strength"].default_value = 1.5
+            nt.links.new(env.outputs["Color"], emission.inputs["Color"])
+            nt.links.new(emission.outputs["Emission"], surface)
+        elif kind == "mix":
+            grey = nt.nodes.new("ShaderNodeBackground")
+            grey.inputs["Color"].default_value = (0.3, 0.3, 0.3, 1.0)
+            path = nt.nodes.new("ShaderNodeLightPath")
+            mix = nt.nodes.new("ShaderNodeMixShader")
+            nt.links.new(path.outputs["Is Camera Ray"], mix.inputs["Fac"])
+            nt.links.new(bg.outputs["Background"], mix.inputs[1])
+            nt.links.new(grey.outputs["Background"], mix.inputs[2])
+            nt.links.new(mix.outputs["Shader"], surface)
+            return
+        elif kind == "add":
+            blue = nt.nodes.new("ShaderNodeEmission")
+            blue.inputs["Color"].default_value = (0.1, 0.2, 0.6, 1.0)
+            bg.inputs["Strength"].default_value = 0.7
+            add = nt.nodes.new("ShaderNodeAddShader")
+            nt.links.new(bg.outputs["Background"], add.inputs[0])
+            nt.links.new(blue.outputs["Emission"], add.inputs[1])
+            nt.links.new(add.outputs["Shader"], surface)
+            return
+        else:
+            noise = nt.nodes.new("ShaderNodeTexNoise")
+            noise.inputs["Scale"].default_value = 3.0
+            nt.links.new(nt.nodes["Texture Coordinate"].outputs["Generated"],
+                         noise.inputs["Vector"])
+            nt.links.new(noise.outputs["Fac"], surface)
+        nt.nodes.remove(bg)
+    return setup
+
+
+@pytest.mark.parametrize("kind", ["colour", "emission", "value", "mix", "add"])
+def test_a_world_without_a_background_node_matches_cycles(bpy_drt, kind):
+    """A colour, an Emission, a value or shaders mixed or added in the Background's place
+    (`_no_background`) light and show as in Cycles (the same checks; DRT rendered such
+    worlds black before)."""
+    setup = _no_background(kind)
+    cycles = _render(bpy_drt, "CYCLES", CONTROL_SAMPLES * 4, setup, kind)
+    drt = _render(bpy_drt, "DRT", CONTROL_SAMPLES * 2, setup, kind)
+    assert within(drt, cycles, f"a world of {kind} without a Background node")
+
+
 def _camera_sees_grey(scene):
     """The procedural sky lights the scene, and through a Light Path node's Is Camera Ray
     the camera sees a plain grey background instead (a common set-up)."""

@@ -95,11 +95,18 @@ def _export_background(world, reporter: Reporter) -> "engine.World":
     found = _link(out.inputs["Surface"]) if out is not None else None
     if found is None:
         return engine.World(BLACK, visibility=vis)
-    node = found[0]
-    if node.bl_idname != "ShaderNodeBackground":
-        reporter.warn(f"DRT: world {world.name!r} uses {node.bl_label!r}, not supported yet; "
-                      "using a black background", key=("world", "node"))
-        return engine.World(BLACK, visibility=vis)
+    node, socket = found
+    if socket.type != "SHADER":
+        # a colour or value linked straight into Surface: Cycles puts an Emission of it
+        # there, which a world shades as a Background of the same colour and strength
+        node = _ImplicitBackground(out.inputs["Surface"], socket.type)
+    elif node.bl_idname not in ("ShaderNodeBackground", "ShaderNodeEmission"):
+        # shaders mixed or added (a Light Path's Is Camera Ray picking one for the camera,
+        # as artists set it up): their light, compiled and baked into a map
+        ctx = _WorldCtx(world, reporter)
+        world_out = bake_background(world, out.inputs["Surface"], vis, ctx)
+        ctx.report(reporter)
+        return world_out if world_out is not None else engine.World(BLACK, visibility=vis)
     color, strength = node.inputs["Color"], node.inputs["Strength"]
     s = float(strength.default_value)
     plain = tuple(c * s for c in color.default_value[:3])
@@ -119,6 +126,39 @@ def _export_background(world, reporter: Reporter) -> "engine.World":
         world_out = sky_world(src, s, vis, _mapping(src, ctx), ctx)
     ctx.report(reporter)
     return world_out if world_out is not None else engine.World(plain, visibility=vis)
+
+
+class _Socket:
+    """An input socket of _ImplicitBackground: `default_value`, or what `linked` (a real
+    input socket) is linked to."""
+
+    def __init__(self, name, default_value, linked=None):
+        self.name = self.identifier = name
+        self.default_value = default_value
+        self.type = "RGBA" if name == "Color" else "VALUE"
+        self._linked = linked
+
+    @property
+    def is_linked(self):
+        return self._linked is not None and self._linked.is_linked
+
+    @property
+    def links(self):
+        return self._linked.links if self._linked is not None else ()
+
+
+class _ImplicitBackground:
+    """Cycles' conversion of a colour or value linked into a closure socket (its
+    ShaderGraph's auto-conversion): an Emission of Color 1 and Strength 1, fed the
+    colour on Color or the value on Strength; in a world, a Background of them."""
+    bl_idname = "ShaderNodeBackground"
+    bl_label = "Background"
+
+    def __init__(self, surface, kind):
+        value = kind in ("VALUE", "INT", "BOOLEAN")
+        self.inputs = {"Color": _Socket("Color", (1.0, 1.0, 1.0, 1.0),
+                                        None if value else surface),
+                       "Strength": _Socket("Strength", 1.0, surface if value else None)}
 
 
 def _environment(node, strength, vis, ctx):

@@ -1,5 +1,6 @@
 """A world whose Background Color (or Strength) comes from a node graph DRT has no direct
-model for (gradients, noise, colour ramps, mixes of textures): the graph is compiled into
+model for (gradients, noise, colour ramps, mixes of textures), or whose Surface is a Mix
+or Add Shader of Backgrounds and Emissions (`shader_radiance`): the graph is compiled into
 a shader program, as a material's is (export/nodes), and evaluated once per texel of an
 equirectangular map along that texel's direction, which becomes the world's environment
 map, seen by escaped rays and importance-sampled as a light like an HDRI.
@@ -23,8 +24,12 @@ import numpy as np
 from ..engine_link import engine
 from .nodes import NodeCompiler
 from .nodes.errors import Unsupported
+from .nodes.links import _link
 
 CTX = importlib.import_module(engine.__name__ + ".nodes.context")
+CO = importlib.import_module(engine.__name__ + ".nodes.color_nodes")
+CV = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
+LIGHTS = ("ShaderNodeBackground", "ShaderNodeEmission")
 TEXTURES = importlib.import_module(engine.__name__ + ".textures")
 ENV = importlib.import_module(engine.__name__ + ".environment_map")
 CHUNK = 1 << 15          # directions evaluated at once (the hit rows are ~1 KB each)
@@ -42,14 +47,51 @@ def _light_path_outputs(tree) -> set:
             for o in n.outputs if o.is_linked}
 
 
+def shader_radiance(c, sock, ctx):
+    """The compiled radiance (a colour) of the world shader linked into input `sock`:
+    a Background's or an Emission's Color x Strength, a Mix Shader's blend of its two
+    by its Fac (clamped, as Cycles weighs closures), an Add Shader's sum, and a colour
+    or value linked straight in (Cycles' conversion to an Emission of strength 1).
+    Other shaders give a world no light (reported)."""
+    found = _link(sock)
+    if found is None:
+        return c.const((0.0, 0.0, 0.0), "color")
+    node, out = found
+    if out.type != "SHADER":
+        return c.socket(sock, "color")
+    kind = node.bl_idname
+    if kind in LIGHTS:
+        return c.emit(CO.COL_MIX, "color", [c.const(1.0), c.socket(node.inputs["Color"],
+                                                                   "color"),
+                                            c.socket(node.inputs["Strength"], "color"),
+                                            CO.BLEND_MODES.index("MULTIPLY"), 0])
+    if kind == "ShaderNodeMixShader":
+        fac = c.emit(CV.CV_CLAMP, "float", [c.socket(node.inputs[0], "float"),
+                                            c.const(0.0), c.const(1.0), 0])
+        return c.emit(CO.COL_MIX, "color", [fac, shader_radiance(c, node.inputs[1], ctx),
+                                            shader_radiance(c, node.inputs[2], ctx),
+                                            CO.BLEND_MODES.index("MIX"), 0])
+    if kind == "ShaderNodeAddShader":
+        return c.emit(CO.COL_MIX, "color", [c.const(1.0),
+                                            shader_radiance(c, node.inputs[0], ctx),
+                                            shader_radiance(c, node.inputs[1], ctx),
+                                            CO.BLEND_MODES.index("ADD"), 0])
+    ctx.issue(f"its {node.bl_label!r} node is no world shader and gives no light")
+    return c.const((0.0, 0.0, 0.0), "color")
+
+
 def bake_background(world, background, visibility, ctx):
     """engine.World whose environment map is the Background node's Color x Strength
-    evaluated along every texel's direction; None when the graph cannot be compiled
-    (reported; the caller uses the Background's own colour)."""
+    evaluated along every texel's direction (`background` may also be the World Output's
+    Surface input, whose graph of shaders shader_radiance compiles); None when the graph
+    cannot be compiled (reported; the caller uses the Background's own colour)."""
     c = NodeCompiler(ctx)
     try:
-        color = c.socket(background.inputs["Color"], "color")
-        strength = c.socket(background.inputs["Strength"], "float")
+        if getattr(background, "bl_idname", "") in LIGHTS:
+            color = c.socket(background.inputs["Color"], "color")
+            strength = c.socket(background.inputs["Strength"], "float")
+        else:
+            color, strength = shader_radiance(c, background, ctx), c.const(1.0)
     except Unsupported as e:
         ctx.issue(f"its Background's graph is not evaluated ({e}); using the Background's "
                   "own colour")

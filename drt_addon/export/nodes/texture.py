@@ -1,9 +1,11 @@
-"""Texture nodes to program operations (engine.nodes.texture_nodes): Image, Checker,
-Gradient. An unlinked Vector reads the node's default coordinates, as in Cycles: the
-UV map for Image, Generated for the procedural textures."""
+"""Texture nodes to program operations (engine.nodes.texture_nodes): Image, Environment,
+Checker, Gradient. An unlinked Vector reads the node's default coordinates, as in Cycles:
+the UV map for Image, Generated for the procedural textures, the position for
+Environment (in a world, the ray's direction)."""
 from __future__ import annotations
 
 import importlib
+import math
 
 from ...engine_link import engine
 from ..images import image_texture, read_pixels
@@ -11,6 +13,7 @@ from .errors import Unsupported
 from .input import hit3
 
 X = importlib.import_module(engine.__name__ + ".nodes.texture_nodes")
+CV = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
 C = importlib.import_module(engine.__name__ + ".nodes.context")
 textures = importlib.import_module(engine.__name__ + ".textures")
 
@@ -47,6 +50,40 @@ def _image(c, node, out):
     return c.emit(op, "float" if alpha_out else "color", [uv], varying=True, image=tex)
 
 
+def _math(c, op, a, b=None, d=None):
+    zero = c.const(0.0)
+    return c.emit(CV.CV_MATH, "float", [a, zero if b is None else b,
+                                        zero if d is None else d, CV.MATH_OPS.index(op), 0])
+
+
+def _environment(c, node, out):
+    """An Environment Texture read by direction (Cycles' direction_to_equirectangular:
+    u = 1/2 - atan2(y, x) / 2 pi, v = 1 - acos(z / |d|) / pi), as a world's node graph
+    uses it; a plain one straight into a Background is the world's own map
+    (export/world.py)."""
+    if node.projection != "EQUIRECTANGULAR":
+        raise Unsupported(f"the {node.projection} projection of {node.name!r}")
+    alpha_out = out.identifier == "Alpha"
+    if node.image is None or read_pixels(node.image, c.ctx) is None:
+        return c.const(1.0) if alpha_out else c.const(MISSING, "color")
+    if node.interpolation not in ("Linear", "Closest"):
+        c.ctx.issue(f"{node.name!r} uses {node.interpolation} interpolation; DRT uses Linear")
+    tex = image_texture(node.image, node.interpolation, "REPEAT", c.ctx,
+                        premultiply=not any(o.is_linked for o in node.outputs
+                                            if o.identifier == "Alpha"))
+    d = coordinates(c, node, C.H_P)           # Cycles' default: the position (a world's:
+    x, y, z = (c.emit(CV.CV_SEPARATE, "float", [d, k]) for k in range(3))   # the direction)
+    length = _math(c, "SQRT", _math(c, "MULTIPLY_ADD", x, x,
+                                    _math(c, "MULTIPLY_ADD", y, y, _math(c, "MULTIPLY", z, z))))
+    u = _math(c, "MULTIPLY_ADD", _math(c, "ARCTAN2", y, x), c.const(-0.5 / math.pi),
+              c.const(0.5))
+    v = _math(c, "MULTIPLY_ADD", _math(c, "ARCCOSINE", _math(c, "DIVIDE", z, length)),
+              c.const(-1.0 / math.pi), c.const(1.0))
+    uv = c.emit(CV.CV_COMBINE, "vector", [u, v, c.const(0.0)])
+    op = X.TEX_IMAGE_ALPHA if alpha_out else X.TEX_IMAGE_COLOR
+    return c.emit(op, "float" if alpha_out else "color", [uv], varying=True, image=tex)
+
+
 def _checker(c, node, out):
     co = coordinates(c, node, C.H_GENERATED)
     scale = c.input(node, "Scale", "float")
@@ -67,6 +104,7 @@ def _gradient(c, node, out):
 
 TRANSLATORS = {
     "ShaderNodeTexImage": _image,
+    "ShaderNodeTexEnvironment": _environment,
     "ShaderNodeTexChecker": _checker,
     "ShaderNodeTexGradient": _gradient,
 }
