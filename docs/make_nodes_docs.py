@@ -128,14 +128,16 @@ def supported_nodes(bpy):
 # the closures (drt_addon/export/nodes/shader.py, export/volumes.py, export/world.py);
 # each is compared with Cycles in tests/test_closures_vs_cycles.py and the *_vs_cycles
 # tests of its feature
-SHADERS_ROW = ("| Shader | Principled BSDF, Diffuse BSDF, Glossy BSDF, Glass BSDF, "
+SHADERS_ROW = ("| Shader | Principled BSDF (its Diffuse Roughness: Oren-Nayar), Diffuse "
+               "BSDF (Roughness: Oren-Nayar), Glossy BSDF, Glass BSDF, "
                "Refraction BSDF (GGX, Multiscatter GGX, Beckmann), Metallic BSDF (F82 Tint; a "
                "Physical Conductor as its F82-tint fit), Sheen BSDF, "
                "Translucent BSDF, Emission, Transparent BSDF, Holdout (as the whole "
                "Surface, or mixed: a hole of its weight in the camera's alpha), "
                "Mix Shader, Add Shader; "
                "Principled Volume, Volume Scatter, Volume Absorption, Volume "
-               "Coefficients; Background |")
+               "Coefficients; in a world, Background, Emission, Mix Shader and Add "
+               "Shader, or a colour or value linked straight into its Surface |")
 
 
 def program_cost(size=64, spp=16, repeats=3):

@@ -131,6 +131,9 @@ class Material:
     subsurface_weight: float = 0.0
     subsurface_radius: tuple = (1.0, 0.2, 0.1)
     subsurface_anisotropy: float = 0.0
+    # Oren-Nayar roughness of the diffuse lobe (Cycles' Diffuse BSDF Roughness, the
+    # Principled BSDF's Diffuse Roughness; 0: Lambert), engine/kernels/bsdf/oren_nayar.py
+    diffuse_roughness: float = 0.0
     subsurface_ior: float = 1.4
     subsurface_alpha: Optional[float] = None
     subsurface_method: str = "RANDOM_WALK"

@@ -70,6 +70,9 @@ class MaterialTable:
         self.beckmann = np.array([model == "BECKMANN" for model in models], bool)
         fresnels = _choices(materials, "metal_fresnel", "SCHLICK", METAL_FRESNELS)
         self.metal_constant = np.array([f == "CONSTANT" for f in fresnels], bool)
+        self.diffuse_roughness = np.clip(np.nan_to_num(np.array(
+            [float(getattr(m, "diffuse_roughness", 0.0)) for m in materials], np.float64)),
+            0.0, 1.0)
         # Specular Tint: >= 0 (Cycles clamps the metal's F82 tint to 1, and the tinted
         # F0 of the specular layer to 1, kernels/bsdf/specular_tint.py)
         self.specular_tint = np.maximum(np.array(

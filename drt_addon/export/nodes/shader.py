@@ -68,10 +68,11 @@ def _principled(node, ctx) -> _Closure:
                  spec=const("Specular IOR Level", 0.5),
                  distribution=_distribution(node, ctx), layers=_principled_layers(node, ctx))
     comp.subsurface = subsurface.principled(node, ctx, _constant, comp.ior)
+    if node_input(node, "Diffuse Roughness") is not None:      # Blender 4.3 and later
+        comp.diffuse_roughness = float(const("Diffuse Roughness", 0.0))
     ignored = []
     for sock, what in (("Anisotropic", "anisotropy"),
-                       ("Thin Film Thickness", "thin film"),
-                       ("Diffuse Roughness", "diffuse roughness")):
+                       ("Thin Film Thickness", "thin film")):
         s = node_input(node, sock)
         if s is not None and (s.is_linked or float(s.default_value) > 0.0):
             ignored.append(what)
@@ -179,11 +180,11 @@ def _normal(node, ctx):
 
 def _diffuse(node, ctx) -> _Closure:
     _normal(node, ctx)
-    r = _constant(node, "Roughness", ctx, 0.0)
-    if r > 0.0:
-        ctx.issue(f"{node.name!r} has roughness {r:g} (Oren-Nayar); DRT renders it Lambertian")
+    # Roughness: Oren-Nayar (kernels/bsdf/oren_nayar.py), a constant per material
     return _Closure([(1.0, _Comp(base=_input(node, "Color", ctx, True, (0.8,) * 3),
-                                 spec=0.0))])
+                                 spec=0.0,
+                                 diffuse_roughness=float(_constant(node, "Roughness", ctx,
+                                                                   0.0))))])
 
 
 def _distribution(node, ctx) -> str:

@@ -79,7 +79,8 @@ P_CHIANG_T = 85          # per hit, 3 columns: the fibre's tangent in the shadin
 #                          (Cycles' dPdu: a strand's direction, a triangle's p1 - p0)
 P_CHIANG_NG = 88         # per hit, 3 columns: the geometric normal in the shading frame
 #                          (either side; for h, where across the fibre the view meets it)
-NPARAM = 91
+P_DIFFUSE_ROUGHNESS = 91  # Oren-Nayar sigma of the diffuse lobe, 0 to 1 (0: Lambert)
+NPARAM = 92
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -128,6 +129,7 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_METAL_CONSTANT] = table.metal_constant
     rows[:, P_SPEC_TINT:P_SPEC_TINT + 3] = table.specular_tint
     rows[:, P_HAIR] = table.hair
+    rows[:, P_DIFFUSE_ROUGHNESS] = table.diffuse_roughness
     rows[:, P_HAIR_R:P_HAIR_R + 3] = table.hair_reflection
     rows[:, P_HAIR_R_OFFSET] = -table.hair_reflection_offset
     rows[:, P_HAIR_R_ROUGH:P_HAIR_R_ROUGH + 2] = table.hair_reflection_roughness

@@ -17,7 +17,7 @@ microfacet.ALPHA_MIN):
                                             an IOR adjusted by Specular IOR Level:
                                             F0' = F0(ior) * 2 level (0.5 = plain IOR, 0 =
                                             no specular, 1 = twice F0), IOR' = IOR(F0')
-  diffuse       weight  (1 - m)(1 - t)      Lambert with the base colour, under the specular
+  diffuse       weight  (1 - m)(1 - t)      Lambert or Oren-Nayar, under the specular
                         (1 - E_spec(wo))    layer: it gets only the energy the layer does not
                                             reflect, E_spec(wo) being that layer's albedo as
                                             Cycles estimates it (albedo.py, multiscatter.py)
@@ -59,7 +59,7 @@ from __future__ import annotations
 import math
 
 from ..jit import kernel
-from . import dielectric, fresnel, layers, specular_tint, subsurface_lobe
+from . import dielectric, fresnel, layers, oren_nayar, specular_tint, subsurface_lobe
 from . import microfacet as mf
 from . import multiscatter as ms
 from .albedo import specular_albedo
@@ -145,6 +145,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
         # (less the share that scatters below the surface: subsurface_lobe.py)
         state[S_DIFFUSE + c] = subsurface_lobe.split(row, c, base, clamped, base_w, state)
         diffuse_max = max(diffuse_max, state[S_DIFFUSE + c])
+    oren_nayar.setup(row, woz, state)       # the diffuse lobe's roughness (0: Lambert)
     if m > 0.0 and state[S_METAL_CONST] == 0.0:
         f82_setup(row, state)
     w_diff = base_w if diffuse_max > 0.0 else 0.0

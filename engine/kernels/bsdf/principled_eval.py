@@ -1,18 +1,18 @@
 """Evaluating Blender's Principled BSDF (principled.py's lobes, one hit at a time): f of
 the lobes a light of given kinds sees, from the state principled.setup filled. The base's
-Lambert under its specular layer, the specular, metal and glass microfacet lobes
-(`base_glossy`), scaled by the layers above them, and the layers' own lobes beside
-(layers.py: sheen, coat, translucency, hair)."""
+diffuse (Lambert, or Oren-Nayar: oren_nayar.py) under its specular layer, the specular,
+metal and glass microfacet lobes (`base_glossy`), scaled by the layers above them, and
+the layers' own lobes beside (layers.py: sheen, coat, translucency, hair)."""
 from __future__ import annotations
 
 from ..jit import kernel
-from . import dielectric, fresnel, layers, specular_tint
+from . import dielectric, fresnel, layers, oren_nayar, specular_tint
 from . import microfacet as mf
 from .reflection_lobes import metal_fresnel, reflection_eval
 from .state import (S_DIFFUSE, S_ALPHA, S_BECKMANN, S_ETA_GLASS, S_ETA_SPEC, S_GLASS_SMOOTH,
                     S_GLASS_TINTED, S_LAYERED, S_MS_GLASS, S_MS_METAL, S_MS_SPEC,
-                    S_REFRACT_ONLY, S_SPEC_TINTED, S_TINT, S_W_GLASS, S_W_METAL, S_W_SPEC,
-                    S_WALTER)
+                    S_ON, S_REFRACT_ONLY, S_SPEC_TINTED, S_TINT, S_W_GLASS, S_W_METAL,
+                    S_W_SPEC, S_WALTER)
 from ..warp import INV_PI
 
 
@@ -28,9 +28,12 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
     # light be above the shading normal, not the view (which a smooth mesh's silhouette
     # can put under it)
     if see_d and wiz > 0.0:
-        fr = state[S_DIFFUSE] * INV_PI
-        fg = state[S_DIFFUSE + 1] * INV_PI
-        fb = state[S_DIFFUSE + 2] * INV_PI
+        if state[S_ON + 1] > 0.0:          # with roughness: Oren-Nayar
+            fr, fg, fb = oren_nayar.value(state, wox, woy, woz, wix, wiy, wiz)
+        else:
+            fr = state[S_DIFFUSE] * INV_PI
+            fg = state[S_DIFFUSE + 1] * INV_PI
+            fb = state[S_DIFFUSE + 2] * INV_PI
     gr, gg, gb = base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t)
     if state[S_LAYERED] == 0.0:
         return fr + gr, fg + gg, fb + gb

@@ -36,4 +36,6 @@ S_EST_SSS = layers.NSTATE + 21      # its selection estimate
 S_E_SPEC = layers.NSTATE + 22       # the specular layer's albedo at wo (the Glossy Color pass)
 S_ANY_SIDE = layers.NSTATE + 23     # 1: principled.sample's last direction may leave on
 #                                     either side of the surface (a hair lobe's, as Cycles)
-NSTATE = layers.NSTATE + 24
+S_ON = layers.NSTATE + 24          # 5: Oren-Nayar a, b (b 0: Lambert) and its multiple-
+#                                    scattering term per channel (oren_nayar.py)
+NSTATE = layers.NSTATE + 29
