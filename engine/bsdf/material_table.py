@@ -137,6 +137,13 @@ class MaterialTable:
         alpha_tex = self.textured.get("alpha", np.zeros(len(materials), bool))
         # Materials that may let rays through (stochastic transparency in the integrators)
         self.maybe_transparent = (self.alpha < 1.0) | alpha_tex
+        # a Mix Shader per hit lets shadow rays through where a shader it mixes does
+        # (kernels/transparency.py); its shaders follow it in the list
+        for i in range(len(materials) - 1, -1, -1):
+            c0, c1 = self.mix_children[i]
+            if c0 >= 0:
+                self.maybe_transparent[i] |= self.maybe_transparent[c0] | \
+                    self.maybe_transparent[c1]
         self.any_transparent = bool(self.maybe_transparent.any())
         # Which lobes any material can produce (a scene of plain diffuse materials never
         # touches the microfacet code).

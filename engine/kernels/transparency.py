@@ -40,8 +40,8 @@ from .volume import V_BOUNDARY, attenuate, stack_cross
 from ..sampling.hashing import chain
 from ..nodes.context import N_HIT
 from ..nodes.interpreter import has_program
-from ..nodes.pack import NREGS
-from ..nodes.shading import program_alpha, program_hit
+from ..nodes.pack import MIX, NREGS
+from ..nodes.shading import mix_factor, program_alpha, program_hit
 
 TRANSPARENT_DIM = 1 << 24      # the pass-through numbers' own dimensions (see path.py)
 SHADOW_BIT = visibility.SHADOW
@@ -57,7 +57,8 @@ def _hit_alpha(geometry, materials, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz,
                depth, length):
     """Alpha of the hit of the ray o + t d (a material program's, run for a ray of kind
     `ray`, the path's bounce depth and the hit's distance `length` from the path's last
-    vertex), its material and its surface point."""
+    vertex), its material, its surface point, its UV and, for a Mix Shader whose Fac
+    varies per hit, that Fac (-1 for any other material)."""
     tri_material, corner_uvs = geometry[3], geometry[6]
     _, _, alpha_table, _, T, _ = materials
     px, py, pz, gx, gy, gz, nx, ny, nz, front, _ = surface_at(
@@ -65,13 +66,29 @@ def _hit_alpha(geometry, materials, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz,
     uu, vv = hit_uv(corner_uvs, prim, u, v)
     m = tri_material[prim]
     a = alpha_at(T, alpha_table, m, uu, vv)
+    fac = -1.0
     if has_program(T, m):
         hit = np.zeros(N_HIT)
         regs = np.zeros(max(T[NREGS][0], 1))
         program_hit(T, geometry, m, prim, inst, u, v, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
                     dx, dy, dz, front, ray, depth, length, hit, regs)
         a = program_alpha(T, m, regs, a)
-    return a, m, px, py, pz
+        if T[MIX][m, 0] >= 0:
+            fac = mix_factor(T, m, regs)
+    return a, m, px, py, pz, uu, vv, fac
+
+
+@kernel(allocates=False)
+def _mixed_transmittance(materials, m, uu, vv, fac, c):
+    """What a Mix Shader's two shaders let through, channel c: (1 - Fac) (1 - alpha0)
+    colour0 + Fac (1 - alpha1) colour1 (Cycles sums the two closures, so a shadow ray
+    sees the transparent part of each, e.g. a Light Path's Is Shadow Ray picking a
+    Transparent BSDF for shadows, as architectural glass is made)."""
+    _, _, alpha_table, tcolor, T, _ = materials
+    c0, c1 = T[MIX][m, 0], T[MIX][m, 1]
+    t0 = (1.0 - alpha_at(T, alpha_table, c0, uu, vv)) * tcolor[c0, c]
+    t1 = (1.0 - alpha_at(T, alpha_table, c1, uu, vv)) * tcolor[c1, c]
+    return (1.0 - fac) * t0 + fac * t1
 
 
 @kernel(allocates=False)
@@ -131,7 +148,7 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
             continue
         dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
         p = live[r]
-        a, m, px, py, pz = _hit_alpha(
+        a, m, px, py, pz, _, _, _ = _hit_alpha(
             geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], ro[i, 0], ro[i, 1],
             ro[i, 2], cur_t[i], dx, dy, dz, path_time[p],
             ray_bits[p], depth, travelled[r] + cur_t[i])
@@ -204,13 +221,17 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
             trans[r, 0] = trans[r, 1] = trans[r, 2] = 0.0
             continue
         dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
-        a, m, px, py, pz = _hit_alpha(
+        a, m, px, py, pz, uu, vv, fac = _hit_alpha(
             geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], so[i, 0], so[i, 1],
             so[i, 2], cur_t[i], dx, dy, dz, ray_time[r],
             SHADOW_BIT, 0, cur_t[i])
-        trans[r, 0] *= (1.0 - a) * tcolor[m, 0]
-        trans[r, 1] *= (1.0 - a) * tcolor[m, 1]
-        trans[r, 2] *= (1.0 - a) * tcolor[m, 2]
+        if fac >= 0.0:                    # a Mix Shader per hit: both shaders' share
+            for c in range(3):
+                trans[r, c] *= _mixed_transmittance(materials, m, uu, vv, fac, c)
+        else:
+            trans[r, 0] *= (1.0 - a) * tcolor[m, 0]
+            trans[r, 1] *= (1.0 - a) * tcolor[m, 1]
+            trans[r, 2] *= (1.0 - a) * tcolor[m, 2]
         if not max(trans[r, 0], trans[r, 1], trans[r, 2]) > 0.0:
             continue
         _emit(out, n_out, r, prim, cur_inst[i], px, py, pz, remaining[i] - cur_t[i], light)

@@ -262,6 +262,14 @@ def bump_shadowing(sx, sy, sz, nx, ny, nz, lx, ly, lz, soften):
 
 
 @kernel(allocates=False)
+def mix_factor(T, m, regs):
+    """Material m's Mix Shader Fac at this hit, clamped to [0, 1] (0.5 where no program
+    output drives it), as pick_closure reads it."""
+    k = T[OUTS][m, OUT_MIX]
+    return min(max(regs[k], 0.0), 1.0) if k >= 0 else 0.5
+
+
+@kernel(allocates=False)
 def pick_closure(T, m, regs, u):
     """Cycles' Mix Shader sums its two shaders weighted 1 - Fac and Fac; DRT picks one per
     hit with those probabilities (an unbiased estimate of the sum: the picked shader is
