@@ -67,10 +67,11 @@ CAUSES = {
         "the worst block is a neon tube seen directly (radiance 14, 20 times the image "
         "mean), where DRT is 2 % below Cycles; Cycles' own worst block there is 24 %",
     "RoomExercise.blend":
-        "a room lit through its windows by a world whose HDRI is missing (pink in both), "
-        "the windows an architectural glass (a Light Path's Is Shadow Ray mixing in a "
-        "Transparent BSDF): DRT is 34 % darker on red and blue, most under the ceiling; "
-        "not found yet",
+        "a room lit through its windows by a world whose HDRI is missing (pink in both) "
+        "and by a point lamp; its windows are architectural glass (a Light Path's Is "
+        "Shadow Ray mixing in a Transparent BSDF), which DRT's shadow rays pass since "
+        "2026-12-01 (unchanged here); DRT is 34 % darker on red and blue, most under "
+        "the ceiling; not found yet",
     "tunnel.blend":
         "its images are missing (pink in both) and its Vector Displacement in tangent "
         "space has no UV map to take tangents from: DRT drops the offsets' x and z "

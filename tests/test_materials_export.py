@@ -828,3 +828,25 @@ def test_alpha_comparison_rejects_ignoring_alpha(alpha_renders):
     img = render(s, RenderSettings(samples=16, diffuse_bounces=0))[0].mean()
     rel, mad = compare(img[:, 24:], cycles[:, 24:])
     assert np.any(rel > MEAN_TOLERANCE) or mad > MAD_TOLERANCE, (rel, mad)
+
+
+def test_a_node_tree_without_an_output_is_black_as_in_cycles(bpy_drt):
+    """A material whose node tree has no Material Output (the public RoomExercise.blend
+    has five such objects) has no closure in Cycles: an opaque black surface, not its
+    viewport colour (what DRT rendered before: a green plane here). Both engines, 16
+    samples: the plane's pixels are black, the world around it the same."""
+    from node_probe import new_material, new_scene, render
+    bpy = bpy_drt
+    scene = new_scene(bpy, 32)
+    bpy.ops.mesh.primitive_plane_add(size=1.0)
+    mat, nt = new_material(bpy, "NoOutput")
+    nt.nodes.remove(nt.nodes["Material Output"])
+    mat.diffuse_color = (0.2, 0.9, 0.2, 1.0)
+    bpy.context.object.data.materials.append(mat)
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.location = (0.0, 0.0, 3.0)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    cycles, drt = (render(bpy, scene, e, 16) for e in ("CYCLES", "DRT"))
+    assert cycles[16, 16, :3].max() == 0.0 and drt[16, 16, :3].max() == 0.0
+    np.testing.assert_allclose(drt[0, 0, :3], cycles[0, 0, :3], rtol=1e-3)

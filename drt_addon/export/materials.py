@@ -82,6 +82,7 @@ Displacement (the Material Output's socket)
     bend it; Displacement Only moves the mesh's vertices (engine.displacement, at
     export); Displacement and Bump does both.
 
+A node tree without a Material Output is black and opaque, as in Cycles (no closure).
 Anything else falls back to a diffuse surface of the material's viewport colour. Every
 approximation is reported once per material, in one warning naming the material.
 """
@@ -208,7 +209,7 @@ def export_material(mat, reporter: Reporter, grids=None,
     if not uses_nodes(mat):
         return fallback
     try:
-        result = _from_nodes(mat, ctx, fallback)
+        result = _from_nodes(mat, ctx)
     except Exception as e:     # a node set-up the exporter does not know: the rest renders
         ctx.issues = [f"DRT could not read its nodes ({type(e).__name__}: {e}); it renders "
                       "with its viewport colour"]
@@ -256,15 +257,16 @@ def _is_holdout(socket) -> bool:
     return found is not None and found[0].bl_idname == "ShaderNodeHoldout"
 
 
-def _from_nodes(mat, ctx, fallback) -> "engine.Material":
+def _from_nodes(mat, ctx) -> "engine.Material":
     """The material from its node tree (see the module docstring)."""
     name = mat.name
     for problem in tree_problems(mat.node_tree):
         ctx.issue(problem)
     out = _output_node(mat.node_tree)
     if out is None:
-        ctx.issue("it has no Material Output node; using its viewport colour")
-        result = fallback
+        # Cycles: a node tree without an output has no closure: black, opaque (as an
+        # output whose Surface is unlinked), not the viewport colour
+        result = engine.Material(name, (0.0, 0.0, 0.0), specular_ior_level=0.0)
     elif _is_holdout(out.inputs["Surface"]):
         # Cycles' Holdout: a hole in the alpha for the camera, black to other rays
         result = engine.Material(name, (0.0, 0.0, 0.0), specular_ior_level=0.0,
