@@ -35,7 +35,7 @@ from ..engine_link import engine
 from .errors import Reporter
 from .images import image_cache, image_texture, read_pixels, textures
 from .nodes.links import _link, uses_nodes
-from .world_nodes import bake_background
+from .world_nodes import LIGHTS, bake_background
 from .world_sky import sky_world
 
 BLACK = (0.0, 0.0, 0.0)
@@ -96,69 +96,43 @@ def _export_background(world, reporter: Reporter) -> "engine.World":
     if found is None:
         return engine.World(BLACK, visibility=vis)
     node, socket = found
-    if socket.type != "SHADER":
-        # a colour or value linked straight into Surface: Cycles puts an Emission of it
-        # there, which a world shades as a Background of the same colour and strength
-        node = _ImplicitBackground(out.inputs["Surface"], socket.type)
-    elif node.bl_idname not in ("ShaderNodeBackground", "ShaderNodeEmission"):
-        # shaders mixed or added (a Light Path's Is Camera Ray picking one for the camera,
-        # as artists set it up): their light, compiled and baked into a map
-        ctx = _WorldCtx(world, reporter)
-        world_out = bake_background(world, out.inputs["Surface"], vis, ctx)
-        ctx.report(reporter)
-        return world_out if world_out is not None else engine.World(BLACK, visibility=vis)
+    if socket.type != "SHADER" or node.bl_idname not in LIGHTS:
+        # a colour or value linked straight into Surface (Cycles puts an Emission of it
+        # there: Color 1, Strength 1, fed the one linked), or shaders mixed or added (a
+        # Light Path's Is Camera Ray picking one for the camera, as artists set it up)
+        colour = socket.type != "SHADER"
+        return _graph_world(world, found if colour else None, 1.0,
+                            (1.0, 1.0, 1.0) if colour else BLACK, out.inputs["Surface"],
+                            vis, reporter)
     color, strength = node.inputs["Color"], node.inputs["Strength"]
     s = float(strength.default_value)
     plain = tuple(c * s for c in color.default_value[:3])
     source = _link(color)
     if source is None and _link(strength) is None:
         return engine.World(plain, visibility=vis)
+    return _graph_world(world, source if _link(strength) is None else None, s, plain, node,
+                        vis, reporter)
+
+
+def _graph_world(world, source, strength, plain, target, vis, reporter):
+    """The world lit by a graph: an Environment or Sky Texture's own map where `source`
+    (the (node, output) feeding the colour, strength unlinked) is one, times `strength`;
+    otherwise `target` (a Background or Emission node, or the World Output's Surface
+    input) compiled and baked into a map (world_nodes.py). `plain` where neither is
+    modelled."""
     ctx = _WorldCtx(world, reporter)
     src, socket = source if source is not None else (None, None)
-    direct = _link(strength) is None and src is not None and (
+    direct = src is not None and (
         (src.bl_idname == "ShaderNodeTexEnvironment" and socket.identifier == "Color")
         or src.bl_idname == "ShaderNodeTexSky")
-    if not direct:           # any other graph: evaluated into a map (world_nodes.py)
-        world_out = bake_background(world, node, vis, ctx)
+    if not direct:
+        world_out = bake_background(world, target, vis, ctx)
     elif src.bl_idname == "ShaderNodeTexEnvironment":
-        world_out = _environment(src, s, vis, ctx)
+        world_out = _environment(src, strength, vis, ctx)
     else:
-        world_out = sky_world(src, s, vis, _mapping(src, ctx), ctx)
+        world_out = sky_world(src, strength, vis, _mapping(src, ctx), ctx)
     ctx.report(reporter)
     return world_out if world_out is not None else engine.World(plain, visibility=vis)
-
-
-class _Socket:
-    """An input socket of _ImplicitBackground: `default_value`, or what `linked` (a real
-    input socket) is linked to."""
-
-    def __init__(self, name, default_value, linked=None):
-        self.name = self.identifier = name
-        self.default_value = default_value
-        self.type = "RGBA" if name == "Color" else "VALUE"
-        self._linked = linked
-
-    @property
-    def is_linked(self):
-        return self._linked is not None and self._linked.is_linked
-
-    @property
-    def links(self):
-        return self._linked.links if self._linked is not None else ()
-
-
-class _ImplicitBackground:
-    """Cycles' conversion of a colour or value linked into a closure socket (its
-    ShaderGraph's auto-conversion): an Emission of Color 1 and Strength 1, fed the
-    colour on Color or the value on Strength; in a world, a Background of them."""
-    bl_idname = "ShaderNodeBackground"
-    bl_label = "Background"
-
-    def __init__(self, surface, kind):
-        value = kind in ("VALUE", "INT", "BOOLEAN")
-        self.inputs = {"Color": _Socket("Color", (1.0, 1.0, 1.0, 1.0),
-                                        None if value else surface),
-                       "Strength": _Socket("Strength", 1.0, surface if value else None)}
 
 
 def _environment(node, strength, vis, ctx):
