@@ -262,8 +262,10 @@ class CompiledPathIntegrator:
         tm = np.array(np.broadcast_to(tmax, (n,)), dtype=np.float64)
         no_stop = np.zeros(n, bool)
         skip = None                  # what the rays leave (camera rays: nothing)
-        # one step per bounce, and per crossing of a volume's boundary
-        steps = self.max_bounces + 1 + (VOLUME_BOUNDS_MAX if self.has_volumes else 0)
+        # the camera rays' step, one per bounce (Max Bounces + 1 of them: the last one's
+        # ray gathers what it finds; path_weights.ends_path), and one per crossing of a
+        # volume's boundary
+        steps = self.max_bounces + 2 + (VOLUME_BOUNDS_MAX if self.has_volumes else 0)
         for depth in range(steps):
             if live.size == 0 or (stop is not None and stop.is_set()):
                 break

@@ -4,8 +4,8 @@ surface stage does at a surface, with the Henyey-Greenstein phase function in pl
 the BSDF: next-event estimation (one light sample, one shadow ray through the media,
 MIS against phase sampling) and, within Cycles' volume bounce limit, a new direction
 sampled from the phase function. As in Cycles a volume scattering counts as a bounce,
-is seen by lamps as a diffuse ray, and past `volume_bounces` scatterings a path still
-gathers the direct light of its last one but goes no further.
+is seen by lamps as a diffuse ray, and the scattering that uses up the volume (or the
+total) bounce budget ends the path where its ray arrives (path_weights.ends_path).
 
 The direct light of a homogeneous segment is estimated twice, and the two combined by
 multiple importance sampling over the distance (Cycles' "Multiple Importance" volume
@@ -31,7 +31,8 @@ from .jit import kernel
 from . import light_tally as tl
 from .light_tally import VOLUME_SHARES
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, keep_receiver,
-                           nee_weight, power_heuristic, roulette)
+                           VOLUME, ends_path, nee_weight, power_heuristic,
+                           roulette)
 from .volume import EQUIANGULAR, distance_pdf, hg_phase, hg_sample, medium, volume_dim
 
 
@@ -52,9 +53,6 @@ def scatter(depth, cfg, paths, p, px, py, pz, dx, dy, dz, br, bg, bb, g, tally, 
     mode = cfg.mis_mode
     clamp = cfg.clamp_direct if bounce[p] == 0 else cfg.clamp_indirect
     base = D.FIRST_BOUNCE + depth * D.PER_BOUNCE
-    # whether the phase function samples a next ray; if not, light sampling alone finds
-    # the light (its MIS weight is then 1, as a BSDF's at the last bounce)
-    goes_on = bounce[p] < cfg.max_bounces and vbounce[p] < cfg.volume_bounces
     recv = lt.receiver(px, py, pz, 0.0, 0.0, 0.0, lt.OMNI)    # a point with no normal
     if lt.n_entries(lights) > 0:
         u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK)
@@ -64,7 +62,7 @@ def scatter(depth, cfg, paths, p, px, py, pz, dx, dy, dz, br, bg, bb, g, tally, 
         seen = lt.entry_visibility(lights, k)
         if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0:
             ph = hg_phase(g, dx * wx + dy * wy + dz * wz)
-            w = nee_weight(mode, lpdf, ph if goes_on else 0.0, delta) / lpdf * ph
+            w = nee_weight(mode, lpdf, ph, delta) / lpdf * ph
             w *= distance_weight(lights, k, recv, time, dx, dy, dz, segment)
             cr, cg, cb = br * lr * w, bg * lg * w, bb * lb * w
             if not w > 0.0:
@@ -78,13 +76,15 @@ def scatter(depth, cfg, paths, p, px, py, pz, dx, dy, dz, br, bg, bb, g, tally, 
                 ns = ray_queues.push(shadows, ns, p, bounce[p], px, py, pz, sdx, sdy, sdz,
                                      far, cr, cg, cb, paths.stacks, -1, -1, lprim)
                 tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))
-    if not goes_on:
-        return ns, nn
+    # the path is here within its bounce budget: the phase function samples the next
+    # ray, and the path ends at the vertex it finds if this scattering uses a budget up
     u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.BSDF_DIR)
     wx, wy, wz, pdf = hg_sample(g, dx, dy, dz, u1, u2)
     if bounce[p] + 1 >= ROULETTE_START:
         u_rr = sample_1d(kind, pkey[p], spp, index[p], base + D.ROULETTE)
         paths.cont[p] = roulette(u_rr, br, bg, bb)     # applied where the next ray arrives
+    if ends_path(cfg, bounce[p] + 1, vbounce[p] + 1, VOLUME):
+        paths.cont[p] = 0.0
     if not (max(br, bg, bb) > 0.0 and pdf > 0.0):
         return ns, nn
     paths.beta[p, 0], paths.beta[p, 1], paths.beta[p, 2] = br, bg, bb     # phase / pdf = 1
@@ -134,8 +134,7 @@ def equiangular_light(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, br, b
     its position and a point on it from there, and queues the shadow ray (returned count
     ns). Its weight against phase sampling takes the light's pick probability for that
     point, as a scattering there would pick it."""
-    pkey, index, time, bounce, vbounce = paths.key, paths.index, paths.time[p], \
-        paths.bounce, paths.vbounce
+    pkey, index, time, bounce = paths.key, paths.index, paths.time[p], paths.bounce
     stacks = paths.stacks
     kind, spp = cfg.sampler, cfg.spp
     mode = cfg.mis_mode
@@ -167,10 +166,9 @@ def equiangular_light(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, br, b
     select = lt.select_pdf(lights, k, lt.receiver(px, py, pz, 0.0, 0.0, 0.0, lt.OMNI), time)
     if not select > 0.0:
         return ns                      # the light cannot reach this point (tree.py)
-    goes_on = bounce[p] < cfg.max_bounces and vbounce[p] < cfg.volume_bounces
     ph = hg_phase(g, dx * wx + dy * wy + dz * wz)
     w_t = 1.0 if method == EQUIANGULAR else power_heuristic(pe * by_segment, pd * select)
-    w = (nee_weight(mode, ppoint * select, ph if goes_on else 0.0, delta)
+    w = (nee_weight(mode, ppoint * select, ph, delta)
          / (ppoint * by_segment) * ph * w_t / pe)
     cr = br * ssr * math.exp(-str_ * t) * lr * w
     cg = bg * ssg * math.exp(-stg * t) * lg * w

@@ -41,12 +41,14 @@ from . import hair_tangent
 from . import ray_queues
 from .frame import dot, to_local, to_world
 from .jit import kernel
+from .light_bsdf import lit_bsdf
 from .found_light import background, escaped, lamps_in_front
 from . import light_tally as tl
 from .pass_shares import NO_SHARES, bounce_shares, light_shares, lobe_colours
 from .medium_vertex import scatter
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
-                           TRANSMISSION_BIT, _INF, continues, hit_weight, holdout_share,
+                           TRANSMISSION_BIT, _INF, continues, ends_path, hit_weight,
+                           holdout_share,
                            keep_receiver, nee_weight, previous_receiver, roulette, uncovered)
 from .medium_density import has_heterogeneous
 from .medium_segment import NO_SEGMENT, NO_SEGMENT_MIS, along_ray
@@ -62,7 +64,7 @@ from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import (bent_diffuse, bump_rejects, may_emit,
+from ..nodes.shading import (bent_diffuse, may_emit,
                              valid_reflection_normal)
 
 @kernel
@@ -109,7 +111,6 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
     tri_material, holdout, corner_uvs = geometry[3], geometry[5], geometry[6]
     film_transparent = cfg.film_transparent and alpha.shape[0] > 0
     kind, spp = cfg.sampler, cfg.spp
-    max_bounces = cfg.max_bounces
     clamp_direct, clamp_indirect, mode = cfg.clamp_direct, cfg.clamp_indirect, cfg.mis_mode
     scene_radius = cfg.scene_radius
     n_lights = lt.n_entries(lights)
@@ -251,10 +252,9 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         # counting only where the surface transmits
         recv = lt.receiver(px, py, pz, s0x, s0y, s0z,
                            lt.TWO_SIDED if bsdf.transmits(state) else lt.ONE_SIDED)
-        room = b < max_bounces
-        ad = room and counts[p, 0] < cfg.diffuse_bounces
-        ag = room and counts[p, 1] < cfg.glossy_bounces and keep_g
-        at = room and counts[p, 2] < cfg.transmission_bounces and keep_t
+        # every lobe may continue: a path reaches a vertex only within its bounce budget
+        # (the bounce that used it up ended the path at the vertex it found: ends_path)
+        ad, ag, at = True, keep_g, keep_t
         # 2. next-event estimation: one light entry, one point, one shadow ray
         if n_lights > 0:
             # (one light: nothing to pick, and no number drawn for it)
@@ -271,23 +271,9 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
             see_d = (seen & DIFFUSE_BIT) != 0
             see_g = (seen & GLOSSY_BIT) != 0 and keep_g
             see_t = (seen & TRANSMISSION_BIT) != 0 and keep_t
-            cosine = abs(lz)
-            if bent:
-                # a Normal Map's normal: specular lobes on its valid-reflection frame,
-                # the diffuse lobe on the raw normal with bump shadowing (Cycles)
-                fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, False, see_g,
-                                            see_t)
-                if bump_rejects(s0x, s0y, s0z, nx, ny, nz, wx, wy, wz):
-                    cosine = 0.0
-                fr, fg, fb = fr * cosine, fg * cosine, fb * cosine
-                if see_d:
-                    dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry,
-                                              rz, wx, wy, wz, correct)
-                    fr, fg, fb = fr + dr, fg + dg, fb + db
-                cosine = 1.0
-            else:
-                fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, see_d, see_g,
-                                            see_t)
+            fr, fg, fb, cosine = lit_bsdf(state, bent, wox, woy, woz, lx, ly, lz, see_d,
+                                          see_g, see_t, s0x, s0y, s0z, nx, ny, nz, rx, ry,
+                                          rz, wx, wy, wz, correct)
             # as in Cycles, the lobes alone decide (on the shading normals): a light
             # under the triangle's own plane but above its smooth normal lights it, its
             # shadow ray leaving from the curved surface the normals describe
@@ -299,20 +285,21 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                                                          wz, dist, margin, scene_radius)
                 bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
                                      see_d, see_g, see_t)
-                w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine
                 shares = NO_SHARES
                 if b == 0 and tl.on(tally):
                     shares = light_shares(state, wox, woy, woz, lx, ly, lz, see_d, see_g,
                                           see_t, bent, fr, fg, fb, s0x, s0y, s0z, rx, ry,
                                           rz, wx, wy, wz, correct)
+                w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine
+                fr, fg, fb = fr * w, fg * w, fb * w
                 group = tl.entry_group(tally, k)
                 if not seen & SHADOW_BIT:        # a light casting no shadow: no shadow ray
-                    tl.lit(tally, p, b, br * fr * lr * w, bg * fg * lg * w, bb * fb * lb * w,
+                    tl.lit(tally, p, b, br * fr * lr, bg * fg * lg, bb * fb * lb,
                            clamp_direct if b == 0 else clamp_indirect, shares, group)
                 else:
                     ns_out = ray_queues.push(shadows, ns_out, p, b, sox, soy, soz, sdx, sdy,
-                                             sdz, far, br * fr * lr * w, bg * fg * lg * w,
-                                             bb * fb * lb * w, stacks, own, hit_inst[j],
+                                             sdz, far, br * fr * lr, bg * fg * lg,
+                                             bb * fb * lb, stacks, own, hit_inst[j],
                                              lprim)
                     tl.queued(tally, ns_out - 1, p, b, shares, group)
                     if (vol.shape[0] > 0 and vol[m, V_HAS] != 0.0
@@ -322,8 +309,6 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                         stack_cross(shadows.stack, ns_out - 1, m, front)
             state[S_WALTER] = 0.0
         # 3. continue by BSDF sampling
-        if not (ad or ag or at):
-            continue
         u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.BSDF_DIR)
         ix, iy, iz, wr, wg, wb, spdf, skind, sdelta, valid = bsdf.sample(
             state, wox, woy, woz, u_lobe, u1, u2, ad, ag, at)
@@ -365,6 +350,8 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         if b + 1 >= ROULETTE_START:
             u_rr = sample_1d(kind, pkey[p], spp, index[p], base + D.ROULETTE)
             cont[p] = roulette(u_rr, br, bg, bb)
+        if ends_path(cfg, b + 1, counts[p, skind] + 1, skind):
+            cont[p] = 0.0
         if not max(br, bg, bb) > 0.0 or not (br < _INF and bg < _INF and bb < _INF):
             continue       # nothing left, or overflowed (or NaN): the path ends here
         beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb

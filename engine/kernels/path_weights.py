@@ -105,6 +105,30 @@ def holdout_share(h, u_lobe, b, alpha, p, br, bg, bb):
     return False, u_lobe
 
 
+VOLUME = 3    # the kind of a scattering in a volume (0, 1, 2: the BSDF lobes' skind)
+
+
+@kernel(allocates=False)
+def ends_path(cfg, bounces, kind_count, kind):
+    """Whether the bounce that brings a path to `bounces` bounces, and its kind (0
+    diffuse, 1 glossy, 2 transmission, VOLUME) to `kind_count`, uses up a budget. As in
+    Cycles (scene/integrator.cpp adds one to every limit, "so that a bounce of 0 indicates
+    no global illumination, only direct illumination"), a path may take Max Bounces + 1
+    bounces, and as many of each kind as its own limit + 1; the ray of the bounce that
+    uses a budget up gathers only what it finds (emission and the world, weighted
+    against the light sample of the vertex it left) and the path ends at the vertex it
+    reaches (cont 0, as the roulette ends paths)."""
+    if bounces > cfg.max_bounces:
+        return True
+    if kind == 0:
+        return kind_count > cfg.diffuse_bounces
+    if kind == 1:
+        return kind_count > cfg.glossy_bounces
+    if kind == 2:
+        return kind_count > cfg.transmission_bounces
+    return kind_count > cfg.volume_bounces
+
+
 @kernel(allocates=False)
 def roulette(u, br, bg, bb):
     """Cycles' Russian roulette on throughput b (its path_state_continuation_probability):

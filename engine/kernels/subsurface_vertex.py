@@ -37,7 +37,7 @@ from . import light_tally as tl
 from .light_tally import DIFFUSE_SHARES
 from ..sampling.hashing import stream_uniform
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, keep_receiver,
-                           nee_weight, roulette)
+                           ends_path, nee_weight, roulette)
 from .subsurface import MAX_BOUNCES, object_of, walk, walk_radius
 from ..embree.rays import new_ray_record
 from .surface import hit_uv, rebuild_at_time
@@ -143,7 +143,6 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, p
                 mx, my, mz = bx, by, bz
                 if params[m2, P_SETS_NORMAL] != 0.0:     # a Set Normal: the surface's own
                     n0x, n0y, n0z = bx, by, bz
-    goes_on = b < cfg.max_bounces and counts[p, 0] < cfg.diffuse_bounces
     mode = cfg.mis_mode
     # next-event estimation on the exit's Lambertian surface (lights picked for it as
     # Cycles' tree picks them: one-sided, on the surface's own normal, sd->N)
@@ -158,7 +157,7 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, p
                                                              lx, ly, lz, soften)
         if (lpdf > 0.0 and max(lr, lg, lb) > 0.0 and cosine > 0.0
                 and (seen & DIFFUSE_BIT) != 0):
-            bpdf = cosine * INV_PI if goes_on else 0.0
+            bpdf = cosine * INV_PI
             wt = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine * INV_PI
             cr, cg, cb = tr * lr * wt, tg * lg * wt, tb * lb * wt
             if not seen & SHADOW_BIT:
@@ -174,9 +173,8 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, p
                 ns = ray_queues.push(shadows, ns, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr,
                                      cg, cb, stacks, own, inst2, lprim)
                 tl.queued(tally, ns - 1, p, b, DIFFUSE_SHARES, tl.entry_group(tally, k))
-    if not goes_on:
-        return ns, nn
-    # the diffuse bounce from the exit (f cos / pdf = 1)
+    # the diffuse bounce from the exit (f cos / pdf = 1); the path is here within its
+    # bounce budget, and ends at the vertex this ray finds if it uses it up
     ix, iy, iz = cosine_hemisphere(stream_uniform(key, EXIT_STEP, 3),
                                    stream_uniform(key, EXIT_STEP, 4))
     ox, oy, oz = to_world(ix, iy, iz, mx, my, mz)
@@ -188,6 +186,8 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, p
         return ns, nn
     if b + 1 >= ROULETTE_START:
         cont[p] = roulette(stream_uniform(key, EXIT_STEP, 5), tr, tg, tb)
+    if ends_path(cfg, b + 1, counts[p, 0] + 1, 0):
+        cont[p] = 0.0
     if not (tr < math.inf and tg < math.inf and tb < math.inf):
         return ns, nn
     pdf = iz * INV_PI

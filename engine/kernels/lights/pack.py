@@ -266,7 +266,10 @@ def pack_lights(light_set, tri_visibility=None, timed=True, tree=True) -> tuple:
         vis[entry[prims]] = np.asarray(tri_visibility)[prims]
     L = ((lamps, select_pdf, cdf, suns) + tri + (env, vis) + _pack_map(light_set.world)
          + (guide_table(cdf, guide_cells(len(cdf))), slices, slice_of))
-    if tree and len(select_pdf) > 1:
+    if tree and len(select_pdf) > 0:
+        # a single light too: Cycles' tree then still refuses it to receivers it cannot
+        # light (below a surface that does not transmit), which a closure whose sampling
+        # and evaluation differ (the Hair BSDF's) sees in its MIS weights
         from .tree_build import tree_arrays
         return L + tree_arrays(L, models)
     from .tree_build import N_EMIT, N_NODE
