@@ -289,10 +289,8 @@ def test_unmodelled_sky_types_are_reported(bpy_drt):
 
 
 def test_sampling_method_none_keeps_the_world_from_being_a_light(bpy_drt):
-    """World > Settings > Sampling Method: Auto samples the world as a light, None does
-    not (escaping rays alone find it, as in Cycles). A uniform world is sampled too (for
-    less noise; Cycles relies on escaping rays alone there), marked so that next-event
-    estimation evaluates refraction towards it as those rays see it."""
+    """World > Settings > Sampling Method: Auto samples a world that varies over
+    directions as a light, None does not (escaping rays alone find it, as in Cycles)."""
     from engine.kernels.lights import is_uniform_world, pack_lights
     from engine.lights import LightSet
     world, bg = _world(bpy_drt, "sampled")
@@ -306,9 +304,66 @@ def test_sampling_method_none_keeps_the_world_from_being_a_light(bpy_drt):
     assert not is_uniform_world(pack_lights(lights), lights.env_index)
     assert LightSet([], 10.0, world=unlit).env_index is None
     assert LightSet([], 10.0, world=unlit).world is not None       # still seen by rays
-    plain, _ = _world(bpy_drt, "uniform")
-    uniform = LightSet([], 10.0, world=_export(plain)[0])
-    assert uniform.env_index is not None
-    assert is_uniform_world(pack_lights(uniform), uniform.env_index)
-    plain.cycles.sampling_method = "NONE"
-    assert LightSet([], 10.0, world=_export(plain)[0]).env_index is None
+
+
+def _linked(world, bg, kind, output=0, vector=None):
+    tree = world.node_tree
+    node = tree.nodes.new(kind)
+    if vector is not None:
+        tree.links.new(vector, node.inputs["Vector"])
+    tree.links.new(node.outputs[output], bg.inputs["Color"])
+    return node
+
+
+@pytest.mark.parametrize("build, sampled", [
+    ("plain", False),                  # one colour: Cycles never samples it
+    ("no_nodes", False),
+    ("value", False),                  # an RGB node: still one colour
+    ("light_path", False),             # Is Camera Ray mixing two colours
+    ("noise", True),                   # a texture on its default coordinates
+    ("noise_on_constant", False),      # a texture whose Vector is a constant
+    ("gradient_in_group", True),       # the same, inside a node group
+    ("texture_coordinate", True),      # the direction itself
+    ("layer_weight", True),
+])
+def test_only_a_world_that_varies_over_directions_is_sampled_as_a_light(bpy_drt, build,
+                                                                        sampled):
+    """Cycles samples the world as a light only when its surface varies over directions
+    (Shader::has_surface_spatial_varying: a texture on its own coordinates, a Texture
+    Coordinate, Geometry, Layer Weight ... node compiled into it); a world of one colour
+    is found by escaping rays alone, so a Light Path trick that tells shadow rays apart
+    lets its light in only through the rays that pass (test_shadow_ray_glass_vs_cycles).
+    The exporter decides as Cycles does, and the light set then has no world entry."""
+    from engine.lights import LightSet
+    world, bg = _world(bpy_drt, build)
+    tree = world.node_tree
+    if build == "no_nodes":
+        world.use_nodes = False
+    elif build == "value":
+        _linked(world, bg, "ShaderNodeRGB")
+    elif build == "light_path":
+        mix = _linked(world, bg, "ShaderNodeMix", output=2)
+        mix.data_type = "RGBA"
+        tree.links.new(tree.nodes.new("ShaderNodeLightPath").outputs["Is Camera Ray"],
+                       mix.inputs["Factor"])
+    elif build == "noise":
+        _linked(world, bg, "ShaderNodeTexNoise", output="Color")
+    elif build == "noise_on_constant":
+        xyz = tree.nodes.new("ShaderNodeCombineXYZ")
+        _linked(world, bg, "ShaderNodeTexNoise", output="Color", vector=xyz.outputs[0])
+    elif build == "gradient_in_group":
+        group = bpy_drt.data.node_groups.new("Sky", "ShaderNodeTree")
+        group.interface.new_socket("Color", in_out="OUTPUT", socket_type="NodeSocketColor")
+        out = group.nodes.new("NodeGroupOutput")
+        gradient = group.nodes.new("ShaderNodeTexGradient")
+        group.links.new(gradient.outputs["Color"], out.inputs[0])
+        node = tree.nodes.new("ShaderNodeGroup")
+        node.node_tree = group
+        tree.links.new(node.outputs[0], bg.inputs["Color"])
+    elif build == "texture_coordinate":
+        _linked(world, bg, "ShaderNodeTexCoord", output="Generated")
+    elif build == "layer_weight":
+        _linked(world, bg, "ShaderNodeLayerWeight", output="Facing")
+    exported = _export(world)[0]
+    assert exported.light_sampling == sampled
+    assert (LightSet([], 10.0, world=exported).env_index is not None) == sampled

@@ -129,8 +129,9 @@ SETTINGS: list[FileSetting] = [
        "the shutter's openness over time, sampled as Cycles samples it"),
     _s("scene.world.cycles.sampling_method", "World > Settings > Surface > Sampling Method",
        READ, "None: the world is not sampled as a light (only escaping rays find it); "
-       "Auto and Manual: it is, an environment by its own importance map (a uniform "
-       "world, which Cycles never samples, with the refraction its escaping rays see)"),
+       "Auto and Manual: it is where it varies over directions (a texture or coordinates "
+       "feed it), by its own importance map; a world of one colour never is, as in "
+       "Cycles"),
     _s("scene.world.cycles.sample_map_resolution", "World > Settings > Surface > Map "
        "Resolution", NO_EFFECT, "DRT's importance map has the image's own resolution: "
        + NOISE_ONLY),

@@ -197,8 +197,8 @@ def export_material(mat, reporter: Reporter, grids=None,
     approximated is reported once, in one warning naming the material. On a Volume
     object, `grids` ({name: engine.volume_grid.VoxelGrid}) are what its Attribute nodes
     read and `density_scale` its Object-space density (export.volume_objects)."""
-    if mat is None:
-        return engine.Material("none")
+    if mat is None:      # Cycles' default surface: a Principled BSDF at its defaults
+        return engine.Material("none", glossy_model="MULTI_GGX")
     name = mat.name
     ctx = _Ctx(mat, reporter)
     ctx.volume_grids = grids or {}

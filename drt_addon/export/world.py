@@ -36,6 +36,7 @@ from .errors import Reporter
 from .images import image_cache, image_texture, read_pixels, textures
 from .nodes.links import _link, uses_nodes
 from .world_nodes import LIGHTS, bake_background
+from .world_sampling import world_varies
 from .world_sky import sky_world
 
 BLACK = (0.0, 0.0, 0.0)
@@ -75,11 +76,15 @@ def _visibility(world) -> int:
 
 
 def export_world(world, reporter: Reporter) -> "engine.World":
-    """The world's background; World > Settings > Sampling Method None (Cycles'
-    `world.cycles.sampling_method`) keeps it from being sampled as a light."""
+    """The world's background, sampled as a light where Cycles samples it: a surface that
+    varies over directions (world_sampling.py), and World > Settings > Sampling Method
+    other than None (`world.cycles.sampling_method`)."""
     out = _export_background(world, reporter)
     settings = getattr(world, "cycles", None)
     if settings is not None and getattr(settings, "sampling_method", "AUTOMATIC") == "NONE":
+        out.light_sampling = False
+    if world is not None and not world_varies(
+            world, world_output(world.node_tree) if uses_nodes(world) else None):
         out.light_sampling = False
     return out
 
