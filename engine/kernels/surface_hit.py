@@ -27,7 +27,7 @@ def run_program(programs, params, geometry, counts, path_info, p, m, prim, inst,
     path_fields(hit_row, counts, path_info[0], p, cone_at(path_info[1], p, t_geom))
     program_hit(programs, geometry, m, prim, inst, hu, hv, uu, vv, px, py, pz, gx, gy, gz, nx, ny,
                 nz, dx, dy, dz, front, ray_bit, b, t_geom, hit_row, regs)
-    ms, u_lobe = pick_closure(programs, m, regs, u_lobe)
+    ms, u_lobe = pick_closure(programs, m, regs, u_lobe, uu, vv)
     correct = params[ms, P_BUMP_CORRECTION] != 0.0
     sx, sy, sz, rx, ry, rz = program_normal(programs, ms, regs, nx, ny, nz, gx, gy, gz, -dx,
                                             -dy, -dz, correct)

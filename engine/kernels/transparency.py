@@ -41,7 +41,7 @@ from ..sampling.hashing import chain
 from ..nodes.context import N_HIT
 from ..nodes.interpreter import has_program
 from ..nodes.pack import MIX, NREGS
-from ..nodes.shading import mix_factor, program_alpha, program_hit
+from ..nodes.shading import coverage, mix_factor, program_alpha, program_hit
 
 TRANSPARENT_DIM = 1 << 24      # the pass-through numbers' own dimensions (see path.py)
 SHADOW_BIT = visibility.SHADOW
@@ -55,40 +55,39 @@ def alpha_dim(depth, layer):
 @kernel
 def _hit_alpha(geometry, materials, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz, time, ray,
                depth, length):
-    """Alpha of the hit of the ray o + t d (a material program's, run for a ray of kind
-    `ray`, the path's bounce depth and the hit's distance `length` from the path's last
-    vertex), its material, its surface point, its UV and, for a Mix Shader whose Fac
-    varies per hit, that Fac (-1 for any other material)."""
+    """What the hit of the ray o + t d lets through (a material program's, run for a ray
+    of kind `ray`, the path's bounce depth and the hit's distance `length` from the path's
+    last vertex): (its alpha, its material, its surface point, the colour it transmits,
+    (1 - alpha) x its transparent colour). A Mix Shader whose Fac varies per hit lets
+    through both shaders' share: alpha (1 - Fac) alpha0 + Fac alpha1 and colour
+    (1 - Fac) (1 - alpha0) colour0 + Fac (1 - alpha1) colour1, Cycles' sum of the two
+    closures (a Light Path's Is Shadow Ray or Is Diffuse Ray picking a Transparent BSDF,
+    as architectural glass is made); the shading then picks between the opaque parts
+    (engine.nodes.shading.pick_closure)."""
     tri_material, corner_uvs = geometry[3], geometry[6]
-    _, _, alpha_table, _, T, _ = materials
+    _, _, alpha_table, tcolor, T, _ = materials
     px, py, pz, gx, gy, gz, nx, ny, nz, front, _ = surface_at(
         geometry, prim, inst, u, v, ox, oy, oz, t, dx, dy, dz, time)
     uu, vv = hit_uv(corner_uvs, prim, u, v)
     m = tri_material[prim]
     a = alpha_at(T, alpha_table, m, uu, vv)
-    fac = -1.0
     if has_program(T, m):
         hit = np.zeros(N_HIT)
         regs = np.zeros(max(T[NREGS][0], 1))
         program_hit(T, geometry, m, prim, inst, u, v, uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz,
                     dx, dy, dz, front, ray, depth, length, hit, regs)
         a = program_alpha(T, m, regs, a)
-        if T[MIX][m, 0] >= 0:
-            fac = mix_factor(T, m, regs)
-    return a, m, px, py, pz, uu, vv, fac
-
-
-@kernel(allocates=False)
-def _mixed_transmittance(materials, m, uu, vv, fac, c):
-    """What a Mix Shader's two shaders let through, channel c: (1 - Fac) (1 - alpha0)
-    colour0 + Fac (1 - alpha1) colour1 (Cycles sums the two closures, so a shadow ray
-    sees the transparent part of each, e.g. a Light Path's Is Shadow Ray picking a
-    Transparent BSDF for shadows, as architectural glass is made)."""
-    _, _, alpha_table, tcolor, T, _ = materials
-    c0, c1 = T[MIX][m, 0], T[MIX][m, 1]
-    t0 = (1.0 - alpha_at(T, alpha_table, c0, uu, vv)) * tcolor[c0, c]
-    t1 = (1.0 - alpha_at(T, alpha_table, c1, uu, vv)) * tcolor[c1, c]
-    return (1.0 - fac) * t0 + fac * t1
+        c0, c1 = T[MIX][m, 0], T[MIX][m, 1]
+        if c0 >= 0:
+            f = mix_factor(T, m, regs)
+            a0, a1 = coverage(T, c0, regs, uu, vv), coverage(T, c1, regs, uu, vv)
+            w0, w1 = (1.0 - f) * (1.0 - a0), f * (1.0 - a1)
+            return ((1.0 - f) * a0 + f * a1, m, px, py, pz,
+                    w0 * tcolor[c0, 0] + w1 * tcolor[c1, 0],
+                    w0 * tcolor[c0, 1] + w1 * tcolor[c1, 1],
+                    w0 * tcolor[c0, 2] + w1 * tcolor[c1, 2])
+    return (a, m, px, py, pz, (1.0 - a) * tcolor[m, 0], (1.0 - a) * tcolor[m, 1],
+            (1.0 - a) * tcolor[m, 2])
 
 
 @kernel(allocates=False)
@@ -128,7 +127,7 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
     on beyond it as it is. ro: the origins the hits cur_* are measured from (row i's at
     ro[i]). Writes the rays that go on (row, origin, remaining distance, what they name);
     returns their count."""
-    tri_material, maybe_transparent, _, tcolor, _, tri_vis = materials
+    tri_material, maybe_transparent, _, _, _, tri_vis = materials
     cur_t, cur_prim, cur_inst, cur_u, cur_v = cur.t, cur.prim, cur.inst, cur.u, cur.v
     out = (out_rows, out_org, out_far, out_skip)
     n_out = 0
@@ -148,7 +147,7 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
             continue
         dx, dy, dz = rd[r, 0], rd[r, 1], rd[r, 2]
         p = live[r]
-        a, m, px, py, pz, _, _, _ = _hit_alpha(
+        a, m, px, py, pz, tr, tg, tb = _hit_alpha(
             geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], ro[i, 0], ro[i, 1],
             ro[i, 2], cur_t[i], dx, dy, dz, path_time[p],
             ray_bits[p], depth, travelled[r] + cur_t[i])
@@ -157,9 +156,10 @@ def alpha_pass(depth, layer, limit, kind, spp, pkey, index, live, used, ray_bits
         if used[p] >= limit:
             stopped[r] = True
             continue
-        factor[r, 0] *= tcolor[m, 0]
-        factor[r, 1] *= tcolor[m, 1]
-        factor[r, 2] *= tcolor[m, 2]
+        # passed with probability 1 - alpha: the colour it lets through over that
+        factor[r, 0] *= tr / (1.0 - a)
+        factor[r, 1] *= tg / (1.0 - a)
+        factor[r, 2] *= tb / (1.0 - a)
         used[p] += 1
         travelled[r] += cur_t[i]
         _emit(out, n_out, r, prim, cur_inst[i], px, py, pz, tmax[r] - travelled[r], (-1, -1))
@@ -181,7 +181,7 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
     the heterogeneous program-run counter; engine.kernels.medium_density), used by the
     rays whose media include a heterogeneous one (ratio tracking). skip: what the rows
     name (row i's at skip[i]: the layer it left, the emissive triangle it goes to)."""
-    tri_material, maybe_transparent, _, tcolor, T, tri_vis = materials
+    tri_material, maybe_transparent, _, _, T, tri_vis = materials
     keys, het_count = tracking
     cur_t, cur_prim, cur_inst, cur_u, cur_v = cur.t, cur.prim, cur.inst, cur.u, cur.v
     out = (out_rows, out_org, out_far, out_skip)
@@ -221,17 +221,13 @@ def shadow_pass(layer, limit, rows, so, sd, ray_time, remaining, cur, trans, geo
             trans[r, 0] = trans[r, 1] = trans[r, 2] = 0.0
             continue
         dx, dy, dz = sd[r, 0], sd[r, 1], sd[r, 2]
-        a, m, px, py, pz, uu, vv, fac = _hit_alpha(
+        _, _, px, py, pz, tr, tg, tb = _hit_alpha(
             geometry, materials, prim, cur_inst[i], cur_u[i], cur_v[i], so[i, 0], so[i, 1],
             so[i, 2], cur_t[i], dx, dy, dz, ray_time[r],
             SHADOW_BIT, 0, cur_t[i])
-        if fac >= 0.0:                    # a Mix Shader per hit: both shaders' share
-            for c in range(3):
-                trans[r, c] *= _mixed_transmittance(materials, m, uu, vv, fac, c)
-        else:
-            trans[r, 0] *= (1.0 - a) * tcolor[m, 0]
-            trans[r, 1] *= (1.0 - a) * tcolor[m, 1]
-            trans[r, 2] *= (1.0 - a) * tcolor[m, 2]
+        trans[r, 0] *= tr
+        trans[r, 1] *= tg
+        trans[r, 2] *= tb
         if not max(trans[r, 0], trans[r, 1], trans[r, 2]) > 0.0:
             continue
         _emit(out, n_out, r, prim, cur_inst[i], px, py, pz, remaining[i] - cur_t[i], light)

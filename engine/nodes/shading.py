@@ -14,7 +14,8 @@ import numpy as np
 
 from ..kernels.bsdf import principled as bsdf
 from ..kernels.jit import kernel
-from ..kernels.textures import I_TEXTURE, INPUTS, TEX_EMISSION
+from ..kernels.textures import (I_TEXTURE, INPUTS, PLAIN, TEX_ALPHA, TEX_EMISSION,
+                                textured_value)
 from ..kernels.curve_hit import strand_info
 from .context import (H_HAIR_INTERCEPT, H_HAIR_IS_STRAND, H_HAIR_LENGTH, H_HAIR_RANDOM,
                       H_HAIR_TANGENT_NORMAL, H_HAIR_THICKNESS, fill, mirrors,
@@ -270,11 +271,27 @@ def mix_factor(T, m, regs):
 
 
 @kernel(allocates=False)
-def pick_closure(T, m, regs, u):
-    """Cycles' Mix Shader sums its two shaders weighted 1 - Fac and Fac; DRT picks one per
-    hit with those probabilities (an unbiased estimate of the sum: the picked shader is
-    the hit's BSDF for its light sample and its next direction). Nested mixes pick in
-    turn. Returns (the material shaded, u rescaled to [0, 1) for the lobe choice)."""
+def coverage(T, m, regs, u, v):
+    """Material m's alpha at a hit whose program ran into regs (its opaque share: 1 - the
+    weight of its transparent closure): the program's Alpha, else its texture's or its
+    constant, clipped to [0, 1]."""
+    if T[INPUTS][m, TEX_ALPHA, I_TEXTURE] >= 0:
+        a = textured_value(T, m, TEX_ALPHA, u, v)[0]
+    else:
+        a = T[PLAIN][m, TEX_ALPHA, 0]
+    return program_alpha(T, m, regs, min(max(a, 0.0), 1.0))
+
+
+@kernel(allocates=False)
+def pick_closure(T, m, regs, u, uu, vv):
+    """Cycles' Mix Shader sums its two shaders weighted 1 - Fac and Fac. The transparent
+    part of that sum is taken before shading, by the transparency passes
+    (engine.kernels.transparency); what is shaded is its opaque part, (1 - Fac) alpha0
+    shader0 + Fac alpha1 shader1 (alpha: each shader's `coverage` at the hit, (uu, vv)
+    its UV). DRT picks one shader per hit with those weights (an unbiased estimate of the
+    sum: the picked shader is the hit's BSDF for its light sample and its next
+    direction). Nested mixes pick in turn. Returns (the material shaded, u rescaled to
+    [0, 1) for the lobe choice)."""
     children = T[MIX]
     outs = T[OUTS]
     for _ in range(32):
@@ -282,6 +299,10 @@ def pick_closure(T, m, regs, u):
             break
         k = outs[m, OUT_MIX]
         f = min(max(regs[k], 0.0), 1.0) if k >= 0 else 0.5
+        w0 = (1.0 - f) * coverage(T, children[m, 0], regs, uu, vv)
+        w1 = f * coverage(T, children[m, 1], regs, uu, vv)
+        if w0 + w1 > 0.0:
+            f = w1 / (w0 + w1)
         if u < 1.0 - f:
             u = u / max(1.0 - f, 1e-300)
             m = children[m, 0]
