@@ -10,12 +10,12 @@ The estimator, at each surface vertex:
   2. next-event estimation: one light entry (lamp or emissive triangle) picked in
      proportion to its power, one point on it, one shadow ray, weighted against BSDF
      sampling by the power heuristic;
-  3. BSDF sampling over the lobes whose bounce budget (Cycles' diffuse, glossy,
-     transmission and total limits) is not used up; Cycles' Russian roulette: the ray
-     leaves with a verdict (survival probability q = min(sqrt(max throughput), 1), or
-     ended), applied at the vertex it finds, after the emission found there (step 1).
-Where no lobe may continue, light sampling takes the whole weight (no MIS), so direct
-light stays unbiased with zero bounces. The integrator's `mis_mode` (a test and debug
+  3. BSDF sampling over every lobe; Cycles' Russian roulette: the ray leaves with a
+     verdict (survival probability q = min(sqrt(max throughput), 1), or ended), applied
+     at the vertex it finds, after the emission found there (step 1). A bounce that uses
+     up a budget (Cycles' total, diffuse, glossy and transmission limits, each plus one:
+     path_weights.ends_path) leaves with the verdict "ended": its ray gathers only what
+     it finds, as in Cycles. The integrator's `mis_mode` (a test and debug
 hook, not a user setting) selects the weights of the two estimators of direct light:
 'mis' (default) the power heuristic; 'light' light sampling only; 'bsdf' BSDF sampling
 only (next-event estimation is kept for delta lights and for directions the BSDF cannot
