@@ -257,7 +257,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         ad, ag, at = True, keep_g, keep_t
         # 2. next-event estimation: one light entry, one point, one shadow ray
         if n_lights > 0:
-            # (one light: nothing to pick, and no number drawn for it)
+            # (one light: no number drawn to pick it; the tree may still refuse it)
             u_pick = sample_1d(kind, pkey[p], spp, index[p], base + D.LIGHT_PICK) \
                 if n_lights > 1 else 0.0
             u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)

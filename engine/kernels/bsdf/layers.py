@@ -20,15 +20,15 @@ and sample add this module's lobes. A row with P_LAYERS = 0 never reads a slot h
 
 Lobe kinds: coat GLOSSY; sheen DIFFUSE (Cycles labels it diffuse reflection); translucent
 TRANSMISSION for the bounce that follows it (it leaves through the surface) and seen by
-lights as diffuse, as Cycles classifies it; it is sampled only while both the diffuse
-and the transmission bounce budgets last (Cycles counts it against both); hair R
+lights as diffuse, as Cycles classifies it; it is sampled only where both diffuse and
+transmission lobes are allowed (principled.sample's allow flags); hair R
 GLOSSY, hair TT TRANSMISSION (Cycles' closure classes, which the lights' visibility and
 the passes follow). A sampled hair direction is kept on either side of the surface, as
 Cycles keeps it (`hair_sample`; principled.sample weighs it with the density drawn).
 The Principled Hair closure is GLOSSY for the lights and the passes (Cycles' class) and
-may be sampled while the glossy or the transmission budget lasts; the bounce it makes
+may be sampled where glossy or transmission lobes are allowed; the bounce it makes
 counts as GLOSSY for its R lobe and TRANSMISSION for the three through the fibre
-(Cycles' labels), and a lobe past its budget ends the path, as in Cycles.
+(Cycles' labels), against those kinds' bounce limits (path_weights.ends_path).
 """
 from __future__ import annotations
 

@@ -37,9 +37,10 @@ Sampling: a lobe is chosen with probability proportional to an estimate of its a
 wo, at least MIN_SELECTION of its weight; the mixture pdf is sum_i q_i pdf_i over the
 allowed lobes (the delta part of a smooth glass has no density: pdf = inf, delta True).
 The allow flags over DIFFUSE / GLOSSY / TRANSMISSION restrict sampling and its pdf to the
-lobe kinds whose bounce budget is not exhausted (Cycles' diffuse, glossy and transmission
-limits; glass reflection counts as GLOSSY, refraction as TRANSMISSION). The state's
-slots: state.py. Tests reach these kernels over arrays through batch.py.
+lobe kinds a hit keeps (the Caustics switches drop glossy reflection or refraction after a
+diffuse bounce, as Cycles filters those closures; bounce limits end paths instead,
+path_weights.ends_path; glass reflection counts as GLOSSY, refraction as TRANSMISSION).
+The state's slots: state.py. Tests reach these kernels over arrays through batch.py.
 
 Use, per hit:
     setup(row, front_facing, wox, woy, woz, tables, state)   # fills state[:NSTATE]
@@ -382,13 +383,12 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     if not ok:
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
     # non-delta choices: one-sample mixture estimator f |cos| / sum_j q_j pdf_j, of the
-    # allowed lobes only (a lobe past its bounce limit adds nothing, as in Cycles, where
-    # a path that picks it ends)
+    # allowed lobes only (a lobe a Caustics switch drops adds nothing)
     fr, fg, fb = eval_seen(state, wox, woy, woz, wix, wiy, wiz, allow_d, allow_g, allow_t)
     p = mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t)
     c = abs(wiz)
     if q[10] > 0.0 and not allow_g and c > 0.0:
-        # the Principled Hair closure is selectable on its transmission budget alone:
+        # the Principled Hair closure is selectable with its transmission lobes alone:
         # its value counts (eval_seen gates it as the glossy closure it is for lights)
         cr, cg, cb, _ = layers.chiang_eval(state, wox, woy, woz, wix, wiy, wiz)
         fr, fg, fb = fr + cr / c, fg + cg / c, fb + cb / c
