@@ -1,5 +1,5 @@
 """Scene materials as arrays (`MaterialTable`), indexed by a hit's material id: the
-Principled parameters of engine/scene.py's `Material`s, with their textures."""
+Principled parameters of engine/scene/material.py's `Material`s, with their textures."""
 from __future__ import annotations
 
 import numpy as np
