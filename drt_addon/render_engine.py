@@ -13,17 +13,16 @@ import os
 import sys
 import time
 import traceback
-from importlib import import_module
 
 import bpy
 import numpy as np
 from bpy.props import BoolProperty, PointerProperty
 
 from . import denoise, light_passes, shadow_catcher
-from .blender_compat import (AO_PASS, ENVIRONMENT_PASS, MATERIAL_INDEX_PASS,
-                             OBJECT_INDEX_PASS, set_pass_pixels)
-from .render_passes import (CRYPTOMATTE, FIRST_HIT, PASSES, FirstHit, cryptomatte_passes,
-                            enabled_passes, shader_aov_passes, vector_pass)
+from .blender_compat import AO_PASS, set_pass_pixels
+from .render_passes import (PASSES, FirstHit, cryptomatte_passes, enabled_passes,
+                            shader_aov_passes, vector_pass)
+from .render_result import rgba_bottom_up, write_cryptomatte, write_passes
 
 # The tracer (engine: kernels compiled by Numba, Embree through its C API) and the export
 # are imported by the first DRT render, not when Blender registers the add-on: a Blender
@@ -75,21 +74,6 @@ def _threads_label(threads: int) -> str:
     if not threads:
         return "all cores"
     return f"{threads} thread" + ("s" if threads > 1 else "")
-
-
-def _bottom_up(image: np.ndarray) -> np.ndarray:
-    """(h, w[, c]) top-down image to Blender's flat bottom-up float32 buffer."""
-    return np.ascontiguousarray(image[::-1], dtype=np.float32).reshape(-1)
-
-
-def _rgba_bottom_up(image: np.ndarray, alpha: np.ndarray | None = None) -> np.ndarray:
-    """(h, w, 3) top-down float image (premultiplied) and (h, w) alpha to Blender's flat
-    bottom-up RGBA float32."""
-    h, w, _ = image.shape
-    out = np.empty((h, w, 4), dtype=np.float32)
-    out[..., :3] = image[::-1]
-    out[..., 3] = 1.0 if alpha is None else alpha[::-1]
-    return out.reshape(-1)
 
 
 PREVIEW_SAMPLES = 16
@@ -288,7 +272,7 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                 if last_render.get("first_sample_seconds") is None:
                     # depsgraph to first sample: export, BVH build, first pass
                     last_render["first_sample_seconds"] = time.perf_counter() - t0
-                set_pass_pixels(combined, _rgba_bottom_up(*shadow_catcher.combined(
+                set_pass_pixels(combined, rgba_bottom_up(*shadow_catcher.combined(
                     ctx, film, view_layer)))
                 self.update_result(result)
                 self.update_progress(fraction)
@@ -335,9 +319,9 @@ class DRTRenderEngine(bpy.types.RenderEngine):
                     noisy, image = image, clean.astype(np.float64)
                     if layer.passes.get(denoise.NOISY_PASS) is not None:
                         set_pass_pixels(layer.passes[denoise.NOISY_PASS],
-                                        _rgba_bottom_up(noisy, alpha))
+                                        rgba_bottom_up(noisy, alpha))
                     last_render["passes"][denoise.NOISY_PASS] = noisy
-            set_pass_pixels(combined, _rgba_bottom_up(image, alpha))
+            set_pass_pixels(combined, rgba_bottom_up(image, alpha))
             extra = (enabled_passes(view_layer) or cryptomatte_passes(view_layer)
                      or shader_aov_passes(view_layer) or light_passes.enabled(view_layer)
                      or light_passes.group_passes(view_layer))
@@ -347,9 +331,10 @@ class DRTRenderEngine(bpy.types.RenderEngine):
             elif stats.cancelled:
                 last_render["cancelled_in"] = "tracing"
             if not stats.cancelled:
-                self._write_passes(layer, ctx, film, view_layer, description, first_hit,
-                                   lambda: vector_pass(self, depsgraph, settings, region))
-                self._write_cryptomatte(result, layer, ctx, view_layer)
+                write_passes(self, layer, ctx, film, view_layer, description, first_hit,
+                             lambda: vector_pass(self, depsgraph, settings, region),
+                             last_render)
+                write_cryptomatte(self, result, layer, ctx, view_layer, last_render)
         finally:
             ctx.close()
             self.end_result(result)
@@ -364,73 +349,3 @@ class DRTRenderEngine(bpy.types.RenderEngine):
         last_render.update(ok=not stats.cancelled, error="cancelled" if stats.cancelled else None,
                            warnings=reporter.warnings, stats=stats, pixels=image,
                            alpha=alpha, export_seconds=export_seconds)
-
-    def _write_cryptomatte(self, result, layer, ctx, view_layer):
-        """The Cryptomatte passes the view layer asks for, and their metadata."""
-        wanted = cryptomatte_passes(view_layer)
-        if not wanted:
-            return
-        self.update_stats("", "DRT: Cryptomatte")
-        from .engine_link import engine
-        aov = import_module(engine.__name__ + ".aov")
-        crypto = import_module(engine.__name__ + ".cryptomatte")
-        depth = int(view_layer.pass_cryptomatte_depth)
-        layers = aov.cryptomatte(ctx, list(wanted), depth)
-        for kind, names in wanted.items():
-            ids, coverage = layers[kind]
-            for i, name in enumerate(names):
-                rgba = np.zeros(ids.shape[:2] + (4,), np.float32)
-                for j in range(2):
-                    if 2 * i + j < depth:
-                        rgba[..., 2 * j] = ids[..., 2 * i + j]
-                        rgba[..., 2 * j + 1] = coverage[..., 2 * i + j]
-                if layer.passes.get(name) is not None:
-                    set_pass_pixels(layer.passes[name], _bottom_up(rgba))
-                last_render["passes"][name] = rgba
-            fields = crypto.metadata(f"{view_layer.name}.Crypto{CRYPTOMATTE[kind]}",
-                                     layers["names"][kind])
-            for key, value in fields.items():
-                result.stamp_data_add_field(key, value)
-            last_render["metadata"].update(fields)
-
-    def _write_passes(self, layer, ctx, film, view_layer, description, first_hit, vectors):
-        wanted = [name for name in enabled_passes(view_layer)
-                  if layer.passes.get(name) is not None]
-        aovs = [row for row in shader_aov_passes(view_layer)
-                if layer.passes.get(row[0]) is not None]
-        lights = [name for name in (light_passes.enabled(view_layer)
-                                    + light_passes.group_passes(view_layer))
-                  if layer.passes.get(name) is not None]
-        if not wanted and not aovs and not lights:
-            return
-        images = light_passes.images(film, description.light_groups, lights)
-        if ENVIRONMENT_PASS in wanted:
-            images[ENVIRONMENT_PASS] = light_passes.environment(film)
-        wanted += lights
-        if any(n in wanted for n in FIRST_HIT):
-            self.update_stats("", "DRT: first-hit passes")
-            first, _ = first_hit()
-            images.update({"Depth": first.depth, "Normal": first.normal,
-                           "Denoising Albedo": first.albedo,
-                           "Denoising Normal": first.camera_normal(description.camera.matrix),
-                           "Mist": first.mist, "Position": first.position, "UV": first.uv,
-                           OBJECT_INDEX_PASS: first.object_index,
-                           MATERIAL_INDEX_PASS: first.material_index,
-                           AO_PASS: first.ambient_occlusion})
-        if aovs:
-            self.update_stats("", "DRT: shader AOVs")
-            first, _ = first_hit()
-            for name, channels, _, _ in aovs:
-                v = first.shader_aovs[name]          # (h, w, 4) RGBA or (h, w, 1)
-                images[name] = v[..., 0] if channels == 1 else v
-                wanted.append(name)
-        if shadow_catcher.PASS in wanted:
-            images[shadow_catcher.PASS] = shadow_catcher.shadow_pass(ctx, film)
-        if "DRT Noise" in wanted:
-            images["DRT Noise"] = np.sqrt(film.variance_of_mean())
-        if "Vector" in wanted:
-            self.update_stats("", "DRT: Vector pass")
-            images["Vector"] = vectors()
-        for name in wanted:
-            set_pass_pixels(layer.passes[name], _bottom_up(images[name]))
-            last_render["passes"][name] = images[name]
