@@ -110,7 +110,16 @@ class SurfaceBuilder:
                     parts.append(np.repeat(flat[:, None, :], 3, axis=1))
                 offset += t
             self.corner_normals = np.concatenate(parts)
+        # faces shaded flat beside corner normals that are not theirs (a Normal Map builds
+        # on their own normal; their shadow rays leave from their plane); None: none
+        self.flat_faces = None
+        if any(getattr(m, "flat_faces", None) is not None for m in ordered):
+            self.flat_faces = np.concatenate([
+                np.asarray(m.flat_faces, np.uint8) if getattr(m, "flat_faces", None)
+                is not None else np.zeros(len(m.triangles), np.uint8) for m in ordered])
         self.terminator_cutoff = _terminator_cutoff(ordered, accel.moving_start)
+        if self.terminator_cutoff is not None and self.flat_faces is not None:
+            self.terminator_cutoff[self.flat_faces != 0] = 0.0
         # Texture coordinates per triangle corner (Blender's UV map), for the meshes that
         # have them; triangles of meshes without UVs read (0, 0), as in Cycles.
         self._geometry = None           # geometry(), made on the first build()
@@ -176,7 +185,8 @@ class SurfaceBuilder:
         engine.nodes.shading): (positions, corners, centre, material, corner normals,
         holdout, corner UVs, moving objects, triangle objects, object table, corner
         tangents, corner colours, camera, terminator cutoffs, corners' undisplaced
-        points, hair strands (engine.kernels.curve_hit.PackedCurves)); empty arrays for
+        points, hair strands (engine.kernels.curve_hit.PackedCurves), flat faces beside
+        corner normals (uint8 per triangle)); empty arrays for
         what the scene has not. camera: the packed render camera (engine.kernels.camera_rays),
         which shader nodes read; None: none."""
         from .nodes.context import N_OBJ
@@ -193,7 +203,8 @@ class SurfaceBuilder:
                 np.zeros(0) if camera is None else camera,
                 or_empty(self.terminator_cutoff, 0, np.float64),
                 or_empty(self.corner_undisplaced, (0, 3, 3), np.float32),
-                self.accel.packed_curves)
+                self.accel.packed_curves,
+                or_empty(self.flat_faces, 0, np.uint8))
 
     def build(self, hits: Hits, index: np.ndarray, ray_dirs: np.ndarray,
               time: np.ndarray | None = None, origins: np.ndarray | None = None

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..engine_link import engine
 from .errors import ExportError
-from .mesh import LocalMesh, instance_mesh, undisplaced_corners
+from .mesh import LocalMesh, flat_faces, instance_mesh, undisplaced_corners
 from .object_info import random_of
 
 
@@ -174,7 +174,8 @@ def _instanced(g: Group):
     mesh = engine.TriangleMesh(g.name, local.positions, local.triangles, materials,
                                corner_normals=local.normals, uvs=local.uvs,
                                tangents=local.tangents, colors=local.colors,
-                               undisplaced=undisplaced_corners(local), instances=places)
+                               undisplaced=undisplaced_corners(local),
+                               flat_faces=flat_faces(local), instances=places)
     _settings(mesh, g)
     # the texture space Generated coordinates map to (the same for every place)
     mesh.object_info = engine.ObjectInfo(np.eye(4), texspace_location=g.texspace[0],

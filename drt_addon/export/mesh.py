@@ -357,7 +357,18 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
     slots = np.asarray(material_slots if len(material_slots) else [0], dtype=np.int32)
     global_mat = slots[np.clip(local.material, 0, len(slots) - 1)]
     return engine.TriangleMesh(name, world, tris, global_mat, corner_normals=normals, uvs=uvs,
-                               tangents=tangents, colors=colors, undisplaced=undisplaced)
+                               tangents=tangents, colors=colors, undisplaced=undisplaced,
+                               flat_faces=flat_faces(local))
+
+
+def flat_faces(local: LocalMesh) -> Optional[np.ndarray]:
+    """The faces shaded flat of a displaced mesh with corner normals (T,) bool
+    (engine.TriangleMesh.flat_faces: Displacement and Bump gives them the undisplaced
+    vertex normals); None for any other mesh, whose flat faces have their own normals."""
+    if local.offset is None or local.smooth is None or local.normals is None:
+        return None
+    flat = ~np.asarray(local.smooth, bool)
+    return flat if flat.any() else None
 
 
 def undisplaced_corners(local: LocalMesh) -> Optional[np.ndarray]:

@@ -71,7 +71,10 @@ H_HAIR_LENGTH = H_HAIR_IS_STRAND + 2
 H_HAIR_THICKNESS = H_HAIR_IS_STRAND + 3
 H_HAIR_RANDOM = H_HAIR_IS_STRAND + 4
 H_HAIR_TANGENT_NORMAL = H_HAIR_IS_STRAND + 5   # (3)
-N_HIT = H_HAIR_IS_STRAND + 8
+# 1 on a face shaded flat whose shading normal is not its own (engine.scene
+# TriangleMesh.flat_faces): a Normal Map builds on the geometric normal there
+H_FLAT_FACE = H_HAIR_IS_STRAND + 8
+N_HIT = H_HAIR_IS_STRAND + 9
 
 # ---------------------------------------------------------------- object table columns
 O_TO_OBJECT = 0      # 3 x 4 world -> object, row-major (12)

@@ -17,7 +17,7 @@ from ..kernels.jit import kernel
 from ..kernels.textures import (I_TEXTURE, INPUTS, PLAIN, TEX_ALPHA, TEX_EMISSION,
                                 textured_value)
 from ..kernels.curve_hit import strand_info
-from .context import (H_HAIR_INTERCEPT, H_HAIR_IS_STRAND, H_HAIR_LENGTH, H_HAIR_RANDOM,
+from .context import (H_FLAT_FACE, H_HAIR_INTERCEPT, H_HAIR_IS_STRAND, H_HAIR_LENGTH, H_HAIR_RANDOM,
                       H_HAIR_TANGENT_NORMAL, H_HAIR_THICKNESS, fill, mirrors,
                       set_undisplaced, to_world_direction)
 from .differentials import fill_differentials
@@ -70,6 +70,8 @@ def program_hit(T, geometry, m, prim, inst, bu, bv, uu, vv, px, py, pz, gx, gy, 
     (hit[H_HAIR_IS_STRAND], hit[H_HAIR_INTERCEPT], hit[H_HAIR_LENGTH], hit[H_HAIR_THICKNESS],
      hit[H_HAIR_RANDOM], hit[H_HAIR_TANGENT_NORMAL], hit[H_HAIR_TANGENT_NORMAL + 1],
      hit[H_HAIR_TANGENT_NORMAL + 2]) = strand_info(geometry[15], prim, bu, -dx, -dy, -dz)
+    flat_faces = geometry[16]
+    hit[H_FLAT_FACE] = 1.0 if flat_faces.shape[0] > 0 and flat_faces[prim] != 0 else 0.0
     undisplaced = geometry[14]
     if undisplaced.shape[0] > 0 and not math.isnan(undisplaced[prim, 0, 0]):
         b0 = 1.0 - bu - bv

@@ -99,6 +99,12 @@ class TriangleMesh:
     # (T, 3, 3) float32: a displaced mesh's corners before displacement, in object space
     # (engine.displacement): its hits read Generated coordinates there, as in Cycles
     undisplaced: Optional[np.ndarray] = None
+    # (T,) bool: the faces shaded flat of a mesh whose corner normals are not all its
+    # faces' own (Displacement and Bump leaves them the undisplaced vertex normals, as
+    # Cycles' bump does): there, as on every face Cycles does not shade smooth, a Normal
+    # Map builds on the face's own normal and shadow rays leave from its plane; None:
+    # no such face
+    flat_faces: Optional[np.ndarray] = None
     # Shadow Terminator > Geometry Offset (Cycles' per-object setting; 0 = off): how far
     # shadow rays start from the curved surface of a smooth mesh (engine.kernels.terminator)
     terminator_offset: float = 0.1
@@ -128,6 +134,11 @@ class TriangleMesh:
                              f"for {len(self.triangles)} triangles")
         self.uvs = self._per_corner(self.uvs, 2, "UV")
         self.undisplaced = self._per_corner(self.undisplaced, 3, "undisplaced")
+        if self.flat_faces is not None:
+            self.flat_faces = np.asarray(self.flat_faces, bool).reshape(-1)
+            if len(self.flat_faces) != len(self.triangles):
+                raise ValueError(f"mesh {self.name!r}: {len(self.flat_faces)} flat-face "
+                                 f"flags for {len(self.triangles)} triangles")
         if len(self.triangles) and (self.triangles.min() < 0
                                     or self.triangles.max() >= len(self.positions)):
             raise ValueError(f"mesh {self.name!r}: triangle index out of range")
