@@ -117,6 +117,7 @@ class _Ctx:
         self.nodes = NodeCompiler(self)
         self.normal = None          # the per-hit shading normal (a program Value), if any
         self.sets_normal = False    # ... set as the surface's own (the Displacement's bump)
+        self.surface_normal = None  # the surface's own where a shader has a Normal of its own
         self.volume_programs = True     # a volume varying in space joins the program
         self.volume_outputs = {}        # ... as these outputs (export/volumes.py)
 
@@ -162,8 +163,10 @@ def _material(cl, ctx, name) -> "engine.Material":
 
 
 def _displace(mat, socket, ctx):
-    """The Displacement socket as Cycles' Bump Only (export/nodes/displacement.py): the
-    bent normal becomes the material's shading normal."""
+    """The Displacement socket as Cycles' bump (export/nodes/displacement.py), which sets
+    the surface's own normal (Cycles' Set Normal, sd->N): the material's shading normal,
+    or where a shader has a Normal of its own (which its lobes keep), the surface normal
+    alone (bent lobes are shadowed against it, lights picked for it)."""
     try:
         bent = displacement_normal(mat, socket, ctx)
     except Unsupported as e:
@@ -172,8 +175,7 @@ def _displace(mat, socket, ctx):
     if bent is None:
         return
     if ctx.normal is not None:
-        ctx.issue("its displacement is not rendered where a shader has a Normal of its "
-                  "own (DRT uses the shader's)")
+        ctx.surface_normal, ctx.sets_normal = bent, True
         return
     ctx.normal, ctx.sets_normal = bent, True      # Cycles' Set Normal
 
@@ -185,6 +187,8 @@ def _attach_programs(m, ctx, program):
     if ctx.normal is not None:
         outputs["normal"] = ctx.normal
         m.sets_normal = ctx.sets_normal
+    if ctx.surface_normal is not None:
+        outputs["surface_normal"] = ctx.surface_normal
     if outputs:
         m.shader = dataclasses.replace(program, outputs=outputs)
     for side in (m.mix or ()):

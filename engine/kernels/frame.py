@@ -47,3 +47,12 @@ def to_world(lx, ly, lz, nx, ny, nz):
 @kernel(allocates=False)
 def length(x, y, z):
     return math.sqrt(x * x + y * y + z * z)
+
+
+@kernel(allocates=False)
+def unit(x, y, z):
+    """(x, y, z) scaled to length 1; (0, 0, 0) stays."""
+    ln = math.sqrt(x * x + y * y + z * z)
+    if ln > 0.0:
+        return x / ln, y / ln, z / ln
+    return 0.0, 0.0, 0.0

@@ -64,7 +64,7 @@ from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import (bent_diffuse, may_emit,
+from ..nodes.shading import (bent_diffuse, may_emit, surface_normal,
                              valid_reflection_normal)
 
 @kernel
@@ -214,8 +214,8 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         # by: the surface's own normal, or the bent one where the program sets it (the
         # Displacement socket's bump)
         s0x, s0y, s0z = n0x, n0y, n0z
-        if params[ms, P_SETS_NORMAL] != 0.0:
-            s0x, s0y, s0z = rx, ry, rz
+        if programs is not None and params[ms, P_SETS_NORMAL] != 0.0:
+            s0x, s0y, s0z = surface_normal(programs, ms, regs, n0x, n0y, n0z)
         if not bent and correct and (nx != gx or ny != gy or nz != gz):
             # a smooth mesh's normal, as Cycles' specular lobes (and the subsurface
             # entry) use it: made a valid reflector for the view (a silhouette's normal

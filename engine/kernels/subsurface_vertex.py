@@ -45,7 +45,7 @@ from .surface_hit import run_program
 from .terminator import shadow_origin
 from .warp import INV_PI, cosine_hemisphere
 from ..nodes.interpreter import has_program
-from ..nodes.shading import bump_shadowing
+from ..nodes.shading import bump_shadowing, surface_normal
 
 EXIT_STEP = MAX_BOUNCES + 1     # the walk stream's step whose numbers the exit uses
 
@@ -142,7 +142,7 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, p
             if bent:
                 mx, my, mz = bx, by, bz
                 if params[m2, P_SETS_NORMAL] != 0.0:     # a Set Normal: the surface's own
-                    n0x, n0y, n0z = bx, by, bz
+                    n0x, n0y, n0z = surface_normal(programs, m2, regs, n0x, n0y, n0z)
     mode = cfg.mis_mode
     # next-event estimation on the exit's Lambertian surface (lights picked for it as
     # Cycles' tree picks them: one-sided, on the surface's own normal, sd->N)

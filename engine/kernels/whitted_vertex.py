@@ -48,7 +48,7 @@ from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import bent_diffuse
+from ..nodes.shading import bent_diffuse, surface_normal
 
 CENTRE = 0.5           # the fixed point of every lamp: its sample at (1/2, 1/2)
 
@@ -159,7 +159,7 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
                 hit_u[j], hit_v[j], uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front,
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
             if params[ms, P_SETS_NORMAL] != 0.0:      # a Set Normal: the surface's own
-                n0x, n0y, n0z = rx, ry, rz
+                n0x, n0y, n0z = surface_normal(programs, ms, regs, n0x, n0y, n0z)
         holed, u_lobe = holdout_share(params[ms, P_HOLDOUT], u_lobe, b, alpha, p, br, bg, bb)
         if holed:
             continue                      # a Holdout's share: a hole, or no light

@@ -27,6 +27,7 @@ from .pack import MIX, OUTS
 OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_MIX = range(7)
 OUT_VOL_SA, OUT_VOL_SS, OUT_VOL_EM = 7, 8, 9      # engine.kernels.medium_density
 OUT_HAIR_COLOR, OUT_HAIR_MELANIN = 10, 11          # a Principled Hair's (hair_chiang.py)
+OUT_SURFACE_NORMAL = 12                             # Cycles' sd->N, where set (surface_normal)
 
 
 @kernel(allocates=False)
@@ -194,6 +195,25 @@ def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz, correct):
         return x, y, z, x, y, z
     vx, vy, vz = valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z)
     return vx, vy, vz, x, y, z
+
+
+@kernel(allocates=False)
+def surface_normal(T, m, regs, nx, ny, nz):
+    """Cycles' sd->N where material m's program sets it (its Material Output's
+    Displacement as a bump, Cycles' Set Normal), normalised: the program's surface_normal
+    output where a shader also has a Normal of its own (which its lobes use), else its
+    normal output; n where it sets none. Bent lobes are shadowed against it, lights picked
+    for it and shadow rays lifted by it."""
+    k = T[OUTS][m, OUT_SURFACE_NORMAL]
+    if k < 0:
+        k = T[OUTS][m, OUT_NORMAL]
+    if k < 0:
+        return nx, ny, nz
+    x, y, z = regs[k], regs[k + 1], regs[k + 2]
+    ln = math.sqrt(x * x + y * y + z * z)
+    if not ln > 0.0 or not math.isfinite(ln):
+        return nx, ny, nz
+    return x / ln, y / ln, z / ln
 
 
 @kernel(allocates=False)

@@ -5,9 +5,8 @@
                                                  Distance, Length)
   VEC_MAPPING out, vector, location, rotation, scale, type   Mapping (MAPPING_TYPES;
                                                  rotation as Euler XYZ)
-  VEC_NORMAL_MAP out, color, strength            Normal Map in tangent space (the hit's
-                                                 tangent and bitangent sign, Cycles'
-                                                 svm_node_normal_map)
+  VEC_NORMAL_MAP out, color, strength            Normal Map in tangent space
+                                                 (normal_map.py)
 """
 from __future__ import annotations
 
@@ -15,9 +14,10 @@ import math
 
 import numpy as np
 
+from ..kernels.frame import unit as _normalize
 from ..kernels.jit import kernel
-from .context import H_BACKFACING, H_FLAT_FACE, H_N, H_NG, H_TANGENT, H_TANGENT_SIGN
 from .converter_nodes import MATH_OPS, math_op, safe_divide
+from .normal_map import normal_map
 
 VEC_MATH = 400
 VEC_MATH_VALUE = 401
@@ -31,14 +31,6 @@ VECTOR_OPS = ("ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "CROSS_PR
               "COSINE", "TANGENT")
 VALUE_OPS = ("DOT_PRODUCT", "DISTANCE", "LENGTH")
 MAPPING_TYPES = ("POINT", "TEXTURE", "VECTOR", "NORMAL")
-
-
-@kernel(allocates=False)
-def _normalize(x, y, z):
-    ln = math.sqrt(x * x + y * y + z * z)
-    if ln > 0.0:
-        return x / ln, y / ln, z / ln
-    return 0.0, 0.0, 0.0
 
 
 # The per-component operations, as the Math operation that computes each component
@@ -125,40 +117,6 @@ def mapping(kind, x, y, z, lx, ly, lz, rx, ry, rz, sx, sy, sz):
     if kind == 3:
         return _normalize(tx, ty, tz)
     return tx, ty, tz
-
-
-@kernel(allocates=False)
-def normal_map(hit, cr, cg, cb, strength):
-    """Cycles' tangent-space normal map: the colour (2c - 1), its x and y scaled by
-    strength and its z mixed from 1 by strength clamped to [0, 1], in the frame of the
-    tangent, sign x N x T and the normal N it builds on (un-flipped for the maths,
-    flipped back on a back-facing hit); the shading normal where the mesh has no
-    tangents. N is the shading normal, but on a face shaded flat the face's own normal,
-    as in Cycles (sd->Ng there): they differ on the flat faces Displacement and Bump
-    moved, whose shading normal is the undisplaced one."""
-    nx, ny, nz = hit[H_N], hit[H_N + 1], hit[H_N + 2]
-    sign = hit[H_TANGENT_SIGN]
-    if sign == 0.0:
-        return nx, ny, nz
-    back = hit[H_BACKFACING] > 0.0
-    qx, qy, qz = nx, ny, nz
-    if hit[H_FLAT_FACE] != 0.0:
-        qx, qy, qz = hit[H_NG], hit[H_NG + 1], hit[H_NG + 2]
-    ox, oy, oz = (-qx, -qy, -qz) if back else (qx, qy, qz)
-    tx, ty, tz = hit[H_TANGENT], hit[H_TANGENT + 1], hit[H_TANGENT + 2]
-    bx = sign * (oy * tz - oz * ty)
-    by = sign * (oz * tx - ox * tz)
-    bz = sign * (ox * ty - oy * tx)
-    cx, cy = 2.0 * (cr - 0.5) * strength, 2.0 * (cg - 0.5) * strength
-    mix = min(max(strength, 0.0), 1.0)
-    cz = 1.0 + (2.0 * (cb - 0.5) - 1.0) * mix
-    x, y, z = _normalize(cx * tx + cy * bx + cz * ox, cx * ty + cy * by + cz * oy,
-                         cx * tz + cy * bz + cz * oz)
-    if back:
-        x, y, z = -x, -y, -z
-    if x == 0.0 and y == 0.0 and z == 0.0:
-        return nx, ny, nz
-    return x, y, z
 
 
 @kernel(allocates=False)

@@ -10,17 +10,10 @@ from __future__ import annotations
 
 import math
 
+from ..frame import unit as _unit
 from ..jit import kernel
 
 BIG_T = 1e12              # an infinite segment's far end, for directions towards it
-
-
-@kernel(allocates=False)
-def _unit(x, y, z):
-    d = math.sqrt(x * x + y * y + z * z)
-    if d > 0.0:
-        return x / d, y / d, z / d
-    return 0.0, 0.0, 0.0
 
 
 @kernel(allocates=False)

@@ -1,0 +1,81 @@
+"""Cycles' tangent-space Normal Map node (kernel/svm/tex_coord.h, svm_node_normal_map),
+for one hit: the colour's 2c - 1, its x and y scaled by Strength and its z mixed from 1 by
+Strength clamped to [0, 1], taken in the frame of the UV map's tangent T, the bitangent
+sign x N x T and the normal N it builds on, in the object's space, and the result taken
+back to the world as a normal (by the inverse transpose of the object's matrix). In
+object space, as Cycles works: with a non-uniform scale a frame built in the world
+differs.
+
+N is the interpolated shading normal, but on a face shaded flat the face's own normal
+(Cycles' sd->Ng there): they differ on the flat faces Displacement and Bump moved, whose
+shading normal is the undisplaced one (engine.scene TriangleMesh.flat_faces). Where the
+mesh has no tangents the map gives the shading normal."""
+from __future__ import annotations
+
+import math
+
+from ..kernels.frame import cross as _cross, unit as _unit
+from ..kernels.jit import kernel
+from .context import (H_BACKFACING, H_FLAT_FACE, H_N, H_NG, H_OBJ_MATRIX, H_TANGENT,
+                      H_TANGENT_SIGN)
+
+
+@kernel(allocates=False)
+def _cofactors(hit):
+    """The rows of the cofactor matrix C = det(M) M^-T of the hit's object matrix M
+    (context.H_OBJ_MATRIX, rows a, b, c): b x c, c x a, a x b; and det(M)."""
+    m = H_OBJ_MATRIX
+    ax, ay, az = hit[m], hit[m + 1], hit[m + 2]
+    bx, by, bz = hit[m + 3], hit[m + 4], hit[m + 5]
+    cx, cy, cz = hit[m + 6], hit[m + 7], hit[m + 8]
+    r0 = _cross(bx, by, bz, cx, cy, cz)
+    r1 = _cross(cx, cy, cz, ax, ay, az)
+    r2 = _cross(ax, ay, az, bx, by, bz)
+    det = ax * r0[0] + ay * r0[1] + az * r0[2]
+    return r0, r1, r2, det
+
+
+@kernel(allocates=False)
+def normal_map(hit, cr, cg, cb, strength):
+    """The Normal Map's normal at the hit (the module's docstring), unit length and
+    facing as the hit's shading normal faces."""
+    nx, ny, nz = hit[H_N], hit[H_N + 1], hit[H_N + 2]
+    sign = hit[H_TANGENT_SIGN]
+    if sign == 0.0:
+        return nx, ny, nz
+    back = hit[H_BACKFACING] > 0.0
+    qx, qy, qz = nx, ny, nz
+    if hit[H_FLAT_FACE] != 0.0:
+        qx, qy, qz = hit[H_NG], hit[H_NG + 1], hit[H_NG + 2]
+    if back:                    # the maths on the normal as the mesh has it
+        qx, qy, qz = -qx, -qy, -qz
+    tx, ty, tz = hit[H_TANGENT], hit[H_TANGENT + 1], hit[H_TANGENT + 2]
+    r0, r1, r2, det = _cofactors(hit)
+    if det == 0.0 or not math.isfinite(det):
+        return nx, ny, nz
+    flip = 1.0 if det > 0.0 else -1.0
+    m = H_OBJ_MATRIX
+    # into object space: the normal by M^T, the tangent by M^-1 (= C^T / det); the
+    # world sign already holds a mirror's flip (the world bitangent is a cross product)
+    ox, oy, oz = _unit(hit[m] * qx + hit[m + 3] * qy + hit[m + 6] * qz,
+                       hit[m + 1] * qx + hit[m + 4] * qy + hit[m + 7] * qz,
+                       hit[m + 2] * qx + hit[m + 5] * qy + hit[m + 8] * qz)
+    ux, uy, uz = _unit(flip * (tx * r0[0] + ty * r1[0] + tz * r2[0]),
+                       flip * (tx * r0[1] + ty * r1[1] + tz * r2[1]),
+                       flip * (tx * r0[2] + ty * r1[2] + tz * r2[2]))
+    s = sign * flip
+    bx, by, bz = _cross(ox, oy, oz, ux, uy, uz)
+    bx, by, bz = s * bx, s * by, s * bz
+    cx, cy = 2.0 * (cr - 0.5) * strength, 2.0 * (cg - 0.5) * strength
+    cz = 1.0 + (2.0 * (cb - 0.5) - 1.0) * min(max(strength, 0.0), 1.0)
+    x, y, z = _unit(cx * ux + cy * bx + cz * ox, cx * uy + cy * by + cz * oy,
+                    cx * uz + cy * bz + cz * oz)
+    # back to the world as a normal: M^-T = C / det
+    x, y, z = _unit(flip * (r0[0] * x + r0[1] * y + r0[2] * z),
+                    flip * (r1[0] * x + r1[1] * y + r1[2] * z),
+                    flip * (r2[0] * x + r2[1] * y + r2[2] * z))
+    if back:
+        x, y, z = -x, -y, -z
+    if x == 0.0 and y == 0.0 and z == 0.0:
+        return nx, ny, nz
+    return x, y, z
