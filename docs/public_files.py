@@ -73,10 +73,13 @@ CAUSES = {
         "Diffuse Ray). Red and blue went from -34 % to +1.2 % on 2026-12-01: diffuse rays "
         "now pass such a mix (tests/test_shadow_ray_glass_vs_cycles.py), and bounce "
         "limits count as Cycles counts them (tests/test_bounce_budget_vs_cycles.py). "
-        "Green is the lamp's light alone (the world has none): it leaks into the room "
-        "along the line where the walls meet the zero-thickness ceiling, in both "
-        "engines, DRT's line 3.4 times as bright as Cycles' (shadow rays starting within "
-        "a pixel of the seam); not fixed yet",
+        "Green is the lamp's light alone (the world has none), reflected into view by "
+        "the ceiling strip along the far wall: the ceiling is flat shaded and moved by "
+        "Displacement and Bump, which tilts its edge faces, and its Normal Map was built "
+        "on the undisplaced normals there (Cycles builds it on the face's own), and in "
+        "the world rather than the object's space: green from +90.7 % to +1.3 % on "
+        "2026-12-01 (tests/test_displacement_vs_cycles.py). The worst block, 9.5 %, is "
+        "within the 8.1 % Cycles itself shows at 64 samples (times 1.25)",
     "tunnel.blend":
         "its images are missing (pink in both) and its Vector Displacement in tangent "
         "space has no UV map to take tangents from: DRT drops the offsets' x and z "
