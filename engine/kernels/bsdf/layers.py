@@ -20,8 +20,9 @@ and sample add this module's lobes. A row with P_LAYERS = 0 never reads a slot h
 
 Lobe kinds: coat GLOSSY; sheen DIFFUSE (Cycles labels it diffuse reflection); translucent
 TRANSMISSION for the bounce that follows it (it leaves through the surface) and seen by
-lights as diffuse, as Cycles classifies it; it is sampled only where both diffuse and
-transmission lobes are allowed (principled.sample's allow flags); hair R
+lights as diffuse, as Cycles classifies it; it is sampled wherever diffuse lobes are
+(principled.sample's allow flags: Refractive Caustics off leaves it, as Cycles' filter
+leaves its diffuse closures); hair R
 GLOSSY, hair TT TRANSMISSION (Cycles' closure classes, which the lights' visibility and
 the passes follow). A sampled hair direction is kept on either side of the surface, as
 Cycles keeps it (`hair_sample`; principled.sample weighs it with the density drawn).
@@ -328,7 +329,7 @@ def selection(state, allow_d, allow_g, allow_t):
     Principled Hair) over the allowed kinds."""
     wc = state[S_EST_COAT] if allow_g else 0.0
     ws = state[S_EST_SHEEN] if allow_d else 0.0
-    wt = state[S_EST_TRANS] if (allow_d and allow_t) else 0.0
+    wt = state[S_EST_TRANS] if allow_d else 0.0    # diffuse to Cycles' Caustics switches
     whr = state[S_EST_HAIR_R] if allow_g else 0.0
     wht = state[S_EST_HAIR_TT] if allow_t else 0.0
     wch = state[S_EST_CHIANG] if (allow_g or allow_t) else 0.0
