@@ -97,7 +97,7 @@ class PhaseRecorder:
     def _time_cache_loads(self):
         from numba.core import caching
 
-        from engine.kernels.jit import EngineFunctionCache
+        from engine.kernels.kernel_cache import EngineFunctionCache
         for cls in (caching.Cache, EngineFunctionCache):   # Numba's, and the engine's
             self._time_loads_of(cls)
 

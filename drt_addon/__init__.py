@@ -14,7 +14,7 @@ def _use_extension_numba_cache(bpy) -> None:
     (<user extensions>/.user/<repo>/drt/numba_cache): the installed extension's own folder
     may be read-only and is wiped on every update. A user's NUMBA_CACHE_DIR wins. Outside
     an extension (source checkout, legacy add-on) extension_path_user raises and nothing is
-    set and engine/kernels/jit.py picks a cache folder itself.
+    set and engine/kernels/kernel_cache.py picks a cache folder itself.
 
     Must run before the tracer (and so the kernels' @kernel decorators, which pick the
     cache location) is imported. Numba reads NUMBA_CACHE_DIR once, when numba.core.config

@@ -7,7 +7,7 @@ it runs `python -m drt_addon compile` in a subprocess that compiles for that tie
 (`engine.kernels.cache_files.tier_environment`) into one cache folder. The folder goes into
 the zip as `engine/kernels/prebuilt/`; the installed engine loads from it the best tier
 the user's CPU runs when its own cache has nothing for the kernel
-(`engine/kernels/jit.py`, `cache_files.py`), whatever the extension's repository is called.
+(`engine/kernels/kernel_cache.py`, `cache_files.py`), whatever the extension's repository is called.
 
 Nothing here imports bpy; the tracer is imported for its tier names only.
 """

@@ -1,6 +1,6 @@
 """`python -m drt_addon compile`: compile and cache DRT's kernels before the first render.
 
-Numba compiles DRT's kernels on first use and caches them on disk (engine/kernels/jit.py),
+Numba compiles DRT's kernels on first use and caches them on disk (engine/kernels/kernel_cache.py),
 so a machine's first render pays the compile once (docs/benchmarks.md measures it). This
 command pays it during set-up instead: it renders a few of the sample scenes, each
 chosen for code paths the others do not reach, at a tiny size and one sample, with

@@ -373,8 +373,9 @@ facts["env_cache_dir"] = os.environ.get("NUMBA_CACHE_DIR")
 config = sys.modules.get("numba.core.config")
 facts["numba_cache_dir"] = getattr(config, "CACHE_DIR", None)
 jit = sys.modules.get(args["pkg"] + ".engine.kernels.jit")
-facts["jit_cache"] = getattr(jit, "CACHE", None)
-facts["shipped_root"] = getattr(jit, "SHIPPED_ROOT", None)
+cache = sys.modules.get(args["pkg"] + ".engine.kernels.kernel_cache")
+facts["jit_cache"] = getattr(cache, "CACHE", None)
+facts["shipped_root"] = getattr(cache, "SHIPPED_ROOT", None)
 kernels = {}
 if jit is not None:
     # the engine's kernels (jit.Kernel); a kernel's Numba dispatchers exist once it was

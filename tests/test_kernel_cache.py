@@ -1,4 +1,4 @@
-"""The compiled-kernel cache (engine/kernels/jit.py): a change to any engine source a
+"""The compiled-kernel cache (engine/kernels/kernel_cache.py): a change to any engine source a
 kernel can see recompiles every kernel that could have inlined it (Numba alone would keep
 a caller's stale machine code when only a callee in another module changed), a change no
 kernel can see recompiles nothing, a user-chosen cache folder is honoured, and with no
@@ -67,7 +67,7 @@ def _stamps(folder):
 
 def test_a_change_no_kernel_can_see_recompiles_nothing(tmp_path):
     """The fingerprint covers the modules that define kernels and what they import
-    (jit.kernel_sources): a change to the denoiser, which no kernel imports, keeps every
+    (kernel_cache.kernel_sources): a change to the denoiser, which no kernel imports, keeps every
     cached kernel (no cache file is rewritten); the callee case above shows the reverse."""
     src = _copy_engine(tmp_path)
     first = _run(src)
@@ -81,11 +81,12 @@ def test_a_change_no_kernel_can_see_recompiles_nothing(tmp_path):
 
 
 def test_kernel_sources_follow_the_kernels_imports():
-    from engine.kernels import jit
-    names = {os.path.relpath(p, jit.ENGINE_DIR).replace(os.sep, "/")
-             for p in jit.kernel_sources()}
+    from engine.kernels import kernel_cache
+    names = {os.path.relpath(p, kernel_cache.ENGINE_DIR).replace(os.sep, "/")
+             for p in kernel_cache.kernel_sources()}
     # kernels, their callees' modules, and plain modules they read constants from
-    assert {"kernels/jit.py", "kernels/path_vertex.py", "sampling/hashing.py",
+    assert {"kernels/jit.py", "kernels/kernel_cache.py", "kernels/path_vertex.py",
+            "sampling/hashing.py",
             "sampling/dispatch.py", "visibility.py", "kernels/lights/light_set.py",
             "embree/rays.py", "embree/library.py"} <= names
     # Python-side modules no kernel imports
@@ -135,7 +136,7 @@ print(repr(v), hits, loaded, repr(float(spread(np.arange(5.0)))), len(kernels), 
 
 def test_cached_kernels_load_without_numbas_compiler_registries(tmp_path):
     """A second process loads its kernels from the cache without importing Numba's
-    typing and lowering registries (engine.kernels.jit.EngineFunctionCache: 0.2 s of a
+    typing and lowering registries (engine.kernels.kernel_cache.EngineFunctionCache: 0.2 s of a
     render process), and a function compiled after them still compiles and runs."""
     src = _copy_engine(tmp_path)
     env = dict(os.environ, PYTHONPATH=str(src), NUMBA_CACHE_DIR=str(tmp_path / "cache"))
@@ -163,7 +164,7 @@ def test_cached_kernels_load_without_numbas_compiler_registries(tmp_path):
 
 def test_a_cache_built_elsewhere_loads_where_the_engine_is_installed(tmp_path):
     """The cache's folders are named after the engine's own subfolders, not Numba's hash
-    of their absolute path (engine.kernels.jit.EngineCacheLocator): kernels cached by a
+    of their absolute path (engine.kernels.kernel_cache.EngineCacheLocator): kernels cached by a
     copy of the engine in one place load in a copy installed in another, as the extension
     package's caches must."""
     cache = tmp_path / "cache"

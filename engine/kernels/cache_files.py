@@ -16,7 +16,7 @@ it runs on. Code compiled for a CPU tier runs on every CPU with that tier's inst
 `compatible` accepts code compiled for `generic` x86-64 everywhere, and for a named x86-64
 level or an explicit feature list where the running CPU has every feature it needs. The
 extension ships the `x86-64-v3` and `generic` tiers (`engine/kernels/prebuilt` inside the
-zip, drt_addon/prebuilt_kernels.py); `EngineFunctionCache` (jit.py) looks there when the writable
+zip, drt_addon/prebuilt_kernels.py); `EngineFunctionCache` (kernel_cache.py) looks there when the writable
 cache has no code for this CPU.
 """
 from __future__ import annotations
