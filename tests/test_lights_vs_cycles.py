@@ -208,3 +208,55 @@ def test_light_nodes_drt_cannot_read_are_reported(bpy_drt):
         reporter.warnings
     assert scene.lights[0].strength == pytest.approx(
         tuple(light.energy * c for c in light.color))
+
+
+def _spot_in_a_mirror(bpy, soft_falloff):
+    """A spot lamp of radius 0.1 seen in a perfect mirror (Principled, Metallic 1,
+    Roughness 0) through a 200 mm lens, its cone's edge (Blend 0.15) crossing the lamp's
+    image: only the lamp's lower part shines towards the mirror. A sphere lamp
+    (soft_falloff off) or Blender's default disc facing the shaded point."""
+    import math
+    from mathutils import Euler, Vector
+    from node_probe import new_material, new_scene
+    scene = new_scene(bpy, 64)
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    bpy.ops.mesh.primitive_plane_add(size=6.0)
+    mat, nt = new_material(bpy, "Mirror")
+    bsdf = nt.nodes["Principled BSDF"]
+    bsdf.inputs["Metallic"].default_value = 1.0
+    bsdf.inputs["Roughness"].default_value = 0.0
+    bpy.context.object.data.materials.append(mat)
+    lamp = bpy.data.objects.new("Spot", bpy.data.lights.new("Spot", "SPOT"))
+    lamp.data.energy, lamp.data.shadow_soft_size = 100.0, 0.1
+    lamp.data.use_soft_falloff = soft_falloff
+    lamp.location, lamp.rotation_euler = (0.0, 1.0, 1.0), (math.radians(-30), 0.0, 0.0)
+    axis = Euler(lamp.rotation_euler).to_matrix() @ Vector((0.0, 0.0, -1.0))
+    lamp.data.spot_size = 2.0 * axis.angle(Vector((0.0, -1.0, -1.0)).normalized())
+    lamp.data.spot_blend = 0.15
+    lamp.visible_camera = False
+    scene.collection.objects.link(lamp)
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.data.lens = 200.0
+    cam.location, cam.rotation_euler = (0.0, -1.0, 1.0), (math.radians(45), 0.0, 0.0)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    return scene
+
+
+@pytest.mark.parametrize("soft_falloff", [False, True])
+def test_spot_cone_weighs_each_ray_by_its_own_direction(bpy_drt, soft_falloff):
+    """Cycles weighs a spot lamp's light by the cone at each ray's own direction from the
+    lamp, so the cone's edge crosses a sphere (or disc) lamp seen up close. Measured (DRT
+    256, Cycles 1024 samples): means within 0.05 %, worst block 1.25 %. Before (DRT
+    weighed the whole lamp by the direction to its centre), the disc's lit part lay on
+    the wrong side of its image (rows 19-30 of 64 against Cycles' 33-44);
+    OddBitWizard.blend's mirror showed it."""
+    from node_probe import image_errors, render
+    bpy = bpy_drt
+    scene = _spot_in_a_mirror(bpy, soft_falloff)
+    cycles = render(bpy, scene, "CYCLES", 1024)
+    drt = render(bpy, scene, "DRT", 256)
+    mean, block = image_errors(drt, cycles)
+    print(f"spot in a mirror (soft falloff {soft_falloff}): mean {mean:.2%}, "
+          f"largest block {block:.2%}")
+    assert mean < 0.01 and block < 0.03, (mean, block)

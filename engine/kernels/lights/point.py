@@ -4,6 +4,10 @@ Kinds (pack.T_*): T_POINT (delta point or spot), T_SPHERE (radius > 0: the unifo
 the sphere subtends, uniform sphere from inside), T_DISC (radius > 0 with soft_falloff: a
 disc facing the shaded point, sampled uniformly by area). Every function takes the lamp
 table and the lamp's row k.
+
+A spot's cone weighs each ray by its own direction from the lamp (Cycles' spot_light
+attenuation of -D), so the cone's edge crosses a sphere lamp seen up close, in a mirror
+say; no cone inside a sphere lamp, as in Cycles.
 """
 from __future__ import annotations
 
@@ -68,7 +72,7 @@ def _sample_disc(lamps, k, px, py, pz, u0, u1, ax, ay, az, dist_c):
     area = PI * (radius * radius)
     ok = dist > 0.0 and cos_l > 0.0 and dist_c > 0.0
     pdf = dist * dist / (area * cos_l) if ok else 0.0
-    s = spot_factor(lamps, k, -ax, -ay, -az) * (1.0 if ok else 0.0)
+    s = spot_factor(lamps, k, -wx, -wy, -wz) * (1.0 if ok else 0.0)   # the ray's own
     return (wx, wy, wz, dist, lamps[k, C_RAD] * s, lamps[k, C_RAD + 1] * s,
             lamps[k, C_RAD + 2] * s, pdf, False)
 
@@ -88,6 +92,7 @@ def sample_point(lamps, k, px, py, pz, u0, u1):
     if kind == T_DISC:
         return _sample_disc(lamps, k, px, py, pz, u0, u1, ax, ay, az, dist_c)
     r = lamps[k, C_RADIUS]
+    s = 1.0                                 # inside the sphere: no cone (Cycles)
     if d2 <= r * r:                         # inside the sphere: uniform sphere
         wx, wy, wz = uniform_sphere(u0, u1)
         ocx = px - lamps[k, C_POS]
@@ -108,8 +113,8 @@ def sample_point(lamps, k, px, py, pz, u0, u1):
         proj = dist_c * lz
         dist = proj - math.sqrt(max0(r * r - d2 * sin2))
         pdf = 1.0 / (TWO_PI * (1e-300 if om < 1e-300 else om))
+        s = spot_factor(lamps, k, -wx, -wy, -wz)
     dist = max0(dist)
-    s = spot_factor(lamps, k, -ax, -ay, -az)
     return (wx, wy, wz, dist, lamps[k, C_RAD] * s, lamps[k, C_RAD + 1] * s,
             lamps[k, C_RAD + 2] * s, pdf, False)
 
@@ -122,7 +127,9 @@ def intersect_point(lamps, k, ox, oy, oz, dx, dy, dz):
     px, py, pz = lamps[k, C_POS], lamps[k, C_POS + 1], lamps[k, C_POS + 2]
     radius = lamps[k, C_RADIUS]
     ax, ay, az, dist_c = safe_unit(px - ox, py - oy, pz - oz)
-    s = spot_factor(lamps, k, -ax, -ay, -az)
+    # the cone along the ray's own direction, as Cycles (not the centre's; none inside)
+    inside = lamps[k, C_TYPE] != T_DISC and dist_c * dist_c <= radius * radius
+    s = 1.0 if inside else spot_factor(lamps, k, -dx, -dy, -dz)
     r, g, b = lamps[k, C_RAD] * s, lamps[k, C_RAD + 1] * s, lamps[k, C_RAD + 2] * s
     if lamps[k, C_TYPE] == T_DISC:
         den = dx * ax + dy * ay + dz * az
