@@ -215,7 +215,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         # Displacement socket's bump)
         s0x, s0y, s0z = n0x, n0y, n0z
         if programs is not None and params[ms, P_SETS_NORMAL] != 0.0:
-            s0x, s0y, s0z = surface_normal(programs, ms, regs, n0x, n0y, n0z)
+            s0x, s0y, s0z = surface_normal(programs, ms, regs, rx, ry, rz)
         if not bent and correct and (nx != gx or ny != gy or nz != gz):
             # a smooth mesh's normal, as Cycles' specular lobes (and the subsurface
             # entry) use it: made a valid reflector for the view (a silhouette's normal

@@ -135,14 +135,14 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, p
         m2 = geometry[3][prim2]
         if has_program(programs, m2):
             uu, vv = hit_uv(geometry[6], prim2, u, v)
-            _, _, bx, by, bz, _, _, _, bent, soften = run_program(
+            _, _, bx, by, bz, rx, ry, rz, bent, soften = run_program(
                 programs, params, geometry, counts, path_info, p, m2, prim2, inst2, u, v,
                 uu, vv, qx, qy, qz, hx, hy, hz, mx, my, mz, -wdx, -wdy, -wdz, front2,
                 ray_bits[p], b, 0.0, hit_row, regs, 0.5)
             if bent:
                 mx, my, mz = bx, by, bz
                 if params[m2, P_SETS_NORMAL] != 0.0:     # a Set Normal: the surface's own
-                    n0x, n0y, n0z = surface_normal(programs, m2, regs, n0x, n0y, n0z)
+                    n0x, n0y, n0z = surface_normal(programs, m2, regs, rx, ry, rz)
     mode = cfg.mis_mode
     # next-event estimation on the exit's Lambertian surface (lights picked for it as
     # Cycles' tree picks them: one-sided, on the surface's own normal, sd->N)

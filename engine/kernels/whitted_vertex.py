@@ -159,7 +159,7 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
                 hit_u[j], hit_v[j], uu, vv, px, py, pz, gx, gy, gz, nx, ny, nz, dx, dy, dz, front,
                 ray_bits[p], b, t_geom, hit_row, regs, u_lobe)
             if params[ms, P_SETS_NORMAL] != 0.0:      # a Set Normal: the surface's own
-                n0x, n0y, n0z = surface_normal(programs, ms, regs, n0x, n0y, n0z)
+                n0x, n0y, n0z = surface_normal(programs, ms, regs, rx, ry, rz)
         holed, u_lobe = holdout_share(params[ms, P_HOLDOUT], u_lobe, b, alpha, p, br, bg, bb)
         if holed:
             continue                      # a Holdout's share: a hole, or no light

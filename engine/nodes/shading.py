@@ -17,9 +17,9 @@ from ..kernels.jit import kernel
 from ..kernels.textures import (I_TEXTURE, INPUTS, PLAIN, TEX_ALPHA, TEX_EMISSION,
                                 textured_value)
 from ..kernels.curve_hit import strand_info
-from .context import (H_FLAT_FACE, H_HAIR_INTERCEPT, H_HAIR_IS_STRAND, H_HAIR_LENGTH, H_HAIR_RANDOM,
-                      H_HAIR_TANGENT_NORMAL, H_HAIR_THICKNESS, fill, mirrors,
-                      set_undisplaced, to_world_direction)
+from .context import (H_FLAT_FACE, H_HAIR_INTERCEPT, H_HAIR_IS_STRAND, H_HAIR_LENGTH,
+                      H_HAIR_RANDOM, H_HAIR_TANGENT_NORMAL, H_HAIR_THICKNESS, fill,
+                      mirrors, set_undisplaced, to_world_direction)
 from .differentials import fill_differentials
 from .interpreter import reads_differentials, run
 from .pack import MIX, OUTS
@@ -183,14 +183,9 @@ def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz, correct):
     the view direction I (valid_reflection_normal) when `correct` (the material's Bump
     Map Correction), then as its diffuse lobe uses it, unchanged. Both are n when the
     program does not set one."""
-    k = T[OUTS][m, OUT_NORMAL]
-    if k < 0:
+    x, y, z, ok = _unit_output(T, m, OUT_NORMAL, regs)
+    if not ok:
         return nx, ny, nz, nx, ny, nz
-    x, y, z = regs[k], regs[k + 1], regs[k + 2]
-    ln = math.sqrt(x * x + y * y + z * z)
-    if not ln > 0.0 or not math.isfinite(ln):
-        return nx, ny, nz, nx, ny, nz
-    x, y, z = x / ln, y / ln, z / ln
     if not correct:
         return x, y, z, x, y, z
     vx, vy, vz = valid_reflection_normal(gx, gy, gz, ix, iy, iz, x, y, z)
@@ -198,22 +193,30 @@ def program_normal(T, m, regs, nx, ny, nz, gx, gy, gz, ix, iy, iz, correct):
 
 
 @kernel(allocates=False)
-def surface_normal(T, m, regs, nx, ny, nz):
-    """Cycles' sd->N where material m's program sets it (its Material Output's
-    Displacement as a bump, Cycles' Set Normal), normalised: the program's surface_normal
-    output where a shader also has a Normal of its own (which its lobes use), else its
-    normal output; n where it sets none. Bent lobes are shadowed against it, lights picked
-    for it and shadow rays lifted by it."""
-    k = T[OUTS][m, OUT_SURFACE_NORMAL]
+def _unit_output(T, m, out, regs):
+    """Material m's program output `out` (a direction) normalised, and whether it has one
+    (an output it does not set, or of zero or non-finite length, has none)."""
+    k = T[OUTS][m, out]
     if k < 0:
-        k = T[OUTS][m, OUT_NORMAL]
-    if k < 0:
-        return nx, ny, nz
+        return 0.0, 0.0, 1.0, False
     x, y, z = regs[k], regs[k + 1], regs[k + 2]
     ln = math.sqrt(x * x + y * y + z * z)
     if not ln > 0.0 or not math.isfinite(ln):
-        return nx, ny, nz
-    return x / ln, y / ln, z / ln
+        return 0.0, 0.0, 1.0, False
+    return x / ln, y / ln, z / ln, True
+
+
+@kernel(allocates=False)
+def surface_normal(T, m, regs, rx, ry, rz):
+    """Cycles' sd->N where material m's program sets it (its Material Output's
+    Displacement as a bump, Cycles' Set Normal): the program's surface_normal output
+    where a shader also has a Normal of its own (which its lobes use), else r, the
+    program's normal as program_normal gives it raw. Bent lobes are shadowed against
+    it, lights picked for it and shadow rays lifted by it."""
+    x, y, z, ok = _unit_output(T, m, OUT_SURFACE_NORMAL, regs)
+    if ok:
+        return x, y, z
+    return rx, ry, rz
 
 
 @kernel(allocates=False)
