@@ -131,10 +131,11 @@ def test_principled_values(bpy_drt):
     m, warnings = _export(mat)
     assert warnings == [] and m.subsurface_method == "RANDOM_WALK_SKIN"
     assert m.subsurface_ior == pytest.approx(1.33)
-    p.subsurface_method = "BURLEY"             # Christensen-Burley: by the walk, reported
+    p.subsurface_method = "BURLEY"             # Christensen-Burley: Cycles' disk
     m, warnings = _export(mat)
-    assert len(warnings) == 1 and "'P'" in warnings[0] and "Random Walk" in warnings[0]
-    assert m.subsurface_method == "RANDOM_WALK" and m.subsurface_weight == pytest.approx(0.5)
+    assert warnings == [] and m.subsurface_method == "BURLEY"
+    assert m.subsurface_weight == pytest.approx(0.5) and close(m.subsurface_radius,
+                                                               (0.2, 0.1, 0.05))
     p.subsurface_method = "RANDOM_WALK"
     p.inputs["Subsurface Weight"].default_value = 0.0
     # Specular Tint: the metal's F82 tint, the specular layer's and the glass's F0 tint

@@ -64,3 +64,27 @@ def test_subsurface_scene_matches_cycles(bpy_drt):
     assert agrees("subsurface", _render(bpy_drt, "DRT", DRT_SAMPLES))
     assert not agrees("subsurface rendered diffuse (control)",
                       _render(bpy_drt, "DRT", 128, _diffuse_instead))
+
+
+def _burley(scene):
+    """Every subsurface material by Christensen-Burley (Principled's Subsurface Method,
+    the Subsurface Scattering node's Falloff): Cycles' disk sampling, no walk."""
+    import bpy
+    for mat in bpy.data.materials:
+        for node in (mat.node_tree.nodes if mat.node_tree is not None else ()):
+            if node.bl_idname == "ShaderNodeBsdfPrincipled":
+                node.subsurface_method = "BURLEY"
+            elif node.bl_idname == "ShaderNodeSubsurfaceScattering":
+                node.falloff = "BURLEY"
+
+
+def test_christensen_burley_matches_cycles(bpy_drt):
+    """The same scene by Christensen-Burley: DRT's disk sampling against Cycles', at the
+    tolerances above. The control, the random walk DRT rendered in its place before,
+    must fail against Cycles' Burley."""
+    cycles = _render(bpy_drt, "CYCLES", CYCLES_SAMPLES, _burley)
+    assert _agrees("Christensen-Burley", _render(bpy_drt, "DRT", DRT_SAMPLES, _burley),
+                   cycles, BLOCK_TOLERANCE, BLOCK_MAD_TOLERANCE)
+    assert not _agrees("random walk against Cycles' Burley (control)",
+                       _render(bpy_drt, "DRT", DRT_SAMPLES), cycles, BLOCK_TOLERANCE,
+                       BLOCK_MAD_TOLERANCE)

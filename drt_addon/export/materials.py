@@ -23,8 +23,8 @@ Principled BSDF
     default, Cycles' energy-compensated GGX) or 'GGX' (single scattering).
 Subsurface Scattering
     Cycles' random walk of its Color, Radius x Scale, IOR, Roughness and Anisotropy
-    (Random Walk and Random Walk (Skin); Christensen-Burley is rendered by the random
-    walk, reported).
+    (Random Walk and Random Walk (Skin)), or Christensen-Burley's profile of its Color and
+    Radius x Scale by Cycles' disk sampling.
 Diffuse BSDF
     Lambert with its colour (no specular layer). Roughness > 0 (Oren-Nayar) is reported.
 Glossy BSDF

@@ -8,6 +8,8 @@ import numpy as np
 GLOSSY_MODELS = ("GGX", "MULTI_GGX", "BLINN_PHONG", "BECKMANN")
 # The Fresnel term of the metal lobe (`Material.metal_fresnel`)
 METAL_FRESNELS = ("SCHLICK", "CONSTANT")
+# Cycles' subsurface methods (`Material.subsurface_method`), in the order of their codes
+SUBSURFACE_METHODS = ("RANDOM_WALK", "RANDOM_WALK_SKIN", "BURLEY")
 
 
 def flatten_mixes(materials):
@@ -231,7 +233,7 @@ class MaterialTable:
     def _subsurface_params(self, materials):
         """Subsurface scattering (engine/kernels/subsurface.py): weight, radius (mean free
         path per channel, scene units), anisotropy, the entry's IOR and GGX alpha (< 0:
-        the hit's roughness^2) and whether the method is Random Walk (Skin)."""
+        the hit's roughness^2) and the method (SUBSURFACE_METHODS)."""
         n = len(materials)
         self.subsurface_weight = np.clip(np.array(
             [float(getattr(m, "subsurface_weight", 0.0)) for m in materials], np.float64), 0, 1)
@@ -244,9 +246,14 @@ class MaterialTable:
             [float(getattr(m, "subsurface_ior", 1.4)) for m in materials], np.float64)
         alpha = [getattr(m, "subsurface_alpha", None) for m in materials]
         self.subsurface_alpha = np.array([-1.0 if a is None else float(a) for a in alpha])
-        self.subsurface_skin = np.array(
-            [getattr(m, "subsurface_method", "RANDOM_WALK") == "RANDOM_WALK_SKIN"
-             for m in materials], bool)
+        methods = [getattr(m, "subsurface_method", "RANDOM_WALK") for m in materials]
+        unknown = sorted(set(methods) - set(SUBSURFACE_METHODS))
+        if unknown:
+            raise ValueError(f"subsurface_method {unknown[0]!r} is none of "
+                             f"{', '.join(SUBSURFACE_METHODS)}")
+        # engine.kernels.bsdf.params' SSS_RANDOM_WALK, SSS_SKIN, SSS_BURLEY
+        self.subsurface_method_code = np.array(
+            [SUBSURFACE_METHODS.index(k) for k in methods], np.float64)
         for name in ("subsurface_weight", "subsurface_radius", "subsurface_anisotropy",
                      "subsurface_ior", "subsurface_alpha"):
             _require_finite(materials, name, getattr(self, name))

@@ -242,7 +242,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         if row[P_HAIR] != 0.0:           # a hair closure: the fibre's direction at the hit
             hair_tangent.write(geometry, prim, hit_inst[j], hit_u[j], hit_v[j], path_time[p],
                                nx, ny, nz, row)
-        keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p])
+        keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p], counts[p, 0])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
         if b == 0 and tl.on(tally):
             d_col, g_col, t_col = lobe_colours(state, woz)
@@ -321,8 +321,8 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                 cone_moves(path_info[1], p, t_geom)
                 ns_out, nn_out = scatter_below(
                     cfg, walk_key(pkey[p], index[p], depth), p, paths, sss,
-                    geometry, row, prim, hit_inst[j], px, py, pz, gx, gy, gz, nx, ny, nz,
-                    dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, tally, lights,
+                    geometry, row, prim, hit_inst[j], front, px, py, pz, gx, gy, gz, nx,
+                    ny, nz, dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, tally, lights,
                     shadows, ns_out, nexts, nn_out, programs, params, hit_row, regs)
             continue
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)

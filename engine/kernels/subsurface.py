@@ -146,15 +146,15 @@ def object_of(mesh_start, prim):
 
 
 @kernel(allocates=False)
-def local_hit(rays, rec, mesh, inst, ox, oy, oz, dx, dy, dz, tmax, time, skip=-1):
-    """The first hit within tmax of the surface of mesh `mesh` placed as instance `inst`
-    (-1: not instanced) along o + t d, passing other objects' triangles and triangle
-    `skip` of the mesh (the one the ray leaves; -1: none). rays: (the scene's
+def local_hit(rays, rec, mesh, inst, ox, oy, oz, dx, dy, dz, tmax, time, skip=-1,
+              tnear=0.0):
+    """The first hit within [tnear, tmax] of the surface of mesh `mesh` placed as instance
+    `inst` (-1: not instanced) along o + t d, passing other objects' triangles and
+    triangle `skip` of the mesh (the one the ray leaves; -1: none). rays: (the scene's
     engine.embree.rays.Target, each mesh's first global triangle); rec: a RayRecord of
     it. Returns (prim, inst, t, u, v); prim -1 when nothing is hit."""
     tg, mesh_start = rays
     center, geom_base, geom_row = tg.center, tg.geom_base, tg.geom_row
-    tnear = 0.0
     for _ in range(MAX_SKIPS):
         g, pr, k, e, t, u, v = intersect1(tg.handle, rec, ox - center[0], oy - center[1],
                                           oz - center[2], dx, dy, dz, tnear, tmax, time,

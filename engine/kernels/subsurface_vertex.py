@@ -30,7 +30,8 @@ from . import lights as lt
 from . import ray_queues
 from .bsdf import microfacet as mf
 from .bsdf.params import (P_BASE, P_ROUGHNESS, P_SETS_NORMAL, P_SSS_ALPHA,
-                          P_SSS_ANISOTROPY, P_SSS_IOR, P_SSS_RADIUS, P_SSS_SKIN)
+                          P_SSS_ANISOTROPY, P_SSS_IOR, P_SSS_METHOD, P_SSS_RADIUS,
+                          SSS_BURLEY, SSS_SKIN)
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from . import light_tally as tl
@@ -39,6 +40,7 @@ from ..sampling.hashing import stream_uniform
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, keep_receiver,
                            ends_path, nee_weight, roulette)
 from .subsurface import MAX_BOUNCES, object_of, walk, walk_radius
+from .subsurface_disk import find_exit
 from ..embree.rays import new_ray_record
 from .surface import hit_uv, rebuild_at_time
 from .surface_hit import run_program
@@ -55,7 +57,7 @@ def entry_direction(row, dx, dy, dz, nx, ny, nz, u1, u2):
     """The direction into the surface for a ray along d hitting shading normal n (facing
     the ray), or ok False."""
     wix, wiy, wiz = -dx, -dy, -dz
-    skin = row[P_SSS_SKIN] != 0.0
+    skin = row[P_SSS_METHOD] == SSS_SKIN
     if skin:
         if u1 < 0.5:
             lx, ly, lz = cosine_hemisphere(2.0 * u1, u2)
@@ -84,7 +86,7 @@ def entry_direction(row, dx, dy, dz, nx, ny, nz, u1, u2):
 @kernel(allocates=False)
 def walk_params(row):
     """(albedo, walk radius) per channel, and the anisotropy, of material row `row`."""
-    skin = row[P_SSS_SKIN] != 0.0
+    skin = row[P_SSS_METHOD] == SSS_SKIN
     ior = min(max(row[P_SSS_IOR], 1.01), 3.8)
     a0 = min(max(row[P_BASE], 0.0), 1.0)
     a1 = min(max(row[P_BASE + 1], 0.0), 1.0)
@@ -96,13 +98,14 @@ def walk_params(row):
 
 
 @kernel(allocates=False)
-def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, pz,
+def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, front, px, py, pz,
                   gx, gy, gz, nx, ny, nz, dx, dy, dz, u1, u2, br, bg, bb, tally,
                   lights, shadows, ns, nexts, nn, programs, params, hit_row, regs):
     """Path p (throughput b, the lobe's weight included) enters the surface it hit at p
-    (triangle prim of instance inst; geometric normal g and shading normal n facing the
-    ray along d), walks from p, its first ray naming prim
-    (as Cycles' walk starts), and leaves: queues at most one shadow ray (count ns) and
+    (triangle prim of instance inst, from outside where front; geometric normal g and
+    shading normal n facing the ray along d), walks from p, its first ray naming prim
+    (as Cycles' walk starts), or for Christensen-Burley finds its exit by the disk
+    (subsurface_disk.find_exit), and leaves: queues at most one shadow ray (count ns) and
     one next ray (count nn), as path_vertex.shade does. key: the walk's stream
     (subsurface.walk_key); rays: the scene for rays cast here (subsurface.local_hit).
     programs (None in a scene without shader
@@ -113,14 +116,21 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, px, py, p
     cont, prev_pdf, prev_pos, ray_bits = paths.cont, paths.prev_pdf, paths.prev_pos, \
         paths.ray_bits
     min_pdf, stacks, path_info = paths.min_pdf, paths.stacks, (paths.used, paths.cone)
-    ex_dx, ex_dy, ex_dz, ok = entry_direction(row, dx, dy, dz, nx, ny, nz, u1, u2)
-    if not ok or dot(ex_dx, ex_dy, ex_dz, gx, gy, gz) >= 0.0:
-        return ns, nn
-    albedo, radius, g = walk_params(row)
     mesh = object_of(rays[1], prim)
-    left, prim2, inst2, u, v, wdx, wdy, wdz, tr, tg, tb = walk(
-        rays, new_ray_record(rays[0]), key, time, mesh, inst, prim, px, py, pz, ex_dx,
-        ex_dy, ex_dz, nx, ny, nz, albedo, radius, g, (br, bg, bb), True)
+    if row[P_SSS_METHOD] == SSS_BURLEY:
+        left, prim2, inst2, u, v, wdx, wdy, wdz, tr, tg, tb = find_exit(
+            rays, new_ray_record(rays[0]), geometry, key, time, mesh, inst, front, px, py,
+            pz, gx, gy, gz, (max(row[P_SSS_RADIUS], 0.0), max(row[P_SSS_RADIUS + 1], 0.0),
+                             max(row[P_SSS_RADIUS + 2], 0.0)), u1, u2)
+        tr, tg, tb = br * tr, bg * tg, bb * tb
+    else:
+        ex_dx, ex_dy, ex_dz, ok = entry_direction(row, dx, dy, dz, nx, ny, nz, u1, u2)
+        if not ok or dot(ex_dx, ex_dy, ex_dz, gx, gy, gz) >= 0.0:
+            return ns, nn
+        albedo, radius, g = walk_params(row)
+        left, prim2, inst2, u, v, wdx, wdy, wdz, tr, tg, tb = walk(
+            rays, new_ray_record(rays[0]), key, time, mesh, inst, prim, px, py, pz, ex_dx,
+            ex_dy, ex_dz, nx, ny, nz, albedo, radius, g, (br, bg, bb), True)
     if not left or not max(tr, tg, tb) > 0.0:
         return ns, nn
     # the exit, seen from outside along the walk's last direction reversed

@@ -66,7 +66,8 @@ class Material:
     subsurface_anisotropy. It enters by a GGX refraction of IOR subsurface_ior and alpha
     subsurface_alpha (None: roughness^2 at the hit, Principled's rule) and leaves as a
     diffuse surface. subsurface_method: 'RANDOM_WALK' or 'RANDOM_WALK_SKIN' (Cycles' two
-    random walks).
+    random walks), or 'BURLEY' (Christensen-Burley: no walk and no entry refraction, the
+    exit found by Cycles' disk sampling, engine/kernels/subsurface_disk.py).
 
     bump_correction: Cycles' Material > Settings > Bump Map Correction (on by default),
     for a normal bent by the shader (Normal Map, Bump): its specular lobes on the bent

@@ -10,7 +10,8 @@ Subsurface Scattering node: its Color is the albedo and the whole closure's weig
 Radius x Scale, Anisotropy, IOR, and Roughness as the entry's alpha (not squared, as
 Cycles reads it).
 
-Christensen-Burley (Cycles' disk sampling) is rendered by the random walk, reported.
+Christensen-Burley has no entry refraction and no walk: the exit is found by Cycles' disk
+sampling (engine/kernels/subsurface_disk.py); IOR, Anisotropy and Roughness do not apply.
 Weight, radius, scale, IOR, anisotropy and roughness are constants: a linked one is its
 average (reported by `_constant`)."""
 from __future__ import annotations
@@ -19,7 +20,7 @@ from dataclasses import dataclass
 
 from ...blender_compat import node_input
 
-METHODS = ("RANDOM_WALK", "RANDOM_WALK_SKIN")
+METHODS = ("RANDOM_WALK", "RANDOM_WALK_SKIN", "BURLEY")
 
 
 @dataclass
@@ -35,8 +36,10 @@ class Subsurface:
 def _method(node, prop, ctx) -> str:
     method = getattr(node, prop, "RANDOM_WALK")
     if method not in METHODS:
-        ctx.issue(f"{node.name!r} scatters below the surface by "
-                  f"{method.replace('_', ' ').title()}; DRT renders it by Random Walk")
+        # Blender reads a method it does not know (a file from another version) as ''
+        name = method.replace('_', ' ').title() if method else "a method Blender does not know"
+        ctx.issue(f"{node.name!r} scatters below the surface by {name}; DRT renders it by "
+                  f"Random Walk, as Cycles does")
         return "RANDOM_WALK"
     return method
 

@@ -46,7 +46,8 @@ P_SSS_RADIUS = 41        # 3 columns: mean free path per channel (Radius x Scale
 P_SSS_ANISOTROPY = 44    # Henyey-Greenstein g inside
 P_SSS_IOR = 45           # the entry's refraction IOR
 P_SSS_ALPHA = 46         # the entry's GGX alpha; < 0: the hit's roughness^2 (Principled)
-P_SSS_SKIN = 47          # 0 / 1: Random Walk (Skin), Cycles' other radius and entry
+P_SSS_METHOD = 47        # SSS_RANDOM_WALK, SSS_SKIN (Random Walk (Skin): Cycles' other
+#                          radius and entry) or SSS_BURLEY (Christensen-Burley's disk)
 P_SETS_NORMAL = 48       # 0 / 1: the program's normal becomes the surface's (Cycles' Set
 #                          Normal: the Displacement socket's bump), so lobes are not
 #                          shadowed against the smooth normal it bends
@@ -86,6 +87,9 @@ GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
 GLOSSY_MULTI_GGX = 2     # GGX with Cycles' multiple-scattering compensation
 GLOSSY_BECKMANN = 3      # Beckmann (beckmann.py), never compensated, as in Cycles
+SSS_RANDOM_WALK = 0      # P_SSS_METHOD: Cycles' subsurface methods
+SSS_SKIN = 1
+SSS_BURLEY = 2
 
 
 def pack_materials(table) -> np.ndarray:
@@ -125,7 +129,7 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_SSS_ANISOTROPY] = table.subsurface_anisotropy
     rows[:, P_SSS_IOR] = table.subsurface_ior
     rows[:, P_SSS_ALPHA] = table.subsurface_alpha
-    rows[:, P_SSS_SKIN] = table.subsurface_skin
+    rows[:, P_SSS_METHOD] = table.subsurface_method_code
     rows[:, P_METAL_CONSTANT] = table.metal_constant
     rows[:, P_SPEC_TINT:P_SPEC_TINT + 3] = table.specular_tint
     rows[:, P_HAIR] = table.hair
