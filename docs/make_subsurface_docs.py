@@ -127,8 +127,8 @@ which rendered Christensen-Burley before, against Cycles' Burley, and it must fa
 |---|---|---|---|
 {chr(10).join(rows_b)}
 
-Render times at 64 x 48: DRT {t_drt_b:.1f} s ({DRT_SAMPLES} samples; by random walk
-{t_drt:.1f} s), Cycles {t_cycles_b:.1f} s ({CYCLES_SAMPLES} samples).
+Render times at 64 x 48: DRT {t_drt_b:.1f} s ({DRT_SAMPLES} samples), Cycles
+{t_cycles_b:.1f} s ({CYCLES_SAMPLES} samples).
 
 ## What it costs
 
