@@ -11,7 +11,7 @@ from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _Layers, _sum
 from ..material_params import TOL, _is_tex, _lin, _scale
 from .links import _link
 from .shader_inputs import _constant, _input
-from .shader_mix import _mix_factor, _mixed_by_average, _plastic
+from .shader_mix import _mix_factor, _plastic, lifted_mix
 from . import hair, metallic, subsurface
 
 
@@ -221,6 +221,17 @@ def _transparent(node, ctx) -> _Closure:
 MAX_SHADER_READS = 2048
 
 
+def _add(a: _Closure, b: _Closure, ctx) -> _Closure:
+    """An Add Shader of a and b: an emission added to the other's closures, or two BSDFs'
+    lobes summed."""
+    if a.is_emission_only() or b.is_emission_only():
+        emit, other = (a, b) if a.is_emission_only() else (b, a)
+        return _Closure(other.comps, other.t_weight, other.t_color,
+                        _lin([(1.0, emit.emission), (1.0, other.emission)], ctx,
+                             "emission"), other.alpha_texture, h_weight=other.h_weight)
+    return _sum(a, b, ctx)
+
+
 def _closure(socket, ctx, depth=0) -> _Closure:
     """The closure feeding a shader socket."""
     found = _link(socket)
@@ -274,30 +285,21 @@ def _closure(socket, ctx, depth=0) -> _Closure:
                 ctx.issue(f"the Fresnel-driven {node.name!r} is rendered as a Principled "
                           f"specular layer of IOR {ior:.3g}")
                 return p
-        mixed = _sum(a.scaled(1.0 - fac, ctx), b.scaled(fac, ctx), ctx)
         if varying is None:
-            _mixed_by_average(a, b, ctx)
-        else:
-            # per hit, if this Mix Shader is the material's own shader (or one of a
-            # chain of them): export_material makes a Material of each side
-            mixed.mix = (a, b, varying)
+            # a per-hit Mix below is lifted above this one (lifted_mix)
+            return lifted_mix(lambda x, y: _sum(x.scaled(1.0 - fac, ctx),
+                                                y.scaled(fac, ctx), ctx), a, b)
+        # per hit: export_material makes a Material of each side
+        mixed = _sum(a.scaled(1.0 - fac, ctx), b.scaled(fac, ctx), ctx)
+        mixed.mix = (a, b, varying)
         return mixed
     if kind == "ShaderNodeAddShader":
         a = _closure(node.inputs[0], ctx, depth + 1)
         b = _closure(node.inputs[1], ctx, depth + 1)
-        _mixed_by_average(a, b, ctx)
-        if a.is_emission_only() or b.is_emission_only():
-            emit, other = (a, b) if a.is_emission_only() else (b, a)
-            if other.alpha_texture is not None:
-                return _Closure(other.comps, other.t_weight, other.t_color,
-                                _lin([(1.0, emit.emission), (1.0, other.emission)], ctx,
-                                     "emission"), other.alpha_texture)
-            return _Closure(other.comps, other.t_weight, other.t_color,
-                            _lin([(1.0, emit.emission), (1.0, other.emission)], ctx,
-                                 "emission"))
-        ctx.issue(f"{node.name!r} adds two BSDFs; DRT renders their sum as one Principled "
-                  f"BSDF (lobe weights and colours summed)")
-        return _sum(a, b, ctx)
+        if not (a.is_emission_only() or b.is_emission_only()):
+            ctx.issue(f"{node.name!r} adds two BSDFs; DRT renders their sum as one "
+                      f"Principled BSDF (lobe weights and colours summed)")
+        return lifted_mix(lambda x, y: _add(x, y, ctx), a, b)
     ctx.issue(f"it uses the {node.bl_label!r} node, which DRT does not support yet; "
               f"rendering it as a diffuse surface of its viewport colour")
     return _Closure([(1.0, ctx.viewport_comp())])

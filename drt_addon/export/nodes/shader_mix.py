@@ -1,7 +1,7 @@
 """What the Mix and Add Shaders of export.nodes.shader need besides the closures they
 combine: a Mix Shader's Fac (its constant or average, a Fresnel IOR, the per-hit value),
-a Fresnel-mixed pair read as one Principled specular layer (`_plastic`), and the report
-of per-hit mixes mixed by their Fac's average."""
+a Fresnel-mixed pair read as one Principled specular layer (`_plastic`), and per-hit mixes
+lifted above the constant mixes and Add Shaders that combine them (`lifted_mix`)."""
 from __future__ import annotations
 
 import importlib
@@ -50,12 +50,21 @@ def _mix_factor(node, ctx):
     return float(np.clip(ctx.nodes.mean(value), 0.0, 1.0)), None, value
 
 
-def _mixed_by_average(a, b, ctx):
-    """Report per-hit Mix Shaders that a constant Mix or an Add Shader combines (DRT then
-    mixes them by their Fac's average)."""
-    if a.mix is not None or b.mix is not None:
-        ctx.issue("a Mix Shader with a per-hit Fac inside another Mix or Add Shader mixes "
-                  "by its Fac's average")
+def lifted_mix(combine, a, b):
+    """combine(a, b) (a constant Mix or an Add Shader of closures a and b), with a per-hit
+    Mix Shader below it lifted above it: a constant combination distributes over a
+    per-hit mix, combine(mix(f; A1, A2), B) = mix(f; combine(A1, B), combine(A2, B)), so
+    each hit still picks one side by f (Material.mix) and shades the constant
+    combination of that side. Where both have one, B's is lifted into each of A's sides
+    (a chain of per-hit mixes)."""
+    out = combine(a, b)
+    if a.mix is not None:
+        a1, a2, f = a.mix
+        out.mix = (lifted_mix(combine, a1, b), lifted_mix(combine, a2, b), f)
+    elif b.mix is not None:
+        b1, b2, f = b.mix
+        out.mix = (lifted_mix(combine, a, b1), lifted_mix(combine, a, b2), f)
+    return out
 
 
 def _plastic(a: _Closure, b: _Closure, ior, fac, ctx):
