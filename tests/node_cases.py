@@ -158,7 +158,9 @@ def _vertex_colors(kind, domain, output):
 INPUT = [("tc_generated", _tex_coord("Generated")), ("tc_uv", _tex_coord("UV")),
          ("tc_object", _tex_coord("Object")),
          ("oi_color", _object_info("Color")), ("oi_location", _object_info("Location")),
-         ("oi_index", _object_info("Object Index")), ("light_path", _light_path),
+         ("oi_index", _object_info("Object Index")),
+         ("oi_random", _object_info("Random")),      # Cycles: a hash of the object's name
+         ("light_path", _light_path),
          ("color_attribute", _vertex_colors("ShaderNodeVertexColor", "CORNER", "Color")),
          ("color_attribute_alpha", _vertex_colors("ShaderNodeVertexColor", "CORNER",
                                                   "Alpha")),

@@ -19,7 +19,7 @@ from .layer_overrides import material_override, render_world, slot_materials
 from .materials import export_default_volume, export_material
 from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh, uv_request
 from .motion import MotionExport, read_settings
-from .object_info import object_info, object_values
+from .object_info import object_info, object_values, random_id
 from .volume_objects import density_scale, domain, read_volume
 from .volumes import is_heterogeneous, world_volume
 from .world import export_world
@@ -188,7 +188,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             source = groups.known.get(key) if key is not None else None
             if source is not None:               # a place of a source worked out before
                 holdouts += source.holdout
-                groups.place(source, inst.matrix_world, inst.random_id)
+                groups.place(source, inst.matrix_world, random_id(inst, obj))
                 continue
             holdout = _is_holdout(inst, obj, view_layer)
             holdouts += holdout
@@ -218,7 +218,7 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
                             color, pass_index, holdout, crypto_names(inst, obj))
             if tracker is None:
                 # without motion blur, repeated geometry becomes instances (export.instances)
-                groups.place(source, inst.matrix_world, inst.random_id)
+                groups.place(source, inst.matrix_world, random_id(inst, obj))
                 # a volume that varies in space has one material per object: not shared
                 if not any(is_heterogeneous(materials[i]) for i in slots):
                     groups.known[key] = source
@@ -236,7 +236,8 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
             tracker.note_mesh(inst, obj, local, slots, len(meshes) - 1, name)
             # with motion blur, each place is a mesh of its own until the shutter is
             # sampled; those that do not move become instances then (regroup_still)
-            held.append((len(meshes) - 1, source, inst.matrix_world.copy(), inst.random_id))
+            held.append((len(meshes) - 1, source, inst.matrix_world.copy(),
+                         random_id(inst, obj)))
         elif obj.type in LEFT_OUT_TYPES and (inst.is_instance or inst.show_self):
             left_out.note_object(obj)
         elif obj.type == "LIGHT":
@@ -361,7 +362,7 @@ def _place_volume(inst, obj, k, groups, material_id, reporter, view_layer,
     source = Source(groups.group(domain(grids), slots, name, holdout, 0.0, seen, True,
                                  texspace),
                     color, pass_index, holdout, crypto_names(inst, obj))
-    groups.place(source, inst.matrix_world, inst.random_id)
+    groups.place(source, inst.matrix_world, random_id(inst, obj))
 
 
 # the key of the one warning about a black image (said by the export, or after the render)

@@ -1,6 +1,6 @@
 """What shader nodes read of an object instance (engine.scene.ObjectInfo): its colour,
 pass index and texture space, worked out once per source object (`object_values`), and
-its random number, one per instance (`random_of`)."""
+its random number, one per instance (`random_id`, `random_of`)."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,6 +9,50 @@ from ..engine_link import engine
 from .matrices import to_numpy
 
 _UNIT = np.float32(1.0 / 0xFFFFFFFF)
+_U32 = 0xFFFFFFFF
+
+
+def _rot(x: int, k: int) -> int:
+    return ((x << k) | (x >> (32 - k))) & _U32
+
+
+def hash_uint2(kx: int, ky: int) -> int:
+    """Cycles' hash_uint2 (util/hash.h: Jenkins' lookup3 final mix of two words)."""
+    a = b = c = (0xDEADBEEF + (2 << 2) + 13) & _U32
+    b, a = (b + ky) & _U32, (a + kx) & _U32
+    c ^= b
+    c = (c - _rot(b, 14)) & _U32
+    a ^= c
+    a = (a - _rot(c, 11)) & _U32
+    b ^= a
+    b = (b - _rot(a, 25)) & _U32
+    c ^= b
+    c = (c - _rot(b, 16)) & _U32
+    a ^= c
+    a = (a - _rot(c, 4)) & _U32
+    b ^= a
+    b = (b - _rot(a, 14)) & _U32
+    c ^= b
+    return (c - _rot(b, 24)) & _U32
+
+
+def hash_string(text: str) -> int:
+    """Cycles' hash_string (util/hash.h): i = 37 i + byte, over the UTF-8 bytes."""
+    i = 0
+    for byte in text.encode("utf-8"):
+        i = (i * 37 + byte) & _U32
+    return i
+
+
+def random_id(inst, obj) -> int:
+    """The random id Cycles gives a depsgraph object instance: Blender's own for an
+    instance (particles, collection instances, Geometry Nodes); for an object that is not
+    an instance, which Blender gives id 0, hash_uint2(hash_string(name), 0), so that
+    every object has its own Object Info Random (measured against Cycles 5.0: the
+    Randoms of six objects of LoveCandles.blend)."""
+    if getattr(inst, "is_instance", False):
+        return int(getattr(inst, "random_id", 0))
+    return hash_uint2(hash_string(obj.name), 0)
 
 
 def random_of(random_ids) -> np.ndarray:
@@ -32,6 +76,6 @@ def object_info(inst, obj, matrix_world) -> "engine.ObjectInfo":
     """Object Info's Color, Random and pass index, the transform and the texture space of
     one instance."""
     color, pass_index, (loc, size) = object_values(obj)
-    random = float(random_of([int(getattr(inst, "random_id", 0))])[0])
+    random = float(random_of([random_id(inst, obj)])[0])
     return engine.ObjectInfo(np.asarray(to_numpy(matrix_world), np.float64), color, random,
                              pass_index, loc, size)
