@@ -172,6 +172,15 @@ def new_scene(bpy, size=64):
     return scene
 
 
+def empty_material(bpy, name):
+    """A new node material with nothing but its Material Output: (material, node tree,
+    output node)."""
+    mat, nt = new_material(bpy, name)
+    for node in list(nt.nodes):
+        nt.nodes.remove(node)
+    return mat, nt, nt.nodes.new("ShaderNodeOutputMaterial")
+
+
 def new_material(bpy, name):
     """A new node material (Principled BSDF into the Material Output) and its tree."""
     mat = bpy.data.materials.new(name)

@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .material_params import _plain
+from .material_params import _lin, _plain
 
 WHITE = (1.0, 1.0, 1.0)
 BLACK = (0.0, 0.0, 0.0)
@@ -33,7 +33,7 @@ class _Layers:
     sheen_roughness: float = 0.5
     sheen_tint: tuple = WHITE
     sheen_layered: bool = True
-    translucent_color: tuple = BLACK
+    translucent_color: object = BLACK       # a colour, or per hit a NodeParam
     hair_reflection: tuple = BLACK
     hair_reflection_roughness: tuple = (0.1, 1.0)
     hair_reflection_offset: float = 0.0
@@ -98,8 +98,9 @@ def _blend_layers(comps, ctx):
                 len(with_layers) < len(comps):
             ctx.issue("a coated or sheened Principled BSDF is mixed with other shaders; DRT "
                       "layers the mixture's coat and sheen over all of them")
-    out.translucent_color = _plain(sum(c * np.asarray(L.translucent_color, float)
-                                       for c, L in with_layers))
+    # (per hit where one is: the program sums them)
+    out.translucent_color = _lin([(c, L.translucent_color) for c, L in with_layers], ctx,
+                                 "translucent colour") or BLACK
     for part in HAIR_PARTS:
         # colours summed; roughness and offset averaged by the colours' weight
         hw = [(c * max(getattr(L, part)), L) for c, L in with_layers

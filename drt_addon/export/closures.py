@@ -171,6 +171,9 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
     if p["layers"] is not None:
         for k in LAYER_FIELDS:
             v = getattr(p["layers"], k)
+            if _is_tex(v):               # per hit (a Translucent BSDF's colour)
+                program_outputs(m)[k] = v.value
+                v = tuple(float(x) for x in v.mean())
             setattr(m, k, tuple(float(x) for x in v) if isinstance(v, tuple) else v)
         for k, v in (p["layers"].principled_hair_programs or {}).items():
             program_outputs(m)[k] = v.value       # per hit (hair_chiang's colour, Melanin)

@@ -195,9 +195,14 @@ class MaterialTable:
             [1.0 if getattr(m, "holdout", False)
              else float(np.clip(getattr(m, "holdout_weight", 0.0), 0.0, 1.0))
              for m in materials], np.float64)
+        # a Translucent BSDF's colour per hit (its program's translucent_color), which may
+        # average to black (a ramp of the Object Info's Random, say)
+        translucent_per_hit = np.array(
+            ["translucent_color" in getattr(getattr(m, "shader", None), "outputs", {})
+             for m in materials], bool)
         self.layered = ((self.coat_weight > 1e-5) | (self.sheen_weight > 1e-5)
-                        | (self.translucent_color.max(1) > 0.0) | self.refraction_only
-                        | self.hair)
+                        | (self.translucent_color.max(1) > 0.0) | translucent_per_hit
+                        | self.refraction_only | self.hair)
         for name in ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",
                      "sheen_roughness", "sheen_tint", "translucent_color", "hair_reflection",
                      "hair_reflection_offset", "hair_reflection_roughness",

@@ -6,13 +6,13 @@ Numba then compiles these without that code."""
 from __future__ import annotations
 
 from .bsdf.params import (P_BASE, P_BUMP_CORRECTION, P_CHIANG_COLOR, P_CHIANG_MELANIN,
-                          P_HAIR, P_METALLIC, P_ROUGHNESS)
+                          P_HAIR, P_LAYERS, P_METALLIC, P_ROUGHNESS, P_TRANSLUCENT)
 from .jit import kernel
 from .textures import apply_to_row, emission_at
 from ..nodes.context import path_fields
 from ..nodes.differentials import cone_at
-from ..nodes.shading import (apply_hair, apply_rows, pick_closure, program_emission,
-                             program_hit, program_normal)
+from ..nodes.shading import (apply_hair, apply_rows, apply_translucent, pick_closure,
+                             program_emission, program_hit, program_normal)
 
 
 @kernel(allocates=False)
@@ -55,5 +55,7 @@ def material_row(params, textures, programs, ms, uu, vv, regs, programmed, row):
         apply_to_row(textures, ms, uu, vv, row, P_BASE, P_METALLIC, P_ROUGHNESS)
     if programs is not None and programmed:
         apply_rows(programs, ms, regs, row, P_BASE, P_METALLIC, P_ROUGHNESS)
+        if row[P_LAYERS] != 0.0:     # a Translucent BSDF's colour, per hit
+            apply_translucent(programs, ms, regs, row, P_TRANSLUCENT)
         if row[P_HAIR] != 0.0:       # a Principled Hair's colour and Melanin, per hit
             apply_hair(programs, ms, regs, row, P_CHIANG_COLOR, P_CHIANG_MELANIN)

@@ -28,6 +28,7 @@ OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_
 OUT_VOL_SA, OUT_VOL_SS, OUT_VOL_EM = 7, 8, 9      # engine.kernels.medium_density
 OUT_HAIR_COLOR, OUT_HAIR_MELANIN = 10, 11          # a Principled Hair's (hair_chiang.py)
 OUT_SURFACE_NORMAL = 12                             # Cycles' sd->N, where set (surface_normal)
+OUT_TRANSLUCENT = 13                                # a Translucent BSDF's colour (layers.py)
 
 
 @kernel(allocates=False)
@@ -115,6 +116,16 @@ def apply_hair(T, m, regs, row, P_COLOR, P_MELANIN):
     r = outs[m, OUT_HAIR_MELANIN]
     if r >= 0:
         row[P_MELANIN] = regs[r]
+
+
+@kernel(allocates=False)
+def apply_translucent(T, m, regs, row, P_TRANSLUCENT):
+    """Write the program's Translucent BSDF colour (weight included) into the row."""
+    r = T[OUTS][m, OUT_TRANSLUCENT]
+    if r >= 0:
+        row[P_TRANSLUCENT] = max(regs[r], 0.0)
+        row[P_TRANSLUCENT + 1] = max(regs[r + 1], 0.0)
+        row[P_TRANSLUCENT + 2] = max(regs[r + 2], 0.0)
 
 
 @kernel(allocates=False)

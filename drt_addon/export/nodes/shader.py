@@ -104,11 +104,12 @@ def _sheen(node, ctx) -> _Closure:
 
 
 def _translucent(node, ctx) -> _Closure:
-    """Translucent BSDF: Lambertian transmission of its colour."""
+    """Translucent BSDF: Lambertian transmission of its colour (per hit where linked)."""
     _normal(node, ctx)
-    color = _constant(node, "Color", ctx, (0.8,) * 3, color=True)
+    color = _input(node, "Color", ctx, True, (0.8,) * 3)
+    color = color if _is_tex(color) else tuple(color)
     return _Closure([(1.0, _Comp(base=BLACK, spec=0.0,
-                                 layers=_Layers(translucent_color=tuple(color))))])
+                                 layers=_Layers(translucent_color=color)))])
 
 
 def _scattering(node, ctx) -> _Closure:
