@@ -87,9 +87,17 @@ KNOWN = """## Known differences
   DRT shades each hit by one of them, picked with the Fac's probability (unbiased, a
   little noisier; `test_mix_shader_with_per_hit_factor_matches_cycles`: a checker mask
   and a Layer Weight Facing, both within 0.1% of Cycles' mean). A per-hit Mix Shader
-  inside another Mix or Add Shader whose Fac is constant mixes by its Fac's average
-  (reported). A Fresnel or Layer Weight Fresnel factor between a diffuse and a glossy
-  shader stays Principled's specular layer of that IOR, as before.
+  inside a Mix Shader whose Fac is constant, or inside an Add Shader, is lifted above
+  it: a constant combination distributes over a per-hit mix, so each hit picks a side
+  by the inner Fac and shades the constant combination of that side
+  (`test_a_per_hit_mix_inside_a_constant_mix_or_add_matches_cycles`: 0.34% and 0.04%
+  of Cycles' mean). A Fresnel or Layer Weight Fresnel factor between a diffuse and a
+  glossy shader stays Principled's specular layer of that IOR, as before.
+- **Object Info's Random** of an object that is not an instance is Cycles' hash of the
+  object's name (Blender gives such objects random id 0); of an instance, Blender's
+  random id (the `oi_random` tile).
+- **A Translucent BSDF's Color** may vary per hit (a texture, or a ramp of Object Info's
+  Random: `test_a_translucent_colour_that_varies_per_hit_matches_cycles`).
 - **Procedural textures** follow Blender 5's hashes (its 2D to 4D Voronoi places cells
   with an integer hash that Blender 4.x did not use, so on 4.x those differ); White
   Noise hashes the exact float bits of its input, so it matches where both engines
