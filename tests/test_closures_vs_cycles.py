@@ -1,5 +1,6 @@
 """Coat, sheen, translucency, the Refraction BSDF, Beckmann, the Glossy BSDF, the
-Principled Specular Tint and the Metallic BSDF against Cycles: nine small scenes
+Principled Specular Tint, the Glass BSDF's Color and the Metallic BSDF against Cycles:
+ten small scenes
 (64 x 48 pixels) built here with bpy at Blender's defaults (bounces, Filter Glossy,
 Principled inputs not named), rendered by Cycles (512 samples per pixel) and DRT (512),
 each compared with `compare` of tests/test_multiscatter_vs_cycles.py: image means within
@@ -32,6 +33,9 @@ a control, DRT rendering it without the feature (as it did before), which must f
     tints (what DRT rendered before).
   * glass_tint: a smooth and a rough Principled glass (IOR 2.2) with strong Specular
     Tints (the reflection's F0 tinted, 1 - F_c let through); control: white tints.
+  * glass_color: a smooth and a rough Glass BSDF with a strong Color, which Cycles
+    applies to the reflection as well as the refraction; control: Principled glasses
+    whose refraction has that tint and whose reflection is white (DRT before).
   * metallic: four Metallic BSDF spheres (Blender 4.3+), F82 Tint and Physical Conductor
     (DRT: the F82-tint fit, tests/test_metallic_node.py), each at its defaults and with
     a metal's colours, over the three distributions; control: grey diffuse spheres
@@ -48,6 +52,7 @@ samples (at 1024 the worst blocks were 0.06 % to 1.62 %, the means the same with
   glossy       -0.04 %, 0.31 %;  control +0.89 / +1.1 / +1.2 %, 6.8 %
   specular_tint 0.00 %, 0.59 %;  control +1.27 / +1.66 / +0.33 %, 4.2 %
   glass_tint   -0.31 / -0.18 / -0.28 %, 1.72 %;  control -0.36 / +0.42 / -0.99 %, 7.8 %
+  glass_color  -0.04 %, 0.45 %;  control +2.2 / +3.2 / +2.0 %, 9.2 %
   metallic     +0.08 / +0.06 / -0.06 %, 0.50 %;  control +3.9 / +8.1 / +16.9 %, 37 %
 """
 from __future__ import annotations
@@ -295,6 +300,25 @@ def glass_tint_scene(bpy, control=False):
     return scene
 
 
+def glass_color_scene(bpy, control=False):
+    """Glass BSDF spheres (smooth and rough, IOR 1.6) with a strong Color: Cycles tints
+    their reflection by it as well as their refraction (its reflection_tint); control:
+    Principled glasses of base colour Color^2, whose refraction is tinted by Color and
+    reflection is white (what DRT rendered a Glass BSDF as before)."""
+    scene = _striped_room(bpy)
+    for k, (colour, rough) in enumerate((((0.15, 0.45, 0.95), 0.0),
+                                          ((0.95, 0.35, 0.1), 0.3))):
+        if control:
+            mat = _principled(bpy, f"ColouredGlass{k}", **{
+                "Base Color": (*(c * c for c in colour), 1.0), "Transmission Weight": 1.0,
+                "IOR": 1.6, "Roughness": rough})
+        else:
+            mat, _ = _bsdf(bpy, f"ColouredGlass{k}", "ShaderNodeBsdfGlass",
+                           Color=(*colour, 1.0), IOR=1.6, Roughness=rough)
+        _sphere(bpy, (-0.7 + 1.4 * k, 0.0, 0.75), 0.65, mat)
+    return scene
+
+
 def metallic_scene(bpy, control=False):
     """Four Metallic BSDF spheres (Blender 4.3+): F82 Tint at the node's defaults and
     with a gold colour and a red edge (GGX), Physical Conductor at its defaults (Multiscatter
@@ -323,7 +347,7 @@ def metallic_scene(bpy, control=False):
 SCENES = {"coat": coat_scene, "sheen": sheen_scene, "translucent": translucent_scene,
           "refraction": refraction_scene, "beckmann": beckmann_scene, "glossy": glossy_scene,
           "specular_tint": tint_scene, "glass_tint": glass_tint_scene,
-          "metallic": metallic_scene}
+          "glass_color": glass_color_scene, "metallic": metallic_scene}
 
 
 def render(bpy, name, engine, control=False):

@@ -162,6 +162,8 @@ def test_diffuse_glossy_glass_emission_transparent(bpy_drt):
     assert m.transmission == 1.0 and m.metallic == 0.0
     assert m.ior == pytest.approx(1.45) and m.roughness == pytest.approx(0.1)
     assert close(m.glass_color, (0.7, 0.9, 0.8)) and w == []
+    # Cycles tints the reflection by the Color too (its reflection_tint); Principled: white
+    assert close(m.glass_reflection_tint, (0.7, 0.9, 0.8))
 
     m, w = _export(_single(bpy, "ShaderNodeEmission", Color=(1.0, 0.5, 0.0, 1),
                            Strength=3.0)[0])

@@ -28,6 +28,8 @@ class _Comp:
     metal_fresnel: str = "SCHLICK"  # 'CONSTANT': a Glossy BSDF's (Material.metal_fresnel)
     specular_tint: tuple = WHITE    # Principled's, the metal lobe's F82 tint
     glass_color: object = None      # None: sqrt(base colour) per crossing (Principled)
+    glass_reflect: object = None    # the glass reflection's tint (a Glass BSDF's Color;
+    #                                 None: white, Principled's)
     distribution: str = "MULTI_GGX"  # 'MULTI_GGX', 'GGX' or 'BECKMANN' (glossy_model)
     layers: object = None           # a _Layers: coat, sheen, translucency (None: none)
     refraction_only: bool = False   # the glass lobe does not reflect (Refraction BSDF)
@@ -157,6 +159,7 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
         m.metal_color = tuple(mc)
     if p["glass_color"] is not None:
         m.glass_color = tuple(_mean(p["glass_color"]))
+    m.glass_reflection_tint = tuple(float(x) for x in p["glass_reflect"])
     m.refraction_only = bool(p["refraction_only"])
     sss = p["subsurface"]
     if sss is not None and sss.weight > 0:
@@ -231,8 +234,9 @@ def _blend(comps, ctx) -> dict:
                     roughness=c.roughness, ior=c.ior, spec=c.spec,
                     metal_color=None if c.metal_color is None or _same(c.metal_color, c.base)
                     else c.metal_color,
-                    glass_color=c.glass_color, distribution=c.distribution,
-                    layers=c.layers, refraction_only=c.refraction_only,
+                    glass_color=c.glass_color,
+                    glass_reflect=c.glass_reflect if c.glass_reflect is not None else WHITE,
+                    distribution=c.distribution, layers=c.layers, refraction_only=c.refraction_only,
                     metal_fresnel=c.metal_fresnel, specular_tint=c.specular_tint,
                     subsurface=c.subsurface, diffuse_roughness=c.diffuse_roughness)
     lw = [(c, comp, *comp.weights()) for c, comp in comps]
@@ -264,6 +268,11 @@ def _blend(comps, ctx) -> dict:
                       else np.sqrt(np.clip(np.asarray(_mean(comp.base)), 0.0, 1.0)))
                      for c, comp, _, g, _ in lw if g > 0]
             glass_color = _plain(sum(w * t for w, t in tints) / Wg)
+    glass_reflect = WHITE
+    if Wg > 0 and any(comp.glass_reflect is not None for _, comp, _, g, _ in lw if g > 0):
+        glass_reflect = _plain(sum(c * g * np.asarray(comp.glass_reflect if comp.glass_reflect
+                                                       is not None else WHITE, float)
+                                   for c, comp, _, g, _ in lw if g > 0) / Wg)
     # the dielectric base lobe's specular layer: level weighted by the base lobes
     spec = (sum(c * b * comp.spec for c, comp, _, _, b in lw) / Wb) if Wb > 0 else 0.5
     # roughness and IOR: weighted by the lobes that use them
@@ -301,7 +310,8 @@ def _blend(comps, ctx) -> dict:
         ctx.issue("a Refraction BSDF is mixed with a glass; DRT renders both as glass")
     return dict(base=base, metallic=metallic, transmission=float(np.clip(transmission, 0, 1)),
                 roughness=roughness, ior=ior, spec=spec, metal_color=metal_color,
-                glass_color=glass_color, distribution=distribution,
+                glass_color=glass_color, glass_reflect=glass_reflect,
+                distribution=distribution,
                 layers=_blend_layers(comps, ctx), refraction_only=refr == {True},
                 metal_fresnel=metal_fresnel, specular_tint=specular_tint,
                 subsurface=_blend_subsurface(lw, Wb, ctx),

@@ -90,6 +90,10 @@ class MaterialTable:
                                      zip(metal, self.base_color)], np.float64).reshape(-1, 3)
         self.glass_color = np.array([(c if c is not None else (1.0, 1.0, 1.0))[:3]
                                      for c in glass], np.float64).reshape(-1, 3)
+        self.glass_reflection_tint = np.maximum(np.array(
+            [tuple(getattr(m, "glass_reflection_tint", (1.0, 1.0, 1.0)))[:3]
+             for m in materials], np.float64).reshape(-1, 3), 0.0)
+        _require_finite(materials, "glass_reflection_tint", self.glass_reflection_tint)
         self._layer_params(materials)
         self._subsurface_params(materials)
         self.transparent_color = np.array(

@@ -30,7 +30,9 @@ class Material:
                    white at grazing angles; the glass lets 1 - F through), as in Cycles;
                    white: none;
       glass_color  the tint of each refraction through the glass lobe (Principled uses
-                   sqrt(base colour); a Glass BSDF node its colour).
+                   sqrt(base colour); a Glass BSDF node its colour);
+      glass_reflection_tint  the glass lobe's reflection times this (a Glass BSDF node's
+                   colour, Cycles' reflection_tint; Principled: white).
 
     glossy_model: the microfacet model of the specular, metal and glass lobes: 'GGX'
     (single scattering, the default here and Blender's "GGX"), 'MULTI_GGX' (Blender's
@@ -93,6 +95,7 @@ class Material:
     metal_fresnel: str = "SCHLICK"
     specular_tint: tuple = (1.0, 1.0, 1.0)
     glass_color: Optional[tuple] = None
+    glass_reflection_tint: tuple = (1.0, 1.0, 1.0)
     transparent_color: tuple = (1.0, 1.0, 1.0)
     glossy_model: str = "GGX"
     coat_weight: float = 0.0

@@ -195,8 +195,8 @@ def _glass(node, ctx, refraction=False) -> _Closure:
     distribution = _distribution(node, ctx)
     color = _input(node, "Color", ctx, True, WHITE)
     if _is_tex(color):
-        ctx.issue(f"the colour of {node.name!r} is textured; DRT tints its refraction "
-                  f"with the texture's average")
+        ctx.issue(f"the colour of {node.name!r} is textured; DRT tints its reflection "
+                  f"and refraction with the texture's average")
         color = color.mean()
     s = node_input(node, "Thin Film Thickness")
     if s is not None and (s.is_linked or float(s.default_value) > 0.0):
@@ -204,6 +204,7 @@ def _glass(node, ctx, refraction=False) -> _Closure:
     comp = _Comp(base=color, transmission=1.0,
                  roughness=_input(node, "Roughness", ctx, False, 0.0),
                  ior=_constant(node, "IOR", ctx, 1.5), glass_color=color,
+                 glass_reflect=tuple(float(x) for x in color),
                  distribution=distribution, refraction_only=refraction)
     return _Closure([(1.0, comp)])
 

@@ -81,7 +81,9 @@ P_CHIANG_T = 85          # per hit, 3 columns: the fibre's tangent in the shadin
 P_CHIANG_NG = 88         # per hit, 3 columns: the geometric normal in the shading frame
 #                          (either side; for h, where across the fibre the view meets it)
 P_DIFFUSE_ROUGHNESS = 91  # Oren-Nayar sigma of the diffuse lobe, 0 to 1 (0: Lambert)
-NPARAM = 92
+P_GLASS_REFLECT = 92     # 3 columns: the glass lobe's reflection tint (a Glass or Refraction
+#                          BSDF's Color, as Cycles' reflection_tint; white for Principled)
+NPARAM = 95
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -107,6 +109,7 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_HAS_METAL_COLOR] = table.has_metal_color
     rows[:, P_GLASS_COLOR:P_GLASS_COLOR + 3] = table.glass_color
     rows[:, P_HAS_GLASS_COLOR] = table.has_glass_color
+    rows[:, P_GLASS_REFLECT:P_GLASS_REFLECT + 3] = table.glass_reflection_tint
     rows[:, P_GLOSSY_MODEL] = np.select(
         [table.blinn_phong, table.multiscatter, table.beckmann],
         [GLOSSY_BLINN_PHONG, GLOSSY_MULTI_GGX, GLOSSY_BECKMANN], GLOSSY_GGX)

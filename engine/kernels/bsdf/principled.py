@@ -68,12 +68,14 @@ from .compensation import compensate
 from .reflection_lobes import f82_setup, metal_fresnel, reflection_pdf, reflection_sample
 from .state import (NSTATE, S_ALPHA, S_ANY_SIDE, S_BECKMANN, S_BLINN, S_DIFFUSE,  # noqa: F401
                     S_EST, S_ETA_GLASS, S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH,
-                    S_GLASS_TINTED, S_LAYERED, S_METAL_CONST, S_METAL_F0, S_METAL_F82,
+                    S_GLASS_RTINT, S_GLASS_TINTED, S_LAYERED, S_METAL_CONST, S_METAL_F0,
+                    S_METAL_F82,
                     S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY,
                     S_SPEC_TINTED, S_EST_SSS, S_E_SPEC, S_SSS, S_TINT, S_W_GLASS, S_W_METAL,
                     S_W_SPEC, S_WALTER)
 from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX,  # noqa: F401
-                     GLOSSY_MULTI_GGX, NPARAM, P_BASE, P_GLASS_COLOR, P_GLOSSY_MODEL,
+                     GLOSSY_MULTI_GGX, NPARAM, P_BASE, P_GLASS_COLOR, P_GLASS_REFLECT,
+                     P_GLOSSY_MODEL,
                      P_HAS_GLASS_COLOR, P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR,
                      P_LAYERS, P_METAL_COLOR, P_METAL_CONSTANT, P_METALLIC,
                      P_REFRACT_ONLY, P_ROUGHNESS, P_SPEC_LEVEL, P_TRANSMISSION,
@@ -143,6 +145,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
             state[S_TINT + c] = min(max(row[P_GLASS_COLOR + c], 0.0), 1.0)
         else:
             state[S_TINT + c] = math.sqrt(clamped)
+        state[S_GLASS_RTINT + c] = max(row[P_GLASS_REFLECT + c], 0.0)
         # (less the share that scatters below the surface: subsurface_lobe.py)
         state[S_DIFFUSE + c] = subsurface_lobe.split(row, c, base, clamped, base_w, state)
         diffuse_max = max(diffuse_max, state[S_DIFFUSE + c])
@@ -363,9 +366,8 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
         if not ok:
             return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
         w = ws * state[S_W_GLASS] / q_sel
-        wr, wg, wb = w, w, w
-        if refr:
-            wr, wg, wb = state[S_TINT] * w, state[S_TINT + 1] * w, state[S_TINT + 2] * w
+        t = S_TINT if refr else S_GLASS_RTINT
+        wr, wg, wb = state[t] * w, state[t + 1] * w, state[t + 2] * w
         if state[S_GLASS_TINTED] != 0.0:        # Specular Tint: per channel F_c for F
             eta = state[S_ETA_GLASS]
             wr *= specular_tint.glass_factor(state, 0, F, eta, not refr)

@@ -10,7 +10,8 @@ from . import dielectric, fresnel, layers, oren_nayar, specular_tint
 from . import microfacet as mf
 from .reflection_lobes import metal_fresnel, reflection_eval
 from .state import (S_DIFFUSE, S_ALPHA, S_BECKMANN, S_ETA_GLASS, S_ETA_SPEC, S_GLASS_SMOOTH,
-                    S_GLASS_TINTED, S_LAYERED, S_MS_GLASS, S_MS_METAL, S_MS_SPEC,
+                    S_GLASS_RTINT, S_GLASS_TINTED, S_LAYERED, S_MS_GLASS, S_MS_METAL,
+                    S_MS_SPEC,
                     S_ON, S_REFRACT_ONLY, S_SPEC_TINTED, S_TINT, S_W_GLASS, S_W_METAL,
                     S_W_SPEC, S_WALTER)
 from ..warp import INV_PI
@@ -83,9 +84,10 @@ def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
             k0 = specular_tint.glass_factor(state, 0, F, state[S_ETA_GLASS], refl)
             k1 = specular_tint.glass_factor(state, 1, F, state[S_ETA_GLASS], refl)
             k2 = specular_tint.glass_factor(state, 2, F, state[S_ETA_GLASS], refl)
-        fr += (f_r + f_t * state[S_TINT]) * k0 * w_glass * state[S_MS_GLASS]
-        fg += (f_r + f_t * state[S_TINT + 1]) * k1 * w_glass * state[S_MS_GLASS + 1]
-        fb += (f_r + f_t * state[S_TINT + 2]) * k2 * w_glass * state[S_MS_GLASS + 2]
+        r, t = S_GLASS_RTINT, S_TINT
+        fr += (f_r * state[r] + f_t * state[t]) * k0 * w_glass * state[S_MS_GLASS]
+        fg += (f_r * state[r + 1] + f_t * state[t + 1]) * k1 * w_glass * state[S_MS_GLASS + 1]
+        fb += (f_r * state[r + 2] + f_t * state[t + 2]) * k2 * w_glass * state[S_MS_GLASS + 2]
     return fr, fg, fb
 
 

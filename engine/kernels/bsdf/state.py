@@ -38,4 +38,5 @@ S_ANY_SIDE = layers.NSTATE + 23     # 1: principled.sample's last direction may 
 #                                     either side of the surface (a hair lobe's, as Cycles)
 S_ON = layers.NSTATE + 24          # 5: Oren-Nayar a, b (b 0: Lambert) and its multiple-
 #                                    scattering term per channel (oren_nayar.py)
-NSTATE = layers.NSTATE + 29
+S_GLASS_RTINT = layers.NSTATE + 29  # 3: the glass lobe's reflection tint (a Glass BSDF's Color)
+NSTATE = layers.NSTATE + 32
