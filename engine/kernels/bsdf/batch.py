@@ -155,6 +155,7 @@ class Principled:
                        (R.P_SPEC_LEVEL, specular_ior_level), (R.P_GLOSSY_MODEL, glossy_model)):
             rows[:, col] = v
         rows[:, R.P_SPEC_TINT:R.P_SPEC_TINT + 3] = 1.0         # no Specular Tint
+        rows[:, R.P_GLASS_REFLECT:R.P_GLASS_REFLECT + 3] = 1.0  # nor a reflection tint
         return cls(rows, front, walter)
 
     @classmethod
