@@ -19,6 +19,10 @@ walk leaves as Cycles does (integrator/subsurface.h):
    diffuse bounce is left, a cosine-distributed next ray. The walk is no bounce (Cycles
    does not count it); the exit's bounce is a diffuse one.
 
+Christensen-Burley has neither entry nor walk: its exit comes from Cycles' disk sampling
+(engine/kernels/subsurface_disk.py), with the disk drawn from the vertex's own BSDF
+sample numbers, and is shaded as in step 3.
+
 The entry direction uses the vertex's own BSDF sample numbers; the walk and the exit use
 the walk's hashed stream, independent of them.
 """
