@@ -16,24 +16,18 @@ def _rot(x: int, k: int) -> int:
     return ((x << k) | (x >> (32 - k))) & _U32
 
 
+# lookup3's final mix: (target, source, rotation) for x ^= y; x -= rot(y, k), on (a, b, c)
+_FINAL = ((2, 1, 14), (0, 2, 11), (1, 0, 25), (2, 1, 16), (0, 2, 4), (1, 0, 14), (2, 1, 24))
+
+
 def hash_uint2(kx: int, ky: int) -> int:
     """Cycles' hash_uint2 (util/hash.h: Jenkins' lookup3 final mix of two words)."""
-    a = b = c = (0xDEADBEEF + (2 << 2) + 13) & _U32
-    b, a = (b + ky) & _U32, (a + kx) & _U32
-    c ^= b
-    c = (c - _rot(b, 14)) & _U32
-    a ^= c
-    a = (a - _rot(c, 11)) & _U32
-    b ^= a
-    b = (b - _rot(a, 25)) & _U32
-    c ^= b
-    c = (c - _rot(b, 16)) & _U32
-    a ^= c
-    a = (a - _rot(c, 4)) & _U32
-    b ^= a
-    b = (b - _rot(a, 14)) & _U32
-    c ^= b
-    return (c - _rot(b, 24)) & _U32
+    start = (0xDEADBEEF + (2 << 2) + 13) & _U32
+    abc = [(start + kx) & _U32, (start + ky) & _U32, start]
+    for x, y, k in _FINAL:
+        abc[x] ^= abc[y]
+        abc[x] = (abc[x] - _rot(abc[y], k)) & _U32
+    return abc[2]
 
 
 def hash_string(text: str) -> int:
