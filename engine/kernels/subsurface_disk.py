@@ -31,13 +31,13 @@ import math
 from ..embree.rays import new_ray_record
 from ..sampling.hashing import stream_uniform
 from .frame import basis, dot
+from .bsdf.subsurface_lobe import MIN_RADIUS     # Cycles' BSSRDF_MIN_RADIUS
 from .jit import kernel
 from .subsurface import local_hit
 from .surface import rebuild_at_time
 
 TRUNCATE = 16.0                       # Cycles' BURLEY_TRUNCATE, in units of d
 TRUNCATE_CDF = 0.9963790093708328     # the profile's CDF there
-MIN_RADIUS = 1e-8                     # Cycles' BSSRDF_MIN_RADIUS
 MAX_CANDIDATES = 64                   # surfaces of the object one probe ray may cross
 PICK = 8                              # the walk stream's first number for the resampling
 
