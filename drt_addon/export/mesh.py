@@ -285,13 +285,7 @@ def _evaluate(obj, want_uv: Optional[str] = None, reporter=None,
         if want_uv is not None and len(tris):
             uvs = mesh_uvs(mesh, want_uv)
         if want_tangents and len(tris):
-            tangents = mesh_tangents(mesh, want_uv or "")
-            if tangents is None and reporter is not None:
-                reporter.warn(f"DRT: object {obj.name!r}: no tangents for its tangent-space "
-                              "Normal Map or Vector Displacement (no UV map, or faces of "
-                              "more than four corners); the map is not applied, the "
-                              "displacement only along the normal",
-                              key=(obj.name, "tangents"))
+            tangents = mesh_tangents(mesh, pos, tris, normals, want_uv or "")
         if want_colors is not None and len(tris):
             colors = mesh_colors(mesh, want_colors)
     finally:

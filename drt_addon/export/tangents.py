@@ -1,11 +1,13 @@
-"""Tangent space for Normal Map and Vector Displacement nodes: Blender's MikkTSpace
-tangents and bitangent signs per triangle corner (`Mesh.calc_tangents`, the tangents
-Cycles reads), exported only for objects whose materials read tangent space."""
+"""Tangent space for Normal Map and Vector Displacement nodes: MikkTSpace tangents and
+bitangent signs per triangle corner, as Cycles computes them (mikktspace.py), exported
+only for objects whose materials read tangent space."""
 from __future__ import annotations
 
 from typing import Optional
 
 import numpy as np
+
+from . import mikktspace
 
 
 def wants_tangents(materials) -> bool:
@@ -34,26 +36,23 @@ def uv_layer(mesh, name: str = ""):
     return layer
 
 
-def mesh_tangents(mesh, uv_name: str = "") -> Optional[np.ndarray]:
+def mesh_tangents(mesh, positions: np.ndarray, triangles: np.ndarray,
+                  corner_normals: Optional[np.ndarray], uv_name: str = "") -> np.ndarray:
     """(T, 3, 4) float32: tangent xyz and bitangent sign per loop-triangle corner, in
-    object space, from UV map `uv_name` ('' or a missing name: the active render map);
-    None when the mesh has no UV map or Blender cannot compute them (n-gons)."""
+    object space, as Cycles computes them: MikkTSpace on the render triangles (n-gons
+    included), from UV map `uv_name` ('' or a missing name: the active render map), or on
+    a mesh without UV maps from map_to_sphere of the positions. `corner_normals` are
+    mesh_arrays' split normals (None when every face is flat); flat faces use their
+    triangle's own normal, as Cycles does."""
+    from .mesh import mesh_uvs, smooth_triangles
+    flat = mikktspace.face_normals(positions.astype(np.float32)[triangles])
+    normals = np.repeat(flat[:, None], 3, axis=1)
+    if corner_normals is not None:
+        smooth = smooth_triangles(mesh)
+        normals[smooth] = corner_normals[smooth]
     layer = uv_layer(mesh, uv_name)
-    if layer is None:
-        return None
-    try:
-        mesh.calc_tangents(uvmap=layer.name)
-    except RuntimeError:
-        return None
-    nt = len(mesh.loop_triangles)
-    loops = np.empty(nt * 3, np.int32)
-    mesh.loop_triangles.foreach_get("loops", loops)
-    t = np.empty(len(mesh.loops) * 3, np.float32)
-    mesh.loops.foreach_get("tangent", t)
-    s = np.empty(len(mesh.loops), np.float32)
-    mesh.loops.foreach_get("bitangent_sign", s)
-    out = np.concatenate([t.reshape(-1, 3)[loops], s[loops, None]], axis=1)
-    return np.ascontiguousarray(out.reshape(nt, 3, 4))
+    uvs = mesh_uvs(mesh, layer.name) if layer is not None else None
+    return mikktspace.tangents(positions, triangles, normals, uvs)
 
 
 def to_world(tangents: Optional[np.ndarray], m3: np.ndarray) -> Optional[np.ndarray]:
