@@ -108,7 +108,7 @@ def first_hit_rows(ctx, si) -> np.ndarray:
     """(n, engine.nodes.context.N_HIT) the hit rows shader programs read at first hits
     `si` of camera rays, as the path tracer fills them there (the hit's position,
     normals, UV, object, tangent and colour attribute: engine.nodes.shading.program_hit)."""
-    from .nodes.context import hit_rows
+    from .nodes.context import H_MAP_NORMAL, hit_rows
     from .visibility import CAMERA
     g = ctx.integrator.geometry
     tri_object, objects, tangents, colors = g[8], g[9], g[10], g[11]
@@ -117,14 +117,19 @@ def first_hit_rows(ctx, si) -> np.ndarray:
     bary = si.bary if si.bary is not None else np.zeros((n, 2))
     inst = si.inst if si.inst is not None else np.full(n, -1, np.int64)
     obj = np.where(inst >= 0, inst, tri_object[prim] if len(tri_object) else -1)
-    tangent = _corner_lerp(tangents, prim, bary) if len(tangents) else None
-    if tangent is not None:      # unit tangents and a bitangent sign (program_hit's)
-        tangent[:, :3] /= np.maximum(np.linalg.norm(tangent[:, :3], axis=1), 1e-30)[:, None]
-        tangent[:, 3] = np.sign(tangent[:, 3])
-    return hit_rows(si.position, si.shading_normal, si.geometric_normal, si.direction,
+    frame = None
+    if len(tangents):            # the Normal Map's object-space frame (program_hit's)
+        from .nodes.tangent_frame import object_frames
+        frame = object_frames(tangents, g[4], objects, np.asarray(prim, np.int64),
+                              np.asarray(inst, np.int64), np.asarray(obj, np.int64),
+                              np.ascontiguousarray(bary, np.float64))
+    rows = hit_rows(si.position, si.shading_normal, si.geometric_normal, si.direction,
                     si.uv, si.front_facing, ray=CAMERA, objects=objects, obj=obj,
-                    tangent=tangent,
+                    tangent=None if frame is None else frame[:, :4],
                     color=_corner_lerp(colors, prim, bary) if len(colors) else None)
+    if frame is not None:
+        rows[:, H_MAP_NORMAL:H_MAP_NORMAL + 3] = frame[:, 4:7]
+    return rows
 
 
 def hit_albedo(ctx, si, hits=None) -> np.ndarray:

@@ -44,8 +44,8 @@ H_OBJ_LOCATION = 38  # the object's location (3)
 H_OBJ_COLOR = 41     # the object's colour (3)
 H_OBJ_RANDOM = 44
 H_OBJ_INDEX = 45     # pass index
-H_TANGENT = 46       # tangent (3), world space, of the UV map (Normal Map)
-H_TANGENT_SIGN = 49  # bitangent sign; 0 where the mesh has no tangents
+H_TANGENT = 46       # the UV map's tangent (3), object space, unnormalised (tangent_frame)
+H_TANGENT_SIGN = 49  # object-space bitangent sign; 0 where the mesh has no tangents
 H_DIFFUSE_DEPTH = 50         # diffuse, glossy, transmission bounces before this hit
 H_GLOSSY_DEPTH = 51
 H_TRANSMISSION_DEPTH = 52
@@ -74,7 +74,10 @@ H_HAIR_TANGENT_NORMAL = H_HAIR_IS_STRAND + 5   # (3)
 # 1 on a face shaded flat whose shading normal is not its own (engine.scene
 # TriangleMesh.flat_faces): a Normal Map builds on the geometric normal there
 H_FLAT_FACE = H_HAIR_IS_STRAND + 8
-N_HIT = H_HAIR_IS_STRAND + 9
+# the smooth normal a tangent-space Normal Map builds on (3): object space, interpolated
+# and unnormalised (tangent_frame); 0 without tangents or corner normals
+H_MAP_NORMAL = H_HAIR_IS_STRAND + 9
+N_HIT = H_HAIR_IS_STRAND + 12
 
 # ---------------------------------------------------------------- object table columns
 O_TO_OBJECT = 0      # 3 x 4 world -> object, row-major (12)

@@ -2,12 +2,13 @@
 for one hit: the colour's 2c - 1, its x and y scaled by Strength and its z mixed from 1 by
 Strength clamped to [0, 1], taken in the frame of the UV map's tangent T, the bitangent
 sign x N x T and the normal N it builds on, in the object's space, and the result taken
-back to the world as a normal (by the inverse transpose of the object's matrix). In
-object space, as Cycles works: with a non-uniform scale a frame built in the world
-differs.
+back to the world as a normal (by the inverse transpose of the object's matrix). As in
+Cycles, T and N are interpolated in object space and not normalised (tangent_frame):
+with a non-uniform scale a frame built in the world differs, and normalised they tilt
+the map less where the corners' normals fan out.
 
-N is the interpolated shading normal, but on a face shaded flat the face's own normal
-(Cycles' sd->Ng there): they differ on the flat faces Displacement and Bump moved, whose
+N is the interpolated smooth normal, but on a face shaded flat the face's own normal
+(Cycles' sd->Ng there), also on the flat faces Displacement and Bump moved, whose
 shading normal is the undisplaced one (engine.scene TriangleMesh.flat_faces). Where the
 mesh has no tangents the map gives the shading normal."""
 from __future__ import annotations
@@ -16,8 +17,8 @@ import math
 
 from ..kernels.frame import cross as _cross, unit as _unit
 from ..kernels.jit import kernel
-from .context import (H_BACKFACING, H_FLAT_FACE, H_N, H_NG, H_OBJ_MATRIX, H_TANGENT,
-                      H_TANGENT_SIGN)
+from .context import (H_BACKFACING, H_FLAT_FACE, H_MAP_NORMAL, H_N, H_NG, H_OBJ_MATRIX,
+                      H_TANGENT, H_TANGENT_SIGN)
 
 
 @kernel(allocates=False)
@@ -44,28 +45,22 @@ def normal_map(hit, cr, cg, cb, strength):
     if sign == 0.0:
         return nx, ny, nz
     back = hit[H_BACKFACING] > 0.0
-    qx, qy, qz = nx, ny, nz
-    if hit[H_FLAT_FACE] != 0.0:
-        qx, qy, qz = hit[H_NG], hit[H_NG + 1], hit[H_NG + 2]
-    if back:                    # the maths on the normal as the mesh has it
-        qx, qy, qz = -qx, -qy, -qz
-    tx, ty, tz = hit[H_TANGENT], hit[H_TANGENT + 1], hit[H_TANGENT + 2]
     r0, r1, r2, det = _cofactors(hit)
     if det == 0.0 or not math.isfinite(det):
         return nx, ny, nz
     flip = 1.0 if det > 0.0 else -1.0
-    m = H_OBJ_MATRIX
-    # into object space: the normal by M^T, the tangent by M^-1 (= C^T / det); the
-    # world sign already holds a mirror's flip (the world bitangent is a cross product)
-    ox, oy, oz = _unit(hit[m] * qx + hit[m + 3] * qy + hit[m + 6] * qz,
-                       hit[m + 1] * qx + hit[m + 4] * qy + hit[m + 7] * qz,
-                       hit[m + 2] * qx + hit[m + 5] * qy + hit[m + 8] * qz)
-    ux, uy, uz = _unit(flip * (tx * r0[0] + ty * r1[0] + tz * r2[0]),
-                       flip * (tx * r0[1] + ty * r1[1] + tz * r2[1]),
-                       flip * (tx * r0[2] + ty * r1[2] + tz * r2[2]))
-    s = sign * flip
+    ox, oy, oz = hit[H_MAP_NORMAL], hit[H_MAP_NORMAL + 1], hit[H_MAP_NORMAL + 2]
+    if hit[H_FLAT_FACE] != 0.0 or (ox == 0.0 and oy == 0.0 and oz == 0.0):
+        qx, qy, qz = hit[H_NG], hit[H_NG + 1], hit[H_NG + 2]
+        if back:                # the maths on the normal as the mesh has it
+            qx, qy, qz = -qx, -qy, -qz
+        m = H_OBJ_MATRIX        # into object space by M^T, normalised (Cycles' safe_normalize)
+        ox, oy, oz = _unit(hit[m] * qx + hit[m + 3] * qy + hit[m + 6] * qz,
+                           hit[m + 1] * qx + hit[m + 4] * qy + hit[m + 7] * qz,
+                           hit[m + 2] * qx + hit[m + 5] * qy + hit[m + 8] * qz)
+    ux, uy, uz = hit[H_TANGENT], hit[H_TANGENT + 1], hit[H_TANGENT + 2]
     bx, by, bz = _cross(ox, oy, oz, ux, uy, uz)
-    bx, by, bz = s * bx, s * by, s * bz
+    bx, by, bz = sign * bx, sign * by, sign * bz
     cx, cy = 2.0 * (cr - 0.5) * strength, 2.0 * (cg - 0.5) * strength
     cz = 1.0 + (2.0 * (cb - 0.5) - 1.0) * min(max(strength, 0.0), 1.0)
     x, y, z = _unit(cx * ux + cy * bx + cz * ox, cx * uy + cy * by + cz * oy,

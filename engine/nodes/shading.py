@@ -18,10 +18,11 @@ from ..kernels.textures import (I_TEXTURE, INPUTS, PLAIN, TEX_ALPHA, TEX_EMISSIO
                                 textured_value)
 from ..kernels.curve_hit import strand_info
 from .context import (H_FLAT_FACE, H_HAIR_INTERCEPT, H_HAIR_IS_STRAND, H_HAIR_LENGTH,
-                      H_HAIR_RANDOM, H_HAIR_TANGENT_NORMAL, H_HAIR_THICKNESS, fill,
-                      mirrors, set_undisplaced, to_world_direction)
+                      H_HAIR_RANDOM, H_HAIR_TANGENT_NORMAL, H_HAIR_THICKNESS, H_MAP_NORMAL,
+                      fill, set_undisplaced)
 from .differentials import fill_differentials
 from .interpreter import reads_differentials, run
+from .tangent_frame import object_frame
 from .pack import MIX, OUTS
 
 OUT_BASE, OUT_METALLIC, OUT_ROUGHNESS, OUT_EMISSION, OUT_ALPHA, OUT_NORMAL, OUT_MIX = range(7)
@@ -42,22 +43,10 @@ def program_hit(T, geometry, m, prim, inst, bu, bv, uu, vv, px, py, pz, gx, gy, 
     differentials are filled only for a program that reads them (a Bump's)."""
     tri_object, objects, corner_tangents = geometry[8], geometry[9], geometry[10]
     obj = inst if inst >= 0 else (tri_object[prim] if tri_object.shape[0] > 0 else -1)
-    tx = ty = tz = ts = 0.0
+    tx = ty = tz = ts = mx = my = mz = 0.0
     if corner_tangents.shape[0] > 0:
-        c = corner_tangents
-        b0 = 1.0 - bu - bv
-        tx = b0 * c[prim, 0, 0] + bu * c[prim, 1, 0] + bv * c[prim, 2, 0]
-        ty = b0 * c[prim, 0, 1] + bu * c[prim, 1, 1] + bv * c[prim, 2, 1]
-        tz = b0 * c[prim, 0, 2] + bu * c[prim, 1, 2] + bv * c[prim, 2, 2]
-        ts = b0 * c[prim, 0, 3] + bu * c[prim, 1, 3] + bv * c[prim, 2, 3]
-        if inst >= 0:        # an object-space tangent, into the world by the place's matrix
-            tx, ty, tz = to_world_direction(objects[inst], tx, ty, tz)
-            if mirrors(objects[inst]):
-                ts = -ts     # the bitangent is a cross product: a mirror turns it over
-        ln = math.sqrt(tx * tx + ty * ty + tz * tz)
-        if ln > 0.0:
-            tx, ty, tz = tx / ln, ty / ln, tz / ln
-        ts = 1.0 if ts > 0.0 else (-1.0 if ts < 0.0 else 0.0)
+        tx, ty, tz, ts, mx, my, mz = object_frame(corner_tangents, geometry[4], objects, prim,
+                                                  inst, obj, bu, bv)
     cr = cg = cb = ca = 0.0
     colors = geometry[11]
     if colors.shape[0] > 0:
@@ -72,6 +61,7 @@ def program_hit(T, geometry, m, prim, inst, bu, bv, uu, vv, px, py, pz, gx, gy, 
     (hit[H_HAIR_IS_STRAND], hit[H_HAIR_INTERCEPT], hit[H_HAIR_LENGTH], hit[H_HAIR_THICKNESS],
      hit[H_HAIR_RANDOM], hit[H_HAIR_TANGENT_NORMAL], hit[H_HAIR_TANGENT_NORMAL + 1],
      hit[H_HAIR_TANGENT_NORMAL + 2]) = strand_info(geometry[15], prim, bu, -dx, -dy, -dz)
+    hit[H_MAP_NORMAL], hit[H_MAP_NORMAL + 1], hit[H_MAP_NORMAL + 2] = mx, my, mz
     flat_faces = geometry[16]
     hit[H_FLAT_FACE] = 1.0 if flat_faces.shape[0] > 0 and flat_faces[prim] != 0 else 0.0
     undisplaced = geometry[14]

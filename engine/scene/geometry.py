@@ -78,7 +78,8 @@ class TriangleMesh:
         (Blender's split normals); None means flat shading.
     uvs: optional (T, 3, 2) float32 texture coordinates per corner.
     tangents: optional (T, 3, 4) float32 tangent space per corner (world-space tangent
-        and bitangent sign, Blender's MikkTSpace), for tangent-space Normal Maps.
+        and bitangent sign, MikkTSpace as Cycles computes it), for tangent-space Normal
+        Maps, which take each corner back to the object (engine.nodes.tangent_frame).
     motion: None for a static mesh (positions in world space); an
         `engine.motion.RigidMotion` (positions then in OBJECT space, placed in the world by
         the motion's transform at each ray's time); or an `engine.motion.DeformMotion`
