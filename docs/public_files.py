@@ -86,11 +86,6 @@ CAUSES = {
         "differs only by the antialiasing noise along its edge, which at DRT's 64 samples "
         "is twice Cycles' own (524 % against 252 % of the image mean); the means are "
         "within 0.62 %",
-    "tunnel.blend":
-        "its images are missing (pink in both) and its Vector Displacement in tangent "
-        "space has no UV map to take tangents from: DRT drops the offsets' x and z "
-        "(warned; docs/displacement.md), so the tube's lower edge lies elsewhere; the "
-        "worst block is on the tube",
     "mellowmallow.blend":
         "its marshmallows are a soft body at frame 131 with no cache: every vertex NaN in "
         "both engines; the green is the 1 kW lamp seen in a glass-and-translucent jar, "

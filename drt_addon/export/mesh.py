@@ -332,7 +332,8 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
     if normals is not None:
         normal_matrix = np.linalg.inv(m3).T if abs(det) > 1e-300 else m3
         nw = normals.reshape(-1, 3).astype(np.float64) @ normal_matrix.T
-        nw /= np.maximum(np.linalg.norm(nw, axis=1, keepdims=True), 1e-300)
+        if cycles_applies_transform(local):
+            nw /= np.maximum(np.linalg.norm(nw, axis=1, keepdims=True), 1e-300)
         normals = nw.reshape(-1, 3, 3).astype(np.float32)
     if det < 0:
         # A mirroring transform flips the winding; swap two corners so that the geometric
@@ -353,6 +354,16 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
     return engine.TriangleMesh(name, world, tris, global_mat, corner_normals=normals, uvs=uvs,
                                tangents=tangents, colors=colors, undisplaced=undisplaced,
                                flat_faces=flat_faces(local))
+
+
+def cycles_applies_transform(local: LocalMesh) -> bool:
+    """Whether Cycles moves this mesh into the world before rendering (its
+    ObjectManager::apply_static_transforms), and so interpolates its smooth normals there,
+    each vertex's normalised; it keeps a mesh with true displacement or adaptive
+    subdivision in its object space, where the normals are interpolated before they are
+    taken to the world. Unnormalised world corner normals give the latter (a hit
+    interpolates and then normalises them); they differ under a non-uniform scale."""
+    return local.offset is None and local.diced_from is None
 
 
 def flat_faces(local: LocalMesh) -> Optional[np.ndarray]:
