@@ -73,11 +73,27 @@ def face_normals(p: np.ndarray) -> np.ndarray:
 
 
 def _weld(p, n, uv) -> np.ndarray:
-    """Welded index per corner (3T,): corners equal in position, normal and texcoord."""
+    """Welded index per corner (3T,): corners equal in position, normal and texcoord.
+    Rows are grouped by a 64-bit hash of their bits and checked equal within each group
+    (np.unique on the rows where two differing rows share a hash)."""
     rows = np.concatenate([p.reshape(-1, 3), n.reshape(-1, 3), uv.reshape(-1, 2)], 1)
     rows = np.ascontiguousarray(rows.astype(np.float32) + np.float32(0))   # -0 == 0
-    keys = rows.view(np.dtype((np.void, rows.dtype.itemsize * 8))).ravel()
-    return np.unique(keys, return_inverse=True)[1].astype(np.int64).ravel()
+    bits = rows.view(np.uint32)
+    h = np.full(len(rows), 0xCBF29CE484222325, np.uint64)
+    with np.errstate(over="ignore"):
+        for k in range(bits.shape[1]):
+            h = (h ^ bits[:, k].astype(np.uint64)) * np.uint64(0x100000001B3)
+    order = np.argsort(h, kind="stable")
+    sh = h[order]
+    new = np.r_[True, sh[1:] != sh[:-1]]
+    group = np.cumsum(new) - 1
+    sorted_bits = bits[order]
+    if not np.all(sorted_bits == sorted_bits[np.flatnonzero(new)[group]]):
+        keys = rows.view(np.dtype((np.void, rows.dtype.itemsize * 8))).ravel()
+        return np.unique(keys, return_inverse=True)[1].astype(np.int64).ravel()
+    out = np.empty(len(rows), np.int64)
+    out[order] = group
+    return out
 
 
 def _neighbours(w: np.ndarray) -> np.ndarray:
@@ -85,32 +101,27 @@ def _neighbours(w: np.ndarray) -> np.ndarray:
     edge pairs with its reverse, the k-th of one with the k-th of the other, as mikk's
     greedy pass in triangle order pairs them."""
     g = len(w)
-    a = w.ravel()
-    b = w[:, [1, 2, 0]].ravel()
-    ids = np.arange(3 * g)
-    order = np.lexsort((ids, b, a))
-    sa, sb = a[order], b[order]
-    new = np.r_[True, (sa[1:] != sa[:-1]) | (sb[1:] != sb[:-1])]
-    start = np.maximum.accumulate(np.where(new, np.arange(len(sa)), 0))
+    a = w.ravel().astype(np.int64)
+    b = w[:, [1, 2, 0]].ravel().astype(np.int64)
+    v = int(w.max()) + 1
+    pair = a * v + b
+    order = np.argsort(pair, kind="stable")          # within a pair: triangle order
+    sp = pair[order]
+    new = np.r_[True, sp[1:] != sp[:-1]]
+    start = np.maximum.accumulate(np.where(new, np.arange(len(sp)), 0))
     rank = np.empty(3 * g, np.int64)
-    rank[order] = np.arange(len(sa)) - start
-    # look each edge's reverse up among the sorted (a, b, rank) triples
-    key = np.stack([a, b, rank], 1)
-    want = np.stack([b, a, rank], 1)
-    sorted_key = key[order]
-    lo = _search(sorted_key, want)
-    found = (lo < len(sorted_key)) & np.all(sorted_key[np.minimum(lo, len(sorted_key) - 1)]
-                                            == want, axis=1)
+    rank[order] = np.arange(len(sp)) - start
+    r = int(rank.max()) + 1
+    sorted_key = sp * r + rank[order]
+    want = (b * v + a) * r + rank
+    by_want = np.argsort(want)                       # sorted needles search fast
+    lo = np.empty(3 * g, np.int64)
+    lo[by_want] = np.searchsorted(sorted_key, want[by_want])
+    hit = np.minimum(lo, len(sorted_key) - 1)
+    found = sorted_key[hit] == want
     out = np.full(3 * g, -1, np.int64)
-    out[found] = order[lo[found]] // 3
+    out[found] = order[hit[found]] // 3
     return out.reshape(g, 3)
-
-
-def _search(sorted_rows: np.ndarray, rows: np.ndarray) -> np.ndarray:
-    """Left insertion points of integer triples in lexicographically sorted triples."""
-    base = np.maximum(sorted_rows.max(0), rows.max(0)) + 1
-    enc = lambda r: (r[:, 0] * base[1] + r[:, 1]) * base[2] + r[:, 2]  # noqa: E731
-    return np.searchsorted(enc(sorted_rows), enc(rows))
 
 
 def _corner_links(w, nb, ok):
@@ -143,6 +154,8 @@ def _orient_any(w, nb, orient, any_):
     through triangles with no UV area): per orientation, the lowest such corner connected
     to one of the triangle's corners. Where such triangles chain, each is taken to pass a
     group of either orientation on."""
+    if not any_.any():
+        return orient
     g = len(w)
     corner_any = np.repeat(any_, 3)
     first = []
