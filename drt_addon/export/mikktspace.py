@@ -23,8 +23,6 @@ from __future__ import annotations
 from typing import Optional
 
 import numpy as np
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 
 FLT_MIN = np.float32(1.17549435e-38)
 
@@ -143,8 +141,21 @@ def _corner_links(w, nb, ok):
 
 
 def _components(n, rows, cols):
-    graph = coo_matrix((np.ones(len(rows), np.int8), (rows, cols)), shape=(n, n))
-    return connected_components(graph, directed=False)[1]
+    """A label per node (n,) of the graph with edges (rows, cols): the smallest node of
+    its connected component, by min-label propagation with pointer jumping (the
+    components here are fans of corners around one vertex, so few rounds; plain NumPy,
+    as the extension bundles no SciPy)."""
+    label = np.arange(n)
+    while len(rows):
+        low = np.minimum(label[rows], label[cols])
+        new = label.copy()
+        np.minimum.at(new, rows, low)
+        np.minimum.at(new, cols, low)
+        new = new[new]
+        if np.array_equal(new, label):
+            break
+        label = new
+    return label
 
 
 def _orient_any(w, nb, orient, any_):
