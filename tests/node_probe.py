@@ -155,6 +155,13 @@ def tile_errors(drt, cycles):
     return mean, mad, float(blocks.max()) / ref
 
 
+def drt_against_cycles(bpy, scene, drt_samples, cycles_samples=None):
+    """The scene rendered by Cycles (cycles_samples, by default drt_samples) and by DRT:
+    image_errors(DRT's, Cycles')."""
+    cycles = render(bpy, scene, "CYCLES", cycles_samples or drt_samples)
+    return image_errors(render(bpy, scene, "DRT", drt_samples), cycles)
+
+
 def image_errors(drt, cycles):
     """(|mean ratio - 1|, largest 8 x 8 block difference over the image mean)."""
     h, w, _ = cycles.shape

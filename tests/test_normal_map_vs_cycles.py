@@ -21,7 +21,7 @@ import math
 import pytest
 
 import node_probe
-from node_probe import image_errors, new_material, new_scene
+from node_probe import drt_against_cycles, new_material, new_scene
 
 SAMPLES = 64
 
@@ -94,10 +94,7 @@ def test_normal_map_on_a_scaled_ngon_tube_matches_cycles(bpy_drt, case):
     map, the tangents already MikkTSpace's, the frame interpolated in the world and
     normalised gave mean -2.8 %, largest block 23.5 % (320 pixels, DRT 64 against Cycles
     256 samples); 0.0 % and 1.0 % now."""
-    bpy = bpy_drt
-    scene = _tube_scene(bpy, **CASES[case])
-    cycles = node_probe.render(bpy, scene, "CYCLES", SAMPLES)
-    drt = node_probe.render(bpy, scene, "DRT", SAMPLES)
-    mean, block = image_errors(drt, cycles)
+    scene = _tube_scene(bpy_drt, **CASES[case])
+    mean, block = drt_against_cycles(bpy_drt, scene, SAMPLES)
     print(f"tube, {case}: mean {mean:.2%}, largest block {block:.2%}")
     assert mean < 0.01 and block < 0.03, (mean, block)
