@@ -36,7 +36,7 @@ from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
 from .bsdf import principled as bsdf
-from .bsdf.state import S_ANY_SIDE, S_WALTER
+from .bsdf.state import S_ANY_SIDE, S_DIFFUSE_LABEL, S_WALTER
 from . import hair_tangent
 from . import ray_queues
 from .frame import dot, to_local, to_world
@@ -360,6 +360,8 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         if skind == TRANSMISSION and vol.shape[0] > 0 and vol[m, V_HAS] != 0.0:
             stack_cross(stacks, p, m, front)     # into or out of the material's volume
         ray_bits[p] = DIFFUSE_BIT << skind     # diffuse, glossy, transmission: 2, 4, 8
+        if state[S_DIFFUSE_LABEL] != 0.0:      # a translucent bounce: diffuse as well
+            ray_bits[p] |= DIFFUSE_BIT
         if not sdelta:
             min_pdf[p] = min(min_pdf[p], spdf)
         cone_moves(path_info[1], p, t_geom)

@@ -22,7 +22,9 @@ def prepare_closures(cfg, row, min_pdf, ray_bit, diffuse_bounces):
     (row[P_FILTER_ALPHA]).
 
     Caustics (cfg.caustics_reflective, cfg.caustics_refractive): with one off, a hit of a
-    ray that left a diffuse bounce has no glossy reflection (resp. refraction) lobes.
+    ray that left a diffuse bounce (ray_bit has DIFFUSE: a diffuse lobe's, or a
+    Translucent BSDF's, which is a diffuse and a transmission ray in Cycles) has no glossy
+    reflection (resp. refraction) lobes.
 
     Christensen-Burley subsurface scattering on a path that has made a diffuse bounce
     (diffuse_bounces > 0, Cycles' PATH_RAY_DIFFUSE_ANCESTOR) is a diffuse lobe: its
@@ -38,6 +40,6 @@ def prepare_closures(cfg, row, min_pdf, ray_bit, diffuse_bounces):
             row[P_FILTER_ALPHA] = alpha     # the lobes only (principled.setup)
     if diffuse_bounces > 0 and row[P_SSS_METHOD] == SSS_BURLEY:
         row[P_SSS_RADIUS] = row[P_SSS_RADIUS + 1] = row[P_SSS_RADIUS + 2] = 0.0
-    after_diffuse = ray_bit == DIFFUSE_BIT
+    after_diffuse = (ray_bit & DIFFUSE_BIT) != 0
     return ((cfg.caustics_reflective or not after_diffuse),
             (cfg.caustics_refractive or not after_diffuse))

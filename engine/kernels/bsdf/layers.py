@@ -19,8 +19,10 @@ and sample add this module's lobes. A row with P_LAYERS = 0 never reads a slot h
 (tests/test_layered_bsdf.py checks that with NaN slots).
 
 Lobe kinds: coat GLOSSY; sheen DIFFUSE (Cycles labels it diffuse reflection); translucent
-TRANSMISSION for the bounce that follows it (it leaves through the surface) and seen by
-lights as diffuse, as Cycles classifies it; it is sampled wherever diffuse lobes are
+TRANSMISSION for the bounce that follows it (it leaves through the surface; the ray it
+sends is a diffuse ray as well, as Cycles' diffuse-transmission label makes it:
+principled.sample's S_DIFFUSE_LABEL) and seen by lights as diffuse, as Cycles classifies
+it; it is sampled wherever diffuse lobes are
 (principled.sample's allow flags: Refractive Caustics off leaves it, as Cycles' filter
 leaves its diffuse closures); hair R
 GLOSSY, hair TT TRANSMISSION (Cycles' closure classes, which the lights' visibility and

@@ -67,6 +67,7 @@ from .albedo import specular_albedo
 from .compensation import compensate
 from .reflection_lobes import f82_setup, metal_fresnel, reflection_pdf, reflection_sample
 from .state import (NSTATE, S_ALPHA, S_ANY_SIDE, S_BECKMANN, S_BLINN, S_DIFFUSE,  # noqa: F401
+                    S_DIFFUSE_LABEL,
                     S_EST, S_ETA_GLASS, S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH,
                     S_GLASS_RTINT, S_GLASS_TINTED, S_LAYERED, S_METAL_CONST, S_METAL_F0,
                     S_METAL_F82,
@@ -307,9 +308,12 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     (wix, wiy, wiz, weight_r, weight_g, weight_b, pdf, kind, delta, valid): weight is
     f |cos| / pdf (zero where invalid), pdf the mixture pdf over the allowed lobes (inf
     for the delta choices of a smooth glass, with delta True). state[S_ANY_SIDE] says
-    whether the direction may leave on either side of the surface (a hair lobe's)."""
+    whether the direction may leave on either side of the surface (a hair lobe's),
+    state[S_DIFFUSE_LABEL] whether it is a diffuse ray besides its kind (a translucent
+    lobe's transmission)."""
     q = selection(state, allow_d, allow_g, allow_t)
     state[S_ANY_SIDE] = 0.0
+    state[S_DIFFUSE_LABEL] = 0.0
     lobe = 0
     lo = 0.0
     total = 0.0
@@ -353,6 +357,8 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     elif lobe > 3:                      # coat, sheen, translucent
         wix, wiy, wiz, ok = layers.sample(state, wox, woy, woz, lobe - 4, u1, u2)
         kind = (GLOSSY, DIFFUSE, TRANSMISSION)[lobe - 4]
+        if lobe == 6:
+            state[S_DIFFUSE_LABEL] = 1.0
     elif state[S_GLASS_SMOOTH] != 0.0:
         if state[S_REFRACT_ONLY] != 0.0:
             wix, wiy, wiz, ws, ok = dielectric.smooth_refract(wox, woy, woz,

@@ -39,4 +39,7 @@ S_ANY_SIDE = layers.NSTATE + 23     # 1: principled.sample's last direction may 
 S_ON = layers.NSTATE + 24          # 5: Oren-Nayar a, b (b 0: Lambert) and its multiple-
 #                                    scattering term per channel (oren_nayar.py)
 S_GLASS_RTINT = layers.NSTATE + 29  # 3: the glass lobe's reflection tint (a Glass BSDF's Color)
-NSTATE = layers.NSTATE + 32
+S_DIFFUSE_LABEL = layers.NSTATE + 32  # 1: principled.sample's last direction is diffuse as
+#                                       well as its kind: a Translucent BSDF's (Cycles'
+#                                       LABEL_DIFFUSE | LABEL_TRANSMIT)
+NSTATE = layers.NSTATE + 33
