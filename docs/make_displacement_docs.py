@@ -57,8 +57,9 @@ def _plane_rows(bpy):
 
 
 def _normal_map_rows(bpy):
-    """The Normal Map cases: the tests' two (the tilted flat cube, the plane as Bump Only)
-    and the gap (the plane with true displacement), DRT against Cycles."""
+    """The Normal Map cases, DRT against Cycles: the tests' two (the tilted flat cube,
+    the plane as Bump Only), the gap (the plane with true displacement), and the tube's
+    four (tests/test_normal_map_vs_cycles.py)."""
     import node_probe
     from node_probe import image_errors
     cases = [("a flat cube displaced by a constant (edge quads tilted), Displacement and "
@@ -70,6 +71,18 @@ def _normal_map_rows(bpy):
             return scene
         label = METHODS.get(method, "Bump Only")
         cases.append((f"the plane, {label}", build, SAMPLES))
+    from test_normal_map_vs_cycles import CASES, SAMPLES as TUBE_SAMPLES, _tube_scene
+    tube = ("a 32-sided tube, an n-gon cap at one end, smooth, scaled 4 x along its "
+            "axis")
+    labels = {"uv_map": f"{tube}, Bump Only",
+              "no_uv_map": f"{tube}, no UV map, Bump Only",
+              "true_displacement": f"{tube}, Displacement and Bump at the mid-level",
+              "true_displacement_without_map": f"{tube}, Displacement and Bump at the "
+                                               "mid-level, no Normal Map"}
+    for case in ("uv_map", "no_uv_map", "true_displacement",
+                 "true_displacement_without_map"):
+        cases.append((labels[case], lambda bpy, c=case: _tube_scene(bpy, **CASES[c]),
+                      TUBE_SAMPLES))
     rows = []
     for label, build, spp in cases:
         scene = build(bpy)
@@ -229,24 +242,35 @@ must be off by more than 10 % on some block).
 
 A tangent-space Normal Map is worked out in the object's space, as Cycles does (the
 normal by the object's matrix transposed, the tangent by its inverse, the result back by
-the inverse transpose; an unevenly scaled object's frame differs in the world). On a face
+the inverse transpose; an unevenly scaled object's frame differs in the world), on the
+tangent and smooth normal interpolated there and not normalised. The tangents are
+MikkTSpace's as Cycles computes them (`drt_addon/export/mikktspace.py`): on the render
+triangles, so n-gons have them, from the UV map, or on a mesh without one from
+map_to_sphere of the object-space positions (u differences taken around its wrap). A mesh
+that true displacement moves stays in its object space in Cycles, so its smooth normals
+are interpolated there before they reach the world, with or without a map. On a face
 shaded flat it builds on the face's own normal, not on the undisplaced vertex normals
 Displacement and Bump leaves such a face. Its Strength scales the colour's x and y and
 mixes its z from 1. A shader with a Normal of its own keeps it for its lobes while the
 Displacement socket's bump still sets the surface's own normal (Cycles' Set Normal),
-against which those lobes are shadowed. The Normal Map below: a constant colour whose
-2c - 1 is not of unit length, Strength 0.6, into the Principled BSDF's Normal.
+against which those lobes are shadowed. The Normal Map below: on the cube and the plane a
+constant colour whose 2c - 1 is not of unit length, Strength 0.6; on the tube (from
+OddBitWizard's tunnel.blend) one that tilts the normal far, Strength 1; into the
+Principled BSDF's Normal.
 
 | scene | samples | mean | worst block |
 |---|---|---|---|
 {chr(10).join(normal_map_rows)}
 
 **Not matched yet:** a Normal Map on a smooth surface that true displacement moves (the
-last two rows). Cycles' map output there follows the bumps, and with Displacement and
+plane's last two rows). Cycles' map output there follows the bumps, and with Displacement and
 Bump the surface's own normal (Geometry > Normal, read by an AOV) equals the map's output
 exactly; DRT builds the map on the undisplaced normal (Displacement and Bump) or the
 moved one (Displacement Only), and the two engines' images differ along the bumps, with
-opposite signs in the two modes. The cause is not found yet.
+opposite signs in the two modes. Read by Attribute nodes, Cycles' own undisplaced_N and
+undisplaced_tangent (what its Normal Map reads) are constant on the plane, and DRT's
+map output is the one they give, the same at every point; Cycles' varies with the bumps,
+nearly alike in both modes. The cause is not found yet.
 
 ## Adaptive subdivision
 
@@ -293,9 +317,6 @@ a surface hit never runs the displacement's program
   them is not evaluated (Cycles dices its limit surface).
 - A Vector Displacement node's bump (Bump Only, or the bump of Displacement and Bump):
   the node is evaluated for moving vertices only.
-- A mesh with no UV map gives a Tangent-space Vector Displacement no tangent: its x
-  and z components are dropped (Cycles uses the triangle's own direction there), and
-  the report says so.
 
 Written by `docs/make_displacement_docs.py`.
 """
