@@ -134,3 +134,23 @@ def test_degenerate_and_uvless_triangles_get_finite_unit_tangents():
     np.testing.assert_allclose(np.linalg.norm(out[..., :3], axis=-1), 1.0, atol=1e-6)
     # the degenerate triangle's corner at vertex 1 copies the first good corner there
     np.testing.assert_array_equal(out[2, 0], out[0, 1])
+
+
+def test_non_finite_input_gives_finite_tangents_and_leaves_good_corners_alone():
+    """A triangle with a NaN or infinite position, normal or UV is left out (MikkTSpace's
+    default tangent space at its corners) and adds nothing to the good triangles' groups:
+    their tangents are those of the mesh without it."""
+    pos = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0], [np.nan, 0, 0]], np.float64)
+    tris = np.array([[0, 1, 2], [1, 3, 2], [1, 4, 3]])
+    n = np.tile([0.0, 0.0, 1.0], (3, 3, 1)).astype(np.float32)
+    uv = np.nan_to_num(pos[tris][..., :2]).astype(np.float32)
+    out = mikktspace.tangents(pos, tris, n, uv)
+    clean = mikktspace.tangents(pos[:4], tris[:2], n[:2], uv[:2])
+    assert np.all(np.isfinite(out))
+    np.testing.assert_array_equal(out[:2], clean)
+    for bad in ("normal", "uv"):
+        n2, uv2 = n.copy(), uv.copy()
+        (n2 if bad == "normal" else uv2)[2, 1, 0] = np.inf
+        out = mikktspace.tangents(pos[:4].copy(), np.array([[0, 1, 2], [1, 3, 2], [1, 0, 3]]),
+                                  n2, uv2)
+        assert np.all(np.isfinite(out)), bad

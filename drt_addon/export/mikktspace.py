@@ -201,10 +201,16 @@ def tangents(positions: np.ndarray, triangles: np.ndarray, normals: np.ndarray,
     w = _weld(p, n, uv).reshape(nt, 3)
     degenerate = (np.all(p[:, 0] == p[:, 1], 1) | np.all(p[:, 0] == p[:, 2], 1)
                   | np.all(p[:, 1] == p[:, 2], 1))
+    # a non-finite position, normal or texcoord: left out like a degenerate triangle, so
+    # that no NaN reaches a good corner's group
+    degenerate |= ~(np.isfinite(p).all((1, 2)) & np.isfinite(n).all((1, 2))
+                    & np.isfinite(uv).all((1, 2)))
     good = np.flatnonzero(~degenerate)
     if len(good):
         _good_tangents(out, good, p[good], n[good], uv[good], w[good], uvs is None)
     _copy_to_degenerate(out, good, np.flatnonzero(degenerate), w)
+    bad = ~np.isfinite(out).all(-1)
+    out[bad] = (1.0, 0.0, 0.0, -1.0)
     return out
 
 
