@@ -28,11 +28,12 @@ def is_instanced(mesh: TriangleMesh) -> bool:
 
 def expand(mesh: TriangleMesh) -> list[TriangleMesh]:
     """The K places of an instanced mesh as K world-space meshes (a mesh that is not
-    instanced: itself). Corner normals go through each place's inverse-transpose and
-    tangents through its matrix, not renormalised: hits interpolate them and normalise
-    the result, so a hit on a copy is the hit on the instance (as Cycles interpolates
-    an instance's normals in object space). A mirroring place turns the copy's winding
-    (and bitangent signs) over, as the instance's hits turn its geometric normal back."""
+    instanced: itself). Corner normals go through each place's inverse-transpose, not
+    renormalised: hits interpolate them and normalise the result, so a hit on a copy is
+    the hit on the instance (as Cycles interpolates an instance's normals in object
+    space). Tangents stay in object space, as every mesh's do (engine.nodes.tangent_frame).
+    A mirroring place turns the copy's winding over, as the instance's hits turn its
+    geometric normal back."""
     if not is_instanced(mesh):
         return [mesh]
     inst = mesh.instances
@@ -46,16 +47,9 @@ def expand(mesh: TriangleMesh) -> list[TriangleMesh]:
             inverse_t = np.linalg.pinv(a).T
         normals = None if mesh.corner_normals is None else (
             np.asarray(mesh.corner_normals, np.float64) @ inverse_t.T).astype(np.float32)
-        tangents = None
-        if mesh.tangents is not None:
-            tan = np.asarray(mesh.tangents, np.float64).reshape(-1, 3, 4).copy()
-            tan[..., :3] = tan[..., :3] @ a.T
-            tangents = tan.astype(np.float32)
         order = [0, 1, 2]
         if np.linalg.det(a) < 0.0:
             order = [0, 2, 1]
-            if tangents is not None:
-                tangents[..., 3] *= -1.0
         corner = (lambda x: None if x is None else np.ascontiguousarray(
             np.asarray(x).reshape(len(mesh.triangles), 3, -1)[:, order]))
         names = {}
@@ -68,7 +62,7 @@ def expand(mesh: TriangleMesh) -> list[TriangleMesh]:
                                   pass_index=int(inst.pass_indices[k]))
         out.append(replace(mesh, name=f"{mesh.name}#{k}", positions=mesh.positions @ a.T + t,
                            triangles=mesh.triangles[:, order], corner_normals=corner(normals),
-                           uvs=corner(mesh.uvs), tangents=corner(tangents),
+                           uvs=corner(mesh.uvs), tangents=corner(mesh.tangents),
                            colors=corner(mesh.colors), undisplaced=corner(mesh.undisplaced),
                            object_info=placed_info,
                            instances=None, **names))

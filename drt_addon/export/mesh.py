@@ -14,7 +14,6 @@ import numpy as np
 
 from ..engine_link import engine
 from .errors import ExportError
-from . import tangents as tangent_space
 from ..blender_compat import prepare_corner_normals
 from .matrices import to_numpy
 from .layer_overrides import slot_materials
@@ -325,7 +324,7 @@ def instance_mesh(local: LocalMesh, matrix_world, material_slots, name) -> "engi
     tris = local.triangles
     normals = local.normals
     uvs = local.uvs
-    tangents = tangent_space.to_world(local.tangents, m3)
+    tangents = local.tangents           # object space (engine.nodes.tangent_frame)
     colors = local.colors
     undisplaced = undisplaced_corners(local)
     det = float(np.linalg.det(m3))

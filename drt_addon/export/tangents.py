@@ -53,14 +53,3 @@ def mesh_tangents(mesh, positions: np.ndarray, triangles: np.ndarray,
     layer = uv_layer(mesh, uv_name)
     uvs = mesh_uvs(mesh, layer.name) if layer is not None else None
     return mikktspace.tangents(positions, triangles, normals, uvs)
-
-
-def to_world(tangents: Optional[np.ndarray], m3: np.ndarray) -> Optional[np.ndarray]:
-    """Tangents of an instance with linear part m3: directions by m3 (normalised), signs
-    flipped by a mirroring transform (the bitangent is a cross product)."""
-    if tangents is None:
-        return None
-    t = tangents[..., :3].reshape(-1, 3).astype(np.float64) @ m3.T
-    t /= np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-300)
-    sign = tangents[..., 3:] * (1.0 if np.linalg.det(m3) >= 0 else -1.0)
-    return np.concatenate([t.reshape(-1, 3, 3), sign], axis=2).astype(np.float32)

@@ -7,59 +7,54 @@ sign. Cycles interpolates in object space, also where it has moved a mesh into t
 a non-uniform scale, and normalised they change how far the map tilts the normal where
 the corners' normals fan out.
 
-DRT keeps a mesh that is not instanced in the world (corner tangents through the
-object's matrix, corner normals through its inverse transpose, signs turned over by a
-mirror), so each corner is taken back to the object and renormalised; an instance's
-corners are in its object space already."""
+The tangents are stored in object space for every mesh. DRT keeps the corner normals of a
+mesh that is not instanced in the world (through the object's inverse transpose), so
+each is taken back to the object (by M^T) and renormalised, as Cycles takes its world
+vertex normals back; an instance's corners are in its object space already."""
 from __future__ import annotations
 
 import numpy as np
 
 from ..kernels.frame import unit
 from ..kernels.jit import kernel
-from .context import O_NORMAL, O_TO_OBJECT, mirrors
+from .context import O_NORMAL
 
 
 @kernel(allocates=False)
-def _corner(c, prim, k, objects, obj, world, matrix_at):
-    """Corner k of triangle prim of a (T, 3, >=3) array, unit, in object space: through
-    object row obj's 3 x 3 at column offset matrix_at (O_TO_OBJECT: a tangent by M^-1;
-    O_NORMAL: a normal by M^T) when world is set (a world-space mesh)."""
-    x, y, z = float(c[prim, k, 0]), float(c[prim, k, 1]), float(c[prim, k, 2])
+def _corner_normal(normals, prim, k, objects, obj, world):
+    """Corner k's normal of triangle prim, unit, in object space: by object row obj's
+    M^T (context.O_NORMAL) when world is set (a world-space mesh's)."""
+    x, y, z = (float(normals[prim, k, 0]), float(normals[prim, k, 1]),
+               float(normals[prim, k, 2]))
     if world:
-        o = objects[obj]
-        stride = 4 if matrix_at == O_TO_OBJECT else 3
-        x, y, z = (o[matrix_at] * x + o[matrix_at + 1] * y + o[matrix_at + 2] * z,
-                   o[matrix_at + stride] * x + o[matrix_at + stride + 1] * y
-                   + o[matrix_at + stride + 2] * z,
-                   o[matrix_at + 2 * stride] * x + o[matrix_at + 2 * stride + 1] * y
-                   + o[matrix_at + 2 * stride + 2] * z)
+        o, m = objects[obj], O_NORMAL
+        x, y, z = (o[m] * x + o[m + 1] * y + o[m + 2] * z,
+                   o[m + 3] * x + o[m + 4] * y + o[m + 5] * z,
+                   o[m + 6] * x + o[m + 7] * y + o[m + 8] * z)
     return unit(x, y, z)
 
 
 @kernel(allocates=False)
 def object_frame(tangents, normals, objects, prim, inst, obj, bu, bv):
     """(tx, ty, tz, sign, nx, ny, nz) at barycentrics (bu, bv) of triangle prim: the
-    object-space tangent and smooth normal, interpolated and unnormalised, and the
-    object-space bitangent sign (+-1); the normal is 0 without corner normals (a mesh
-    shaded flat: the map builds on the geometric normal). inst >= 0: a hit on an
-    instance (object-space corners); else obj: the mesh's object row, -1 for none."""
+    object-space tangent and smooth normal, interpolated from unit corners (MikkTSpace's
+    tangents are unit) and unnormalised, and the bitangent sign (+-1); the normal is 0
+    without corner normals (a mesh shaded flat: the map builds on the geometric normal).
+    inst >= 0: a hit on an instance (object-space corners); else obj: the mesh's object
+    row, -1 for none."""
     b = (1.0 - bu - bv, bu, bv)
-    world = inst < 0 and obj >= 0
     tx = ty = tz = ts = 0.0
     for k in range(3):
-        x, y, z = _corner(tangents, prim, k, objects, obj, world, O_TO_OBJECT)
-        tx += b[k] * x
-        ty += b[k] * y
-        tz += b[k] * z
+        tx += b[k] * tangents[prim, k, 0]
+        ty += b[k] * tangents[prim, k, 1]
+        tz += b[k] * tangents[prim, k, 2]
         ts += b[k] * tangents[prim, k, 3]
     ts = 1.0 if ts > 0.0 else (-1.0 if ts < 0.0 else 0.0)
-    if world and mirrors(objects[obj]):
-        ts = -ts                # the world sign holds the mirror's turn (tangents.to_world)
+    world = inst < 0 and obj >= 0
     nx = ny = nz = 0.0
     if normals.shape[0] > 0:
         for k in range(3):
-            x, y, z = _corner(normals, prim, k, objects, obj, world, O_NORMAL)
+            x, y, z = _corner_normal(normals, prim, k, objects, obj, world)
             nx += b[k] * x
             ny += b[k] * y
             nz += b[k] * z

@@ -77,9 +77,10 @@ class TriangleMesh:
     corner_normals: optional (T, 3, 3) float32 shading normals per triangle corner
         (Blender's split normals); None means flat shading.
     uvs: optional (T, 3, 2) float32 texture coordinates per corner.
-    tangents: optional (T, 3, 4) float32 tangent space per corner (world-space tangent
-        and bitangent sign, MikkTSpace as Cycles computes it), for tangent-space Normal
-        Maps, which take each corner back to the object (engine.nodes.tangent_frame).
+    tangents: optional (T, 3, 4) float32 tangent space per corner (tangent and bitangent
+        sign in the OBJECT's space, also for a mesh whose positions are in the world:
+        MikkTSpace as Cycles computes it), for tangent-space Normal Maps, which work in
+        object space (engine.nodes.tangent_frame).
     motion: None for a static mesh (positions in world space); an
         `engine.motion.RigidMotion` (positions then in OBJECT space, placed in the world by
         the motion's transform at each ray's time); or an `engine.motion.DeformMotion`
