@@ -147,7 +147,7 @@ def test_non_finite_input_gives_finite_tangents_and_leaves_good_corners_alone():
     out = mikktspace.tangents(pos, tris, n, uv)
     clean = mikktspace.tangents(pos[:4], tris[:2], n[:2], uv[:2])
     assert np.all(np.isfinite(out))
-    np.testing.assert_array_equal(out[:2], clean)
+    np.testing.assert_allclose(out[:2], clean, atol=1e-6)   # not bit for bit: two runs
     for bad in ("normal", "uv"):
         n2, uv2 = n.copy(), uv.copy()
         (n2 if bad == "normal" else uv2)[2, 1, 0] = np.inf
