@@ -162,16 +162,28 @@ def _material(cl, ctx, name) -> "engine.Material":
     return m
 
 
-def _displace(mat, socket, ctx):
-    """The Displacement socket as Cycles' bump (export/nodes/displacement.py), which sets
-    the surface's own normal (Cycles' Set Normal, sd->N): the material's shading normal,
-    or where a shader has a Normal of its own (which its lobes keep), the surface normal
-    alone (bent lobes are shadowed against it, lights picked for it)."""
+def _bump_pass(mat, out, ctx):
+    """The Displacement socket's bump (export/nodes/displacement.py), compiled before the
+    surface's nodes as Cycles' bump pass runs before them: its bent normal (None: no
+    bump) is the surface's own normal (Cycles' Set Normal, sd->N) for every node after
+    it (NodeCompiler.set_normal)."""
+    disp = out.inputs.get("Displacement")
+    if disp is None or _link(disp) is None:
+        return None
     try:
-        bent = displacement_normal(mat, socket, ctx)
+        bent = displacement_normal(mat, disp, ctx)
     except Unsupported as e:
         ctx.issue(f"its displacement is not rendered ({e})")
-        return
+        return None
+    if bent is not None:
+        ctx.nodes.set_normal(bent)
+    return bent
+
+
+def _displace(bent, ctx):
+    """The bump's normal `bent` as the material's shading normal, or where a shader has a
+    Normal of its own (which its lobes keep), as the surface normal alone (bent lobes are
+    shadowed against it, lights picked for it)."""
     if bent is None:
         return
     if ctx.normal is not None:
@@ -276,10 +288,11 @@ def _from_nodes(mat, ctx) -> "engine.Material":
         result = engine.Material(name, (0.0, 0.0, 0.0), specular_ior_level=0.0,
                                  holdout=True)
     else:
+        bent = _bump_pass(mat, out, ctx)
         result = _material(_closure(out.inputs["Surface"], ctx), ctx, name)
+        _displace(bent, ctx)
         disp = out.inputs.get("Displacement")
         if disp is not None and _link(disp) is not None:
-            _displace(mat, disp, ctx)
             try:
                 result.displacement = true_displacement(mat, disp, ctx)
             except Unsupported as e:

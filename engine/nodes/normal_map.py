@@ -10,14 +10,15 @@ the map less where the corners' normals fan out.
 N is the interpolated smooth normal, but on a face shaded flat the face's own normal
 (Cycles' sd->Ng there), also on the flat faces Displacement and Bump moved, whose
 shading normal is the undisplaced one (engine.scene TriangleMesh.flat_faces). Where the
-mesh has no tangents the map gives the shading normal."""
+mesh has no tangents the map gives the surface normal it is handed (nx, ny, nz: the
+hit's, or the one a Displacement's bump set, Cycles' sd->N)."""
 from __future__ import annotations
 
 import math
 
 from ..kernels.frame import cross as _cross, unit as _unit
 from ..kernels.jit import kernel
-from .context import (H_BACKFACING, H_FLAT_FACE, H_MAP_NORMAL, H_N, H_NG, H_OBJ_MATRIX,
+from .context import (H_BACKFACING, H_FLAT_FACE, H_MAP_NORMAL, H_NG, H_OBJ_MATRIX,
                       H_TANGENT, H_TANGENT_SIGN)
 
 
@@ -37,10 +38,9 @@ def _cofactors(hit):
 
 
 @kernel(allocates=False)
-def normal_map(hit, cr, cg, cb, strength):
+def normal_map(hit, cr, cg, cb, strength, nx, ny, nz):
     """The Normal Map's normal at the hit (the module's docstring), unit length and
-    facing as the hit's shading normal faces."""
-    nx, ny, nz = hit[H_N], hit[H_N + 1], hit[H_N + 2]
+    facing as the surface normal (nx, ny, nz) faces, that normal where the map fails."""
     sign = hit[H_TANGENT_SIGN]
     if sign == 0.0:
         return nx, ny, nz

@@ -5,8 +5,13 @@
                                                  Distance, Length)
   VEC_MAPPING out, vector, location, rotation, scale, type   Mapping (MAPPING_TYPES;
                                                  rotation as Euler XYZ)
-  VEC_NORMAL_MAP out, color, strength            Normal Map in tangent space
-                                                 (normal_map.py)
+  VEC_NORMAL_MAP out, color, strength, normal    Normal Map in tangent space
+                                                 (normal_map.py); normal: the surface
+                                                 normal (sd->N) it falls back to
+  VEC_OBJECT_NORMAL out, normal                  a world normal in the object's space,
+                                                 normalize(M^T normal) (M:
+                                                 context.H_OBJ_MATRIX), as the Texture
+                                                 Coordinate node's Normal
 """
 from __future__ import annotations
 
@@ -16,6 +21,7 @@ import numpy as np
 
 from ..kernels.frame import unit as _normalize
 from ..kernels.jit import kernel
+from .context import H_OBJ_MATRIX
 from .converter_nodes import MATH_OPS, math_op, safe_divide
 from .normal_map import normal_map
 
@@ -23,6 +29,7 @@ VEC_MATH = 400
 VEC_MATH_VALUE = 401
 VEC_MAPPING = 402
 VEC_NORMAL_MAP = 403
+VEC_OBJECT_NORMAL = 404
 
 VECTOR_OPS = ("ADD", "SUBTRACT", "MULTIPLY", "DIVIDE", "MULTIPLY_ADD", "CROSS_PRODUCT",
               "PROJECT", "REFLECT", "REFRACT", "FACEFORWARD", "DOT_PRODUCT", "DISTANCE",
@@ -138,5 +145,14 @@ def execute(ins, regs, hit):
             regs[ro], regs[ro + 1], regs[ro + 2], regs[so], regs[so + 1], regs[so + 2])
     elif code == VEC_NORMAL_MAP:
         c = ins[2]
-        regs[out], regs[out + 1], regs[out + 2] = normal_map(hit, regs[c], regs[c + 1],
-                                                             regs[c + 2], regs[ins[3]])
+        n = ins[4]
+        regs[out], regs[out + 1], regs[out + 2] = normal_map(
+            hit, regs[c], regs[c + 1], regs[c + 2], regs[ins[3]], regs[n], regs[n + 1],
+            regs[n + 2])
+    elif code == VEC_OBJECT_NORMAL:
+        n, m = ins[2], H_OBJ_MATRIX
+        x, y, z = regs[n], regs[n + 1], regs[n + 2]
+        regs[out], regs[out + 1], regs[out + 2] = _normalize(
+            hit[m] * x + hit[m + 3] * y + hit[m + 6] * z,
+            hit[m + 1] * x + hit[m + 4] * y + hit[m + 7] * z,
+            hit[m + 2] * x + hit[m + 5] * y + hit[m + 8] * z)

@@ -15,6 +15,11 @@ compiled again there, as new values (each offset region has its own memo), betwe
 instructions that move the hit and put it back, as Cycles' SVM compiler copies the
 Height's nodes for its offset evaluations.
 
+The Displacement socket's bump is compiled first, as Cycles' bump pass runs before the
+surface's nodes; its bent normal then stands for the surface normal (`set_normal`) in
+every node compiled after it (Geometry, Texture Coordinate, Fresnel, Layer Weight, Bump,
+Normal Map strength), as Cycles' Set Normal writes sd->N.
+
 A node no family translates is reported once per material, naming it, and the socket it
 feeds falls back to its own value: never an error, never a black render.
 """
@@ -31,6 +36,8 @@ program = importlib.import_module(engine.__name__ + ".nodes.program")
 cv = importlib.import_module(engine.__name__ + ".nodes.converter_nodes")
 bump = importlib.import_module(engine.__name__ + ".nodes.bump")
 context = importlib.import_module(engine.__name__ + ".nodes.context")
+in_ops = importlib.import_module(engine.__name__ + ".nodes.input_nodes")
+vec_ops = importlib.import_module(engine.__name__ + ".nodes.vector_nodes")
 
 TRANSLATORS = {}
 for _family in (input, texture, procedural, color, converter, vector):
@@ -48,6 +55,29 @@ class NodeCompiler:
         self._groups = []                  # stack of group nodes being flattened
         self._region = 0                   # the offset region being compiled (0: none)
         self._regions = 0
+        self._normal = None                # sd->N once the Displacement's bump set it
+
+    # -- the surface normal ----------------------------------------------------------
+    def normal(self):
+        """The surface's shading normal as nodes read it (Cycles' sd->N): the hit's, or
+        the one the Displacement socket's bump set (`set_normal`)."""
+        if self._normal is not None:
+            return self._normal
+        return self.emit(in_ops.IN_HIT3, "vector", [context.H_N], varying=True)
+
+    def object_normal(self):
+        """The shading normal in object space (the Texture Coordinate node's Normal)."""
+        if self._normal is not None:
+            return self.emit(vec_ops.VEC_OBJECT_NORMAL, "vector", [self._normal],
+                             varying=True)
+        return self.emit(in_ops.IN_HIT3, "vector", [context.H_OBJ_NORMAL], varying=True)
+
+    def set_normal(self, normal):
+        """Cycles' Set Normal at the end of its bump pass: the nodes compiled from now on
+        read `normal` as the surface's normal, and are compiled anew (a node the bump
+        already read evaluates again, at the bent normal, as Cycles' surface pass does)."""
+        self._normal = normal
+        self._memo.clear()
 
     # -- values --------------------------------------------------------------------
     def const(self, x, kind=None):

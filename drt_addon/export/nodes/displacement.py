@@ -26,7 +26,7 @@ import importlib
 
 from ...engine_link import engine
 from .compiler import NodeCompiler
-from .input import hit3, normal_input
+from .input import normal_input
 from .links import _linked_node
 from .vector import BU, FILTER_WIDTH, VE, _math
 
@@ -103,7 +103,7 @@ def _height(c, socket):
                                                VE.VECTOR_OPS.index("SCALE")])
     else:
         d = c.socket(socket, "vector")
-    n = hit3(c, C.H_N)
+    n = c.normal()
     one = c.const(1.0)
     return c.emit(VE.VEC_MATH_VALUE, "float", [d, n, n, one, VE.VECTOR_OPS.index("DOT_PRODUCT")])
 
@@ -129,7 +129,7 @@ def displacement_normal(mat, socket, ctx):
         steps()
         # Displacement and Bump: Cycles works the bump out in the object's space
         op = BU.BUMP_NORMAL_OBJECT if method == "BOTH" else BU.BUMP_NORMAL
-        return c.emit(op, "vector", [hit3(c, C.H_N), c.const(1.0), c.const(1.0),
+        return c.emit(op, "vector", [c.normal(), c.const(1.0), c.const(1.0),
                                                 width, _math(c, "SUBTRACT", hx, h),
                                                 _math(c, "SUBTRACT", hy, h)], varying=True)
     # Displacement and Bump: on the moved surface, bumped as if it had not moved

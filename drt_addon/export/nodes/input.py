@@ -28,7 +28,7 @@ def normal_input(c, node):
     sock = node.inputs.get("Normal")
     if sock is not None and sock.is_linked:
         return c.socket(sock, "vector")
-    return hit3(c, C.H_N)
+    return c.normal()
 
 
 def _tex_coord(c, node, out):
@@ -38,7 +38,7 @@ def _tex_coord(c, node, out):
     if name == "Generated":
         return hit3(c, C.H_GENERATED)
     if name == "Normal":
-        return hit3(c, C.H_OBJ_NORMAL)
+        return c.object_normal()
     if name == "UV":
         return hit3(c, C.H_UV)
     if name == "Object":
@@ -51,7 +51,7 @@ def _tex_coord(c, node, out):
         incoming = hit3(c, C.H_I)
         minus = c.emit(V.VEC_MATH, "vector", [incoming, incoming, incoming, c.const(-1.0),
                                               V.VECTOR_OPS.index("SCALE")])
-        return c.emit(V.VEC_MATH, "vector", [minus, hit3(c, C.H_N), minus, c.const(1.0),
+        return c.emit(V.VEC_MATH, "vector", [minus, c.normal(), minus, c.const(1.0),
                                              V.VECTOR_OPS.index("REFLECT")])
     raise Unsupported(f"the Texture Coordinate output {name} is not evaluated")
 
@@ -60,12 +60,13 @@ def _uv_map(c, node, out):
     return hit3(c, C.H_UV)
 
 
-GEOMETRY = {"Position": C.H_P, "Normal": C.H_N, "True Normal": C.H_NG,
-            "Incoming": C.H_I}
+GEOMETRY = {"Position": C.H_P, "True Normal": C.H_NG, "Incoming": C.H_I}
 
 
 def _geometry(c, node, out):
     name = out.identifier
+    if name == "Normal":
+        return c.normal()
     if name in GEOMETRY:
         return hit3(c, GEOMETRY[name])
     if name == "Backfacing":

@@ -44,8 +44,8 @@ def _normal_map(c, node, out):
     if node.space != "TANGENT":
         raise Unsupported(f"a Normal Map in {node.space} space is not evaluated")
     return c.emit(VE.VEC_NORMAL_MAP, "vector", [c.input(node, "Color", "color"),
-                                                c.input(node, "Strength", "float")],
-                  varying=True)
+                                                c.input(node, "Strength", "float"),
+                                                c.normal()], varying=True)
 
 
 def _math(c, op, a, b):
