@@ -2,12 +2,14 @@
 
 Every scene triangle whose material has an emission (radiance, colour x strength) of
 positive luminance and whose area is positive becomes a light entry of
-`engine.lights.LightSet`. Emission is two-sided, as Cycles' Emission closure:
+`engine.lights.LightSet`, unless its material's Emission Sampling (Material > Settings;
+engine.Material.emission_sampling, as Cycles decides it: drt_addon/export/
+emission_sampling.py) is None. Emission is two-sided, as Cycles' Emission closure:
 `emissive_simple_eval` returns 1 when |Ng . wi| > 0 (intern/cycles/kernel/closure/
-emissive.h), and Cycles' default "Auto" emission sampling light-samples such a material
-from front and back (EMISSION_SAMPLING_FRONT_BACK, scene/shader.cpp, when its constant
-emission estimate exceeds 0.5; dimmer ones are only found by BSDF rays there, here every
-emissive triangle is light-sampled, which changes noise, not the expected value).
+emissive.h), and next-event estimation samples both sides, or the one side the setting
+names (Front: where the triangle's normal points; `sides`). A side or a triangle not
+sampled is found by BSDF rays alone, with MIS weight 1 (its light pdf is 0 there), as in
+Cycles (SD_MIS_FRONT, SD_MIS_BACK).
 
 Selection (done by the LightSet, jointly with the lamps): triangle j is picked with
 probability proportional to its estimated power  P_j = luminance(L_j) x pi x A_j,  the
@@ -68,28 +70,39 @@ def _coincident_copies(v0, v1, v2, radiance):
     return first[rank], position[inverse.reshape(-1)]
 
 
+# the sides of an emissive triangle that next-event estimation samples (`sides`)
+FRONT, BACK = 1, 2
+SIDES = {"NONE": 0, "FRONT": FRONT, "BACK": BACK, "FRONT_BACK": FRONT | BACK}
+
+
 class EmissiveTriangles:
-    def __init__(self, v0, v1, v2, radiance, prim_ids, n_prims_total: int):
+    def __init__(self, v0, v1, v2, radiance, prim_ids, n_prims_total: int, sides=None):
+        """sides: FRONT, BACK or both (the default) per triangle, the sides sampled."""
         v0, v1, v2 = (np.asarray(v, dtype=np.float64).reshape(-1, 3) for v in (v0, v1, v2))
         radiance = np.asarray(radiance, dtype=np.float64).reshape(-1, 3)
         prim_ids = np.asarray(prim_ids, dtype=np.int64).reshape(-1)
+        sides = (np.full(len(prim_ids), FRONT | BACK, np.int64) if sides is None
+                 else np.asarray(sides, np.int64).reshape(-1))
         e1, e2 = v1 - v0, v2 - v0
         cr = np.cross(e1, e2)
         norm = np.linalg.norm(cr, axis=1)
         area = 0.5 * norm
         power = luminance(np.maximum(radiance, 0.0)) * np.pi * area
-        keep = np.isfinite(power) & (power > 0) & (norm > 0)
+        keep = np.isfinite(power) & (power > 0) & (norm > 0) & (sides != 0)
         self.v0, self.e1, self.e2 = v0[keep], e1[keep], e2[keep]
         self.normal = cr[keep] / norm[keep, None]
         self.area = area[keep]
         self.radiance = radiance[keep]
         self.power = power[keep]
         self.prim = prim_ids[keep]
+        self.sides = sides[keep]
+        # (copies sampled on other sides stay apart)
         first, copy_of = _coincident_copies(v0[keep], v1[keep], v2[keep],
-                                              self.radiance)
+                                              np.column_stack([self.radiance, self.sides]))
         self.entry = np.full(max(int(n_prims_total), 1), -1, dtype=np.int64)
         self.entry[self.prim] = copy_of
-        for name in ("v0", "e1", "e2", "normal", "area", "radiance", "power", "prim"):
+        for name in ("v0", "e1", "e2", "normal", "area", "radiance", "power", "prim",
+                     "sides"):
             setattr(self, name, getattr(self, name)[first])
 
     @classmethod
@@ -119,8 +132,12 @@ class EmissiveTriangles:
             emissive = emissive[np.asarray(only, bool)[emissive]]
         p = accel.positions
         t = tri[emissive]
+        sides = np.full(len(emission), FRONT | BACK, np.int64)
+        sides[:len(scene.materials)] = [
+            SIDES.get(getattr(m, "emission_sampling", "FRONT_BACK"), FRONT | BACK)
+            for m in scene.materials][:len(emission)]
         return cls(p[t[:, 0]], p[t[:, 1]], p[t[:, 2]], emission[mat[emissive]], emissive,
-                   len(tri))
+                   len(tri), sides[mat[emissive]])
 
     def __len__(self):
         return len(self.area)

@@ -65,3 +65,51 @@ def test_next_event_estimation_counts_coincident_copies_once(tree, monkeypatch):
     print("copies apart", apart[0].round(5))
     assert not _agree(bsdf, apart)
     assert np.all(apart[0] > 1.2 * bsdf[0])
+
+
+def _floor_under_one_sided_emitter(sampling):
+    """A grey floor lit by a 0.6 m square emitter facing down at 1 m (its triangles'
+    front, where their normal points, towards the floor), its material's Emission
+    Sampling `sampling`."""
+    lamp = quad((0, 0, 1), (0.0, 0.3, 0), (0.3, 0, 0), "lamp", 1)
+    assert np.cross(*(lamp.positions[lamp.triangles[0, 1:]]
+                      - lamp.positions[lamp.triangles[0, 0]]))[2] < 0     # faces down
+    floor = quad((0, 0, 0), (2, 0, 0), (0, 2, 0), "floor", 0)
+    cam = Camera(look_at((0, -2.5, 2.0), (0, 0, 0.2)), lens=35.0)
+    mats = [Material("grey", (0.5, 0.5, 0.5), specular_ior_level=0.0),
+            Material("glow", (0, 0, 0), emission=(5.0, 4.0, 3.0),
+                     emission_sampling=sampling)]
+    return Scene(cam, 16, 12, [floor, lamp], mats, [], World((0, 0, 0)))
+
+
+def test_emission_sampling_none_leaves_the_triangles_out_of_the_light_set():
+    from engine.render import RenderContext
+    for sampling, n in (("NONE", 0), ("FRONT", 2), ("BACK", 2), ("FRONT_BACK", 2)):
+        ctx = RenderContext(_floor_under_one_sided_emitter(sampling),
+                            RenderSettings(samples=1))
+        ctx.close()
+        assert len(ctx.lights.mesh if ctx.lights.mesh is not None else []) == n, \
+            sampling
+
+
+@pytest.mark.parametrize("tree", [True, False], ids=["light tree", "by power"])
+def test_emission_sampling_changes_noise_not_the_light(tree):
+    """Material > Settings > Emission Sampling (engine.mesh_lights): whichever sides
+    next-event estimation samples, the floor gets the light BSDF rays alone find (a side
+    not sampled weighs its hits 1). Sampling the side that faces the floor (Front, here)
+    cuts the noise; sampling only the other side (Back) or none leaves BSDF rays alone,
+    as noisy as BSDF sampling: which side is the front is checked by that."""
+    scene = _floor_under_one_sided_emitter("FRONT_BACK")
+    bsdf = _image_mean(scene, "bsdf", 256)
+    assert bsdf[0].min() > 0.01
+    errors = {}
+    for sampling in ("FRONT_BACK", "FRONT", "BACK", "NONE"):
+        mis = _image_mean(_floor_under_one_sided_emitter(sampling), "mis", 256,
+                          light_tree=tree)
+        print(sampling, mis[0].round(5), "se", mis[1].round(5), "bsdf", bsdf[0].round(5),
+              "se", bsdf[1].round(5))
+        assert _agree(bsdf, mis), sampling
+        errors[sampling] = mis[1].mean()
+    assert errors["FRONT"] < 0.5 * errors["BACK"]
+    assert errors["FRONT_BACK"] < 0.5 * errors["NONE"]
+    assert errors["BACK"] > 0.7 * bsdf[1].mean() and errors["NONE"] > 0.7 * bsdf[1].mean()

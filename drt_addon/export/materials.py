@@ -93,6 +93,7 @@ from typing import Optional
 
 from ..engine_link import engine
 from .closures import _Comp, _reduce, program_outputs
+from .emission_sampling import emission_sampling
 from .errors import Reporter
 from .images import image_cache
 from .nodes import NodeCompiler
@@ -239,6 +240,7 @@ def export_material(mat, reporter: Reporter, grids=None,
         reporter.warn(f"DRT: material {name!r}: " + "; ".join(ctx.issues),
                       key=(name, "material"))
     result.pass_index = int(getattr(mat, "pass_index", 0))     # the Material Index pass
+    result.emission_sampling = emission_sampling(mat)    # Material > Settings
     return result
 
 

@@ -139,6 +139,10 @@ class Material:
     volume: Optional[object] = None      # Volume: the medium inside its meshes
     surface: bool = True                 # False: no surface shader, a volume's boundary
     pass_index: int = 0                  # Blender's material Pass Index (IndexMA pass)
+    emission_sampling: str = "FRONT_BACK"  # the sides next-event estimation samples of
+    #                                       its emissive triangles: 'NONE', 'FRONT', 'BACK'
+    #                                       or 'FRONT_BACK' (Material > Settings >
+    #                                       Emission Sampling; engine.mesh_lights)
     holdout: bool = False                # a Holdout shader: a hole in the alpha where the
     #                                      camera sees it, black to every other ray
     holdout_weight: float = 0.0          # a Holdout shader's share of the opaque part (a

@@ -24,7 +24,10 @@ every scene):
                  `seen_by` mask, 31 without a world)]; radiance and pdf 0 when the world
                  is not a light or is an environment map.
   L[TRI_VISIBILITY]  int64 (n_tri,): the ray kinds that see emissive triangle j (its
-                 object's engine.visibility mask; all 31 when not given).
+                 object's engine.visibility mask; all 31 when not given), and above them
+                 the sides next-event estimation leaves out (NEE_FRONT_OFF,
+                 NEE_BACK_OFF: engine.mesh_lights, Material > Settings > Emission
+                 Sampling).
   The environment map (`engine.environment_map.EnvironmentMap`, whether or not it is
   bright enough to be a light; empty arrays and M_HAS = 0 without one):
   L[ENV_MAP]     float64 (N_MAP,): the M_* fields below (flags, |det|, strength, matrix
@@ -75,6 +78,8 @@ TRI_RADIANCE = 10
 TRI_ENTRY = 11
 ENV = 12
 TRI_VISIBILITY = 13
+NEE_FRONT_OFF = 32  # bits of L[TRI_VISIBILITY] above the ray kinds (engine.visibility):
+NEE_BACK_OFF = 64   # the side of the triangle (its normal's, the other) not sampled
 ENV_MAP = 14
 ENV_PIXELS = 15
 ENV_TEXTURE = 16
@@ -264,6 +269,12 @@ def pack_lights(light_set, tri_visibility=None, timed=True, tree=True) -> tuple:
         entry = tri[7]
         prims = np.flatnonzero(entry >= 0)
         vis[entry[prims]] = np.asarray(tri_visibility)[prims]
+    sides = getattr(mesh, "sides", None) if n_tri else None
+    if sides is not None:
+        from ...mesh_lights import BACK, FRONT
+        sides = np.asarray(sides, np.int64)
+        vis |= (np.where(sides & FRONT, 0, NEE_FRONT_OFF)
+                | np.where(sides & BACK, 0, NEE_BACK_OFF))
     L = ((lamps, select_pdf, cdf, suns) + tri + (env, vis) + _pack_map(light_set.world)
          + (guide_table(cdf, guide_cells(len(cdf))), slices, slice_of))
     if tree and len(select_pdf) > 0:

@@ -31,7 +31,8 @@ from .pack import (C_AREA, C_AX, C_AXIS, C_AY, C_CENTER, C_COS_HALF, C_INTENSITY
                    C_IS_SPOT, C_IRRADIANCE, C_NORMAL, C_ONE_MINUS, C_POS, C_RAD, C_RADIUS,
                    C_TO_LIGHT, C_TYPE, LAMP_SLICES, LAMPS, SLICE_OF, T_AREA, T_DISC,
                    T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA, TRI_AREA, TRI_E1, TRI_E2,
-                   TRI_RADIANCE, TRI_V0)
+                   TRI_NORMAL, TRI_RADIANCE, TRI_V0, TRI_VISIBILITY, NEE_BACK_OFF,
+                   NEE_FRONT_OFF)
 from .tree_cone import EMPTY, box_measure, measure, merge
 
 PI = math.pi
@@ -165,6 +166,12 @@ def entry_measures(L, models):
         t[:, E_AXIS:E_AXIS + 3] = -e1 / np.where(n > 0.0, n, 1.0)    # in the plane:
         t[:, E_THETA_O] = PI / 2                                     # two-sided
         t[:, E_THETA_E] = PI / 2
+        # one side sampled (Emission Sampling Front or Back): the cone of its normal
+        off = L[TRI_VISIBILITY] & (NEE_FRONT_OFF | NEE_BACK_OFF)
+        for bit, sign in ((NEE_BACK_OFF, 1.0), (NEE_FRONT_OFF, -1.0)):
+            one = off == bit
+            t[one, E_AXIS:E_AXIS + 3] = sign * L[TRI_NORMAL][one]
+            t[one, E_THETA_O] = 0.0
         t[:, E_ENERGY] = L[TRI_AREA] * np.abs(L[TRI_RADIANCE]).mean(axis=1)
     bad = ~np.isfinite(emit).all(axis=1)
     emit[bad, E_ENERGY] = 0.0

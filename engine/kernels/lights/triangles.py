@@ -1,12 +1,13 @@
 """Emissive triangles as lights (`engine.mesh_lights.EmissiveTriangles`): Heitz's
-low-distortion square-to-triangle map, uniform by area, two-sided emission."""
+low-distortion square-to-triangle map, uniform by area, two-sided emission, sampled from
+the sides the material's Emission Sampling names (`sampled_side`)."""
 from __future__ import annotations
 
 import math
 
 from ..jit import kernel
-from .pack import (TRI_AREA, TRI_E1, TRI_E2, TRI_ENTRY, TRI_NORMAL, TRI_PRIM, TRI_RADIANCE,
-                   TRI_V0)
+from .pack import (NEE_BACK_OFF, NEE_FRONT_OFF, TRI_AREA, TRI_E1, TRI_E2, TRI_ENTRY,
+                   TRI_NORMAL, TRI_PRIM, TRI_RADIANCE, TRI_V0, TRI_VISIBILITY)
 
 
 # Shadow rays stop this far (relative to the sampled point's largest coordinate, over
@@ -29,6 +30,20 @@ def square_to_triangle(u0, u1):
 
 
 @kernel(allocates=False)
+def sampled_side(L, j, px, py, pz):
+    """Whether next-event estimation samples triangle entry j from p: the side of its
+    plane p is on (in front: where its normal points) is one its material's Emission
+    Sampling names, as Cycles decides by the sign of the distance to the plane."""
+    off = L[TRI_VISIBILITY][j] & (NEE_FRONT_OFF | NEE_BACK_OFF)
+    if off == 0:
+        return True
+    v0, nrm = L[TRI_V0], L[TRI_NORMAL]
+    behind = (nrm[j, 0] * (v0[j, 0] - px) + nrm[j, 1] * (v0[j, 1] - py)
+              + nrm[j, 2] * (v0[j, 2] - pz)) > 0.0
+    return (off & (NEE_BACK_OFF if behind else NEE_FRONT_OFF)) == 0
+
+
+@kernel(allocates=False)
 def sample_triangle(L, j, px, py, pz, u0, u1):
     """A uniform point of triangle entry j, seen from p (pick probability NOT included):
     (wix, wiy, wiz, dist, r, g, b, pdf, prim, margin), prim the triangle's global id,
@@ -47,7 +62,7 @@ def sample_triangle(L, j, px, py, pz, u0, u1):
     else:
         wx, wy, wz = 0.0, 0.0, 1.0
     cos_l = abs(wx * nrm[j, 0] + wy * nrm[j, 1] + wz * nrm[j, 2])
-    if not (dist > 0.0 and cos_l > GRAZING):
+    if not (dist > 0.0 and cos_l > GRAZING and sampled_side(L, j, px, py, pz)):
         return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0, L[TRI_PRIM][j], 0.0
     pdf = dist * dist / (L[TRI_AREA][j] * cos_l)
     rad = L[TRI_RADIANCE]
@@ -67,7 +82,9 @@ def triangle_entry(L, prim):
 @kernel(allocates=False)
 def pdf_triangle(L, j, px, py, pz, qx, qy, qz):
     """The solid-angle pdf at p of the point q
-    on triangle entry j, d^3 / (A |n . (q - p)|)."""
+    on triangle entry j, d^3 / (A |n . (q - p)|); 0 from a side not sampled."""
+    if not sampled_side(L, j, px, py, pz):
+        return 0.0
     tx, ty, tz = qx - px, qy - py, qz - pz
     d2 = tx * tx + ty * ty + tz * tz
     nrm = L[TRI_NORMAL]
