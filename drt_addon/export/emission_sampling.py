@@ -54,11 +54,21 @@ def _strength_link(found, depth):
     return [1.0, 1.0, 1.0]
 
 
-def _estimate(found, depth=0):
-    """The emission estimate (r, g, b) of the closure output `found` = (node, socket)."""
+def _estimate(found, depth=0, memo=None):
+    """The emission estimate (r, g, b) of the closure output `found` = (node, socket),
+    each output estimated once (`memo`: a chain of Mix Shaders feeding both inputs of
+    the next would otherwise take 2^length steps)."""
     node, out = found
-    if depth > 32:
+    if depth > 64:
         return [1.0, 1.0, 1.0]
+    memo = {} if memo is None else memo
+    key = (node.as_pointer(), out.identifier)
+    if key not in memo:
+        memo[key] = _estimate_node(node, out, depth, memo)
+    return memo[key]
+
+
+def _estimate_node(node, out, depth, memo):
     kind = node.bl_idname
     if kind in _EMITTERS:
         color_name, strength_name = _EMITTERS[kind]
@@ -68,9 +78,9 @@ def _estimate(found, depth=0):
         return _times(est, _value(strength) if linked is None
                       else _strength_link(linked, depth + 1))
     if kind == "ShaderNodeAddShader":
-        return _plus(*(_closure_input(node.inputs[k], depth) for k in (0, 1)))
+        return _plus(*(_closure_input(node.inputs[k], depth, memo) for k in (0, 1)))
     if kind == "ShaderNodeMixShader":
-        a, b = (_closure_input(node.inputs[k], depth) for k in (1, 2))
+        a, b = (_closure_input(node.inputs[k], depth, memo) for k in (1, 2))
         if _link(node.inputs[0]) is not None:
             return _plus(a, b)
         fac = _value(node.inputs[0])[0]
@@ -81,13 +91,13 @@ def _estimate(found, depth=0):
     total = [0.0, 0.0, 0.0]
     for sock in node.inputs:
         if sock.type == "SHADER":
-            total = _plus(total, _closure_input(sock, depth))
+            total = _plus(total, _closure_input(sock, depth, memo))
     return total
 
 
-def _closure_input(socket, depth):
+def _closure_input(socket, depth, memo):
     found = _link(socket)
-    return [0.0, 0.0, 0.0] if found is None else _estimate(found, depth + 1)
+    return [0.0, 0.0, 0.0] if found is None else _estimate(found, depth + 1, memo)
 
 
 def surface_estimate(mat):
