@@ -18,7 +18,7 @@ Height's nodes for its offset evaluations.
 The Displacement socket's bump is compiled first, as Cycles' bump pass runs before the
 surface's nodes; its bent normal then stands for the surface normal (`set_normal`) in
 every node compiled after it (Geometry, Texture Coordinate, Fresnel, Layer Weight, Bump,
-Normal Map strength), as Cycles' Set Normal writes sd->N.
+the Normal Map where it falls back), as Cycles' Set Normal writes sd->N.
 
 A node no family translates is reported once per material, naming it, and the socket it
 feeds falls back to its own value: never an error, never a black render.
