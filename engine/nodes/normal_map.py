@@ -38,6 +38,16 @@ def _cofactors(hit):
 
 
 @kernel(allocates=False)
+def to_object_normal(hit, x, y, z):
+    """A world normal in the hit object's space: M^T (x, y, z) normalised (Cycles'
+    object_inverse_normal_transform, safe_normalize), M = context.H_OBJ_MATRIX."""
+    m = H_OBJ_MATRIX
+    return _unit(hit[m] * x + hit[m + 3] * y + hit[m + 6] * z,
+                 hit[m + 1] * x + hit[m + 4] * y + hit[m + 7] * z,
+                 hit[m + 2] * x + hit[m + 5] * y + hit[m + 8] * z)
+
+
+@kernel(allocates=False)
 def normal_map(hit, cr, cg, cb, strength, nx, ny, nz):
     """The Normal Map's normal at the hit (the module's docstring), unit length and
     facing as the surface normal (nx, ny, nz) faces, that normal where the map fails."""
@@ -54,10 +64,7 @@ def normal_map(hit, cr, cg, cb, strength, nx, ny, nz):
         qx, qy, qz = hit[H_NG], hit[H_NG + 1], hit[H_NG + 2]
         if back:                # the maths on the normal as the mesh has it
             qx, qy, qz = -qx, -qy, -qz
-        m = H_OBJ_MATRIX        # into object space by M^T, normalised (Cycles' safe_normalize)
-        ox, oy, oz = _unit(hit[m] * qx + hit[m + 3] * qy + hit[m + 6] * qz,
-                           hit[m + 1] * qx + hit[m + 4] * qy + hit[m + 7] * qz,
-                           hit[m + 2] * qx + hit[m + 5] * qy + hit[m + 8] * qz)
+        ox, oy, oz = to_object_normal(hit, qx, qy, qz)
     ux, uy, uz = hit[H_TANGENT], hit[H_TANGENT + 1], hit[H_TANGENT + 2]
     bx, by, bz = _cross(ox, oy, oz, ux, uy, uz)
     bx, by, bz = sign * bx, sign * by, sign * bz

@@ -21,9 +21,8 @@ import numpy as np
 
 from ..kernels.frame import unit as _normalize
 from ..kernels.jit import kernel
-from .context import H_OBJ_MATRIX
 from .converter_nodes import MATH_OPS, math_op, safe_divide
-from .normal_map import normal_map
+from .normal_map import normal_map, to_object_normal
 
 VEC_MATH = 400
 VEC_MATH_VALUE = 401
@@ -150,9 +149,6 @@ def execute(ins, regs, hit):
             hit, regs[c], regs[c + 1], regs[c + 2], regs[ins[3]], regs[n], regs[n + 1],
             regs[n + 2])
     elif code == VEC_OBJECT_NORMAL:
-        n, m = ins[2], H_OBJ_MATRIX
-        x, y, z = regs[n], regs[n + 1], regs[n + 2]
-        regs[out], regs[out + 1], regs[out + 2] = _normalize(
-            hit[m] * x + hit[m + 3] * y + hit[m + 6] * z,
-            hit[m + 1] * x + hit[m + 4] * y + hit[m + 7] * z,
-            hit[m + 2] * x + hit[m + 5] * y + hit[m + 8] * z)
+        n = ins[2]
+        regs[out], regs[out + 1], regs[out + 2] = to_object_normal(hit, regs[n],
+                                                                   regs[n + 1], regs[n + 2])

@@ -38,17 +38,13 @@ def square_to_triangle(u0, u1):
 
 
 @kernel(allocates=False)
-def sampled_side(L, j, px, py, pz):
-    """Whether next-event estimation samples triangle entry j from p: the side of its
-    plane p is on (in front: where its normal points) is one its material's Emission
-    Sampling names, as Cycles decides by the sign of the distance to the plane."""
+def sampled_side(L, j, to_plane):
+    """Whether next-event estimation samples triangle entry j from a point whose signed
+    distance term to its plane is to_plane (`_corners_from`; positive: behind it, where
+    its normal does not point): its material's Emission Sampling names that side, as
+    Cycles decides by the sign of the distance to the plane."""
     off = L[TRI_VISIBILITY][j] & (NEE_FRONT_OFF | NEE_BACK_OFF)
-    if off == 0:
-        return True
-    v0, nrm = L[TRI_V0], L[TRI_NORMAL]
-    behind = (nrm[j, 0] * (v0[j, 0] - px) + nrm[j, 1] * (v0[j, 1] - py)
-              + nrm[j, 2] * (v0[j, 2] - pz)) > 0.0
-    return (off & (NEE_BACK_OFF if behind else NEE_FRONT_OFF)) == 0
+    return off == 0 or (off & (NEE_BACK_OFF if to_plane > 0.0 else NEE_FRONT_OFF)) == 0
 
 
 @kernel(allocates=False)
@@ -58,7 +54,8 @@ def _corners_from(L, j, px, py, pz):
     distance to p divided by twice its area (Cycles' triangle_light_sample and
     triangle_light_pdf compare the edge with dot(N, V0 - P) / |N|^2, N the unnormalised
     normal: a heuristic of mixed units, kept as it is, since it decides the MIS weights
-    of the light that only next-event estimation finds)."""
+    of the light that only next-event estimation finds), and that distance term (signed:
+    positive behind the triangle, for `sampled_side`)."""
     v0, e1, e2, nrm = L[TRI_V0], L[TRI_E1], L[TRI_E2], L[TRI_NORMAL]
     ax, ay, az = v0[j, 0] - px, v0[j, 1] - py, v0[j, 2] - pz
     bx, by, bz = ax + e1[j, 0], ay + e1[j, 1], az + e1[j, 2]
@@ -69,7 +66,7 @@ def _corners_from(L, j, px, py, pz):
            + (e2[j, 2] - e1[j, 2]) ** 2)
     longest = max(e0, max(e_1, e_2))
     to_plane = (nrm[j, 0] * ax + nrm[j, 1] * ay + nrm[j, 2] * az) / (2.0 * L[TRI_AREA][j])
-    return ax, ay, az, bx, by, bz, cx, cy, cz, longest > to_plane * to_plane
+    return ax, ay, az, bx, by, bz, cx, cy, cz, longest > to_plane * to_plane, to_plane
 
 
 @kernel(allocates=False)
@@ -92,7 +89,7 @@ def sample_triangle(L, j, px, py, pz, u0, u1):
     (engine.embree.self_hits) so that it does not meet the light itself, as Cycles'
     shadow rays name ls->prim, and margin how far short of the point it stops (REACH)."""
     v0, e1, e2, nrm = L[TRI_V0], L[TRI_E1], L[TRI_E2], L[TRI_NORMAL]
-    ax, ay, az, bx, by, bz, cx, cy, cz, near = _corners_from(L, j, px, py, pz)
+    ax, ay, az, bx, by, bz, cx, cy, cz, near, to_plane = _corners_from(L, j, px, py, pz)
     pdf = 0.0
     if near:
         ax, ay, az, bx, by, bz, cx, cy, cz, omega = _spherical(ax, ay, az, bx, by, bz,
@@ -122,7 +119,7 @@ def sample_triangle(L, j, px, py, pz, u0, u1):
         else:
             wx, wy, wz = 0.0, 0.0, 1.0
     cos_l = abs(wx * nrm[j, 0] + wy * nrm[j, 1] + wz * nrm[j, 2])
-    if not (dist > 0.0 and cos_l > GRAZING and sampled_side(L, j, px, py, pz)):
+    if not (dist > 0.0 and cos_l > GRAZING and sampled_side(L, j, to_plane)):
         return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0, L[TRI_PRIM][j], 0.0
     if not near:
         pdf = dist * dist / (L[TRI_AREA][j] * cos_l)
@@ -147,7 +144,8 @@ def pdf_triangle(L, j, px, py, pz, qx, qy, qz):
     """The solid-angle pdf at p of the point q on triangle entry j, as `sample_triangle`
     draws it: 1 / (its solid angle) when near, else d^3 / (A |n . (q - p)|); 0 from a
     side not sampled."""
-    if not sampled_side(L, j, px, py, pz):
+    ax, ay, az, bx, by, bz, cx, cy, cz, near, to_plane = _corners_from(L, j, px, py, pz)
+    if not sampled_side(L, j, to_plane):
         return 0.0
     tx, ty, tz = qx - px, qy - py, qz - pz
     d2 = tx * tx + ty * ty + tz * tz
@@ -155,7 +153,6 @@ def pdf_triangle(L, j, px, py, pz, qx, qy, qz):
     cos_abs_d = abs(tx * nrm[j, 0] + ty * nrm[j, 1] + tz * nrm[j, 2])
     if not (cos_abs_d > GRAZING * math.sqrt(d2) and d2 > 0.0):
         return 0.0
-    ax, ay, az, bx, by, bz, cx, cy, cz, near = _corners_from(L, j, px, py, pz)
     if near:
         omega = _spherical(ax, ay, az, bx, by, bz, cx, cy, cz)[9]
         return 1.0 / omega if omega > 0.0 else 0.0
