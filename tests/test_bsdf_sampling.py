@@ -122,21 +122,28 @@ def make_principled(params, n):
                                   walter=True)
 
 
-def case_principled(deg, name, allowed="all"):
+def case_principled(deg, name, allowed="all", diffuse_n=(0.0, 0.0, 1.0)):
     params = PRINCIPLED[name]
     mask = np.array(ALLOWED[allowed], bool)
 
     def sample(u):
         n = len(u)
         s = make_principled(params, n).sample(wo_at(deg, n), u[:, 0], u[:, 1:],
-                                              np.tile(mask, (n, 1)))
+                                              np.tile(mask, (n, 1)), diffuse_n)
         assert not s.delta.any()
         return s.wi, s.valid
 
     def pdf(w):
         n = len(w)
-        return make_principled(params, n).pdf(wo_at(deg, n), w, np.tile(mask, (n, 1)))
+        return make_principled(params, n).pdf(wo_at(deg, n), w, np.tile(mask, (n, 1)),
+                                              diffuse_n)
     return sample, pdf
+
+
+# a bent frame's raw normal, 40 degrees off the frame's (principled.bend_diffuse): the
+# diffuse lobe is drawn about it, partly under the frame's plane
+BENT = (np.sin(np.radians(40.0)) * np.cos(1.0), np.sin(np.radians(40.0)) * np.sin(1.0),
+        np.cos(np.radians(40.0)))
 
 
 CASES = [("cosine", case_cosine, (None,))]
@@ -158,6 +165,8 @@ CASES += [(f"principled-{m}-{d:g}deg", case_principled, (d, m))
 CASES += [(f"principled-{m}-{a}-45deg", case_principled, (45.0, m, a))
           for m in ("all_lobes", "all_lobes_multiscatter")
           for a in ("transmission_only", "no_transmission")]
+CASES += [(f"principled-{m}-bent_diffuse-{d:g}deg", case_principled, (d, m, "all", BENT))
+          for m in ("all_lobes", "blinn_phong") for d in (0.0, 85.0)]
 
 # every chi-square test run by this file, including the negative controls
 N_TESTS = len(CASES) + 2

@@ -244,6 +244,9 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                                nx, ny, nz, row)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p], counts[p, 0])
         bsdf.setup(row, front, wox, woy, woz, tables, state)
+        if bent:     # the diffuse lobe sampled about the raw normal, as Cycles' is
+            dnx, dny, dnz = to_local(rx, ry, rz, nx, ny, nz)
+            bsdf.bend_diffuse(state, dnx, dny, dnz)
         if b == 0 and tl.on(tally):
             d_col, g_col, t_col = lobe_colours(state, woz)
             tl.colours(tally, p, br, bg, bb, d_col, g_col, t_col)
@@ -328,12 +331,13 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
         if bent and ad and not sdelta and spdf > 0.0:
             # the diffuse lobe's share of the weight, moved from the sampling frame's
-            # cosine to the raw normal's (with bump shadowing)
+            # cosine (eval_seen's, above its plane only) to the raw normal's (with bump
+            # shadowing)
             fd_r, fd_g, fd_b = bsdf.eval_seen(state, wox, woy, woz, 0.0, 0.0, 1.0, True,
                                               False, False)
             dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry, rz, wx, wy,
                                       wz, correct)
-            c = abs(iz)
+            c = max(iz, 0.0)
             wr = max(wr + (dr - fd_r * c) / spdf, 0.0)
             wg = max(wg + (dg - fd_g * c) / spdf, 0.0)
             wb = max(wb + (db - fd_b * c) / spdf, 0.0)

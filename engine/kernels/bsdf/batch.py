@@ -42,8 +42,9 @@ def eval_f_batch(rows, front, wo, wi, tables, walter=False):
 
 
 @kernel
-def pdf_batch(rows, front, wo, wi, allowed, tables, walter=False):
-    """Mixture pdf (n,) with allowed (n, 3) bool over DIFFUSE, GLOSSY, TRANSMISSION."""
+def pdf_batch(rows, front, wo, wi, allowed, tables, walter=False, diffuse_n=(0.0, 0.0, 1.0)):
+    """Mixture pdf (n,) with allowed (n, 3) bool over DIFFUSE, GLOSSY, TRANSMISSION
+    (diffuse_n: the diffuse lobe's normal, principled.bend_diffuse)."""
     n = wo.shape[0]
     out = np.zeros(n)
     state = np.empty(P.NSTATE)
@@ -51,13 +52,16 @@ def pdf_batch(rows, front, wo, wi, allowed, tables, walter=False):
         P.setup(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state)
         if walter:
             state[S_WALTER] = 1.0
+        if diffuse_n[2] != 1.0:
+            P.bend_diffuse(state, diffuse_n[0], diffuse_n[1], diffuse_n[2])
         out[k] = P.pdf(state, wo[k, 0], wo[k, 1], wo[k, 2], wi[k, 0], wi[k, 1], wi[k, 2],
                        allowed[k, 0], allowed[k, 1], allowed[k, 2])
     return out
 
 
 @kernel
-def sample_batch(rows, front, wo, u_lobe, u_dir, allowed, tables, walter=False):
+def sample_batch(rows, front, wo, u_lobe, u_dir, allowed, tables, walter=False,
+                 diffuse_n=(0.0, 0.0, 1.0)):
     """(wi (n, 3), weight (n, 3), pdf (n,), kind (n,), delta (n,), valid (n,))."""
     n = wo.shape[0]
     wi = np.zeros((n, 3))
@@ -71,6 +75,8 @@ def sample_batch(rows, front, wo, u_lobe, u_dir, allowed, tables, walter=False):
         P.setup(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state)
         if walter:
             state[S_WALTER] = 1.0
+        if diffuse_n[2] != 1.0:
+            P.bend_diffuse(state, diffuse_n[0], diffuse_n[1], diffuse_n[2])
         s = P.sample(state, wo[k, 0], wo[k, 1], wo[k, 2], u_lobe[k], u_dir[k, 0],
                      u_dir[k, 1], allowed[k, 0], allowed[k, 1], allowed[k, 2])
         wi[k, 0], wi[k, 1], wi[k, 2] = s[0], s[1], s[2]
@@ -181,10 +187,11 @@ class Principled:
         return eval_seen_batch(self.rows, self.front, self._dirs(wo), self._dirs(wi),
                                self._allowed(allowed), self.tables, self.walter)
 
-    def pdf(self, wo, wi, allowed=None):
-        """The pdf (n,) over wi of `sample` with the same `allowed`."""
+    def pdf(self, wo, wi, allowed=None, diffuse_n=(0.0, 0.0, 1.0)):
+        """The pdf (n,) over wi of `sample` with the same `allowed` (and diffuse_n)."""
         return pdf_batch(self.rows, self.front, self._dirs(wo), self._dirs(wi),
-                         self._allowed(allowed), self.tables, self.walter)
+                         self._allowed(allowed), self.tables, self.walter,
+                         tuple(float(x) for x in diffuse_n))
 
     def states(self, wo=(0.0, 0.0, 1.0)):
         """The per-hit state vectors (n, NSTATE) at wo (slots: state.py)."""
@@ -195,8 +202,11 @@ class Principled:
         return selection_batch(self.rows, self.front, self._dirs(wo),
                                self._allowed(allowed), self.tables, self.walter)
 
-    def sample(self, wo, u_lobe, u_dir, allowed=None) -> Sample:
+    def sample(self, wo, u_lobe, u_dir, allowed=None, diffuse_n=(0.0, 0.0, 1.0)) -> Sample:
+        """Directions drawn at wo; diffuse_n: the diffuse lobe's unit normal in the
+        local frame (a bent frame's raw normal, principled.bend_diffuse)."""
         u_lobe = np.ascontiguousarray(np.broadcast_to(np.asarray(u_lobe, np.float64), (self.n,)))
         u_dir = np.ascontiguousarray(np.broadcast_to(np.asarray(u_dir, np.float64), (self.n, 2)))
         return Sample(*sample_batch(self.rows, self.front, self._dirs(wo), u_lobe, u_dir,
-                                    self._allowed(allowed), self.tables, self.walter))
+                                    self._allowed(allowed), self.tables, self.walter,
+                                    tuple(float(x) for x in diffuse_n)))

@@ -34,8 +34,9 @@ P_LAYERS / P_REFRACT_ONLY), the Beckmann distribution (beckmann.py) and the tint
 specular layer and glass (specular_tint.py) complete Cycles' closures.
 
 Sampling: a lobe is chosen with probability proportional to an estimate of its albedo at
-wo, at least MIN_SELECTION of its weight; the mixture pdf is sum_i q_i pdf_i over the
-allowed lobes (the delta part of a smooth glass has no density: pdf = inf, delta True).
+wo, at least MIN_SELECTION of its weight; the diffuse lobe is drawn about its own normal
+(the frame's, or a bent frame's raw one: bend_diffuse); the mixture pdf is
+sum_i q_i pdf_i over the allowed lobes (the delta part of a smooth glass has no density: pdf = inf, delta True).
 The allow flags over DIFFUSE / GLOSSY / TRANSMISSION restrict sampling and its pdf to the
 lobe kinds a hit keeps (the Caustics switches drop glossy reflection or refraction after a
 diffuse bounce, as Cycles filters those closures; bounce limits end paths instead,
@@ -67,7 +68,7 @@ from .albedo import specular_albedo
 from .compensation import compensate
 from .reflection_lobes import f82_setup, metal_fresnel, reflection_pdf, reflection_sample
 from .state import (NSTATE, S_ALPHA, S_ANY_SIDE, S_BECKMANN, S_BLINN, S_DIFFUSE,  # noqa: F401
-                    S_DIFFUSE_LABEL,
+                    S_DIFFUSE_LABEL, S_DIFFUSE_N,
                     S_EST, S_ETA_GLASS, S_ETA_SPEC, S_EXPONENT, S_GLASS_SMOOTH,
                     S_GLASS_RTINT, S_GLASS_TINTED, S_LAYERED, S_METAL_CONST, S_METAL_F0,
                     S_METAL_F82,
@@ -83,6 +84,7 @@ from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX,  # noqa: F
                      pack_materials)
 from .tables import kernel_tables  # noqa: F401  (re-exported)
 from .principled_eval import base_glossy, eval_f, eval_seen  # noqa: F401  (re-exported)
+from ..frame import to_world
 from ..warp import INV_PI, cosine_hemisphere
 
 DIFFUSE, GLOSSY, TRANSMISSION = 0, 1, 2    # lobe kinds
@@ -108,6 +110,7 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     state[S_LAYERED] = 1.0 if layered else 0.0
     state[S_REFRACT_ONLY] = row[P_REFRACT_ONLY]
     state[S_WALTER] = 0.0       # Cycles' refraction pairs (path_vertex sets it per light)
+    state[S_DIFFUSE_N], state[S_DIFFUSE_N + 1], state[S_DIFFUSE_N + 2] = 0.0, 0.0, 1.0
     if layered:
         layers.setup(row, wox, woy, woz, tables, state)
     alpha = mf.clamp_alpha(rough * rough)
@@ -224,6 +227,22 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
 
 
 @kernel(allocates=False)
+def bend_diffuse(state, x, y, z):
+    """Sample the diffuse lobe, and count its density, about the unit normal (x, y, z) of
+    the local frame: a bent frame's raw normal (path_vertex), as Cycles' diffuse closure
+    keeps the node's normal where its microfacet lobes take the valid reflection one.
+    Its value stays the caller's (nodes.shading.bent_diffuse)."""
+    state[S_DIFFUSE_N], state[S_DIFFUSE_N + 1], state[S_DIFFUSE_N + 2] = x, y, z
+
+
+@kernel(allocates=False)
+def _diffuse_cosine(state, wix, wiy, wiz):
+    """cos of wi to the diffuse lobe's normal (wiz unless bend_diffuse moved it)."""
+    return (state[S_DIFFUSE_N] * wix + state[S_DIFFUSE_N + 1] * wiy
+            + state[S_DIFFUSE_N + 2] * wiz)
+
+
+@kernel(allocates=False)
 def transmits(state):
     """True where light from behind the surface can contribute (glass, translucency, a
     Hair BSDF's transmission, a Principled Hair BSDF)."""
@@ -259,8 +278,9 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
     the subsurface lobe's has no density here)."""
     q0, q1, q2, q3, qc, qs, qt, qhr, qht, qu, qch = q
     p = 0.0
-    if wiz > 0.0:
-        p += q0 * (wiz * INV_PI)
+    cos_d = _diffuse_cosine(state, wix, wiy, wiz)
+    if cos_d > 0.0:
+        p += q0 * (cos_d * INV_PI)
     q_refl = q1 + q2
     if q_refl > 0.0:
         p += q_refl * reflection_pdf(state, wox, woy, woz, wix, wiy, wiz)
@@ -336,6 +356,9 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     hr = hg = hb = 0.0
     if lobe == 0:
         wix, wiy, wiz = cosine_hemisphere(u1, u2)
+        if state[S_DIFFUSE_N + 2] != 1.0:       # about a bent frame's raw normal
+            wix, wiy, wiz = to_world(wix, wiy, wiz, state[S_DIFFUSE_N],
+                                     state[S_DIFFUSE_N + 1], state[S_DIFFUSE_N + 2])
     elif lobe == 1 or lobe == 2:
         wix, wiy, wiz, ok = reflection_sample(state, wox, woy, woz, u1, u2)
         kind = GLOSSY

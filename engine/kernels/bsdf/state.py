@@ -42,4 +42,6 @@ S_GLASS_RTINT = layers.NSTATE + 29  # 3: the glass lobe's reflection tint (a Gla
 S_DIFFUSE_LABEL = layers.NSTATE + 32  # 1: principled.sample's last direction is diffuse as
 #                                       well as its kind: a Translucent BSDF's (Cycles'
 #                                       LABEL_DIFFUSE | LABEL_TRANSMIT)
-NSTATE = layers.NSTATE + 33
+S_DIFFUSE_N = layers.NSTATE + 33   # 3: the diffuse lobe's normal in the local frame: (0, 0, 1),
+#                                     or a bent frame's raw normal (bend_diffuse)
+NSTATE = layers.NSTATE + 36
