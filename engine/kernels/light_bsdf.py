@@ -2,13 +2,13 @@
 f(wo, wi) and |cos| of the lobes of the kinds the light is seen by.
 
 A Normal Map's bent normal: the specular lobes on its valid-reflection frame, the diffuse
-lobe on the raw normal with bump shadowing (Cycles' bent diffuse); a direction the bump
-rejects has no cosine."""
+lobe on the raw normal with bump shadowing (Cycles' bent diffuse), the translucent one on
+the frame with bump shadowing; a direction the bump rejects has no cosine."""
 from __future__ import annotations
 
 from .bsdf import principled as bsdf
 from .jit import kernel
-from ..nodes.shading import bent_diffuse, bump_rejects
+from ..nodes.shading import bent_diffuse, bent_translucent, bump_rejects
 
 
 @kernel(allocates=False)
@@ -29,5 +29,6 @@ def lit_bsdf(state, bent, wox, woy, woz, lx, ly, lz, see_d, see_g, see_t, s0x, s
     if see_d:
         dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry, rz, wx, wy,
                                   wz, correct)
-        fr, fg, fb = fr + dr, fg + dg, fb + db
+        tr, tg, tb = bent_translucent(state, s0x, s0y, s0z, nx, ny, nz, wx, wy, wz, correct)
+        fr, fg, fb = fr + dr + tr, fg + dg + tg, fb + db + tb
     return fr, fg, fb, 1.0

@@ -8,7 +8,7 @@ lobes (Lambert, sheen, translucency), its glossy reflection (specular, metal, co
 glass's reflection, hair R) and its transmission (a glass's refraction, hair TT),
 evaluated by
 principled.eval_seen restricted to that kind. Where a Normal Map bends the normal, the
-diffuse part is path_vertex's bent_diffuse, as the light itself is."""
+diffuse part is path_vertex's bent_diffuse and bent_translucent, as the light's is."""
 from __future__ import annotations
 
 import math
@@ -23,7 +23,7 @@ from .bsdf.state import (S_ALPHA, S_DIFFUSE, S_E_SPEC, S_ETA_GLASS, S_LAYERED, S
 from .jit import kernel
 from .light_tally import DIFFUSE_CLASS, GLOSSY_CLASS, TRANSMISSION_CLASS, one_class, \
     surface_shares
-from ..nodes.shading import bent_diffuse
+from ..nodes.shading import bent_diffuse, bent_translucent
 
 NO_SHARES = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
@@ -44,14 +44,18 @@ def _shares(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t, fr, fg, fb, dr, d
 
 @kernel(allocates=False)
 def light_shares(state, wox, woy, woz, lx, ly, lz, see_d, see_g, see_t, bent, fr, fg, fb,
-                 s0x, s0y, s0z, rx, ry, rz, wx, wy, wz, correct):
+                 s0x, s0y, s0z, nx, ny, nz, rx, ry, rz, wx, wy, wz, correct):
     """Shares of next-event estimation's value f (path_vertex.shade's, towards the light
-    at local l, world w; with a bent normal it includes the cosine)."""
+    at local l, world w; with a bent normal it includes the cosine; s the surface's own
+    normal, n the frame's, r the raw bent one)."""
     dr = dg = db = 0.0
     if see_d:
         if bent:
             dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry, rz, wx,
                                       wy, wz, correct)
+            tr, tg, tb = bent_translucent(state, s0x, s0y, s0z, nx, ny, nz, wx, wy, wz,
+                                          correct)
+            dr, dg, db = dr + tr, dg + tg, db + tb
         else:
             dr, dg, db = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, True, False, False)
     return _shares(state, wox, woy, woz, lx, ly, lz, see_g, see_t, fr, fg, fb, dr, dg, db,
@@ -72,6 +76,8 @@ def bounce_shares(state, wox, woy, woz, ix, iy, iz, kind, delta, bent, s0x, s0y,
         c = abs(iz)
         dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry, rz, wx, wy,
                                   wz, correct)
+        tr, tg, tb = bsdf.translucent_seen(state, iz)     # as sampled: no bump shadowing
+        dr, dg, db = dr + tr * c, dg + tg * c, db + tb * c
         fr, fg, fb = fr * c + dr, fg * c + dg, fb * c + db
     else:
         dr, dg, db = bsdf.eval_seen(state, wox, woy, woz, ix, iy, iz, True, False, False)

@@ -291,8 +291,8 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                 shares = NO_SHARES
                 if b == 0 and tl.on(tally):
                     shares = light_shares(state, wox, woy, woz, lx, ly, lz, see_d, see_g,
-                                          see_t, bent, fr, fg, fb, s0x, s0y, s0z, rx, ry,
-                                          rz, wx, wy, wz, correct)
+                                          see_t, bent, fr, fg, fb, s0x, s0y, s0z, nx, ny,
+                                          nz, rx, ry, rz, wx, wy, wz, correct)
                 w = nee_weight(mode, lpdf, bpdf, delta) / lpdf * cosine
                 fr, fg, fb = fr * w, fg * w, fb * w
                 group = tl.entry_group(tally, k)

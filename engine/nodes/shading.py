@@ -250,6 +250,21 @@ def bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz, softe
 
 
 @kernel(allocates=False)
+def bent_translucent(state, sx, sy, sz, nx, ny, nz, lx, ly, lz, soften):
+    """The translucent lobe's f x |cos| towards world direction l on the bent frame's
+    normal n: Cycles puts its Translucent closure on the valid reflection normal, as it
+    does the microfacet lobes, and evaluates it towards lights with a diffuse closure's
+    bump shadowing against the surface's own shading normal s (its sampled directions
+    carry none)."""
+    cos_n = nx * lx + ny * ly + nz * lz
+    tr, tg, tb = bsdf.translucent_seen(state, cos_n)
+    if not max(tr, tg, tb) > 0.0:
+        return 0.0, 0.0, 0.0
+    k = -cos_n * bump_shadowing(sx, sy, sz, nx, ny, nz, lx, ly, lz, soften)
+    return tr * k, tg * k, tb * k
+
+
+@kernel(allocates=False)
 def bump_rejects(sx, sy, sz, nx, ny, nz, lx, ly, lz):
     """Cycles 5.0's test of a lobe on a normal n that is not the surface's own shading
     normal s: light from direction l is refused when l and n lie on opposite sides of

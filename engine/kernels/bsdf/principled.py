@@ -83,7 +83,8 @@ from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX,  # noqa: F
                      P_REFRACT_ONLY, P_ROUGHNESS, P_SPEC_LEVEL, P_TRANSMISSION,
                      pack_materials)
 from .tables import kernel_tables  # noqa: F401  (re-exported)
-from .principled_eval import base_glossy, eval_f, eval_seen  # noqa: F401  (re-exported)
+from .principled_eval import (base_glossy, eval_f, eval_seen,  # noqa: F401  (re-exported)
+                              translucent_seen)
 from ..frame import to_world
 from ..warp import INV_PI, cosine_hemisphere
 

@@ -45,6 +45,17 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
 
 
 @kernel(allocates=False)
+def translucent_seen(state, wiz):
+    """f (1/sr) of the translucent lobe alone (a Translucent BSDF's, layers.py) towards
+    local wi: nothing above the surface, or without that lobe."""
+    if state[S_LAYERED] == 0.0 or not state[layers.S_EST_TRANS] > 0.0 or not wiz < 0.0:
+        return 0.0, 0.0, 0.0
+    t = INV_PI
+    return (state[layers.S_TRANS] * t, state[layers.S_TRANS + 1] * t,
+            state[layers.S_TRANS + 2] * t)
+
+
+@kernel(allocates=False)
 def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
     """f (1/sr) of the specular, metal and glass lobes a light of these kinds sees."""
     fr = 0.0
