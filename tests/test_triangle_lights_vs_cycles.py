@@ -8,7 +8,7 @@ case: each face takes light from under its own plane but above its smooth normal
 the other faces through the mesh, which Cycles' BSDF sampling refuses and its light
 sampling takes. With the light tree off (lights picked by power), DRT's faces take
 what Cycles' take. With the tree on, Cycles' picks (its two-level tree of meshes and
-triangles) give these faces 0.249 against DRT's 0.191 (docs/public_files.md, the
+triangles) give these faces 0.249 against DRT's 0.187 (docs/public_files.md, the
 lantern).
 
 A smooth octahedron, turned so that its silhouettes bend many normals to Cycles' valid
