@@ -18,6 +18,7 @@ import node_probe
 from node_probe import drt_against_cycles, empty_material, new_scene
 
 SAMPLES = 64
+SUN_ANGLE = math.radians(0.526)       # a new sun lamp's angular diameter in Blender
 
 
 def _leaf_material(bpy, normal_map):
@@ -55,14 +56,9 @@ def _leaf_scene(bpy):
     lamp.data.energy, lamp.data.size = 150.0, 1.0
     lamp.location, lamp.rotation_euler = (0.4, 0.3, -2.0), (math.pi, 0.0, 0.0)
     scene.collection.objects.link(lamp)
-    sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
-    sun.data.energy = 2.0
-    sun.rotation_euler = (math.radians(160.0), math.radians(20.0), 0.0)
-    scene.collection.objects.link(sun)
-    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    cam.location = (0.0, 0.0, 3.2)
-    scene.collection.objects.link(cam)
-    scene.camera = cam
+    node_probe.sun_and_camera(bpy, scene, 2.0, SUN_ANGLE,
+                              (math.radians(160.0), math.radians(20.0), 0.0),
+                              (0.0, 0.0, 3.2), (0.0, 0.0, 0.0))
     return scene
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from .bsdf import principled as bsdf
 from .jit import kernel
-from ..nodes.shading import bent_diffuse, bent_translucent, bump_rejects
+from ..nodes.shading import bent_diffuse_lobes, bump_rejects
 
 
 @kernel(allocates=False)
@@ -27,8 +27,7 @@ def lit_bsdf(state, bent, wox, woy, woz, lx, ly, lz, see_d, see_g, see_t, s0x, s
         cosine = 0.0
     fr, fg, fb = fr * cosine, fg * cosine, fb * cosine
     if see_d:
-        dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry, rz, wx, wy,
-                                  wz, correct)
-        tr, tg, tb = bent_translucent(state, s0x, s0y, s0z, nx, ny, nz, wx, wy, wz, correct)
-        fr, fg, fb = fr + dr + tr, fg + dg + tg, fb + db + tb
+        dr, dg, db = bent_diffuse_lobes(state, wox, woy, woz, s0x, s0y, s0z, nx, ny, nz, rx,
+                                        ry, rz, wx, wy, wz, correct)
+        fr, fg, fb = fr + dr, fg + dg, fb + db
     return fr, fg, fb, 1.0

@@ -23,7 +23,7 @@ from .bsdf.state import (S_ALPHA, S_DIFFUSE, S_E_SPEC, S_ETA_GLASS, S_LAYERED, S
 from .jit import kernel
 from .light_tally import DIFFUSE_CLASS, GLOSSY_CLASS, TRANSMISSION_CLASS, one_class, \
     surface_shares
-from ..nodes.shading import bent_diffuse, bent_translucent
+from ..nodes.shading import bent_diffuse, bent_diffuse_lobes
 
 NO_SHARES = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
@@ -51,11 +51,8 @@ def light_shares(state, wox, woy, woz, lx, ly, lz, see_d, see_g, see_t, bent, fr
     dr = dg = db = 0.0
     if see_d:
         if bent:
-            dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry, rz, wx,
-                                      wy, wz, correct)
-            tr, tg, tb = bent_translucent(state, s0x, s0y, s0z, nx, ny, nz, wx, wy, wz,
-                                          correct)
-            dr, dg, db = dr + tr, dg + tg, db + tb
+            dr, dg, db = bent_diffuse_lobes(state, wox, woy, woz, s0x, s0y, s0z, nx, ny, nz,
+                                            rx, ry, rz, wx, wy, wz, correct)
         else:
             dr, dg, db = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, True, False, False)
     return _shares(state, wox, woy, woz, lx, ly, lz, see_g, see_t, fr, fg, fb, dr, dg, db,

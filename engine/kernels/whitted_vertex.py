@@ -48,7 +48,7 @@ from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
 from ..nodes.interpreter import has_program
 from ..nodes.pack import NREGS
-from ..nodes.shading import bent_diffuse, bent_translucent, surface_normal
+from ..nodes.shading import bent_diffuse_lobes, surface_normal
 
 CENTRE = 0.5           # the fixed point of every lamp: its sample at (1/2, 1/2)
 
@@ -187,11 +187,8 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
             if not (lpdf > 0.0 and max(lr, lg, lb) > 0.0):
                 continue
             if bent:
-                fr, fg, fb = bent_diffuse(state, wox, woy, woz, n0x, n0y, n0z, rx, ry, rz,
-                                          wx, wy, wz, correct)
-                tr, tg, tb = bent_translucent(state, n0x, n0y, n0z, nx, ny, nz, wx, wy, wz,
-                                              correct)
-                fr, fg, fb = fr + tr, fg + tg, fb + tb
+                fr, fg, fb = bent_diffuse_lobes(state, wox, woy, woz, n0x, n0y, n0z, nx, ny,
+                                                nz, rx, ry, rz, wx, wy, wz, correct)
             else:
                 lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
                 fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, lx, ly, lz, True, False,

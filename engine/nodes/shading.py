@@ -265,6 +265,18 @@ def bent_translucent(state, sx, sy, sz, nx, ny, nz, lx, ly, lz, soften):
 
 
 @kernel(allocates=False)
+def bent_diffuse_lobes(state, wox, woy, woz, sx, sy, sz, nx, ny, nz, rx, ry, rz, lx, ly, lz,
+                       soften):
+    """f x cos of the diffuse-kind lobes towards a light at world direction l on a bent
+    frame (normal n, raw normal r, the surface's own s): `bent_diffuse` and
+    `bent_translucent`."""
+    dr, dg, db = bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz,
+                              soften)
+    tr, tg, tb = bent_translucent(state, sx, sy, sz, nx, ny, nz, lx, ly, lz, soften)
+    return dr + tr, dg + tg, db + tb
+
+
+@kernel(allocates=False)
 def bump_rejects(sx, sy, sz, nx, ny, nz, lx, ly, lz):
     """Cycles 5.0's test of a lobe on a normal n that is not the surface's own shading
     normal s: light from direction l is refused when l and n lie on opposite sides of

@@ -52,8 +52,7 @@ def pdf_batch(rows, front, wo, wi, allowed, tables, walter=False, diffuse_n=(0.0
         P.setup(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state)
         if walter:
             state[S_WALTER] = 1.0
-        if diffuse_n[2] != 1.0:
-            P.bend_diffuse(state, diffuse_n[0], diffuse_n[1], diffuse_n[2])
+        P.bend_diffuse(state, diffuse_n[0], diffuse_n[1], diffuse_n[2])
         out[k] = P.pdf(state, wo[k, 0], wo[k, 1], wo[k, 2], wi[k, 0], wi[k, 1], wi[k, 2],
                        allowed[k, 0], allowed[k, 1], allowed[k, 2])
     return out
@@ -75,8 +74,7 @@ def sample_batch(rows, front, wo, u_lobe, u_dir, allowed, tables, walter=False,
         P.setup(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state)
         if walter:
             state[S_WALTER] = 1.0
-        if diffuse_n[2] != 1.0:
-            P.bend_diffuse(state, diffuse_n[0], diffuse_n[1], diffuse_n[2])
+        P.bend_diffuse(state, diffuse_n[0], diffuse_n[1], diffuse_n[2])
         s = P.sample(state, wo[k, 0], wo[k, 1], wo[k, 2], u_lobe[k], u_dir[k, 0],
                      u_dir[k, 1], allowed[k, 0], allowed[k, 1], allowed[k, 2])
         wi[k, 0], wi[k, 1], wi[k, 2] = s[0], s[1], s[2]

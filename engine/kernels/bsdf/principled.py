@@ -36,7 +36,8 @@ specular layer and glass (specular_tint.py) complete Cycles' closures.
 Sampling: a lobe is chosen with probability proportional to an estimate of its albedo at
 wo, at least MIN_SELECTION of its weight; the diffuse lobe is drawn about its own normal
 (the frame's, or a bent frame's raw one: bend_diffuse); the mixture pdf is
-sum_i q_i pdf_i over the allowed lobes (the delta part of a smooth glass has no density: pdf = inf, delta True).
+sum_i q_i pdf_i over the allowed lobes (the delta part of a smooth glass has no density:
+pdf = inf, delta True).
 The allow flags over DIFFUSE / GLOSSY / TRANSMISSION restrict sampling and its pdf to the
 lobe kinds a hit keeps (the Caustics switches drop glossy reflection or refraction after a
 diffuse bounce, as Cycles filters those closures; bounce limits end paths instead,
