@@ -104,7 +104,12 @@ CAUSES = {
         "on the undisplaced normals there (Cycles builds it on the face's own), and in "
         "the world rather than the object's space: green from +90.7 % to +1.3 % on "
         "2026-12-01 (tests/test_displacement_vs_cycles.py). The worst block, 9.5 %, is "
-        "within the 8.1 % Cycles itself shows at 64 samples (times 1.25)",
+        "within the 8.1 % Cycles itself shows at 64 samples (times 1.25). Since 2026-12-01 "
+        "the diffuse lobe is drawn about the normal-mapped normal, as Cycles draws it: "
+        "at 256 samples each, red and blue went from -0.35 % to -1.39 %, darker almost "
+        "evenly over the image (its missing normal maps are pink, so every wall's "
+        "normal leans far); a plane with that map under a uniform world matches Cycles "
+        "(0.005 %): the cause in the room was not found yet",
     "OddBitWizard.blend":
         "the worst blocks hold a spot lamp's sphere seen in a mirror (radiance 197, 1,500 "
         "times the image mean): its image matches Cycles' pixel for pixel inside, and "
