@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import visibility
+from .light_distribution import cycles_distribution
 from .luminance import luminance
 from .scene import AreaLight, PointLight, SunLight
 from .warp import orthonormal_basis
@@ -175,12 +176,16 @@ WORLD = "world"         # LightSet.sources' name for the world's own light
 class LightSet:
     """All lights of a scene: the lamps (`models`) followed by the emissive triangles
     (`mesh`, an engine.mesh_lights.EmissiveTriangles, may be None), as one list of
-    entries. Next-event estimation picks one entry per shading point with probability
-    proportional to its estimated power (luminance of radiance x pi x area for area
-    lights and triangles, of strength for points, of irradiance x pi R^2 for suns):
-    `select_pdf`, over len(self) entries; entry k >= n_lamps is triangle k - n_lamps."""
+    entries; entry k >= n_lamps is triangle k - n_lamps. With the light tree off,
+    next-event estimation picks one entry per shading point as Cycles' light
+    distribution does (engine.light_distribution: lamps and the world alike, triangles by
+    area): `select_pdf`, over len(self) entries. Each model's estimated power (luminance
+    of radiance x pi x area for area lights and triangles, of strength for points, of
+    irradiance x pi R^2 for suns) is what the tree weighs it by, and a light of none is
+    left out. world_sun: the lamp of `lights` that is the world's Sky Texture sun."""
 
-    def __init__(self, lights, scene_radius: float, mesh_lights=None, world=None):
+    def __init__(self, lights, scene_radius: float, mesh_lights=None, world=None,
+                 world_sun=None):
         self.models = [make_light(l) for l in lights]
         # what each model was made from: a lamp of `lights`, or WORLD (light groups)
         self.sources = list(lights)
@@ -206,10 +211,11 @@ class LightSet:
         env = [k for k, m in enumerate(self.models) if getattr(m, "is_environment", False)]
         self.env_index = env[0] if env else None
         self.mesh = mesh_lights if mesh_lights is not None and len(mesh_lights) else None
-        mesh_power = self.mesh.power if self.mesh is not None else np.zeros(0)
-        power = np.concatenate([power[keep], mesh_power])
-        total = power.sum()
-        self.select_pdf = power / total if total > 0 else power
+        sun = [k for k, src in enumerate(self.sources)
+               if world_sun is not None and src is world_sun]
+        self.select_pdf = cycles_distribution(
+            self.n_lamps, self.env_index, sun[0] if sun else None,
+            self.mesh.area if self.mesh is not None else np.zeros(0))
         self.cdf = np.cumsum(self.select_pdf)
         if len(self.cdf):
             self.cdf[-1] = 1.0

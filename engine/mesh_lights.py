@@ -11,10 +11,11 @@ names (Front: where the triangle's normal points; `sides`). A side or a triangle
 sampled is found by BSDF rays alone, with MIS weight 1 (its light pdf is 0 there), as in
 Cycles (SD_MIS_FRONT, SD_MIS_BACK).
 
-Selection (done by the LightSet, jointly with the lamps): triangle j is picked with
-probability proportional to its estimated power  P_j = luminance(L_j) x pi x A_j,  the
-power one side emits: a point in front of a two-sided triangle only ever receives one
-side's light, so this is the same estimate an equally bright one-sided area lamp gets.
+Selection (done by the LightSet, jointly with the lamps): with the light tree off,
+triangle j is picked in proportion to its area, as Cycles does (engine.light_distribution);
+the tree weighs it by its estimated power  P_j = luminance(L_j) x pi x A_j,  the power one
+side emits: a point in front of a two-sided triangle only ever receives one side's light,
+so this is the same estimate an equally bright one-sided area lamp gets.
 
 Sampling (engine/kernels/lights/triangles.py) a point on triangle (v0, v1, v2) from u in
 [0,1)^2 uses Heitz's low-distortion map (E. Heitz, "A Low-Distortion Map Between Triangle and Square", 2019):

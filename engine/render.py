@@ -108,7 +108,7 @@ class RenderContext:
         sun = getattr(scene.world, "sun", None)
         lamps = list(scene.lights) + ([sun] if sun is not None else [])
         self.lights = LightSet(lamps, self.scene_radius, mesh_lights=mesh_lights,
-                               world=self.world)
+                               world=self.world, world_sun=sun)
         self.light_visible_camera = np.array(
             [getattr(m, "visible_camera", True) for m in self.lights.models] or [True])
 

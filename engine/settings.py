@@ -28,7 +28,8 @@ class RenderSettings:
     caustics_reflective: bool = True
     caustics_refractive: bool = True
     # Cycles' Sampling > Lights > Light Tree: pick the light to sample for each shading
-    # point by its importance there (engine/kernels/lights/tree.py), else by power alone
+    # point by its importance there (engine/kernels/lights/tree.py), else as Cycles does
+    # without the tree (engine.light_distribution)
     light_tree: bool = True
     # Film
     filter_type: str = "BLACKMAN_HARRIS"

@@ -257,7 +257,7 @@ def test_light_paths_and_clamps_are_the_files_own(factory_scene):
 
 def test_light_tree_is_the_files_own(factory_scene):
     """Sampling > Lights > Light Tree is read, not warned about: on (Cycles' default)
-    the engine picks lights with the tree, off by power."""
+    the engine picks lights with the tree, off as Cycles' light distribution."""
     _quiet_defaults(factory_scene)
     assert factory_scene.drt.to_engine_settings().light_tree
     factory_scene.cycles.use_light_tree = False

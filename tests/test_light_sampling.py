@@ -515,18 +515,20 @@ def test_negative_control_area_pdf_for_solid_angle_samples_fails():
 
 
 def test_negative_control_wrong_selection_pdf_fails():
-    """Triangles picked by power, pdf claiming they are picked by area alone."""
+    """Triangles picked by area (Cycles' distribution without the tree), pdf claiming
+    they are picked by power (their radiances differ)."""
     mesh = emissive_mesh()
     ls = LightSet([], 1.0, mesh_lights=mesh)
     p = np.array([0.1, 0.0, 0.0])
     chart, sample, pdf = _mesh_case(p, ls)
-    by_area = mesh.area / mesh.area.sum()
+    np.testing.assert_allclose(ls.select_pdf, mesh.area / mesh.area.sum())
+    by_power = mesh.power / mesh.power.sum()
 
     def wrong_pdf(wi, d=None):
         tri, _, t = chart.hit(wi)
         j = np.maximum(tri, 0)
         right = pdf(wi)
-        return np.where(tri >= 0, right / ls.select_pdf[j] * by_area[j], 0.0)
+        return np.where(tri >= 0, right / ls.select_pdf[j] * by_power[j], 0.0)
 
     res = chart_chi2(sample, wrong_pdf, chart, seed=4, rows=40, cols=10, adaptive=False)
     print(res)

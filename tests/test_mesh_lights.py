@@ -7,7 +7,7 @@ copy's light in next-event estimation, while a BSDF ray sees one surface: that f
 rendered 0.5 % too bright with the light tree, and the merged entries fix it. Checked
 here: copies (in any corner order and winding, and -0.0 for 0.0) share an entry, copies of
 another radiance do not, and a floor under a lamp of two coincident copies gets the same
-light from next-event estimation (MIS with the light tree and by power) as from BSDF rays
+light from next-event estimation (MIS with the light tree and without it) as from BSDF rays
 alone, which an unmerged light set fails (the control)."""
 from __future__ import annotations
 
@@ -50,7 +50,7 @@ def _lamp_of_two_copies():
     return Scene(cam, 16, 12, [floor, lamp, flipped], mats, [], World((0, 0, 0)))
 
 
-@pytest.mark.parametrize("tree", [True, False], ids=["light tree", "by power"])
+@pytest.mark.parametrize("tree", [True, False], ids=["light tree", "tree off"])
 def test_next_event_estimation_counts_coincident_copies_once(tree, monkeypatch):
     scene = _lamp_of_two_copies()
     bsdf = _image_mean(scene, "bsdf", 256)
@@ -92,7 +92,7 @@ def test_emission_sampling_none_leaves_the_triangles_out_of_the_light_set():
             sampling
 
 
-@pytest.mark.parametrize("tree", [True, False], ids=["light tree", "by power"])
+@pytest.mark.parametrize("tree", [True, False], ids=["light tree", "tree off"])
 def test_emission_sampling_changes_noise_not_the_light(tree):
     """Material > Settings > Emission Sampling (engine.mesh_lights): whichever sides
     next-event estimation samples, the floor gets the light BSDF rays alone find (a side

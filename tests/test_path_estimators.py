@@ -67,7 +67,7 @@ def _image_mean(scene, mode, samples, light_scale=1.0, light_tree=None):
     tree unless `light_tree` is False or `light_scale` is not 1."""
     # each pixel's camera ray through its centre: no edge of a lamp or an emitter seen
     # by the camera adds noise that all three estimators share
-    # (the control scales the power pick's probabilities: it picks lights by power)
+    # (the control scales the pick's probabilities: it picks lights without the tree)
     settings = RenderSettings(samples=samples, seed=11, max_bounces=1, clamp_direct=0.0,
                               clamp_indirect=0.0, filter_glossy=0.0, filter_type="BOX",
                               filter_width=1e-3,

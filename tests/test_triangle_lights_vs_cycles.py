@@ -6,7 +6,7 @@ finds some light, the weight is the light found. A smooth-shaded icosahedron (Bl
 Ico Sphere at 1 subdivision), emitting 10 over a grey base in a black world, is such a
 case: each face takes light from under its own plane but above its smooth normal, from
 the other faces through the mesh, which Cycles' BSDF sampling refuses and its light
-sampling takes. With the light tree off (lights picked by power), DRT's faces take
+sampling takes. With the light tree off (triangles picked by area, as Cycles), DRT's faces take
 what Cycles' take. With the tree on, Cycles' picks (its two-level tree of meshes and
 triangles) give these faces 0.249 against DRT's 0.187 (docs/public_files.md, the
 lantern).

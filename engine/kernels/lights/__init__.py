@@ -43,15 +43,15 @@ Use:
     n_entries(L);  entry_visibility(L, k)
     select_pdf(L, k, recv, time)                     # the probability `sample` picks k
     pick_entry(L, recv, u_pick, time) -> (k, probability)   # as `sample` picks
-    pick(L, u_pick) -> k                             # by power alone
+    pick(L, u_pick) -> k                             # by L[SELECT_PDF] alone
     sample_entry(L, k, px, py, pz, u1, u2, time)     # one entry, pick not included
     entry_center(L, k, time) -> (has_one, x, y, z)   # towards which distances are sampled
 
 Every pdf is in solid angle with the pick probability included: the light tree's for the
-receiver (tree.py), as Cycles picks lights by default, or LightSet.select_pdf (by power)
-when the tree is off. `time` is
-the ray's shutter time in [0, 1]: a lamp that moves during the shutter is its slice at
-that time (pack.py, TimeSlicedLight). Array drivers for tests: `batch`.
+receiver (tree.py), as Cycles picks lights by default, or LightSet.select_pdf (Cycles'
+distribution without the tree) when the tree is off. `time` is the ray's shutter time in
+[0, 1]: a lamp that moves during the shutter is its slice at that time (pack.py,
+TimeSlicedLight). Array drivers for tests: `batch`.
 """
 from .light_set import (entry_center, environment_pdf, environment_radiance, hit_lamps,
                         is_uniform_world, lamp_hit, lamp_pdf, entry_visibility, mesh_pdf,

@@ -115,7 +115,7 @@ def select_pdf(L, k, recv, time):
 
 @kernel(allocates=False)
 def pick_entry(L, recv, u_pick, time):
-    """(k, probability): an entry picked for the receiver (by the tree, else by power),
+    """(k, probability): an entry picked for the receiver (by the tree, else by L[SELECT_PDF]),
     k -1 when there is none."""
     if has_tree(L):
         return tree_pick(L, recv, u_pick, time)

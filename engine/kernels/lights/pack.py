@@ -48,7 +48,7 @@ every scene):
                  count K (0 for a lamp that does not move). A moving lamp's own row in
                  L[LAMPS] is its middle slice (K // 2, as TimeSlicedLight without a time);
                  a ray at shutter time t in [0, 1] sees slice min(floor(t K), K - 1).
-  The light tree (tree_build.py; all three empty when lights are picked by power alone,
+  The light tree (tree_build.py; all three empty when lights are picked without the tree,
   as with Cycles' Light Tree off or a single entry):
   L[TREE_NODES]  float64 (n_nodes, tree_build.N_NODE), L[TREE_SLOTS] int64 (n_slots,),
   L[TREE_EMIT]   float64 (n_entries, tree_build.N_EMIT).
@@ -226,8 +226,8 @@ def pack_lights(light_set, tri_visibility=None, timed=True, tree=True) -> tuple:
     A lamp that moves during the shutter (`TimeSlicedLight`) has a row per slice in
     L[LAMP_SLICES] (see the module docstring); with `timed` False (a render that samples
     no time: the shutter is closed) it is its middle slice alone, as TimeSlicedLight
-    without a time. `tree`: pick lights with the light tree (Cycles' default), else in
-    proportion to their power."""
+    without a time. `tree`: pick lights with the light tree (Cycles' default), else by
+    LightSet.select_pdf (Cycles' distribution without the tree)."""
     models = light_set.models
     lamps = np.zeros((len(models), N_COLUMNS))
     slice_of = np.zeros((len(models), 2), dtype=np.int64)

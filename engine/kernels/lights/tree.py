@@ -28,7 +28,7 @@ __all__ = ["OMNI", "ONE_SIDED", "TWO_SIDED", "SEGMENT", "receiver", "segment_rec
 
 @kernel(allocates=False)
 def has_tree(L):
-    """Whether L picks its lights with a tree (else by power alone)."""
+    """Whether L picks its lights with a tree (else by L[SELECT_PDF]: Cycles' light distribution)."""
     return L[TREE_NODES].shape[0] > 0
 
 
