@@ -1,7 +1,8 @@
 """Renders the many-lights scene (sample_blends/night_street.blend) and writes
 docs/light_tree.md: DRT against Cycles (the test's comparison, measured against a
 4096-sample Cycles reference, and its control), and what the light tree buys: the error
-of DRT with the tree and with lights picked by power, at equal samples and per second
+of DRT with the tree and without it (lights picked as Cycles' light distribution picks
+them), at equal samples and per second
 of rendering, against a 4096-sample DRT reference, with images side by side.
 
     .venv/bin/python docs/make_light_tree_docs.py
@@ -75,7 +76,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         pngs, captions = [], []
         for spp in SAMPLES:
-            for label, setup in (("tree", None), ("by power", _tree_off)):
+            for label, setup in (("tree", None), ("tree off", _tree_off)):
                 png = os.path.join(tmp, f"{label}_{spp}.png") if spp == SAMPLES[0] else None
                 img, seconds = render(bpy, BLEND, "DRT", spp, setup=_seeded(setup), png=png)
                 err = rel_mse(img, drt_ref)
@@ -92,18 +93,18 @@ def main() -> int:
     for name in FEW_LIGHTS:
         path = os.path.join(ROOT, "sample_blends", f"{name}.blend")
         seconds = {}
-        for label, setup in (("tree", None), ("by power", _tree_off)):
+        for label, setup in (("tree", None), ("tree off", _tree_off)):
             render(bpy, path, "DRT", 4, setup=setup)          # loads, not timed
             seconds[label] = min(render(bpy, path, "DRT", COST_SAMPLES, setup=setup)[1]
                                  for _ in range(2))
-        cost.append(f"| {name} | {seconds['tree']:.2f} s | {seconds['by power']:.2f} s | "
-                    f"{seconds['tree'] / seconds['by power']:.2f}x |")
+        cost.append(f"| {name} | {seconds['tree']:.2f} s | {seconds['tree off']:.2f} s | "
+                    f"{seconds['tree'] / seconds['tree off']:.2f}x |")
     table = []
     for spp, label, seconds, err in noise:
         table.append(f"| {spp} | {label} | {seconds:.1f} s | {err:.2e} | {err * seconds:.2e} |")
-    gain = {spp: next(e for s, lb, t, e in noise if s == spp and lb == "by power")
+    gain = {spp: next(e for s, lb, t, e in noise if s == spp and lb == "tree off")
             / next(e for s, lb, t, e in noise if s == spp and lb == "tree") for spp in SAMPLES}
-    eff = {spp: next(e * t for s, lb, t, e in noise if s == spp and lb == "by power")
+    eff = {spp: next(e * t for s, lb, t, e in noise if s == spp and lb == "tree off")
            / next(e * t for s, lb, t, e in noise if s == spp and lb == "tree")
            for spp in SAMPLES}
     text = f"""# Many lights: the light tree
@@ -128,7 +129,11 @@ DRT, with Cycles' bounds and choices (`engine/kernels/lights/tree_build.py`, `tr
   previous vertex, walking up from the light's leaf, for multiple importance sampling.
 
 It follows the file's Sampling > Lights > Light Tree (`scene.cycles.use_light_tree`);
-off, lights are picked by power, as Cycles does then.
+off, lights are picked as Cycles' light distribution picks them then: every lamp (and
+the world) alike whatever its power, emissive triangles by area, each half of the picks
+when there are both (`engine/light_distribution.py`). That is not only noise: where a
+bent normal lets next-event estimation take light that BSDF sampling refuses (as Cycles'
+closures do), the image depends on the picks (`tests/test_light_distribution_vs_cycles.py`).
 
 ![DRT with and without the tree, and Cycles](images/light_tree.png)
 
@@ -154,7 +159,8 @@ Render times at 64 x 48 on this machine's 2 cores: DRT {t_drt:.1f} s (512 sample
 
 Error against a DRT reference of {REFERENCE} samples ({t_drt_ref:.0f} s), as relMSE
 (the mean of (image - reference)^2 / (reference^2 + 0.01)), with the tree and with lights
-picked by power, each with a sampler seed other than the reference's:
+picked as Cycles without the tree ("tree off"), each with a sampler seed other than the
+reference's:
 
 | samples | lights picked | time | relMSE | relMSE x time |
 |---|---|---|---|---|
@@ -162,16 +168,16 @@ picked by power, each with a sampler seed other than the reference's:
 
 At equal samples the tree's error is {gain[SAMPLES[0]]:.1f}x ({SAMPLES[0]} samples) and
 {gain[SAMPLES[1]]:.1f}x ({SAMPLES[1]} samples) smaller. A pick walks the tree, which
-costs more than a search of the power CDF, so per second of rendering the gain is
+costs more than a search of a CDF, so per second of rendering the gain is
 {eff[SAMPLES[0]]:.1f}x and {eff[SAMPLES[1]]:.1f}x. `tests/test_light_tree.py` measures the
-variance of a street of 64 lamps at equal samples: the tree's is a fraction of picking
-by power's, and both converge to the same image.
+variance of a street of 64 lamps at equal samples: the tree's is a fraction of the
+pick without it, and both converge to the same image.
 
 A scene with a single light builds no tree and picks nothing. The sample scenes with a
 few lights (a lamp and the sky, three lamps and the sky, a sun and the sky) render
 {COST_SAMPLES} samples at 64 x 48 in these times (best of two):
 
-| scene | tree | by power | ratio |
+| scene | tree | tree off | ratio |
 |---|---|---|---|
 {chr(10).join(cost)}
 
@@ -182,7 +188,7 @@ segment through the medium, with the tree's volume form as Cycles does
 its distance to the segment's line; suns and the world, towards which no distance is
 sampled, are left to the scattering). The two strategies are weighted by their densities
 of the pair (light, distance). `tests/test_lit_fog.py` measures a row of 16 spot beams
-in fog: at equal samples the variance with the tree is a fraction of picking by power.
+in fog: at equal samples the variance with the tree is a fraction of the pick without it.
 
 Written by `docs/make_light_tree_docs.py`.
 """

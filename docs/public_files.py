@@ -105,11 +105,15 @@ CAUSES = {
         "the world rather than the object's space: green from +90.7 % to +1.3 % on "
         "2026-12-01 (tests/test_displacement_vs_cycles.py). The worst block, 9.5 %, is "
         "within the 8.1 % Cycles itself shows at 64 samples (times 1.25). Since 2026-12-01 "
-        "the diffuse lobe is drawn about the normal-mapped normal, as Cycles draws it: "
-        "at 256 samples each, red and blue went from -0.35 % to -1.39 %, darker almost "
-        "evenly over the image (its missing normal maps are pink, so every wall's "
-        "normal leans far); a plane with that map under a uniform world matches Cycles "
-        "(0.005 %): the cause in the room was not found yet",
+        "the diffuse lobe is drawn about the normal-mapped normal, as Cycles draws it, "
+        "and red and blue went from -0.35 % to -1.39 % at 256 samples each. The cause "
+        "was not that: the floor and ceiling's Displacement and Bump make their shading "
+        "normal the undisplaced mesh's (up to 45 degrees off their faces), so next-event "
+        "estimation takes light through them that BSDF sampling refuses, and the image "
+        "depends on how lights are picked. The file turns the light tree off, and Cycles "
+        "then picks the lamp and the world alike; DRT picked by power (the world nearly "
+        "always). Picking as Cycles (2026-12-01, tests/test_light_distribution_vs_cycles.py): "
+        "-0.04 %, +0.45 %, -0.04 % at 256 samples, worst block 4.9 %",
     "OddBitWizard.blend":
         "the worst blocks hold a spot lamp's sphere seen in a mirror (radiance 197, 1,500 "
         "times the image mean): its image matches Cycles' pixel for pixel inside, and "
@@ -123,7 +127,9 @@ CAUSES = {
         "clamp the engines agree (green +1.8 %, within the caustics' noise); with it "
         "Cycles keeps 61 % of its green and DRT 73 %. What a clamp keeps depends on the "
         "estimator (Cycles' green moves by 14 % when the pink world, which has no green, "
-        "is removed); which of DRT's pick and MIS weights differ was not found yet",
+        "is removed): the file turns the light tree off, and Cycles then picks the lamp "
+        "and the world alike, where DRT picked by power. Picking as Cycles (2026-12-01): "
+        "green +22.0 % -> +7.7 %, worst block 37.2 % -> 17.3 %; the rest is not found yet",
 }
 
 

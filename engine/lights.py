@@ -14,7 +14,7 @@ Units (Blender's, checked against Cycles 5.0, see ../shared/notes/blender-facts.
 - Emissive triangles (engine.mesh_lights): radiance = the material's emission, two-sided.
 
 Every light model has its parameters (what engine.kernels.lights.pack puts in a row) and
-power(scene_radius), the estimated power the light set picks entries by. The sampling
+power(scene_radius), the estimated power the light tree weighs entries by. The sampling
 strategies are in the kernels' modules: engine/kernels/lights/point.py, sun.py, area.py
 (with spherical_rectangle.py), environment.py, environment_map.py and triangles.py.
 """

@@ -230,8 +230,9 @@ SETTINGS: list[FileSetting] = [
     _ignored("scene.cycles.light_sampling_threshold", "Sampling > Advanced > Light "
              "Threshold", f"DRT never skips a light sample; {NOISE_ONLY}", 0.01),
     _s("scene.cycles.use_light_tree", "Sampling > Lights > Light Tree", READ,
-       "DRT picks the light to sample for each shading point with Cycles' light tree, or "
-       "in proportion to the lights' power when it is off, as Cycles does"),
+       "DRT picks the light to sample for each shading point with Cycles' light tree, or, "
+       "when it is off, as Cycles' light distribution does: every lamp and the world "
+       "alike, emissive triangles by area"),
     _ignored("scene.cycles.direct_light_sampling_type", "Sampling > Advanced > Direct Light "
              "Sampling", f"DRT combines light and BSDF sampling with multiple importance "
              f"sampling; {NOISE_ONLY}", "MULTIPLE_IMPORTANCE_SAMPLING"),
