@@ -179,6 +179,20 @@ def new_scene(bpy, size=64):
     return scene
 
 
+def tilted_square(bpy, make_material, world_strength):
+    """A new 64 x 64 scene with a default world at world_strength and a 2 m square of
+    the material make_material() returns (made in the new scene) at the origin, tilted
+    20 degrees about x and -15 about y: the scene."""
+    scene = new_scene(bpy, 64)
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = \
+        world_strength
+    bpy.ops.mesh.primitive_plane_add(size=2.0)
+    square = bpy.context.object
+    square.rotation_euler = (math.radians(20.0), math.radians(-15.0), 0.0)
+    square.data.materials.append(make_material())
+    return scene
+
+
 def empty_material(bpy, name):
     """A new node material with nothing but its Material Output: (material, node tree,
     output node)."""

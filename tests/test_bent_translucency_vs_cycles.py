@@ -46,12 +46,7 @@ def _leaf_material(bpy, normal_map):
 def _leaf_scene(bpy):
     """A leaf (a plane tilted towards the camera) with a normal-mapped leaf material,
     lit from behind by a sun and an area lamp, and from the front by a dim world."""
-    scene = new_scene(bpy, 64)
-    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.2
-    bpy.ops.mesh.primitive_plane_add(size=2.0)
-    leaf = bpy.context.object
-    leaf.rotation_euler = (math.radians(20.0), math.radians(-15.0), 0.0)
-    leaf.data.materials.append(_leaf_material(bpy, True))
+    scene = node_probe.tilted_square(bpy, lambda: _leaf_material(bpy, True), 0.2)
     lamp = bpy.data.objects.new("Behind", bpy.data.lights.new("Behind", "AREA"))
     lamp.data.energy, lamp.data.size = 150.0, 1.0
     lamp.location, lamp.rotation_euler = (0.4, 0.3, -2.0), (math.pi, 0.0, 0.0)

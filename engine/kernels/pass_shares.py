@@ -72,7 +72,7 @@ def bounce_shares(state, wox, woy, woz, ix, iy, iz, kind, delta, bent, s0x, s0y,
     if bent:
         c = abs(iz)
         dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry, rz, wx, wy,
-                                  wz, correct)
+                                  wz, ix, iy, iz, correct)
         tr, tg, tb = bsdf.translucent_seen(state, iz)     # as sampled: no bump shadowing
         dr, dg, db = dr + tr * c, dg + tg * c, db + tb * c
         fr, fg, fb = fr * c + dr, fg * c + dg, fb * c + db

@@ -243,10 +243,10 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
             hair_tangent.write(geometry, prim, hit_inst[j], hit_u[j], hit_v[j], path_time[p],
                                nx, ny, nz, row)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p], counts[p, 0])
-        bsdf.setup(row, front, wox, woy, woz, tables, state)
-        if bent:     # the diffuse lobe sampled about the raw normal, as Cycles' is
+        dnx, dny, dnz = 0.0, 0.0, 1.0
+        if bent:     # the diffuse and sheen lobes about the raw normal, as Cycles' are
             dnx, dny, dnz = to_local(rx, ry, rz, nx, ny, nz)
-            bsdf.bend_diffuse(state, dnx, dny, dnz)
+        bsdf.setup_about(row, front, wox, woy, woz, tables, state, dnx, dny, dnz)
         if b == 0 and tl.on(tally):
             d_col, g_col, t_col = lobe_colours(state, woz)
             tl.colours(tally, p, br, bg, bb, d_col, g_col, t_col)
@@ -330,17 +330,17 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
             continue
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
         if bent and ad and not sdelta and spdf > 0.0:
-            # the diffuse lobe's share of the weight, moved from the sampling frame's
-            # cosine (eval_seen's, above its plane only) to the raw normal's (with bump
-            # shadowing)
-            fd_r, fd_g, fd_b = bsdf.eval_seen(state, wox, woy, woz, 0.0, 0.0, 1.0, True,
-                                              False, False)
+            # the diffuse and sheen lobes' share of the weight, moved from the sampling
+            # frame's cosine (eval_seen's: the diffuse above its plane only) to the raw
+            # normal's (with bump shadowing)
+            fd_r, fd_g, fd_b = bsdf.base_diffuse(state, wox, woy, woz)
+            fs_r, fs_g, fs_b = bsdf.sheen_seen(state, woz, ix, iy, iz)
             dr, dg, db = bent_diffuse(state, wox, woy, woz, s0x, s0y, s0z, rx, ry, rz, wx, wy,
-                                      wz, correct)
-            c = max(iz, 0.0)
-            wr = max(wr + (dr - fd_r * c) / spdf, 0.0)
-            wg = max(wg + (dg - fd_g * c) / spdf, 0.0)
-            wb = max(wb + (db - fd_b * c) / spdf, 0.0)
+                                      wz, ix, iy, iz, correct)
+            c, a = max(iz, 0.0), abs(iz)
+            wr = max(wr + (dr - fd_r * c - fs_r * a) / spdf, 0.0)
+            wg = max(wg + (dg - fd_g * c - fs_g * a) / spdf, 0.0)
+            wb = max(wb + (db - fd_b * c - fs_b * a) / spdf, 0.0)
         side = dot(wx, wy, wz, gx, gy, gz)
         if state[S_ANY_SIDE] == 0.0 and ((side >= 0.0) if skind == TRANSMISSION
                                           else (side <= 0.0)):

@@ -173,8 +173,10 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
                                nx, ny, nz, row)
         row[P_SSS_WEIGHT] = 0.0          # Whitted's model: subsurface light is diffuse
         # 2. direct light: one shadow ray to each lamp's fixed point, on the lobes that
-        # are not followed (diffuse, sheen, translucency)
-        bsdf.setup(row, front, wox, woy, woz, tables, state)
+        # are not followed (diffuse, sheen, translucency); on a bent frame the sheen about
+        # the raw normal, as Cycles' (principled.setup_about)
+        dnx, dny, dnz = to_local(rx, ry, rz, nx, ny, nz) if bent else (0.0, 0.0, 1.0)
+        bsdf.setup_about(row, front, wox, woy, woz, tables, state, dnx, dny, dnz)
         clamp = clamp_direct if b == 0 else clamp_indirect
         for k in range(lamps.shape[0]):
             if lamps[k, C_TYPE] == T_ENV or lamps[k, C_TYPE] == T_ENV_MAP:

@@ -17,6 +17,7 @@ from ..kernels.jit import kernel
 from ..kernels.textures import (I_TEXTURE, INPUTS, PLAIN, TEX_ALPHA, TEX_EMISSION,
                                 textured_value)
 from ..kernels.curve_hit import strand_info
+from ..kernels.frame import to_local
 from .context import (H_FLAT_FACE, H_HAIR_INTERCEPT, H_HAIR_IS_STRAND, H_HAIR_LENGTH,
                       H_HAIR_RANDOM, H_HAIR_TANGENT_NORMAL, H_HAIR_THICKNESS, H_MAP_NORMAL,
                       fill, set_undisplaced)
@@ -235,18 +236,21 @@ def normal_rows(T, material, regs, ns, ng, incoming, correct):
 
 
 @kernel(allocates=False)
-def bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz, soften):
-    """The diffuse lobe's f x cos towards world direction l under the raw bent normal r
-    (Cycles: Lambert on the node's normal, times bump_shadowing against the surface's
-    own shading normal s, softened when the material's Bump Map Correction is on), with
-    the lobe's (direction-independent) value read from the BSDF set up on the specular
-    frame."""
+def bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz, ix, iy, iz,
+                 soften):
+    """The diffuse and sheen lobes' f x cos towards world direction l (i in the local
+    frame) under the raw bent normal r (Cycles: Lambert, and its sheen, on the node's
+    normal, times bump_shadowing against the surface's own shading normal s, softened
+    when the material's Bump Map Correction is on), with the diffuse lobe's (direction-
+    independent) value read from the BSDF set up on the specular frame, and the sheen's
+    about r (principled.setup_about)."""
     cos_d = rx * lx + ry * ly + rz * lz
     if not cos_d > 0.0:
         return 0.0, 0.0, 0.0
-    fr, fg, fb = bsdf.eval_seen(state, wox, woy, woz, 0.0, 0.0, 1.0, True, False, False)
+    fr, fg, fb = bsdf.base_diffuse(state, wox, woy, woz)
+    sr, sg, sb = bsdf.sheen_seen(state, woz, ix, iy, iz)
     k = cos_d * bump_shadowing(sx, sy, sz, rx, ry, rz, lx, ly, lz, soften)
-    return fr * k, fg * k, fb * k
+    return (fr + sr) * k, (fg + sg) * k, (fb + sb) * k
 
 
 @kernel(allocates=False)
@@ -270,8 +274,9 @@ def bent_diffuse_lobes(state, wox, woy, woz, sx, sy, sz, nx, ny, nz, rx, ry, rz,
     """f x cos of the diffuse-kind lobes towards a light at world direction l on a bent
     frame (normal n, raw normal r, the surface's own s): `bent_diffuse` and
     `bent_translucent`."""
-    dr, dg, db = bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz,
-                              soften)
+    ix, iy, iz = to_local(lx, ly, lz, nx, ny, nz)
+    dr, dg, db = bent_diffuse(state, wox, woy, woz, sx, sy, sz, rx, ry, rz, lx, ly, lz, ix,
+                              iy, iz, soften)
     tr, tg, tb = bent_translucent(state, sx, sy, sz, nx, ny, nz, lx, ly, lz, soften)
     return dr + tr, dg + tg, db + tb
 

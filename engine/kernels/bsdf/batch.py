@@ -44,15 +44,15 @@ def eval_f_batch(rows, front, wo, wi, tables, walter=False):
 @kernel
 def pdf_batch(rows, front, wo, wi, allowed, tables, walter=False, diffuse_n=(0.0, 0.0, 1.0)):
     """Mixture pdf (n,) with allowed (n, 3) bool over DIFFUSE, GLOSSY, TRANSMISSION
-    (diffuse_n: the diffuse lobe's normal, principled.bend_diffuse)."""
+    (diffuse_n: the diffuse and sheen lobes' normal, principled.setup_about)."""
     n = wo.shape[0]
     out = np.zeros(n)
     state = np.empty(P.NSTATE)
     for k in range(n):
-        P.setup(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state)
+        P.setup_about(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state,
+                      diffuse_n[0], diffuse_n[1], diffuse_n[2])
         if walter:
             state[S_WALTER] = 1.0
-        P.bend_diffuse(state, diffuse_n[0], diffuse_n[1], diffuse_n[2])
         out[k] = P.pdf(state, wo[k, 0], wo[k, 1], wo[k, 2], wi[k, 0], wi[k, 1], wi[k, 2],
                        allowed[k, 0], allowed[k, 1], allowed[k, 2])
     return out
@@ -71,10 +71,10 @@ def sample_batch(rows, front, wo, u_lobe, u_dir, allowed, tables, walter=False,
     valid = np.zeros(n, dtype=np.bool_)
     state = np.empty(P.NSTATE)
     for k in range(n):
-        P.setup(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state)
+        P.setup_about(rows[k], front[k], wo[k, 0], wo[k, 1], wo[k, 2], tables, state,
+                      diffuse_n[0], diffuse_n[1], diffuse_n[2])
         if walter:
             state[S_WALTER] = 1.0
-        P.bend_diffuse(state, diffuse_n[0], diffuse_n[1], diffuse_n[2])
         s = P.sample(state, wo[k, 0], wo[k, 1], wo[k, 2], u_lobe[k], u_dir[k, 0],
                      u_dir[k, 1], allowed[k, 0], allowed[k, 1], allowed[k, 2])
         wi[k, 0], wi[k, 1], wi[k, 2] = s[0], s[1], s[2]
@@ -202,7 +202,7 @@ class Principled:
 
     def sample(self, wo, u_lobe, u_dir, allowed=None, diffuse_n=(0.0, 0.0, 1.0)) -> Sample:
         """Directions drawn at wo; diffuse_n: the diffuse lobe's unit normal in the
-        local frame (a bent frame's raw normal, principled.bend_diffuse)."""
+        local frame (a bent frame's raw normal, principled.setup_about; the sheen's too)."""
         u_lobe = np.ascontiguousarray(np.broadcast_to(np.asarray(u_lobe, np.float64), (self.n,)))
         u_dir = np.ascontiguousarray(np.broadcast_to(np.asarray(u_dir, np.float64), (self.n, 2)))
         return Sample(*sample_batch(self.rows, self.front, self._dirs(wo), u_lobe, u_dir,

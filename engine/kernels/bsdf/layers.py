@@ -18,6 +18,11 @@ here, which fills the slots below and returns nothing else, and principled's eva
 and sample add this module's lobes. A row with P_LAYERS = 0 never reads a slot here
 (tests/test_layered_bsdf.py checks that with NaN slots).
 
+The sheen lies on its own normal (S_SHEEN_N, in the local frame): the frame's, or where
+path_vertex bends the frame to Cycles' valid reflection normal, the raw normal, as
+Cycles' sheen keeps the node's normal (svm/closure.h); its LTC is set up for wo's angle to
+that normal, and its value, density and samples are taken about it (`sheen_seen`).
+
 Lobe kinds: coat GLOSSY; sheen DIFFUSE (Cycles labels it diffuse reflection); translucent
 TRANSMISSION for the bounce that follows it (it leaves through the surface; the ray it
 sends is a diffuse ray as well, as Cycles' diffuse-transmission label makes it:
@@ -35,6 +40,7 @@ counts as GLOSSY for its R lobe and TRANSMISSION for the three through the fibre
 """
 from __future__ import annotations
 
+from ..frame import to_local, to_world
 from ..jit import kernel
 from . import coat, hair, hair_chiang, sheen, translucent
 from . import microfacet as mf
@@ -81,24 +87,30 @@ S_CHIANG_ALBEDO = 84            # 3: Cycles' albedo estimate at wo (the Color pa
 S_EST_CHIANG = 87               # its selection estimate
 S_CHIANG_MESH = 88              # 1: on a triangle, where lights see Cycles' bump test
 S_CHIANG_AS_SAMPLED = 89        # 1: principled.sample weighs the closure's own direction
-NSTATE = 90
+S_SHEEN_N = 90                  # 3: the sheen's normal in the local frame ((0, 0, 1): the frame's)
+NSTATE = 93
 
 
 @kernel(allocates=False)
-def setup(row, wox, woy, woz, tables, state):
-    """Fill the slots above for outgoing wo (local, wo_z > 0)."""
+def setup(row, wox, woy, woz, tables, state, snx, sny, snz):
+    """Fill the slots above for outgoing wo (local, wo_z > 0), the sheen on the unit
+    normal sn (local; (0, 0, 1): the frame's)."""
     cos_o = min(max(woz, 0.0), 1.0)
     scale = 1.0                                  # the layers' scalar factor so far
-    # sheen
+    # sheen, set up for wo as its own normal sees it
+    state[S_SHEEN_N], state[S_SHEEN_N + 1], state[S_SHEEN_N + 2] = snx, sny, snz
+    sox, soy, soz = wox, woy, woz
+    if snz != 1.0:
+        sox, soy, soz = to_local(wox, woy, woz, snx, sny, snz)
     sw = max(row[P_SHEEN_WEIGHT], 0.0)
     sheen_max = 0.0
-    state[S_SHEEN_CX], state[S_SHEEN_CY] = sheen.azimuth(wox, woy)
+    state[S_SHEEN_CX], state[S_SHEEN_CY] = sheen.azimuth(sox, soy)
     state[S_SHEEN_A], state[S_SHEEN_B] = 1.0, 0.0
     for c in range(3):
         state[S_SHEEN_W + c] = 0.0
     if sw > WEIGHT_CUTOFF:
         rough = min(max(row[P_SHEEN_ROUGHNESS], 0.0), 1.0)
-        a, b, R = sheen.lookup(cos_o, rough, tables)
+        a, b, R = sheen.lookup(min(max(soz, 0.0), 1.0), rough, tables)
         state[S_SHEEN_A], state[S_SHEEN_B] = a, b
         for c in range(3):
             w = sw * max(row[P_SHEEN_TINT + c], 0.0) * max(R, 0.0)
@@ -266,16 +278,32 @@ def base_scale_max(state):
 
 
 @kernel(allocates=False)
+def sheen_seen(state, woz, wix, wiy, wiz):
+    """f (1/sr) of the sheen towards local wi, about its own normal (none while wo is
+    under the frame's normal, unless the sheen has a normal of its own)."""
+    if not state[S_EST_SHEEN] > 0.0 or not (woz > 0.0 or state[S_SHEEN_N + 2] != 1.0):
+        return 0.0, 0.0, 0.0
+    x, y, z = _about_sheen(state, wix, wiy, wiz)
+    s = sheen.shape(x, y, z, state[S_SHEEN_CX], state[S_SHEEN_CY], state[S_SHEEN_A],
+                    state[S_SHEEN_B])
+    return state[S_SHEEN_W] * s, state[S_SHEEN_W + 1] * s, state[S_SHEEN_W + 2] * s
+
+
+@kernel(allocates=False)
+def _about_sheen(state, x, y, z):
+    """Local direction (x, y, z) in the sheen's own frame."""
+    if state[S_SHEEN_N + 2] == 1.0:
+        return x, y, z
+    return to_local(x, y, z, state[S_SHEEN_N], state[S_SHEEN_N + 1], state[S_SHEEN_N + 2])
+
+
+@kernel(allocates=False)
 def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
     """f (1/sr) of the sheen, coat, translucent and hair lobes that a light of the given
     kinds sees (principled.eval_seen adds the scaled base)."""
     fr = fg = fb = 0.0
-    if see_d and state[S_EST_SHEEN] > 0.0 and woz > 0.0:
-        s = sheen.shape(wix, wiy, wiz, state[S_SHEEN_CX], state[S_SHEEN_CY],
-                        state[S_SHEEN_A], state[S_SHEEN_B])
-        fr += state[S_SHEEN_W] * s
-        fg += state[S_SHEEN_W + 1] * s
-        fb += state[S_SHEEN_W + 2] * s
+    if see_d:
+        fr, fg, fb = sheen_seen(state, woz, wix, wiy, wiz)
     if see_g and state[S_COAT_W] > 0.0:
         v = state[S_COAT_W] * coat.eval_unit(wox, woy, woz, wix, wiy, wiz,
                                              state[S_COAT_ALPHA], state[S_COAT_IOR])
@@ -345,7 +373,8 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht, qch):
     if qc > 0.0:
         p += qc * mf.reflection_pdf(wox, woy, woz, wix, wiy, wiz, state[S_COAT_ALPHA])
     if qs > 0.0:
-        p += qs * sheen.pdf(wix, wiy, wiz, state[S_SHEEN_CX], state[S_SHEEN_CY],
+        x, y, z = _about_sheen(state, wix, wiy, wiz)
+        p += qs * sheen.pdf(x, y, z, state[S_SHEEN_CX], state[S_SHEEN_CY],
                             state[S_SHEEN_A], state[S_SHEEN_B])
     if qt > 0.0:
         p += qt * translucent.pdf(woz, wiz)
@@ -366,6 +395,10 @@ def sample(state, wox, woy, woz, lobe, u1, u2):
     if lobe == 1:
         x, y, z = sheen.sample(u1, u2, state[S_SHEEN_CX], state[S_SHEEN_CY],
                                state[S_SHEEN_A], state[S_SHEEN_B])
-        return x, y, z, z > 0.0 and woz > 0.0
+        if state[S_SHEEN_N + 2] == 1.0:
+            return x, y, z, z > 0.0 and woz > 0.0
+        wx, wy, wz = to_world(x, y, z, state[S_SHEEN_N], state[S_SHEEN_N + 1],
+                              state[S_SHEEN_N + 2])
+        return wx, wy, wz, z > 0.0
     x, y, z = translucent.sample(u1, u2)
     return x, y, z, z < 0.0

@@ -35,7 +35,7 @@ specular layer and glass (specular_tint.py) complete Cycles' closures.
 
 Sampling: a lobe is chosen with probability proportional to an estimate of its albedo at
 wo, at least MIN_SELECTION of its weight; the diffuse lobe is drawn about its own normal
-(the frame's, or a bent frame's raw one: bend_diffuse); the mixture pdf is
+(the frame's, or a bent frame's raw one: setup_about), as is the sheen; the mixture pdf is
 sum_i q_i pdf_i over the allowed lobes (the delta part of a smooth glass has no density:
 pdf = inf, delta True).
 The allow flags over DIFFUSE / GLOSSY / TRANSMISSION restrict sampling and its pdf to the
@@ -84,8 +84,8 @@ from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX,  # noqa: F
                      P_REFRACT_ONLY, P_ROUGHNESS, P_SPEC_LEVEL, P_TRANSMISSION,
                      pack_materials)
 from .tables import kernel_tables  # noqa: F401  (re-exported)
-from .principled_eval import (base_glossy, eval_f, eval_seen,  # noqa: F401  (re-exported)
-                              translucent_seen)
+from .principled_eval import (base_diffuse, base_glossy, eval_f,  # noqa: F401  (re-exported)
+                              eval_seen, sheen_seen, translucent_seen)
 from ..frame import to_world
 from ..warp import INV_PI, cosine_hemisphere
 
@@ -102,6 +102,16 @@ ONE_MINUS_EPS = 1.0 - 2.0 ** -53
 @kernel(allocates=False)
 def setup(row, front_facing, wox, woy, woz, tables, state):
     """Fill state[:NSTATE] with the lobes' parameters at this hit for outgoing wo."""
+    setup_about(row, front_facing, wox, woy, woz, tables, state, 0.0, 0.0, 1.0)
+
+
+@kernel(allocates=False)
+def setup_about(row, front_facing, wox, woy, woz, tables, state, dnx, dny, dnz):
+    """`setup`, with the diffuse and sheen lobes about the unit normal dn of the local
+    frame: a bent frame's raw normal (path_vertex), as Cycles' diffuse and sheen closures
+    keep the node's normal where its microfacet lobes take the valid reflection one.
+    The diffuse lobe is sampled and its density counted about dn; its value towards a
+    direction stays the caller's (nodes.shading.bent_diffuse)."""
     # parameters, clamped to their ranges
     m = min(max(row[P_METALLIC], 0.0), 1.0)
     t = min(max(row[P_TRANSMISSION], 0.0), 1.0)
@@ -112,9 +122,9 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
     state[S_LAYERED] = 1.0 if layered else 0.0
     state[S_REFRACT_ONLY] = row[P_REFRACT_ONLY]
     state[S_WALTER] = 0.0       # Cycles' refraction pairs (path_vertex sets it per light)
-    state[S_DIFFUSE_N], state[S_DIFFUSE_N + 1], state[S_DIFFUSE_N + 2] = 0.0, 0.0, 1.0
+    state[S_DIFFUSE_N], state[S_DIFFUSE_N + 1], state[S_DIFFUSE_N + 2] = dnx, dny, dnz
     if layered:
-        layers.setup(row, wox, woy, woz, tables, state)
+        layers.setup(row, wox, woy, woz, tables, state, dnx, dny, dnz)
     alpha = mf.clamp_alpha(rough * rough)
     # Filter Glossy widens the lobes after setup, as Cycles' closure blur does: the energy
     # compensation and the layering below keep the material's own alpha
@@ -229,17 +239,8 @@ def setup(row, front_facing, wox, woy, woz, tables, state):
 
 
 @kernel(allocates=False)
-def bend_diffuse(state, x, y, z):
-    """Sample the diffuse lobe, and count its density, about the unit normal (x, y, z) of
-    the local frame: a bent frame's raw normal (path_vertex), as Cycles' diffuse closure
-    keeps the node's normal where its microfacet lobes take the valid reflection one.
-    Its value stays the caller's (nodes.shading.bent_diffuse)."""
-    state[S_DIFFUSE_N], state[S_DIFFUSE_N + 1], state[S_DIFFUSE_N + 2] = x, y, z
-
-
-@kernel(allocates=False)
 def _diffuse_cosine(state, wix, wiy, wiz):
-    """cos of wi to the diffuse lobe's normal (wiz unless bend_diffuse moved it)."""
+    """cos of wi to the diffuse lobe's normal (wiz unless setup_about moved it)."""
     return (state[S_DIFFUSE_N] * wix + state[S_DIFFUSE_N + 1] * wiy
             + state[S_DIFFUSE_N + 2] * wiz)
 

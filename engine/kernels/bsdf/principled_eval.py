@@ -45,6 +45,25 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
 
 
 @kernel(allocates=False)
+def base_diffuse(state, wox, woy, woz):
+    """f (1/sr) of the diffuse lobe alone (Lambert, or Oren-Nayar at the normal), the
+    direction-independent value a bent frame's diffuse lobe takes (nodes.shading)."""
+    if state[S_ON + 1] > 0.0:
+        return oren_nayar.value(state, wox, woy, woz, 0.0, 0.0, 1.0)
+    return (state[S_DIFFUSE] * INV_PI, state[S_DIFFUSE + 1] * INV_PI,
+            state[S_DIFFUSE + 2] * INV_PI)
+
+
+@kernel(allocates=False)
+def sheen_seen(state, woz, wix, wiy, wiz):
+    """f (1/sr) of the sheen alone towards local wi, about its own normal
+    (layers.sheen_seen): nothing without the layers."""
+    if state[S_LAYERED] == 0.0:
+        return 0.0, 0.0, 0.0
+    return layers.sheen_seen(state, woz, wix, wiy, wiz)
+
+
+@kernel(allocates=False)
 def translucent_seen(state, wiz):
     """f (1/sr) of the translucent lobe alone (a Translucent BSDF's, layers.py) towards
     local wi: nothing above the surface, or without that lobe."""
