@@ -109,8 +109,7 @@ KNOWN = """## Known differences
 - **Light Path depths** count the path's diffuse, glossy, transmission and transparent
   bounces as Cycles does; a program run for a surface's alpha (transparent layers,
   shadow rays) sees no bounces.
-- Not evaluated yet (warned): Gabor, Sky and IES textures, Geometry's Tangent,
-  Parametric, Pointiness and Random Per Island, Light Path's Is Singular Ray and Is
+- Not evaluated yet (warned): Gabor, Sky and IES textures, Parametric, Pointiness and Random Per Island, Light Path's Is Singular Ray and Is
   Volume Scatter Ray, Map Range on vectors, Normal Map in object or world space, attributes other than colour
   attributes, a texture node's legacy Mapping panel.
 """
@@ -136,9 +135,11 @@ def supported_nodes(bpy):
 # the closures (drt_addon/export/nodes/shader.py, export/volumes.py, export/world.py);
 # each is compared with Cycles in tests/test_closures_vs_cycles.py and the *_vs_cycles
 # tests of its feature
-SHADERS_ROW = ("| Shader | Principled BSDF (its Diffuse Roughness: Oren-Nayar), Diffuse "
-               "BSDF (Roughness: Oren-Nayar), Glossy BSDF, Glass BSDF, "
-               "Refraction BSDF (GGX, Multiscatter GGX, Beckmann), Metallic BSDF (F82 Tint; a "
+SHADERS_ROW = ("| Shader | Principled BSDF (its Diffuse Roughness: Oren-Nayar; Anisotropic "
+               "along its Tangent, tests/test_anisotropic_vs_cycles.py), Diffuse "
+               "BSDF (Roughness: Oren-Nayar), Glossy BSDF (Anisotropy), Glass BSDF, "
+               "Refraction BSDF (GGX, Multiscatter GGX, Beckmann), Metallic BSDF (F82 Tint, "
+               "Anisotropy; a "
                "Physical Conductor as its F82-tint fit), Sheen BSDF, "
                "Translucent BSDF, Emission, Transparent BSDF, Holdout (as the whole "
                "Surface, or mixed: a hole of its weight in the camera's alpha), "

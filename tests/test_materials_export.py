@@ -853,3 +853,34 @@ def test_a_node_tree_without_an_output_is_black_as_in_cycles(bpy_drt):
     cycles, drt = (render(bpy, scene, e, 16) for e in ("CYCLES", "DRT"))
     assert cycles[16, 16, :3].max() == 0.0 and drt[16, 16, :3].max() == 0.0
     np.testing.assert_allclose(drt[0, 0, :3], cycles[0, 0, :3], rtol=1e-3)
+
+
+def test_anisotropic_bsdfs_export_their_mapping_tangent_and_rotation(bpy_drt):
+    """Principled, Metallic and Glossy anisotropy: the node's mapping, its amount, the
+    tangent as a per-hit program output (the Geometry node's radial tangent when
+    unlinked, as Cycles links it), Rotation plain or per hit; nothing reported. An
+    isotropic BSDF has no tangent output: it pays for nothing."""
+    bpy = bpy_drt
+    m, w = _export(_single(bpy, "ShaderNodeBsdfPrincipled", Metallic=1.0, Anisotropic=0.6,
+                           **{"Anisotropic Rotation": 0.1})[0])
+    assert w == [] and m.anisotropy_kind == "PRINCIPLED"
+    assert m.anisotropy == pytest.approx(0.6) and m.anisotropic_rotation == pytest.approx(0.1)
+    assert "tangent" in m.shader.outputs and "anisotropic_rotation" not in m.shader.outputs
+    m, w = _export(_single(bpy, "ShaderNodeBsdfGlossy", Anisotropy=-0.4)[0])
+    assert w == [] and m.anisotropy_kind == "GLOSSY" and m.anisotropy == pytest.approx(-0.4)
+    mat, nt, node = _single(bpy, "ShaderNodeBsdfMetallic", Anisotropy=0.5)
+    noise = nt.nodes.new("ShaderNodeTexNoise")
+    nt.links.new(noise.outputs["Fac"], node.inputs["Rotation"])
+    tangent = nt.nodes.new("ShaderNodeTangent")
+    tangent.direction_type = "UV_MAP"
+    nt.links.new(tangent.outputs["Tangent"], node.inputs["Tangent"])
+    m, w = _export(mat)
+    assert w == [] and m.anisotropy_kind == "PRINCIPLED"
+    assert {"tangent", "anisotropic_rotation"} <= set(m.shader.outputs)
+    from drt_addon.export.tangents import wants_tangents
+    assert wants_tangents([mat])             # the UV map's tangents are exported
+    for kind, inputs in (("ShaderNodeBsdfPrincipled", {"Metallic": 1.0}),
+                         ("ShaderNodeBsdfGlossy", {"Anisotropy": 0.0}),
+                         ("ShaderNodeBsdfMetallic", {"Anisotropy": 1e-5})):
+        m, w = _export(_single(bpy, kind, **inputs)[0])
+        assert m.anisotropy_kind == "NONE" and m.shader is None and w == [], kind

@@ -13,6 +13,7 @@ from ..engine_link import engine
 from .closure_layers import (BLACK, HAIR_PARTS, LAYER_FIELDS, WHITE,  # noqa: F401
                              _Layers, _blend_layers)                   # (re-exported)
 from .material_params import _is_tex, _lin, _mean, _plain, _same, _scale
+from .nodes import anisotropy
 
 
 @dataclass
@@ -35,6 +36,8 @@ class _Comp:
     refraction_only: bool = False   # the glass lobe does not reflect (Refraction BSDF)
     subsurface: object = None       # nodes/subsurface.Subsurface (None: none)
     diffuse_roughness: float = 0.0  # Oren-Nayar sigma of the diffuse lobe (0: Lambert)
+    anisotropy: object = None       # nodes/anisotropy.Anisotropy of the metal and specular
+    #                                 lobes (None: isotropic)
 
     def glossy_weight(self):
         """Mean weight of the lobes the distribution shapes (metal, glass, specular)."""
@@ -170,6 +173,7 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
         m.subsurface_alpha = None if sss.alpha is None else float(sss.alpha)
         m.subsurface_method = sss.method
     m.metal_fresnel = p["metal_fresnel"]
+    anisotropy.apply(m, p["anisotropy"], program_outputs(m))
     m.specular_tint = tuple(p["specular_tint"])
     if p["layers"] is not None:
         for k in LAYER_FIELDS:
@@ -238,7 +242,8 @@ def _blend(comps, ctx) -> dict:
                     glass_reflect=c.glass_reflect if c.glass_reflect is not None else WHITE,
                     distribution=c.distribution, layers=c.layers, refraction_only=c.refraction_only,
                     metal_fresnel=c.metal_fresnel, specular_tint=c.specular_tint,
-                    subsurface=c.subsurface, diffuse_roughness=c.diffuse_roughness)
+                    subsurface=c.subsurface, diffuse_roughness=c.diffuse_roughness,
+                    anisotropy=c.anisotropy)
     lw = [(c, comp, *comp.weights()) for c, comp in comps]
     Wm = sum(c * m for c, _, m, _, _ in lw)
     Wg = sum(c * g for c, _, _, g, _ in lw)
@@ -315,7 +320,8 @@ def _blend(comps, ctx) -> dict:
                 layers=_blend_layers(comps, ctx), refraction_only=refr == {True},
                 metal_fresnel=metal_fresnel, specular_tint=specular_tint,
                 subsurface=_blend_subsurface(lw, Wb, ctx),
-                diffuse_roughness=_diffuse_roughness(lw, Wb, ctx))
+                diffuse_roughness=_diffuse_roughness(lw, Wb, ctx),
+                anisotropy=anisotropy.blend(comps, ctx))
 
 
 def _diffuse_roughness(lw, Wb, ctx) -> float:

@@ -1,4 +1,4 @@
-"""Tangent space for Normal Map and Vector Displacement nodes: MikkTSpace tangents and
+"""Tangent space for Normal Map, Vector Displacement and UV-map Tangent nodes: MikkTSpace tangents and
 bitangent signs per triangle corner, as Cycles computes them (mikktspace.py), exported
 only for objects whose materials read tangent space."""
 from __future__ import annotations
@@ -12,13 +12,15 @@ from . import mikktspace
 
 def wants_tangents(materials) -> bool:
     """Whether an object's materials (layer_overrides.slot_materials) read tangent space:
-    a Normal Map or a Vector Displacement node in Tangent space."""
+    a Normal Map or a Vector Displacement node in Tangent space, or a Tangent node
+    of a UV map (an anisotropic BSDF's direction)."""
     from .nodes.links import _all_nodes, uses_nodes
     readers = ("ShaderNodeNormalMap", "ShaderNodeVectorDisplacement")
     for mat in materials:
         if mat is None or not uses_nodes(mat):
             continue
-        if any(n.bl_idname in readers and n.space == "TANGENT"
+        if any((n.bl_idname in readers and n.space == "TANGENT")
+               or (n.bl_idname == "ShaderNodeTangent" and n.direction_type == "UV_MAP")
                for n in _all_nodes(mat.node_tree)):
             return True
     return False

@@ -8,6 +8,8 @@ import numpy as np
 GLOSSY_MODELS = ("GGX", "MULTI_GGX", "BLINN_PHONG", "BECKMANN")
 # The Fresnel term of the metal lobe (`Material.metal_fresnel`)
 METAL_FRESNELS = ("SCHLICK", "CONSTANT")
+# How a node's anisotropy maps to two alphas (`Material.anisotropy_kind`; params.ANISO_*)
+ANISOTROPY_KINDS = ("NONE", "PRINCIPLED", "GLOSSY")
 # Cycles' subsurface methods (`Material.subsurface_method`), in the order of their codes
 SUBSURFACE_METHODS = ("RANDOM_WALK", "RANDOM_WALK_SKIN", "BURLEY")
 
@@ -96,6 +98,11 @@ class MaterialTable:
         _require_finite(materials, "glass_reflection_tint", self.glass_reflection_tint)
         self._layer_params(materials)
         self._subsurface_params(materials)
+        kinds = _choices(materials, "anisotropy_kind", "NONE", ANISOTROPY_KINDS)
+        self.anisotropy_kind = np.array([ANISOTROPY_KINDS.index(k) for k in kinds], np.float64)
+        for name in ("anisotropy", "anisotropic_rotation"):
+            setattr(self, name, np.nan_to_num(np.array(
+                [float(getattr(m, name, 0.0)) for m in materials], np.float64)))
         self.transparent_color = np.array(
             [tuple(getattr(m, "transparent_color", (1.0, 1.0, 1.0)))[:3] for m in materials],
             np.float64).reshape(-1, 3)

@@ -38,6 +38,7 @@ from . import lights as lt
 from .bsdf import principled as bsdf
 from .bsdf.state import S_ANY_SIDE, S_DIFFUSE_LABEL, S_WALTER
 from . import hair_tangent
+from .bsdf import anisotropic
 from . import ray_queues
 from .frame import dot, to_local, to_world
 from .jit import kernel
@@ -54,7 +55,7 @@ from .medium_density import has_heterogeneous
 from .medium_segment import NO_SEGMENT, NO_SEGMENT_MIS, along_ray
 from .prepare_closures import prepare_closures
 from .volume import V_BOUNDARY, V_HAS, in_medium, stack_cross
-from .bsdf.params import P_BUMP_CORRECTION, P_HAIR, P_HOLDOUT, P_SETS_NORMAL
+from .bsdf.params import P_ANISO_KIND, P_BUMP_CORRECTION, P_HAIR, P_HOLDOUT, P_SETS_NORMAL
 from .surface import hit_uv, surface_at
 from .terminator import shadow_origin
 from .surface_hit import material_row, run_program, surface_emission
@@ -242,6 +243,8 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
         if row[P_HAIR] != 0.0:           # a hair closure: the fibre's direction at the hit
             hair_tangent.write(geometry, prim, hit_inst[j], hit_u[j], hit_v[j], path_time[p],
                                nx, ny, nz, row)
+        if row[P_ANISO_KIND] != 0.0:     # an anisotropic lobe's tangent, to the frame
+            anisotropic.localize_tangent(row, nx, ny, nz)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p], counts[p, 0])
         dnx, dny, dnz = 0.0, 0.0, 1.0
         if bent:     # the diffuse and sheen lobes about the raw normal, as Cycles' are

@@ -5,13 +5,14 @@ row. `programs` is None in a scene without shader programs (engine.nodes.shading
 Numba then compiles these without that code."""
 from __future__ import annotations
 
-from .bsdf.params import (P_BASE, P_BUMP_CORRECTION, P_CHIANG_COLOR, P_CHIANG_MELANIN,
-                          P_HAIR, P_LAYERS, P_METALLIC, P_ROUGHNESS, P_TRANSLUCENT)
+from .bsdf.params import (P_ANISO_KIND, P_ANISO_ROT, P_BASE, P_BUMP_CORRECTION,
+                          P_CHIANG_COLOR, P_CHIANG_MELANIN, P_HAIR, P_LAYERS, P_METALLIC,
+                          P_ROUGHNESS, P_TANGENT, P_TRANSLUCENT)
 from .jit import kernel
 from .textures import apply_to_row, emission_at
 from ..nodes.context import path_fields
 from ..nodes.differentials import cone_at
-from ..nodes.shading import (apply_hair, apply_rows, apply_translucent, pick_closure,
+from ..nodes.shading import (apply_anisotropy, apply_hair, apply_rows, apply_translucent, pick_closure,
                              program_emission, program_hit, program_normal)
 
 
@@ -59,3 +60,5 @@ def material_row(params, textures, programs, ms, uu, vv, regs, programmed, row):
             apply_translucent(programs, ms, regs, row, P_TRANSLUCENT)
         if row[P_HAIR] != 0.0:       # a Principled Hair's colour and Melanin, per hit
             apply_hair(programs, ms, regs, row, P_CHIANG_COLOR, P_CHIANG_MELANIN)
+        if row[P_ANISO_KIND] != 0.0:  # an anisotropic lobe's tangent (world) and Rotation
+            apply_anisotropy(programs, ms, regs, row, P_TANGENT, P_ANISO_ROT)

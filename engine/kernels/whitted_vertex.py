@@ -34,9 +34,10 @@ from . import lights as lt
 from . import ray_queues
 from .bsdf import principled as bsdf
 from . import hair_tangent
+from .bsdf import anisotropic
 from .bsdf.state import S_ANY_SIDE
-from .bsdf.params import (P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_HAIR, P_HOLDOUT, P_ROUGHNESS,
-                          P_SETS_NORMAL, P_SSS_WEIGHT, P_TRANSLUCENT)
+from .bsdf.params import (P_ANISO_KIND, P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_HAIR, P_HOLDOUT,
+                          P_ROUGHNESS, P_SETS_NORMAL, P_SSS_WEIGHT, P_TRANSLUCENT)
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from .lights.light_set import sample_lamp_at
@@ -171,6 +172,8 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
         if row[P_HAIR] != 0.0:           # a hair closure: the fibre's direction at the hit
             hair_tangent.write(geometry, prim, hit_inst[j], hit_u[j], hit_v[j], path_time[p],
                                nx, ny, nz, row)
+        if row[P_ANISO_KIND] != 0.0:     # an anisotropic lobe's tangent, to the frame
+            anisotropic.localize_tangent(row, nx, ny, nz)
         row[P_SSS_WEIGHT] = 0.0          # Whitted's model: subsurface light is diffuse
         # 2. direct light: one shadow ray to each lamp's fixed point, on the lobes that
         # are not followed (diffuse, sheen, translucency); on a bent frame the sheen about

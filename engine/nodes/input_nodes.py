@@ -14,7 +14,10 @@ from __future__ import annotations
 import math
 
 from ..kernels.jit import kernel
-from .context import H_BACKFACING, H_I, H_RAY
+from ..kernels.frame import cross, unit
+from .context import (H_BACKFACING, H_GENERATED, H_I, H_N, H_RAY, H_TANGENT,
+                      H_TANGENT_SIGN)
+from .normal_map import _cofactors
 
 IN_HIT3 = 0
 IN_HIT1 = 1
@@ -22,6 +25,9 @@ IN_RAY_IS = 2
 IN_FRESNEL = 3
 IN_LAYER_FRESNEL = 4
 IN_LAYER_FACING = 5
+IN_TANGENT = 6
+TANGENT_RADIAL = 0
+TANGENT_UV_MAP = 1
 
 
 @kernel(allocates=False)
@@ -45,6 +51,38 @@ def _cos_in(regs, hit, n):
     if ln > 0.0:
         nx, ny, nz = nx / ln, ny / ln, nz / ln
     return hit[H_I] * nx + hit[H_I + 1] * ny + hit[H_I + 2] * nz
+
+
+@kernel(allocates=False)
+def tangent(hit, kind, axis):
+    """The tangent at the hit as Cycles' Tangent node makes it: the UV map's (object
+    space; zero where the mesh has none), or radial about `axis` through the generated
+    coordinates' centre; taken to the world as a normal is (object_normal_transform: by
+    the inverse transpose of the object's matrix) and made perpendicular to the shading
+    normal, unit length (zero where it is along the normal)."""
+    if kind == TANGENT_UV_MAP:
+        if hit[H_TANGENT_SIGN] == 0.0:
+            return 0.0, 0.0, 0.0
+        x, y, z = hit[H_TANGENT], hit[H_TANGENT + 1], hit[H_TANGENT + 2]
+    else:
+        gx = hit[H_GENERATED] - 0.5
+        gy = hit[H_GENERATED + 1] - 0.5
+        gz = hit[H_GENERATED + 2] - 0.5
+        if axis == 0:
+            x, y, z = 0.0, -gz, gy
+        elif axis == 1:
+            x, y, z = -gz, 0.0, gx
+        else:
+            x, y, z = -gy, gx, 0.0
+    r0, r1, r2, det = _cofactors(hit)
+    if det < 0.0:
+        x, y, z = -x, -y, -z
+    x, y, z = unit(r0[0] * x + r0[1] * y + r0[2] * z, r1[0] * x + r1[1] * y + r1[2] * z,
+                   r2[0] * x + r2[1] * y + r2[2] * z)
+    nx, ny, nz = hit[H_N], hit[H_N + 1], hit[H_N + 2]
+    cx, cy, cz = cross(x, y, z, nx, ny, nz)
+    cx, cy, cz = unit(cx, cy, cz)
+    return cross(nx, ny, nz, cx, cy, cz)
 
 
 @kernel(allocates=False)
@@ -75,3 +113,5 @@ def execute(ins, regs, hit):
             blend = 2.0 * blend if blend < 0.5 else 0.5 / (1.0 - blend)
             f = f ** blend
         regs[out] = 1.0 - f
+    elif code == IN_TANGENT:
+        regs[out], regs[out + 1], regs[out + 2] = tangent(hit, ins[2], ins[3])

@@ -31,6 +31,7 @@ OUT_VOL_SA, OUT_VOL_SS, OUT_VOL_EM = 7, 8, 9      # engine.kernels.medium_densit
 OUT_HAIR_COLOR, OUT_HAIR_MELANIN = 10, 11          # a Principled Hair's (hair_chiang.py)
 OUT_SURFACE_NORMAL = 12                             # Cycles' sd->N, where set (surface_normal)
 OUT_TRANSLUCENT = 13                                # a Translucent BSDF's colour (layers.py)
+OUT_TANGENT, OUT_ANISO_ROT = 14, 15                 # anisotropic reflection (anisotropic.py)
 
 
 @kernel(allocates=False)
@@ -117,6 +118,20 @@ def apply_translucent(T, m, regs, row, P_TRANSLUCENT):
         row[P_TRANSLUCENT] = max(regs[r], 0.0)
         row[P_TRANSLUCENT + 1] = max(regs[r + 1], 0.0)
         row[P_TRANSLUCENT + 2] = max(regs[r + 2], 0.0)
+
+
+@kernel(allocates=False)
+def apply_anisotropy(T, m, regs, row, P_TANGENT, P_ANISO_ROT):
+    """Write the program's tangent (world space) and Rotation into the row."""
+    outs = T[OUTS]
+    r = outs[m, OUT_TANGENT]
+    if r >= 0:
+        row[P_TANGENT] = regs[r]
+        row[P_TANGENT + 1] = regs[r + 1]
+        row[P_TANGENT + 2] = regs[r + 2]
+    r = outs[m, OUT_ANISO_ROT]
+    if r >= 0:
+        row[P_ANISO_ROT] = regs[r]
 
 
 @kernel(allocates=False)

@@ -127,6 +127,13 @@ class Material:
     # Principled BSDF's Diffuse Roughness; 0: Lambert), engine/kernels/bsdf/oren_nayar.py
     diffuse_roughness: float = 0.0
     subsurface_ior: float = 1.4
+    # Anisotropic reflection of the metal and specular lobes (engine/kernels/bsdf/
+    # anisotropic.py): 'NONE', 'PRINCIPLED' (the Principled and Metallic BSDFs' mapping of
+    # Anisotropic to the two roughnesses) or 'GLOSSY' (the Glossy BSDF's Anisotropy);
+    # the tangent is per hit, the program's "tangent" output (none: isotropic)
+    anisotropy_kind: str = "NONE"
+    anisotropy: float = 0.0
+    anisotropic_rotation: float = 0.0    # in turns, about the normal
     subsurface_alpha: Optional[float] = None
     subsurface_method: str = "RANDOM_WALK"
     base_color_texture: Optional[object] = None

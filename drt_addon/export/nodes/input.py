@@ -63,10 +63,28 @@ def _uv_map(c, node, out):
 GEOMETRY = {"Position": C.H_P, "True Normal": C.H_NG, "Incoming": C.H_I}
 
 
+def geometry_tangent(c):
+    """The Geometry node's Tangent (Cycles' primitive_tangent): radial about the
+    object's Z through its generated coordinates; also what an unlinked Tangent input of
+    an anisotropic BSDF reads."""
+    return c.emit(I.IN_TANGENT, "vector", [I.TANGENT_RADIAL, 2], varying=True)
+
+
+def _tangent(c, node, out):
+    """The Tangent node: radial about its axis, or its UV map's tangent (the mesh's
+    MikkTSpace tangents, export.tangents; another map than the default is reported)."""
+    if node.direction_type == "UV_MAP":
+        return c.emit(I.IN_TANGENT, "vector", [I.TANGENT_UV_MAP, 0], varying=True)
+    return c.emit(I.IN_TANGENT, "vector", [I.TANGENT_RADIAL, "XYZ".index(node.axis)],
+                  varying=True)
+
+
 def _geometry(c, node, out):
     name = out.identifier
     if name == "Normal":
         return c.normal()
+    if name == "Tangent":
+        return geometry_tangent(c)
     if name in GEOMETRY:
         return hit3(c, GEOMETRY[name])
     if name == "Backfacing":
@@ -188,6 +206,7 @@ TRANSLATORS = {
     "ShaderNodeTexCoord": _tex_coord,
     "ShaderNodeUVMap": _uv_map,
     "ShaderNodeNewGeometry": _geometry,
+    "ShaderNodeTangent": _tangent,
     "ShaderNodeObjectInfo": _object_info,
     "ShaderNodeHairInfo": _hair_info,
     "ShaderNodeValue": _value,

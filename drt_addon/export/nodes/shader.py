@@ -12,7 +12,7 @@ from ..material_params import TOL, _is_tex, _lin, _scale
 from .links import _link
 from .shader_inputs import _constant, _input
 from .shader_mix import _mix_factor, _plastic, lifted_mix
-from . import hair, metallic, subsurface
+from . import anisotropy, hair, metallic, subsurface
 
 
 # --------------------------------------------------------------------------- nodes
@@ -32,11 +32,11 @@ def _principled(node, ctx) -> _Closure:
     if node_input(node, "Diffuse Roughness") is not None:      # Blender 4.3 and later
         comp.diffuse_roughness = float(const("Diffuse Roughness", 0.0))
     ignored = []
-    for sock, what in (("Anisotropic", "anisotropy"),
-                       ("Thin Film Thickness", "thin film")):
-        s = node_input(node, sock)
-        if s is not None and (s.is_linked or float(s.default_value) > 0.0):
-            ignored.append(what)
+    comp.anisotropy = anisotropy.read(node, ctx, "Anisotropic", "Anisotropic Rotation",
+                                      "PRINCIPLED")
+    s = node_input(node, "Thin Film Thickness")
+    if s is not None and (s.is_linked or float(s.default_value) > 0.0):
+        ignored.append("thin film")
     s = node_input(node, "Specular Tint")
     if s is not None and (s.is_linked or _tinted(s.default_value)):
         # the metal lobe's F82 tint, the specular layer's and the glass's F0 tint
@@ -45,9 +45,6 @@ def _principled(node, ctx) -> _Closure:
         if isinstance(tint, float):               # a pre-4.0 amount of the base colour
             tint = WHITE
         comp.specular_tint = tuple(float(x) for x in tuple(tint)[:3])
-    s = node_input(node, "Tangent")
-    if s is not None and s.is_linked:
-        ignored.append("the tangent input")
     _normal(node, ctx)
     if ignored:
         ctx.issue(f"{node.name!r} uses {', '.join(ignored)}, which DRT does not render "
@@ -161,30 +158,30 @@ def _distribution(node, ctx) -> str:
 def _glossy(node, ctx) -> _Closure:
     _normal(node, ctx)
     distribution = _distribution(node, ctx)
-    s = node_input(node, "Anisotropy")
-    if s is not None and (s.is_linked or float(s.default_value) != 0.0):
-        ctx.issue(f"{node.name!r} is anisotropic; DRT renders it isotropic")
     color = _input(node, "Color", ctx, True, (0.8,) * 3)
     # Cycles' Glossy has no Fresnel term: its colour at every angle
     return _Closure([(1.0, _Comp(base=color, metallic=1.0,
                                  roughness=_input(node, "Roughness", ctx, False, 0.5),
-                                 distribution=distribution, metal_fresnel="CONSTANT"))])
+                                 distribution=distribution, metal_fresnel="CONSTANT",
+                                 anisotropy=anisotropy.read(node, ctx, "Anisotropy",
+                                                            "Rotation", "GLOSSY")))])
 
 
 def _metallic(node, ctx) -> _Closure:
     """Metallic BSDF: the Principled metal lobe (export/nodes/metallic.py)."""
     _normal(node, ctx)
     distribution = _distribution(node, ctx)
-    for sock, what in (("Anisotropy", "anisotropy"), ("Thin Film Thickness", "thin film")):
-        s = node_input(node, sock)
-        if s is not None and (s.is_linked or float(s.default_value) > 0.0):
-            ctx.issue(f"{node.name!r} uses {what}, which DRT does not render (left out)")
+    s = node_input(node, "Thin Film Thickness")
+    if s is not None and (s.is_linked or float(s.default_value) > 0.0):
+        ctx.issue(f"{node.name!r} uses thin film, which DRT does not render (left out)")
     base, tint = metallic.metal_inputs(
         node, ctx, lambda name, default: _input(node, name, ctx, True, default),
         lambda name, default: _constant(node, name, ctx, default, color=True))
     return _Closure([(1.0, _Comp(base=base, metallic=1.0, specular_tint=tint,
                                  roughness=_input(node, "Roughness", ctx, False, 0.5),
-                                 distribution=distribution))])
+                                 distribution=distribution,
+                                 anisotropy=anisotropy.read(node, ctx, "Anisotropy",
+                                                            "Rotation", "PRINCIPLED")))])
 
 
 def _glass(node, ctx, refraction=False) -> _Closure:

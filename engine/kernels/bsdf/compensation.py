@@ -9,10 +9,11 @@ from .state import (S_GLASS_SMOOTH, S_METAL_B, S_METAL_CONST, S_METAL_F0, S_META
 
 
 @kernel(allocates=False)
-def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, w_glass,
-               tables, state):
+def compensate(multiscatter, woz, cos_o, alpha, alpha_glass, eta_spec, eta_glass, w_spec, m,
+               w_glass, tables, state):
     """The multiple-scattering factors at wo: 1 unless
-    `multiscatter`; the lobe weights, metal F0 and Fresnel kind and the tint must be in
+    `multiscatter`; alpha: the reflection lobes' (an anisotropic one's sqrt(alpha_x
+    alpha_y), as Cycles' estimate), alpha_glass the glass lobe's (always isotropic); the lobe weights, metal F0 and Fresnel kind and the tint must be in
     the state already."""
     state[S_MS_SPEC] = 1.0
     state[S_MS_E] = 1.0
@@ -42,7 +43,7 @@ def compensate(multiscatter, woz, cos_o, alpha, eta_spec, eta_glass, w_spec, m, 
     if w_glass > 0.0 and state[S_GLASS_SMOOTH] == 0.0 and state[S_REFRACT_ONLY] == 0.0:
         eta_rel = 1.0 / eta_glass if woz < 0.0 else eta_glass
         c_o = min(abs(woz), 1.0)
-        E = ms.glass_albedo(c_o, alpha, eta_rel, tables)
-        E_avg = ms.glass_albedo_avg(alpha, eta_rel, tables)
+        E = ms.glass_albedo(c_o, alpha_glass, eta_rel, tables)
+        E_avg = ms.glass_albedo_avg(alpha_glass, eta_rel, tables)
         for c in range(3):
             state[S_MS_GLASS + c] = ms.compensation(E, E_avg, state[S_TINT + c])

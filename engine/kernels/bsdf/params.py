@@ -83,12 +83,22 @@ P_CHIANG_NG = 88         # per hit, 3 columns: the geometric normal in the shadi
 P_DIFFUSE_ROUGHNESS = 91  # Oren-Nayar sigma of the diffuse lobe, 0 to 1 (0: Lambert)
 P_GLASS_REFLECT = 92     # 3 columns: the glass lobe's reflection tint (a Glass or Refraction
 #                          BSDF's Color, as Cycles' reflection_tint; white for Principled)
-NPARAM = 95
+# Anisotropic reflection (anisotropic.py): the metal and specular lobes
+P_ANISO_KIND = 95        # ANISO_NONE, ANISO_PRINCIPLED (Principled, Metallic) or ANISO_GLOSSY:
+#                          how Anisotropic / Anisotropy maps to the two alphas
+P_ANISO = 96             # the node's Anisotropic (Principled, Metallic) or Anisotropy (Glossy)
+P_ANISO_ROT = 97         # its Rotation, in turns
+P_TANGENT = 98           # per hit, 3 columns: the tangent (the node's Tangent input), local
+#                          to the shading frame (0: none, the lobe stays isotropic)
+NPARAM = 101
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
 GLOSSY_MULTI_GGX = 2     # GGX with Cycles' multiple-scattering compensation
 GLOSSY_BECKMANN = 3      # Beckmann (beckmann.py), never compensated, as in Cycles
+ANISO_NONE = 0           # P_ANISO_KIND
+ANISO_PRINCIPLED = 1
+ANISO_GLOSSY = 2
 SSS_RANDOM_WALK = 0      # P_SSS_METHOD: Cycles' subsurface methods
 SSS_SKIN = 1
 SSS_BURLEY = 2
@@ -152,4 +162,7 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_CHIANG_OFFSET] = table.chiang_offset
     rows[:, P_CHIANG_RANDOM:P_CHIANG_RANDOM + 3] = table.chiang_random
     rows[:, P_CHIANG_OWN_RANDOM] = table.chiang_own_random
+    rows[:, P_ANISO_KIND] = table.anisotropy_kind
+    rows[:, P_ANISO] = table.anisotropy
+    rows[:, P_ANISO_ROT] = table.anisotropic_rotation
     return rows

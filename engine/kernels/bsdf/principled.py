@@ -62,7 +62,7 @@ from __future__ import annotations
 import math
 
 from ..jit import kernel
-from . import dielectric, fresnel, layers, oren_nayar, specular_tint, subsurface_lobe
+from . import anisotropic, dielectric, fresnel, layers, oren_nayar, specular_tint, subsurface_lobe
 from . import microfacet as mf
 from . import multiscatter as ms
 from .albedo import specular_albedo
@@ -135,6 +135,13 @@ def setup_about(row, front_facing, wox, woy, woz, tables, state, dnx, dny, dnz):
     state[S_METAL_CONST] = row[P_METAL_CONSTANT]
     state[S_METAL_F82] = 0.0
     state[S_EXPONENT] = max(2.0 / (lobe_alpha * lobe_alpha) - 2.0, 0.0)
+    # the metal and specular lobes' own alpha (anisotropic: the isotropic one the
+    # compensation and the layering take); Blinn-Phong stays isotropic
+    alpha_r = alpha
+    if state[S_BLINN] == 0.0:
+        alpha_r = anisotropic.setup(row, rough, row[P_FILTER_ALPHA], state)
+    else:
+        state[anisotropic.S_ANISO] = 0.0
     base_w = (1.0 - m) * (1.0 - t)
     # specular layer: F0 scaled by 2 * level, IOR recomputed from it
     f0 = fresnel.f0_from_ior(ior) * 2.0 * level
@@ -180,20 +187,20 @@ def setup_about(row, front_facing, wox, woy, woz, tables, state, dnx, dny, dnz):
 
     # albedo-dependent weights at wo
     cos_o = min(max(woz, 0.0), 1.0)
-    compensate(row[P_GLOSSY_MODEL] == GLOSSY_MULTI_GGX, woz, cos_o, alpha, eta_spec,
-               eta_glass, w_spec, m, w_glass, tables, state)
+    compensate(row[P_GLOSSY_MODEL] == GLOSSY_MULTI_GGX, woz, cos_o, alpha_r, alpha,
+               eta_spec, eta_glass, w_spec, m, w_glass, tables, state)
     e_spec = 0.0
     est_spec = 0.0
     state[S_SPEC_TINTED] = 0.0
     if w_spec > 0.0:
         # the layer's albedo as the diffuse sees it
-        e_spec = specular_albedo(cos_o, alpha, eta_spec, tables)
+        e_spec = specular_albedo(cos_o, alpha_r, eta_spec, tables)
         if state[S_BLINN] == 0.0:
             if specular_tint.is_tinted(row):
                 e_spec = specular_tint.setup(row, row[P_GLOSSY_MODEL] == GLOSSY_MULTI_GGX,
-                                             cos_o, alpha, eta_spec, e_spec, tables, state)
+                                             cos_o, alpha_r, eta_spec, e_spec, tables, state)
             else:
-                e_est = ms.layer_reflectance(cos_o, alpha, eta_spec, tables) * state[S_MS_E]
+                e_est = ms.layer_reflectance(cos_o, alpha_r, eta_spec, tables) * state[S_MS_E]
                 e_spec = max(e_est, e_spec) * state[S_MS_SPEC]
         est_spec = w_spec * e_spec
     state[S_E_SPEC] = e_spec

@@ -6,11 +6,11 @@ every angle (a Glossy BSDF). principled.py calls these; the state's slots: state
 from __future__ import annotations
 
 from ..jit import kernel
-from . import blinn_phong, fresnel
+from . import anisotropic, blinn_phong, fresnel
 from . import distribution as dist
 from . import microfacet as mf
 from .params import P_SPEC_TINT
-from .state import (S_ALPHA, S_BECKMANN, S_BLINN, S_EXPONENT, S_METAL_B, S_METAL_CONST,
+from .state import (S_ALPHA, S_ANISO, S_BECKMANN, S_BLINN, S_EXPONENT, S_METAL_B, S_METAL_CONST,
                     S_METAL_F0, S_METAL_F82)
 
 
@@ -49,6 +49,8 @@ def reflection_eval(state, ox, oy, oz, ix, iy, iz):
     if state[S_BLINN] != 0.0:
         hx, hy, hz, _ = mf.half_vector(ox, oy, oz, ix, iy, iz)
         return blinn_phong.eval_f(ox, oy, oz, ix, iy, iz, state[S_EXPONENT]), hx, hy, hz
+    if state[S_ANISO] != 0.0:
+        return anisotropic.lobe_eval(state, ox, oy, oz, ix, iy, iz, state[S_BECKMANN] != 0.0)
     return dist.reflection_eval_of(ox, oy, oz, ix, iy, iz, state[S_ALPHA],
                                  state[S_BECKMANN] != 0.0)
 
@@ -57,6 +59,8 @@ def reflection_eval(state, ox, oy, oz, ix, iy, iz):
 def reflection_pdf(state, ox, oy, oz, ix, iy, iz):
     if state[S_BLINN] != 0.0:
         return blinn_phong.pdf(ox, oy, oz, ix, iy, iz, state[S_EXPONENT])
+    if state[S_ANISO] != 0.0:
+        return anisotropic.lobe_pdf(state, ox, oy, oz, ix, iy, iz, state[S_BECKMANN] != 0.0)
     return dist.reflection_pdf_of(ox, oy, oz, ix, iy, iz, state[S_ALPHA],
                                 state[S_BECKMANN] != 0.0)
 
@@ -65,5 +69,7 @@ def reflection_pdf(state, ox, oy, oz, ix, iy, iz):
 def reflection_sample(state, ox, oy, oz, u1, u2):
     if state[S_BLINN] != 0.0:
         return blinn_phong.sample(ox, oy, oz, u1, u2, state[S_EXPONENT])
+    if state[S_ANISO] != 0.0:
+        return anisotropic.lobe_sample(state, ox, oy, oz, u1, u2, state[S_BECKMANN] != 0.0)
     return dist.reflection_sample_of(ox, oy, oz, state[S_ALPHA], u1, u2,
                                    state[S_BECKMANN] != 0.0)

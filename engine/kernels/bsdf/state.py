@@ -44,4 +44,9 @@ S_DIFFUSE_LABEL = layers.NSTATE + 32  # 1: principled.sample's last direction is
 #                                       LABEL_DIFFUSE | LABEL_TRANSMIT)
 S_DIFFUSE_N = layers.NSTATE + 33   # 3: the diffuse lobe's normal in the local frame: (0, 0, 1),
 #                                     or a bent frame's raw normal (bend_diffuse)
-NSTATE = layers.NSTATE + 36
+S_ANISO = layers.NSTATE + 36      # 1: the reflection lobes are anisotropic (anisotropic.py)
+S_ALPHA_X = layers.NSTATE + 37     # ... their alpha along the tangent, Filter Glossy's included
+S_ALPHA_Y = layers.NSTATE + 38     # ... across it
+S_TAN_C = layers.NSTATE + 39       # cos and sin of the tangent's angle in the local frame
+S_TAN_S = layers.NSTATE + 40
+NSTATE = layers.NSTATE + 41
