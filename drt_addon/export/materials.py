@@ -119,6 +119,7 @@ class _Ctx:
         self.normal = None          # the per-hit shading normal (a program Value), if any
         self.sets_normal = False    # ... set as the surface's own (the Displacement's bump)
         self.surface_normal = None  # the surface's own where a shader has a Normal of its own
+        self.coat_normal = None     # a Principled's linked Coat Normal (a program Value)
         self.volume_programs = True     # a volume varying in space joins the program
         self.volume_outputs = {}        # ... as these outputs (export/volumes.py)
 
@@ -202,6 +203,8 @@ def _attach_programs(m, ctx, program):
         m.sets_normal = ctx.sets_normal
     if ctx.surface_normal is not None:
         outputs["surface_normal"] = ctx.surface_normal
+    if ctx.coat_normal is not None:
+        outputs["coat_normal"] = ctx.coat_normal
     if outputs:
         m.shader = dataclasses.replace(program, outputs=outputs)
     for side in (m.mix or ()):

@@ -58,7 +58,7 @@ from .volume import V_BOUNDARY, V_HAS, in_medium, stack_cross
 from .bsdf.params import P_ANISO_KIND, P_BUMP_CORRECTION, P_HAIR, P_HOLDOUT, P_SETS_NORMAL
 from .surface import hit_uv, surface_at
 from .terminator import shadow_origin
-from .surface_hit import material_row, run_program, surface_emission
+from .surface_hit import coat_frame, material_row, run_program, surface_emission
 from .subsurface import walk_key
 from .subsurface_vertex import scatter_below
 from ..nodes.context import N_HIT
@@ -245,6 +245,9 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                                nx, ny, nz, row)
         if row[P_ANISO_KIND] != 0.0:     # an anisotropic lobe's tangent, to the frame
             anisotropic.localize_tangent(row, nx, ny, nz)
+        if programs is not None and programmed:    # a coat keeps its own normal
+            coat_frame(programs, ms, regs, row, bent, s0x, s0y, s0z, gx, gy, gz, -dx, -dy,
+                       -dz, nx, ny, nz)
         keep_g, keep_t = prepare_closures(cfg, row, min_pdf[p], ray_bits[p], counts[p, 0])
         dnx, dny, dnz = 0.0, 0.0, 1.0
         if bent:     # the diffuse and sheen lobes about the raw normal, as Cycles' are

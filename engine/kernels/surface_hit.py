@@ -6,13 +6,17 @@ Numba then compiles these without that code."""
 from __future__ import annotations
 
 from .bsdf.params import (P_ANISO_KIND, P_ANISO_ROT, P_BASE, P_BUMP_CORRECTION,
-                          P_CHIANG_COLOR, P_CHIANG_MELANIN, P_HAIR, P_LAYERS, P_METALLIC,
-                          P_ROUGHNESS, P_TANGENT, P_TRANSLUCENT)
+                          P_CHIANG_COLOR, P_CHIANG_MELANIN, P_COAT_N, P_COAT_WEIGHT, P_HAIR,
+                          P_LAYERS, P_METALLIC, P_ROUGHNESS, P_TANGENT, P_TRANSLUCENT)
+from .frame import to_local
 from .jit import kernel
 from .textures import apply_to_row, emission_at
 from ..nodes.context import path_fields
 from ..nodes.differentials import cone_at
-from ..nodes.shading import (apply_anisotropy, apply_hair, apply_rows, apply_translucent, pick_closure,
+from ..nodes.pack import OUTS
+from ..nodes.shading import (OUT_COAT_NORMAL, apply_anisotropy, apply_hair, apply_rows,
+                             coat_normal,
+                             valid_reflection_normal, apply_translucent, pick_closure,
                              program_emission, program_hit, program_normal)
 
 
@@ -62,3 +66,19 @@ def material_row(params, textures, programs, ms, uu, vv, regs, programmed, row):
             apply_hair(programs, ms, regs, row, P_CHIANG_COLOR, P_CHIANG_MELANIN)
         if row[P_ANISO_KIND] != 0.0:  # an anisotropic lobe's tangent (world) and Rotation
             apply_anisotropy(programs, ms, regs, row, P_TANGENT, P_ANISO_ROT)
+
+
+@kernel(allocates=False)
+def coat_frame(programs, ms, regs, row, bent, s0x, s0y, s0z, gx, gy, gz, ix, iy, iz, nx, ny,
+               nz):
+    """Where the program bent the shading frame to n or gives a Coat Normal, write
+    row[P_COAT_N]: the coat's own normal (its Coat Normal, or the surface's s0, Cycles'
+    sd->N), made a valid reflector for the view I as Cycles' coat closure makes it, local
+    to n's frame. Nothing without a coat."""
+    if row[P_LAYERS] == 0.0 or not row[P_COAT_WEIGHT] > 0.0:
+        return
+    if not bent and programs[OUTS][ms, OUT_COAT_NORMAL] < 0:
+        return
+    cx, cy, cz = coat_normal(programs, ms, regs, s0x, s0y, s0z)
+    cx, cy, cz = valid_reflection_normal(gx, gy, gz, ix, iy, iz, cx, cy, cz)
+    row[P_COAT_N], row[P_COAT_N + 1], row[P_COAT_N + 2] = to_local(cx, cy, cz, nx, ny, nz)

@@ -44,7 +44,7 @@ from .lights.light_set import sample_lamp_at
 from .lights.pack import C_TYPE, LAMPS, T_ENV, T_ENV_MAP
 from .path_weights import DIFFUSE_BIT, SHADOW_BIT, _add, holdout_share, uncovered
 from .surface import hit_uv, surface_at
-from .surface_hit import material_row, run_program, surface_emission
+from .surface_hit import coat_frame, material_row, run_program, surface_emission
 from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
 from ..nodes.interpreter import has_program
@@ -174,6 +174,9 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
                                nx, ny, nz, row)
         if row[P_ANISO_KIND] != 0.0:     # an anisotropic lobe's tangent, to the frame
             anisotropic.localize_tangent(row, nx, ny, nz)
+        if programs is not None and programmed:    # a coat keeps its own normal
+            coat_frame(programs, ms, regs, row, bent, n0x, n0y, n0z, gx, gy, gz, -dx, -dy, -dz, nx,
+                       ny, nz)
         row[P_SSS_WEIGHT] = 0.0          # Whitted's model: subsurface light is diffuse
         # 2. direct light: one shadow ray to each lamp's fixed point, on the lobes that
         # are not followed (diffuse, sheen, translucency); on a bent frame the sheen about

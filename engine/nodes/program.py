@@ -24,17 +24,17 @@ import numpy as np
 # (its parametrization's Color, Tint or Absorption Coefficient) and Melanin, the
 # surface's own normal where the Displacement socket's bump sets it while a shader has a
 # Normal of its own (engine.nodes.shading.surface_normal), a Translucent BSDF's
-# colour (its weight included), and an anisotropic BSDF's tangent (world space) and
-# Rotation (engine.kernels.bsdf.anisotropic)
+# colour (its weight included), an anisotropic BSDF's tangent (world space) and
+# Rotation (engine.kernels.bsdf.anisotropic), and the Principled's Coat Normal
 OUTPUTS = ("base_color", "metallic", "roughness", "emission", "alpha", "normal", "mix",
            "volume_absorption", "volume_scattering", "volume_emission", "hair_color",
            "hair_melanin", "surface_normal", "translucent_color", "tangent",
-           "anisotropic_rotation")
+           "anisotropic_rotation", "coat_normal")
 OUTPUT_WIDTH = {"base_color": 3, "metallic": 1, "roughness": 1, "emission": 3, "alpha": 1,
                 "normal": 3, "mix": 1, "volume_absorption": 3, "volume_scattering": 3,
                 "volume_emission": 3, "hair_color": 3, "hair_melanin": 1,
                 "surface_normal": 3, "translucent_color": 3, "tangent": 3,
-                "anisotropic_rotation": 1}
+                "anisotropic_rotation": 1, "coat_normal": 3}
 N_OUT = len(OUTPUTS)
 WIDTH = 8            # int32 per instruction: opcode, output register, six operands
 

@@ -32,6 +32,7 @@ OUT_HAIR_COLOR, OUT_HAIR_MELANIN = 10, 11          # a Principled Hair's (hair_c
 OUT_SURFACE_NORMAL = 12                             # Cycles' sd->N, where set (surface_normal)
 OUT_TRANSLUCENT = 13                                # a Translucent BSDF's colour (layers.py)
 OUT_TANGENT, OUT_ANISO_ROT = 14, 15                 # anisotropic reflection (anisotropic.py)
+OUT_COAT_NORMAL = 16                                # the Principled's Coat Normal
 
 
 @kernel(allocates=False)
@@ -132,6 +133,20 @@ def apply_anisotropy(T, m, regs, row, P_TANGENT, P_ANISO_ROT):
     r = outs[m, OUT_ANISO_ROT]
     if r >= 0:
         row[P_ANISO_ROT] = regs[r]
+
+
+@kernel(allocates=False)
+def coat_normal(T, m, regs, sx, sy, sz):
+    """The coat's normal: the program's Coat Normal (unit), else s, the surface's own
+    shading normal (Cycles' sd->N, which an unlinked Coat Normal reads)."""
+    r = T[OUTS][m, OUT_COAT_NORMAL]
+    if r < 0:
+        return sx, sy, sz
+    x, y, z = regs[r], regs[r + 1], regs[r + 2]
+    ln = math.sqrt(x * x + y * y + z * z)
+    if not (ln > 0.0 and ln < math.inf):
+        return sx, sy, sz
+    return x / ln, y / ln, z / ln
 
 
 @kernel(allocates=False)

@@ -78,9 +78,10 @@ def _principled_layers(node, ctx):
     if coat <= 0.0 and sheen <= 0.0:
         return None
     s = node_input(node, "Coat Normal")
-    if coat > 0.0 and s is not None and s.is_linked:
-        ctx.issue(f"the Coat Normal of {node.name!r} is not rendered; DRT's coat uses the "
-                  f"surface's normal")
+    if coat > 0.0 and s is not None and _link(s) is not None:
+        # the coat's own normal, per hit (engine.kernels.surface_hit.coat_frame; unlinked,
+        # the kernel gives the coat the surface's normal, as Cycles does)
+        ctx.coat_normal = ctx.nodes.convert(ctx.nodes.socket(s, "vector"), "vector")
     return _Layers(coat_weight=coat, coat_roughness=float(const("Coat Roughness", 0.03)),
                    coat_ior=float(const("Coat IOR", 1.5)),
                    coat_tint=tuple(const("Coat Tint", WHITE, True)), sheen_weight=sheen,

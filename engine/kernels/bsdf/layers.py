@@ -23,6 +23,13 @@ path_vertex bends the frame to Cycles' valid reflection normal, the raw normal, 
 Cycles' sheen keeps the node's normal (svm/closure.h); its LTC is set up for wo's angle to
 that normal, and its value, density and samples are taken about it (`sheen_seen`).
 
+The coat lies on its own normal too (S_COAT_N): the frame's, or where the material's
+program bends the frame or gives a Coat Normal, that Coat Normal or the surface's own
+normal, made a valid reflector for the view (engine.kernels.surface_hit.coat_frame), as
+Cycles' coat closure lies on its Coat Normal (sd->N when unlinked); its layering
+albedo is taken at wo's angle to it, its value and density about it, and its value is
+scaled by wi's cosine to it over the frame's, which the callers multiply by.
+
 Lobe kinds: coat GLOSSY; sheen DIFFUSE (Cycles labels it diffuse reflection); translucent
 TRANSMISSION for the bounce that follows it (it leaves through the surface; the ray it
 sends is a diffuse ray as well, as Cycles' diffuse-transmission label makes it:
@@ -42,53 +49,22 @@ from __future__ import annotations
 
 from ..frame import to_local, to_world
 from ..jit import kernel
-from . import coat, hair, hair_chiang, sheen, translucent
+from . import coat, hair, sheen, translucent
+from .layer_slots import (  # noqa: F401  (re-exported: principled, state, the passes)
+    WEIGHT_CUTOFF, MIN_SELECTION, S_FIRST, S_BASE_SCALE, S_COAT_W, S_COAT_ALPHA, S_COAT_IOR,
+    S_SHEEN_W, S_SHEEN_A, S_SHEEN_B, S_SHEEN_CX, S_SHEEN_CY, S_TRANS, S_EST_COAT,
+    S_EST_SHEEN, S_EST_TRANS, S_HAIR_T, S_HAIR_R, S_HAIR_TT, S_HAIR_R_LOBE, S_HAIR_TT_LOBE,
+    S_EST_HAIR_R, S_EST_HAIR_TT, S_CHIANG_W, S_CHIANG_SIGMA, S_CHIANG_LOBE, S_CHIANG_ALPHA,
+    S_CHIANG_ETA, S_CHIANG_H, S_CHIANG_T, S_CHIANG_ALBEDO, S_EST_CHIANG, S_CHIANG_MESH,
+    S_CHIANG_AS_SAMPLED, S_SHEEN_N, S_COAT_N, NSTATE)
+from .hair_layer import (chiang_eval, chiang_sample, chiang_sampled_done,  # noqa: F401
+                         chiang_setup, hair_pdf, hair_sample)
 from . import microfacet as mf
-from .params import (P_CHIANG, P_CHIANG_COLOR, P_CHIANG_IOR, P_CHIANG_MELANIN,
-                     P_CHIANG_MODE, P_CHIANG_NG, P_CHIANG_OFFSET, P_CHIANG_RANDOM,
-                     P_CHIANG_ROUGH, P_CHIANG_T, P_COAT_IOR, P_COAT_ROUGHNESS, P_COAT_TINT,
-                     P_COAT_WEIGHT, P_FILTER_ALPHA, P_HAIR_CURVE, P_HAIR_R, P_HAIR_R_OFFSET,
+from .params import (P_COAT_IOR, P_COAT_N, P_COAT_ROUGHNESS, P_COAT_TINT, P_COAT_WEIGHT,
+                     P_FILTER_ALPHA, P_HAIR_CURVE, P_HAIR_R, P_HAIR_R_OFFSET,
                      P_HAIR_R_ROUGH, P_HAIR_T, P_HAIR_TT, P_HAIR_TT_OFFSET, P_HAIR_TT_ROUGH,
                      P_SHEEN_LAYERED, P_SHEEN_ROUGHNESS, P_SHEEN_TINT, P_SHEEN_WEIGHT,
                      P_TRANSLUCENT)
-
-WEIGHT_CUTOFF = 1e-5            # Cycles' CLOSURE_WEIGHT_CUTOFF
-MIN_SELECTION = 0.02            # principled.MIN_SELECTION
-
-S_FIRST = 33                    # principled.py's slots end here
-S_BASE_SCALE = 33               # 3: the factor of every base lobe, per channel
-S_COAT_W = 36                   # the coat lobe's weight (coat weight x sheen's factor)
-S_COAT_ALPHA = 37               # the coat lobe's GGX alpha (Filter Glossy included)
-S_COAT_IOR = 38
-S_SHEEN_W = 39                  # 3: sheen weight x tint x R(wo)
-S_SHEEN_A = 42                  # the LTC's a, b and frame (wo's azimuth cx, cy)
-S_SHEEN_B = 43
-S_SHEEN_CX = 44
-S_SHEEN_CY = 45
-S_TRANS = 46                    # 3: the translucent colour
-S_EST_COAT = 49                 # selection estimates of the three lobes
-S_EST_SHEEN = 50
-S_EST_TRANS = 51
-S_HAIR_T = 52                   # 3: the fibre's tangent, local
-S_HAIR_R = 55                   # 3: the hair reflection's colour
-S_HAIR_TT = 58                  # 3: the hair transmission's colour
-S_HAIR_R_LOBE = 61              # 3: its offset (0 off a strand), r1, r2 (clamped)
-S_HAIR_TT_LOBE = 64             # 3: the same for the transmission
-S_EST_HAIR_R = 67               # selection estimates of the two hair lobes
-S_EST_HAIR_TT = 68
-S_CHIANG_W = 69                 # 3: the Principled Hair closure's weight colour
-S_CHIANG_SIGMA = 72             # 3: its absorption
-S_CHIANG_LOBE = 75              # 3: v, s, m0 (hair_chiang.remap, Filter Glossy included)
-S_CHIANG_ALPHA = 78             # the node's Offset
-S_CHIANG_ETA = 79
-S_CHIANG_H = 80
-S_CHIANG_T = 81                 # 3: the fibre's tangent, local
-S_CHIANG_ALBEDO = 84            # 3: Cycles' albedo estimate at wo (the Color passes)
-S_EST_CHIANG = 87               # its selection estimate
-S_CHIANG_MESH = 88              # 1: on a triangle, where lights see Cycles' bump test
-S_CHIANG_AS_SAMPLED = 89        # 1: principled.sample weighs the closure's own direction
-S_SHEEN_N = 90                  # 3: the sheen's normal in the local frame ((0, 0, 1): the frame's)
-NSTATE = 93
 
 
 @kernel(allocates=False)
@@ -119,9 +95,15 @@ def setup(row, wox, woy, woz, tables, state, snx, sny, snz):
         if row[P_SHEEN_LAYERED] != 0.0:
             scale = min(max(1.0 - sheen_max, 0.0), 1.0)
     state[S_EST_SHEEN] = max(sheen_max, MIN_SELECTION * sw) if sheen_max > 0.0 else 0.0
-    # coat
+    # coat, about its own normal where it has one (row[P_COAT_N], per hit)
     cw = max(row[P_COAT_WEIGHT], 0.0)
     ior = max(row[P_COAT_IOR], 1.0)
+    cnx, cny, cnz = row[P_COAT_N], row[P_COAT_N + 1], row[P_COAT_N + 2]
+    if cnx == 0.0 and cny == 0.0 and cnz == 0.0:
+        cnx, cny, cnz = 0.0, 0.0, 1.0
+    state[S_COAT_N], state[S_COAT_N + 1], state[S_COAT_N + 2] = cnx, cny, cnz
+    if cnz != 1.0:
+        cos_o = min(max(wox * cnx + woy * cny + woz * cnz, 0.0), 1.0)
     state[S_COAT_W] = 0.0
     state[S_COAT_IOR] = ior
     state[S_COAT_ALPHA] = 1.0
@@ -170,106 +152,7 @@ def setup(row, wox, woy, woz, tables, state, snx, sny, snz):
         state[S_HAIR_TT_LOBE] = row[P_HAIR_TT_OFFSET] if on_strand else 0.0
         state[S_HAIR_TT_LOBE + 1] = hair.clamp_roughness(row[P_HAIR_TT_ROUGH])
         state[S_HAIR_TT_LOBE + 2] = hair.clamp_roughness(row[P_HAIR_TT_ROUGH + 1])
-    _chiang_setup(row, wox, woy, woz, state)
-
-
-@kernel(allocates=False)
-def _chiang_setup(row, wox, woy, woz, state):
-    """The Principled Hair closure's slots, as Cycles' svm closure and setup make them:
-    Random Roughness scales both roughnesses by 1 + 2 (random - 1/2) amount."""
-    w_max = 0.0
-    for c in range(3):
-        state[S_CHIANG_W + c] = max(row[P_CHIANG + c], 0.0)
-        state[S_CHIANG_ALBEDO + c] = 0.0
-        w_max = max(w_max, state[S_CHIANG_W + c])
-    state[S_EST_CHIANG] = w_max
-    state[S_CHIANG_AS_SAMPLED] = 0.0
-    if not w_max > 0.0:
-        return
-    state[S_CHIANG_MESH] = 0.0 if row[P_HAIR_CURVE] != 0.0 else 1.0
-    random = row[P_CHIANG_RANDOM + 2]
-    k = 1.0 + 2.0 * (random - 0.5) * row[P_CHIANG_RANDOM + 1]
-    rough = row[P_CHIANG_ROUGH] * k
-    radial = row[P_CHIANG_ROUGH + 1] * k
-    cr, cg, cb = row[P_CHIANG_COLOR], row[P_CHIANG_COLOR + 1], row[P_CHIANG_COLOR + 2]
-    sr, sg, sb = hair_chiang.absorption(int(row[P_CHIANG_MODE]), cr, cg, cb,
-                                        row[P_CHIANG_MELANIN], row[P_CHIANG_MELANIN + 1],
-                                        cr, cg, cb, row[P_CHIANG_RANDOM], random, radial)
-    state[S_CHIANG_SIGMA] = sr
-    state[S_CHIANG_SIGMA + 1] = sg
-    state[S_CHIANG_SIGMA + 2] = sb
-    v, s, m0 = hair_chiang.remap(rough, radial, row[P_CHIANG_ROUGH + 2], row[P_FILTER_ALPHA])
-    state[S_CHIANG_LOBE] = v
-    state[S_CHIANG_LOBE + 1] = s
-    state[S_CHIANG_LOBE + 2] = m0
-    state[S_CHIANG_ALPHA] = row[P_CHIANG_OFFSET]
-    eta = max(row[P_CHIANG_IOR], 1e-3)
-    state[S_CHIANG_ETA] = eta
-    # a hit on the back of a triangle: Cycles turns Ng to the view and negates dPdu
-    tx, ty, tz = row[P_CHIANG_T], row[P_CHIANG_T + 1], row[P_CHIANG_T + 2]
-    gx, gy, gz = row[P_CHIANG_NG], row[P_CHIANG_NG + 1], row[P_CHIANG_NG + 2]
-    if gx * wox + gy * woy + gz * woz < 0.0:
-        gx, gy, gz, tx, ty, tz = -gx, -gy, -gz, -tx, -ty, -tz
-    h = hair_chiang.offset_h(gx, gy, gz, tx, ty, tz, wox, woy, woz)
-    state[S_CHIANG_H] = h
-    state[S_CHIANG_T], state[S_CHIANG_T + 1], state[S_CHIANG_T + 2] = tx, ty, tz
-    ar, ag, ab = hair_chiang.albedo(tx, ty, tz, h, sr, sg, sb, v, eta, wox, woy, woz)
-    state[S_CHIANG_ALBEDO] = ar
-    state[S_CHIANG_ALBEDO + 1] = ag
-    state[S_CHIANG_ALBEDO + 2] = ab
-
-
-@kernel(allocates=False)
-def _bump_shadowed(state, wox, woy, woz, wix, wiy, wiz):
-    """Cycles' bump_shadowing_term for the closure evaluated on a triangle: its normal
-    (Y = X x wo, hair_chiang's frame) is not the surface's, so light is refused where
-    N.wi, N.Y and Y.wi do not agree in sign (N, the shading normal, is local z). Not on
-    strands, and not for the closure's own sampled direction (Cycles' bsdf_sample)."""
-    if state[S_CHIANG_MESH] == 0.0 or state[S_CHIANG_AS_SAMPLED] != 0.0:
-        return False
-    tx, ty, tz = state[S_CHIANG_T], state[S_CHIANG_T + 1], state[S_CHIANG_T + 2]
-    yx = ty * woz - tz * woy
-    yy = tz * wox - tx * woz
-    yz = tx * woy - ty * wox
-    return wiz * yz * (yx * wix + yy * wiy + yz * wiz) < 0.0
-
-
-@kernel(allocates=False)
-def chiang_eval(state, wox, woy, woz, wix, wiy, wiz):
-    """The Principled Hair closure's (F_r, F_g, F_b, pdf) (hair_chiang.evaluate), its
-    weight included in F: f |cos|, as Cycles' bsdf_eval (zero where `_bump_shadowed`)."""
-    if _bump_shadowed(state, wox, woy, woz, wix, wiy, wiz):
-        return 0.0, 0.0, 0.0, 0.0
-    T, L = S_CHIANG_T, S_CHIANG_LOBE
-    Fr, Fg, Fb, p = hair_chiang.evaluate(
-        state[T], state[T + 1], state[T + 2], state[S_CHIANG_H], state[S_CHIANG_SIGMA],
-        state[S_CHIANG_SIGMA + 1], state[S_CHIANG_SIGMA + 2], state[L], state[L + 1],
-        state[L + 2], state[S_CHIANG_ALPHA], state[S_CHIANG_ETA], wox, woy, woz, wix, wiy,
-        wiz)
-    W = S_CHIANG_W
-    return Fr * state[W], Fg * state[W + 1], Fb * state[W + 2], p
-
-
-@kernel(allocates=False)
-def chiang_sample(state, wox, woy, woz, u_p, u1, u2):
-    """A direction from the Principled Hair closure: (wi, F (weight included), pdf, p),
-    p 0 for its reflection, 1..3 through the fibre. Until `chiang_sampled_done`,
-    chiang_eval gives this direction its value without Cycles' bump test, as Cycles'
-    sample does."""
-    state[S_CHIANG_AS_SAMPLED] = 1.0
-    T, L = S_CHIANG_T, S_CHIANG_LOBE
-    x, y, z, Fr, Fg, Fb, p, lobe = hair_chiang.sample(
-        state[T], state[T + 1], state[T + 2], state[S_CHIANG_H], state[S_CHIANG_SIGMA],
-        state[S_CHIANG_SIGMA + 1], state[S_CHIANG_SIGMA + 2], state[L], state[L + 1],
-        state[L + 2], state[S_CHIANG_ALPHA], state[S_CHIANG_ETA], wox, woy, woz, u_p, u1,
-        u2)
-    W = S_CHIANG_W
-    return x, y, z, Fr * state[W], Fg * state[W + 1], Fb * state[W + 2], p, lobe
-
-
-@kernel(allocates=False)
-def chiang_sampled_done(state):
-    state[S_CHIANG_AS_SAMPLED] = 0.0
+    chiang_setup(row, wox, woy, woz, state)
 
 
 @kernel(allocates=False)
@@ -298,6 +181,14 @@ def _about_sheen(state, x, y, z):
 
 
 @kernel(allocates=False)
+def _about_coat(state, x, y, z):
+    """Local direction (x, y, z) in the coat's own frame."""
+    if state[S_COAT_N + 2] == 1.0:
+        return x, y, z
+    return to_local(x, y, z, state[S_COAT_N], state[S_COAT_N + 1], state[S_COAT_N + 2])
+
+
+@kernel(allocates=False)
 def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
     """f (1/sr) of the sheen, coat, translucent and hair lobes that a light of the given
     kinds sees (principled.eval_seen adds the scaled base)."""
@@ -305,8 +196,14 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
     if see_d:
         fr, fg, fb = sheen_seen(state, woz, wix, wiy, wiz)
     if see_g and state[S_COAT_W] > 0.0:
-        v = state[S_COAT_W] * coat.eval_unit(wox, woy, woz, wix, wiy, wiz,
-                                             state[S_COAT_ALPHA], state[S_COAT_IOR])
+        ox, oy, oz = _about_coat(state, wox, woy, woz)
+        ix, iy, iz = _about_coat(state, wix, wiy, wiz)
+        v = state[S_COAT_W] * coat.eval_unit(ox, oy, oz, ix, iy, iz, state[S_COAT_ALPHA],
+                                             state[S_COAT_IOR])
+        if state[S_COAT_N + 2] != 1.0 and v > 0.0:
+            # the callers multiply f by wi's cosine to the frame's normal; the coat's is
+            # to its own (Cycles' closure eval includes it)
+            v = v * iz / abs(wiz) if wiz != 0.0 else 0.0
         fr += v
         fg += v
         fb += v
@@ -335,25 +232,6 @@ def eval_seen(state, wox, woy, woz, wix, wiy, wiz, see_d, see_g, see_t):
 
 
 @kernel(allocates=False)
-def hair_pdf(state, wox, woy, woz, wix, wiy, wiz, transmission):
-    """The hair R (or TT) lobe's evaluation pdf, f cos per unit colour (hair.pdf)."""
-    k = S_HAIR_TT_LOBE if transmission else S_HAIR_R_LOBE
-    return hair.pdf(state[S_HAIR_T], state[S_HAIR_T + 1], state[S_HAIR_T + 2], state[k],
-                    state[k + 1], state[k + 2], transmission, wox, woy, woz, wix, wiy, wiz)
-
-
-@kernel(allocates=False)
-def hair_sample(state, wox, woy, woz, transmission, u1, u2):
-    """A direction from the hair R (or TT) lobe, on either side: (wi, its pdf, colour)."""
-    k = S_HAIR_TT_LOBE if transmission else S_HAIR_R_LOBE
-    x, y, z, p = hair.sample(state[S_HAIR_T], state[S_HAIR_T + 1], state[S_HAIR_T + 2],
-                             state[k], state[k + 1], state[k + 2], transmission, wox, woy,
-                             woz, u1, u2)
-    c = S_HAIR_TT if transmission else S_HAIR_R
-    return x, y, z, p, state[c], state[c + 1], state[c + 2]
-
-
-@kernel(allocates=False)
 def selection(state, allow_d, allow_g, allow_t):
     """Unnormalised selection weights (coat, sheen, translucent, hair R, hair TT,
     Principled Hair) over the allowed kinds."""
@@ -371,7 +249,9 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht, qch):
     """sum q_i pdf_i over the coat, sheen, translucent and hair lobes (evaluation's)."""
     p = 0.0
     if qc > 0.0:
-        p += qc * mf.reflection_pdf(wox, woy, woz, wix, wiy, wiz, state[S_COAT_ALPHA])
+        ox, oy, oz = _about_coat(state, wox, woy, woz)
+        ix, iy, iz = _about_coat(state, wix, wiy, wiz)
+        p += qc * mf.reflection_pdf(ox, oy, oz, ix, iy, iz, state[S_COAT_ALPHA])
     if qs > 0.0:
         x, y, z = _about_sheen(state, wix, wiy, wiz)
         p += qs * sheen.pdf(x, y, z, state[S_SHEEN_CX], state[S_SHEEN_CY],
@@ -391,7 +271,13 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht, qch):
 def sample(state, wox, woy, woz, lobe, u1, u2):
     """A direction from lobe 0 (coat), 1 (sheen) or 2 (translucent): (wi, valid)."""
     if lobe == 0:
-        return mf.reflection_sample(wox, woy, woz, state[S_COAT_ALPHA], u1, u2)
+        if state[S_COAT_N + 2] == 1.0:
+            return mf.reflection_sample(wox, woy, woz, state[S_COAT_ALPHA], u1, u2)
+        ox, oy, oz = _about_coat(state, wox, woy, woz)
+        x, y, z, valid = mf.reflection_sample(ox, oy, oz, state[S_COAT_ALPHA], u1, u2)
+        wx, wy, wz = to_world(x, y, z, state[S_COAT_N], state[S_COAT_N + 1],
+                              state[S_COAT_N + 2])
+        return wx, wy, wz, valid
     if lobe == 1:
         x, y, z = sheen.sample(u1, u2, state[S_SHEEN_CX], state[S_SHEEN_CY],
                                state[S_SHEEN_A], state[S_SHEEN_B])

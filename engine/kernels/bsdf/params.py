@@ -90,7 +90,10 @@ P_ANISO = 96             # the node's Anisotropic (Principled, Metallic) or Anis
 P_ANISO_ROT = 97         # its Rotation, in turns
 P_TANGENT = 98           # per hit, 3 columns: the tangent (the node's Tangent input), local
 #                          to the shading frame (0: none, the lobe stays isotropic)
-NPARAM = 101
+P_COAT_N = 101           # per hit, 3 columns: the coat's normal in the shading frame (the
+#                          surface's own, or its Coat Normal, where a program bends the
+#                          frame: Cycles' coat keeps it); 0: the frame's
+NPARAM = 104
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
