@@ -18,8 +18,8 @@ from node_probe import drt_against_cycles, new_material, new_scene
 
 def _sphere_scene(bpy, make_material):
     """A 64 x 64 scene: a smooth 48 x 24 UV sphere (radius 1, turned so that its poles
-    do not face the camera) of the material make_material(bpy) makes, a 1 m area lamp of 300 W up and to the left,
-    a world of strength 0.2 and a camera 4 m in front."""
+    do not face the camera) of the material make_material(bpy) makes, a 2.5 m area lamp
+    of 400 W up and to the left, a world of strength 0.4 and a camera 4 m in front."""
     scene = new_scene(bpy, 64)
     scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.4
     bpy.ops.mesh.primitive_uv_sphere_add(radius=1.0, segments=48, ring_count=24)

@@ -15,8 +15,8 @@ from ..nodes.context import path_fields
 from ..nodes.differentials import cone_at
 from ..nodes.pack import OUTS
 from ..nodes.shading import (OUT_COAT_NORMAL, apply_anisotropy, apply_hair, apply_rows,
-                             coat_normal,
-                             valid_reflection_normal, apply_translucent, pick_closure,
+                             apply_translucent, coat_normal, pick_closure,
+                             valid_reflection_normal,
                              program_emission, program_hit, program_normal)
 
 

@@ -13,7 +13,8 @@ def compensate(multiscatter, woz, cos_o, alpha, alpha_glass, eta_spec, eta_glass
                w_glass, tables, state):
     """The multiple-scattering factors at wo: 1 unless
     `multiscatter`; alpha: the reflection lobes' (an anisotropic one's sqrt(alpha_x
-    alpha_y), as Cycles' estimate), alpha_glass the glass lobe's (always isotropic); the lobe weights, metal F0 and Fresnel kind and the tint must be in
+    alpha_y), as Cycles' estimate), alpha_glass the glass lobe's (always isotropic); the
+    lobe weights, metal F0 and Fresnel kind and the tint must be in
     the state already."""
     state[S_MS_SPEC] = 1.0
     state[S_MS_E] = 1.0
