@@ -80,6 +80,7 @@ def setup(row, wox, woy, woz, tables, state, snx, sny, snz):
         sox, soy, soz = to_local(wox, woy, woz, snx, sny, snz)
     sw = max(row[P_SHEEN_WEIGHT], 0.0)
     sheen_max = 0.0
+    sheen_mean = 0.0
     state[S_SHEEN_CX], state[S_SHEEN_CY] = sheen.azimuth(sox, soy)
     state[S_SHEEN_A], state[S_SHEEN_B] = 1.0, 0.0
     for c in range(3):
@@ -92,9 +93,10 @@ def setup(row, wox, woy, woz, tables, state, snx, sny, snz):
             w = sw * max(row[P_SHEEN_TINT + c], 0.0) * max(R, 0.0)
             state[S_SHEEN_W + c] = w
             sheen_max = max(sheen_max, w)
+            sheen_mean += w / 3.0
         if row[P_SHEEN_LAYERED] != 0.0:
             scale = min(max(1.0 - sheen_max, 0.0), 1.0)
-    state[S_EST_SHEEN] = max(sheen_max, MIN_SELECTION * sw) if sheen_max > 0.0 else 0.0
+    state[S_EST_SHEEN] = max(sheen_mean, MIN_SELECTION * sw) if sheen_max > 0.0 else 0.0
     # coat, about its own normal where it has one (row[P_COAT_N], per hit)
     cw = max(row[P_COAT_WEIGHT], 0.0)
     ior = max(row[P_COAT_IOR], 1.0)
@@ -128,11 +130,11 @@ def setup(row, wox, woy, woz, tables, state, snx, sny, snz):
     for c in range(3):
         state[S_BASE_SCALE + c] = state[S_BASE_SCALE + c] * scale
     # translucent
-    t_max = 0.0
+    t_mean = 0.0
     for c in range(3):
         state[S_TRANS + c] = max(row[P_TRANSLUCENT + c], 0.0)
-        t_max = max(t_max, state[S_TRANS + c])
-    state[S_EST_TRANS] = t_max
+        t_mean += state[S_TRANS + c] / 3.0
+    state[S_EST_TRANS] = t_mean
     # hair: each lobe's f cos integrates to at most 1, so its colour estimates its albedo
     r_max = 0.0
     tt_max = 0.0
@@ -156,8 +158,9 @@ def setup(row, wox, woy, woz, tables, state, snx, sny, snz):
 
 
 @kernel(allocates=False)
-def base_scale_max(state):
-    return max(state[S_BASE_SCALE], max(state[S_BASE_SCALE + 1], state[S_BASE_SCALE + 2]))
+def base_scale_mean(state):
+    """The layers' dimming of the base, averaged over the channels (for selection)."""
+    return (state[S_BASE_SCALE] + state[S_BASE_SCALE + 1] + state[S_BASE_SCALE + 2]) / 3.0
 
 
 @kernel(allocates=False)

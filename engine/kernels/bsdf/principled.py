@@ -34,7 +34,9 @@ P_LAYERS / P_REFRACT_ONLY), the Beckmann distribution (beckmann.py) and the tint
 specular layer and glass (specular_tint.py) complete Cycles' closures.
 
 Sampling: a lobe is chosen with probability proportional to an estimate of its albedo at
-wo, at least MIN_SELECTION of its weight; the diffuse lobe is drawn about its own normal
+wo, averaged over the colour channels as Cycles weighs a closure's sample (its
+sample_weight, the average of its weight times its albedo), at least MIN_SELECTION of
+its weight; the diffuse lobe is drawn about its own normal
 (the frame's, or a bent frame's raw one: setup_about), as is the sheen; the mixture pdf is
 sum_i q_i pdf_i over the allowed lobes (the delta part of a smooth glass has no density:
 pdf = inf, delta True).
@@ -208,14 +210,14 @@ def setup_about(row, front_facing, wox, woy, woz, tables, state, dnx, dny, dnz):
     below = 1.0 - min(e_spec, 1.0)
     for c in range(3):
         state[S_DIFFUSE + c] = state[S_DIFFUSE + c] * below
-        est_diff = max(est_diff, state[S_DIFFUSE + c])
+        est_diff += state[S_DIFFUSE + c] / 3.0
     subsurface_lobe.scale(state, below, below, below)
     subsurface_lobe.estimate(state, MIN_SELECTION * base_w * subsurface_lobe.weight(row))
     est_metal = 0.0
     if m > 0.0:
         F = 0.0
         for c in range(3):
-            F = max(F, metal_fresnel(state, c, cos_o) * state[S_MS_METAL + c])
+            F += metal_fresnel(state, c, cos_o) * state[S_MS_METAL + c] / 3.0
         est_metal = m * F
     est_gr = 0.0
     est_gt = 0.0
@@ -223,10 +225,10 @@ def setup_about(row, front_facing, wox, woy, woz, tables, state, dnx, dny, dnz):
         F = fresnel.dielectric(woz, eta_glass)
         if state[S_REFRACT_ONLY] != 0.0:          # no reflection, refraction unless TIR
             F = 1.0 if F >= 1.0 else 0.0
-        tint_max = max(state[S_TINT], max(state[S_TINT + 1], state[S_TINT + 2]))
-        c_max = max(state[S_MS_GLASS], max(state[S_MS_GLASS + 1], state[S_MS_GLASS + 2]))
-        est_gr = w_glass * F * c_max if state[S_REFRACT_ONLY] == 0.0 else 0.0
-        est_gt = w_glass * (1.0 - F) * tint_max * c_max
+        tint = (state[S_TINT] + state[S_TINT + 1] + state[S_TINT + 2]) / 3.0
+        c_ms = (state[S_MS_GLASS] + state[S_MS_GLASS + 1] + state[S_MS_GLASS + 2]) / 3.0
+        est_gr = w_glass * F * c_ms if state[S_REFRACT_ONLY] == 0.0 else 0.0
+        est_gt = w_glass * (1.0 - F) * tint * c_ms
     # floors so that every present lobe can be sampled
     state[S_EST] = max(est_diff, MIN_SELECTION * w_diff) if w_diff > 0.0 else 0.0
     state[S_EST + 1] = max(est_spec, MIN_SELECTION * w_spec) if w_spec > 0.0 else 0.0
@@ -235,14 +237,14 @@ def setup_about(row, front_facing, wox, woy, woz, tables, state, dnx, dny, dnz):
     state[S_EST + 3] = max(est_gr, half_floor) if w_glass > 0.0 else 0.0
     state[S_EST + 4] = max(est_gt, half_floor) if w_glass > 0.0 else 0.0
     if layered:                  # the layers above dim (and tint) every base lobe
-        smax = layers.base_scale_max(state)
+        s_mean = layers.base_scale_mean(state)
         for c in range(3):
             state[S_DIFFUSE + c] = state[S_DIFFUSE + c] * state[layers.S_BASE_SCALE + c]
         for k in range(5):
-            state[S_EST + k] = state[S_EST + k] * smax
+            state[S_EST + k] = state[S_EST + k] * s_mean
         s = layers.S_BASE_SCALE
         subsurface_lobe.scale(state, state[s], state[s + 1], state[s + 2])
-        state[S_EST_SSS] = state[S_EST_SSS] * smax
+        state[S_EST_SSS] = state[S_EST_SSS] * s_mean
 
 
 @kernel(allocates=False)

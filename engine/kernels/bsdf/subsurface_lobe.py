@@ -58,9 +58,9 @@ def scale(state, factor_r, factor_g, factor_b):
 
 @kernel(allocates=False)
 def estimate(state, floor):
-    """Set the lobe's selection estimate: its largest channel, at least `floor` when it
-    is present."""
-    e = max(state[S_SSS], max(state[S_SSS + 1], state[S_SSS + 2]))
+    """Set the lobe's selection estimate: its channels' average, at least `floor` when
+    it is present."""
+    e = (state[S_SSS] + state[S_SSS + 1] + state[S_SSS + 2]) / 3.0
     state[S_EST_SSS] = max(e, floor) if e > 0.0 else 0.0
 
 
