@@ -109,9 +109,11 @@ def _as_diffuse(bpy):
 def test_hair_bsdf_on_strands_and_meshes_matches_cycles(bpy_drt):
     bpy = bpy_drt
     scene = _scene(bpy)
-    use_engine(scene, "CYCLES", 512)
+    # 1024 and 512 samples: at 256 DRT's worst block alone is 1.1 % to 4.0 % off a
+    # 4096-sample Cycles image over six seeds, too close to the 5 % asked of the pair
+    use_engine(scene, "CYCLES", 1024)
     cycles = render_current(bpy, scene)
-    use_engine(scene, "DRT", 256)
+    use_engine(scene, "DRT", 512)
     drt = render_current(bpy, scene)
     from drt_addon import render_engine
     assert not any("Hair BSDF" in w for w in render_engine.last_render["warnings"]), \

@@ -36,6 +36,7 @@ from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
 from .bsdf import principled as bsdf
+from .bsdf.joint_sample import sample_joint
 from .bsdf.state import S_ANY_SIDE, S_DIFFUSE_LABEL, S_WALTER
 from . import hair_tangent
 from .bsdf import anisotropic
@@ -319,7 +320,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
             state[S_WALTER] = 0.0
         # 3. continue by BSDF sampling
         u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.BSDF_DIR)
-        ix, iy, iz, wr, wg, wb, spdf, skind, sdelta, valid = bsdf.sample(
+        ix, iy, iz, wr, wg, wb, spdf, skind, sdelta, valid = sample_joint(
             state, wox, woy, woz, u_lobe, u1, u2, ad, ag, at)
         if not valid:
             continue

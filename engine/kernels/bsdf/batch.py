@@ -14,6 +14,7 @@ import numpy as np
 from ..jit import kernel
 from . import params as R
 from . import principled as P
+from .joint_sample import sample_joint
 from .state import S_WALTER
 
 
@@ -60,8 +61,10 @@ def pdf_batch(rows, front, wo, wi, allowed, tables, walter=False, diffuse_n=(0.0
 
 @kernel
 def sample_batch(rows, front, wo, u_lobe, u_dir, allowed, tables, walter=False,
-                 diffuse_n=(0.0, 0.0, 1.0)):
-    """(wi (n, 3), weight (n, 3), pdf (n,), kind (n,), delta (n,), valid (n,))."""
+                 diffuse_n=(0.0, 0.0, 1.0), joint=False):
+    """(wi (n, 3), weight (n, 3), pdf (n,), kind (n,), delta (n,), valid (n,)); `joint`:
+    the path tracer's joint_sample.sample_joint (the lobe from u_dir's first number,
+    u_lobe the rest), else principled.sample."""
     n = wo.shape[0]
     wi = np.zeros((n, 3))
     weight = np.zeros((n, 3))
@@ -75,8 +78,12 @@ def sample_batch(rows, front, wo, u_lobe, u_dir, allowed, tables, walter=False,
                       diffuse_n[0], diffuse_n[1], diffuse_n[2])
         if walter:
             state[S_WALTER] = 1.0
-        s = P.sample(state, wo[k, 0], wo[k, 1], wo[k, 2], u_lobe[k], u_dir[k, 0],
-                     u_dir[k, 1], allowed[k, 0], allowed[k, 1], allowed[k, 2])
+        if joint:
+            s = sample_joint(state, wo[k, 0], wo[k, 1], wo[k, 2], u_lobe[k], u_dir[k, 0],
+                             u_dir[k, 1], allowed[k, 0], allowed[k, 1], allowed[k, 2])
+        else:
+            s = P.sample(state, wo[k, 0], wo[k, 1], wo[k, 2], u_lobe[k], u_dir[k, 0],
+                         u_dir[k, 1], allowed[k, 0], allowed[k, 1], allowed[k, 2])
         wi[k, 0], wi[k, 1], wi[k, 2] = s[0], s[1], s[2]
         weight[k, 0], weight[k, 1], weight[k, 2] = s[3], s[4], s[5]
         pdf[k] = s[6]
