@@ -884,3 +884,21 @@ def test_anisotropic_bsdfs_export_their_mapping_tangent_and_rotation(bpy_drt):
                          ("ShaderNodeBsdfMetallic", {"Anisotropy": 1e-5})):
         m, w = _export(_single(bpy, kind, **inputs)[0])
         assert m.anisotropy_kind == "NONE" and m.shader is None and w == [], kind
+
+
+def test_a_principled_thin_film_exports_its_thickness_and_ior(bpy_drt):
+    """Thin Film Thickness and IOR reach the material (engine/kernels/bsdf/thin_film.py);
+    one at Cycles' cut-off (0.1 nm) is none; on a glass DRT says its transmission is
+    rendered without the film."""
+    bpy = bpy_drt
+    m, w = _export(_single(bpy, "ShaderNodeBsdfPrincipled", Metallic=1.0,
+                           **{"Thin Film Thickness": 420.0, "Thin Film IOR": 1.6})[0])
+    assert w == [] and m.thin_film_thickness == pytest.approx(420.0)
+    assert m.thin_film_ior == pytest.approx(1.6)
+    m, w = _export(_single(bpy, "ShaderNodeBsdfPrincipled",
+                           **{"Thin Film Thickness": 0.1})[0])
+    assert w == [] and m.thin_film_thickness == 0.0
+    m, w = _export(_single(bpy, "ShaderNodeBsdfPrincipled", **{"Transmission Weight": 1.0,
+                                                             "Thin Film Thickness": 300.0})[0])
+    assert m.thin_film_thickness == pytest.approx(300.0)
+    assert len(w) == 1 and "thin film" in w[0] and "transmission" in w[0], w

@@ -38,6 +38,8 @@ class _Comp:
     diffuse_roughness: float = 0.0  # Oren-Nayar sigma of the diffuse lobe (0: Lambert)
     anisotropy: object = None       # nodes/anisotropy.Anisotropy of the metal and specular
     #                                 lobes (None: isotropic)
+    thin_film: object = None        # (thickness nm, IOR) of a Thin Film on the specular
+    #                                 and metal lobes (None: none)
 
     def glossy_weight(self):
         """Mean weight of the lobes the distribution shapes (metal, glass, specular)."""
@@ -148,6 +150,8 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
     _set(m, "metallic", p["metallic"])
     _set(m, "roughness", p["roughness"])
     m.diffuse_roughness = p["diffuse_roughness"]
+    if p["thin_film"] is not None:
+        m.thin_film_thickness, m.thin_film_ior = p["thin_film"]
     _set(m, "emission", emission)
     m.ior = float(p["ior"])
     m.transmission = float(p["transmission"])
@@ -243,7 +247,7 @@ def _blend(comps, ctx) -> dict:
                     distribution=c.distribution, layers=c.layers, refraction_only=c.refraction_only,
                     metal_fresnel=c.metal_fresnel, specular_tint=c.specular_tint,
                     subsurface=c.subsurface, diffuse_roughness=c.diffuse_roughness,
-                    anisotropy=c.anisotropy)
+                    anisotropy=c.anisotropy, thin_film=c.thin_film)
     lw = [(c, comp, *comp.weights()) for c, comp in comps]
     Wm = sum(c * m for c, _, m, _, _ in lw)
     Wg = sum(c * g for c, _, _, g, _ in lw)
@@ -321,7 +325,19 @@ def _blend(comps, ctx) -> dict:
                 metal_fresnel=metal_fresnel, specular_tint=specular_tint,
                 subsurface=_blend_subsurface(lw, Wb, ctx),
                 diffuse_roughness=_diffuse_roughness(lw, Wb, ctx),
-                anisotropy=anisotropy.blend(comps, ctx))
+                anisotropy=anisotropy.blend(comps, ctx), thin_film=_thin_film(lw, ctx))
+
+
+def _thin_film(lw, ctx):
+    """The Thin Film of the mixed closures' specular and metal lobes: that of the closure
+    with the most of their weight (reported if they differ)."""
+    terms = [(c * (m + (b if comp.spec > 0 else 0.0)), comp.thin_film)
+             for c, comp, m, _, b in lw]
+    films = {f for w, f in terms if w > 0}
+    if len(films) > 1:
+        ctx.issue("mixed shaders have different thin films; DRT gives all the film of the "
+                  "one that reflects most")
+    return max(terms, key=lambda x: x[0])[1] if terms else None
 
 
 def _diffuse_roughness(lw, Wb, ctx) -> float:

@@ -103,6 +103,13 @@ class MaterialTable:
         for name in ("anisotropy", "anisotropic_rotation"):
             setattr(self, name, np.nan_to_num(np.array(
                 [float(getattr(m, name, 0.0)) for m in materials], np.float64)))
+        # Thin Film (engine/kernels/bsdf/thin_film.py): thickness in nm, IOR
+        self.thin_film_thickness = np.nan_to_num(np.maximum(np.array(
+            [float(getattr(m, "thin_film_thickness", 0.0)) for m in materials], np.float64),
+            0.0))
+        self.thin_film_ior = np.nan_to_num(np.maximum(np.array(
+            [float(getattr(m, "thin_film_ior", 1.33)) for m in materials], np.float64),
+            1e-5), nan=1.33)
         self.transparent_color = np.array(
             [tuple(getattr(m, "transparent_color", (1.0, 1.0, 1.0)))[:3] for m in materials],
             np.float64).reshape(-1, 3)

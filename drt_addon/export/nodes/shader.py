@@ -31,12 +31,9 @@ def _principled(node, ctx) -> _Closure:
     comp.subsurface = subsurface.principled(node, ctx, _constant, comp.ior)
     if node_input(node, "Diffuse Roughness") is not None:      # Blender 4.3 and later
         comp.diffuse_roughness = float(const("Diffuse Roughness", 0.0))
-    ignored = []
     comp.anisotropy = anisotropy.read(node, ctx, "Anisotropic", "Anisotropic Rotation",
                                       "PRINCIPLED")
-    s = node_input(node, "Thin Film Thickness")
-    if s is not None and (s.is_linked or float(s.default_value) > 0.0):
-        ignored.append("thin film")
+    comp.thin_film = _thin_film(node, ctx, comp)
     s = node_input(node, "Specular Tint")
     if s is not None and (s.is_linked or _tinted(s.default_value)):
         # the metal lobe's F82 tint, the specular layer's and the glass's F0 tint
@@ -46,9 +43,6 @@ def _principled(node, ctx) -> _Closure:
             tint = WHITE
         comp.specular_tint = tuple(float(x) for x in tuple(tint)[:3])
     _normal(node, ctx)
-    if ignored:
-        ctx.issue(f"{node.name!r} uses {', '.join(ignored)}, which DRT does not render "
-                  f"(left out)")
     color = val("Emission Color", (1.0, 1.0, 1.0), True)
     strength = const("Emission Strength", 0.0)
     emission = _scale(color, strength)
@@ -58,6 +52,21 @@ def _principled(node, ctx) -> _Closure:
     a = float(np.clip(alpha, 0.0, 1.0))
     # Cycles: BSDF weight a, transparent 1 - a, emission times a
     return _Closure([(a, comp)], 1.0 - a, (1.0 - a,) * 3, _scale(emission, a))
+
+
+def _thin_film(node, ctx, comp):
+    """(thickness nm, IOR) of the Principled BSDF's Thin Film (Blender 4.2 and later), or
+    None. Cycles lays it on the specular layer, the metal and the glass; DRT on the first
+    two (engine/kernels/bsdf/thin_film.py), and says so for a glass."""
+    if node_input(node, "Thin Film Thickness") is None:
+        return None
+    thickness = float(_constant(node, "Thin Film Thickness", ctx, 0.0))
+    if not thickness > 0.10000000149011612:   # Cycles' THINFILM_THICKNESS_CUTOFF, float32
+        return None
+    if comp.transmission > 0.0:
+        ctx.issue(f"{node.name!r}: its thin film is rendered on its reflection and metal, "
+                  f"not on its transmission (glass) lobe")
+    return thickness, max(float(_constant(node, "Thin Film IOR", ctx, 1.33)), 1e-5)
 
 
 def _tinted(tint) -> bool:

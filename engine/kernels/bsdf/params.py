@@ -93,7 +93,9 @@ P_TANGENT = 98           # per hit, 3 columns: the tangent (the node's Tangent i
 P_COAT_N = 101           # per hit, 3 columns: the coat's normal in the shading frame (the
 #                          surface's own, or its Coat Normal, where a program bends the
 #                          frame: Cycles' coat keeps it); 0: the frame's
-NPARAM = 104
+P_THIN_FILM = 104        # Thin Film Thickness (nm; at most thin_film.CUTOFF: none)
+P_THIN_FILM_IOR = 105    # Thin Film IOR
+NPARAM = 106
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -168,4 +170,6 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_ANISO_KIND] = table.anisotropy_kind
     rows[:, P_ANISO] = table.anisotropy
     rows[:, P_ANISO_ROT] = table.anisotropic_rotation
+    rows[:, P_THIN_FILM] = table.thin_film_thickness
+    rows[:, P_THIN_FILM_IOR] = table.thin_film_ior
     return rows

@@ -65,6 +65,7 @@ import math
 
 from ..jit import kernel
 from . import anisotropic, dielectric, fresnel, layers, oren_nayar, specular_tint, subsurface_lobe
+from . import thin_film
 from . import microfacet as mf
 from . import multiscatter as ms
 from .albedo import specular_albedo
@@ -77,14 +78,14 @@ from .state import (NSTATE, S_ALPHA, S_ANY_SIDE, S_BECKMANN, S_BLINN, S_DIFFUSE,
                     S_METAL_F82,
                     S_MS_E, S_MS_GLASS, S_MS_METAL, S_MS_SPEC, S_REFRACT_ONLY,
                     S_SPEC_TINTED, S_EST_SSS, S_E_SPEC, S_SSS, S_TINT, S_W_GLASS, S_W_METAL,
-                    S_W_SPEC, S_WALTER)
+                    S_W_SPEC, S_WALTER, S_THIN_FILM, S_FILM_IOR)
 from .params import (GLOSSY_BECKMANN, GLOSSY_BLINN_PHONG, GLOSSY_GGX,  # noqa: F401
                      GLOSSY_MULTI_GGX, NPARAM, P_BASE, P_GLASS_COLOR, P_GLASS_REFLECT,
                      P_GLOSSY_MODEL,
                      P_HAS_GLASS_COLOR, P_FILTER_ALPHA, P_HAS_METAL_COLOR, P_IOR,
                      P_LAYERS, P_METAL_COLOR, P_METAL_CONSTANT, P_METALLIC,
-                     P_REFRACT_ONLY, P_ROUGHNESS, P_SPEC_LEVEL, P_TRANSMISSION,
-                     pack_materials)
+                     P_REFRACT_ONLY, P_ROUGHNESS, P_SPEC_LEVEL, P_THIN_FILM, P_THIN_FILM_IOR,
+                     P_TRANSMISSION, pack_materials)
 from .tables import kernel_tables  # noqa: F401  (re-exported)
 from .principled_eval import (base_diffuse, base_glossy, eval_f,  # noqa: F401  (re-exported)
                               eval_seen, sheen_seen, translucent_seen)
@@ -136,6 +137,10 @@ def setup_about(row, front_facing, wox, woy, woz, tables, state, dnx, dny, dnz):
     state[S_BECKMANN] = 1.0 if row[P_GLOSSY_MODEL] == GLOSSY_BECKMANN else 0.0
     state[S_METAL_CONST] = row[P_METAL_CONSTANT]
     state[S_METAL_F82] = 0.0
+    # a Thin Film on the specular layer and the metal (thin_film.py; not the glass)
+    film = row[P_THIN_FILM] > thin_film.CUTOFF
+    state[S_THIN_FILM] = row[P_THIN_FILM] if film else 0.0
+    state[S_FILM_IOR] = max(row[P_THIN_FILM_IOR], 1e-5)
     state[S_EXPONENT] = max(2.0 / (lobe_alpha * lobe_alpha) - 2.0, 0.0)
     # the metal and specular lobes' own alpha (anisotropic: the isotropic one the
     # compensation and the layering take); Blinn-Phong stays isotropic
@@ -198,7 +203,7 @@ def setup_about(row, front_facing, wox, woy, woz, tables, state, dnx, dny, dnz):
         # the layer's albedo as the diffuse sees it
         e_spec = specular_albedo(cos_o, alpha_r, eta_spec, tables)
         if state[S_BLINN] == 0.0:
-            if specular_tint.is_tinted(row):
+            if film or specular_tint.is_tinted(row):
                 e_spec = specular_tint.setup(row, row[P_GLOSSY_MODEL] == GLOSSY_MULTI_GGX,
                                              cos_o, alpha_r, eta_spec, e_spec, tables, state)
             else:

@@ -1,17 +1,17 @@
 """The reflection shared by the Principled specular and metal lobes, from the per-hit
 state: the microfacet lobe (GGX or Beckmann, microfacet.py and beckmann.py, or the
 lecture's Blinn-Phong) and the metal lobe's Fresnel factor: Schlick's from F0
-(Principled), Cycles' F82-tint where a Specular Tint is set (fresnel.py), or F0 itself at
-every angle (a Glossy BSDF). principled.py calls these; the state's slots: state.py."""
+(Principled), Cycles' F82-tint where a Specular Tint is set (fresnel.py), under a Thin
+Film (thin_film.py), or F0 itself at every angle (a Glossy BSDF). principled.py calls these; the state's slots: state.py."""
 from __future__ import annotations
 
 from ..jit import kernel
-from . import anisotropic, blinn_phong, fresnel
+from . import anisotropic, blinn_phong, fresnel, thin_film
 from . import distribution as dist
 from . import microfacet as mf
 from .params import P_SPEC_TINT
-from .state import (S_ALPHA, S_ANISO, S_BECKMANN, S_BLINN, S_EXPONENT, S_METAL_B, S_METAL_CONST,
-                    S_METAL_F0, S_METAL_F82)
+from .state import (S_ALPHA, S_ANISO, S_BECKMANN, S_BLINN, S_EXPONENT, S_FILM_IOR, S_METAL_B,
+                    S_METAL_CONST, S_METAL_F0, S_METAL_F82, S_THIN_FILM)
 
 
 @kernel(allocates=False)
@@ -21,6 +21,10 @@ def metal_fresnel(state, c, cos_oh):
     BSDF: Cycles gives it no Fresnel term, its colour is the closure's weight)."""
     if state[S_METAL_CONST] != 0.0:
         return state[S_METAL_F0 + c]
+    if state[S_THIN_FILM] > 0.0:           # a Thin Film over the F82-tint metal
+        b = state[S_METAL_B + c] if state[S_METAL_F82] != 0.0 else 0.0
+        return thin_film.metal(c, cos_oh, state[S_THIN_FILM], state[S_FILM_IOR],
+                               state[S_METAL_F0 + c], b)
     if state[S_METAL_F82] != 0.0:
         return fresnel.f82_tint(state[S_METAL_F0 + c], state[S_METAL_B + c], cos_oh)
     return fresnel.schlick(state[S_METAL_F0 + c], cos_oh)

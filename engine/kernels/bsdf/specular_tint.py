@@ -15,6 +15,11 @@ below is dimmed by the largest channel's albedo, as Cycles' closure_layering_wei
 does. A white tint never reaches this module (principled.setup), so untinted materials
 pay nothing (principle 3). The metal lobe's tint is F82-tint (fresnel.py).
 
+A Thin Film takes this module's per-channel path too (principled.setup): F_c is then the
+film's reflectance (thin_film.specular_layer, with the tint's F0 scaling), and the
+albedo the layer below sees is F_c at wo times the multiscatter factor, Cycles' estimate
+for a film (no table, no floor).
+
 The glass lobe (Principled's transmission) takes the same F_c, from F0 = F(1) of its
 IOR: its reflection carries F_c where the untinted lobe carries F, its refraction
 1 - F_c where it carries 1 - F (Cycles: reflectance F_c, transmittance (1 - F_c) times
@@ -28,8 +33,10 @@ from __future__ import annotations
 from ..jit import kernel
 from . import fresnel
 from . import multiscatter as ms
+from . import thin_film
 from .params import P_SPEC_TINT
-from .state import S_GLASS_F0, S_GLASS_TINTED, S_MS_E, S_SPEC_F0, S_SPEC_MS, S_SPEC_TINTED
+from .state import (S_FILM_IOR, S_GLASS_F0, S_GLASS_TINTED, S_MS_E, S_SPEC_F0, S_SPEC_MS,
+                    S_SPEC_TINTED, S_THIN_FILM)
 
 
 @kernel
@@ -68,6 +75,11 @@ def setup(row, multiscatter, cos_o, alpha, eta_spec, exact, tables, state):
         if multiscatter:
             factor = ms.compensation(state[S_MS_E], E_avg, f0 + (1.0 - f0) * s_ss)
         state[S_SPEC_MS + c] = factor
+        if state[S_THIN_FILM] > 0.0:
+            film = thin_film.specular_layer(c, cos_o, state[S_THIN_FILM], state[S_FILM_IOR],
+                                            eta_spec, f0)
+            albedo = max(albedo, film * factor)
+            continue
         b = (1.0 - f0) / den
         floor = (f0 - b * f0_real) * e_white + b * exact
         cycles = (f0 + (1.0 - f0) * s_est) * state[S_MS_E]
@@ -78,8 +90,11 @@ def setup(row, multiscatter, cos_o, alpha, eta_spec, exact, tables, state):
 @kernel(allocates=False)
 def reflectance(state, c, cos_oh, eta_spec):
     """F_c of the tinted layer times its multiscatter factor, at cos(wo, h) = cos_oh."""
-    s = remap(fresnel.dielectric(cos_oh, eta_spec), fresnel.f0_from_ior(eta_spec))
     f0 = state[S_SPEC_F0 + c]
+    if state[S_THIN_FILM] > 0.0:
+        return thin_film.specular_layer(c, cos_oh, state[S_THIN_FILM], state[S_FILM_IOR],
+                                        eta_spec, f0) * state[S_SPEC_MS + c]
+    s = remap(fresnel.dielectric(cos_oh, eta_spec), fresnel.f0_from_ior(eta_spec))
     return (f0 + (1.0 - f0) * s) * state[S_SPEC_MS + c]
 
 

@@ -49,4 +49,6 @@ S_ALPHA_X = layers.NSTATE + 37     # ... their alpha along the tangent, Filter G
 S_ALPHA_Y = layers.NSTATE + 38     # ... across it
 S_TAN_C = layers.NSTATE + 39       # cos and sin of the tangent's angle in the local frame
 S_TAN_S = layers.NSTATE + 40
-NSTATE = layers.NSTATE + 41
+S_THIN_FILM = layers.NSTATE + 41  # the thin film's thickness (nm; 0: none, thin_film.py)
+S_FILM_IOR = layers.NSTATE + 42    # ... its IOR
+NSTATE = layers.NSTATE + 43
