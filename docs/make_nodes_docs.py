@@ -136,8 +136,8 @@ def supported_nodes(bpy):
 # each is compared with Cycles in tests/test_closures_vs_cycles.py and the *_vs_cycles
 # tests of its feature
 SHADERS_ROW = ("| Shader | Principled BSDF (its Diffuse Roughness: Oren-Nayar; Anisotropic "
-               "along its Tangent, tests/test_anisotropic_vs_cycles.py; Thin Film on its "
-               "specular layer and metal, tests/test_thin_film_vs_cycles.py), Diffuse "
+               "along its Tangent, tests/test_anisotropic_vs_cycles.py; Thin Film, "
+               "tests/test_thin_film_vs_cycles.py), Diffuse "
                "BSDF (Roughness: Oren-Nayar), Glossy BSDF (Anisotropy), Glass BSDF, "
                "Refraction BSDF (GGX, Multiscatter GGX, Beckmann), Metallic BSDF (F82 Tint, "
                "Anisotropy; a "

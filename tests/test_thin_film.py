@@ -110,3 +110,34 @@ def test_a_material_without_a_film_takes_the_plain_path():
     s = bsdf.states((0.3, 0.0, 0.95))
     assert s[0, S_THIN_FILM] == 0.0 and s[0, S_SPEC_TINTED] == 0.0
     assert s[1, S_THIN_FILM] == 300.0 and s[1, S_SPEC_TINTED] == 1.0
+
+
+@pytest.mark.parametrize("front", [True, False], ids=["outside", "inside"])
+def test_a_frosted_glass_under_a_film_samples_its_pdf(front):
+    """The glass chooses reflection or refraction by the film's reflectance
+    (thin_film.glass_choice), in its sampling and in its pdf alike: chi-square, from
+    outside and from inside (where part of the directions are totally reflected)."""
+    from chi2 import chi2_test
+    from engine.kernels import bsdf as kb
+    from engine.kernels.bsdf import batch
+    from test_layered_bsdf import rows_of, sampler_pairs, wo_at
+    params = dict(base_color=(1.0, 1.0, 1.0), transmission=1.0, roughness=0.3,
+                  thin_film_thickness=500.0, thin_film_ior=1.33, glossy_model="MULTI_GGX")
+    deg = 40.0 if front else 30.0
+
+    def sample(u):
+        n = len(u)
+        s = batch.sample_batch(rows_of(params, n), np.full(n, front), wo_at(deg, n),
+                               u[:, 0], np.ascontiguousarray(u[:, 1:]),
+                               np.ones((n, 3), bool), kb.kernel_tables())
+        return s[0], s[5]
+
+    def pdf(w):
+        n = len(w)
+        return batch.pdf_batch(rows_of(params, n), np.full(n, front), wo_at(deg, n),
+                               np.ascontiguousarray(w), np.ones((n, 3), bool),
+                               kb.kernel_tables()) * sampler_pairs(params, wo_at(deg, n), w,
+                                                                   front)
+    res = chi2_test(sample, pdf, 200_000, seed=11 + int(front), n_tests=2)
+    print(res)
+    assert res.passed, str(res)

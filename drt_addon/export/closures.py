@@ -38,8 +38,8 @@ class _Comp:
     diffuse_roughness: float = 0.0  # Oren-Nayar sigma of the diffuse lobe (0: Lambert)
     anisotropy: object = None       # nodes/anisotropy.Anisotropy of the metal and specular
     #                                 lobes (None: isotropic)
-    thin_film: object = None        # (thickness nm, IOR) of a Thin Film on the specular
-    #                                 and metal lobes (None: none)
+    thin_film: object = None        # (thickness nm, IOR) of a Thin Film on the specular,
+    #                                 metal and glass lobes (None: none)
 
     def glossy_weight(self):
         """Mean weight of the lobes the distribution shapes (metal, glass, specular)."""
@@ -329,10 +329,10 @@ def _blend(comps, ctx) -> dict:
 
 
 def _thin_film(lw, ctx):
-    """The Thin Film of the mixed closures' specular and metal lobes: that of the closure
-    with the most of their weight (reported if they differ)."""
-    terms = [(c * (m + (b if comp.spec > 0 else 0.0)), comp.thin_film)
-             for c, comp, m, _, b in lw]
+    """The Thin Film of the mixed closures' specular, metal and glass lobes: that of the
+    closure with the most of their weight (reported if they differ)."""
+    terms = [(c * (m + g + (b if comp.spec > 0 else 0.0)), comp.thin_film)
+             for c, comp, m, g, b in lw]
     films = {f for w, f in terms if w > 0}
     if len(films) > 1:
         ctx.issue("mixed shaders have different thin films; DRT gives all the film of the "

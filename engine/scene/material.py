@@ -134,8 +134,8 @@ class Material:
     anisotropy_kind: str = "NONE"
     anisotropy: float = 0.0
     anisotropic_rotation: float = 0.0    # in turns, about the normal
-    # Principled's Thin Film (engine/kernels/bsdf/thin_film.py) on the specular layer and
-    # the metal lobe: thickness in nm (0: none) and the film's IOR
+    # Principled's Thin Film (engine/kernels/bsdf/thin_film.py) on the specular layer, the
+    # metal and the glass: thickness in nm (0: none) and the film's IOR
     thin_film_thickness: float = 0.0
     thin_film_ior: float = 1.33
     subsurface_alpha: Optional[float] = None

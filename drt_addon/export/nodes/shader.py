@@ -33,7 +33,7 @@ def _principled(node, ctx) -> _Closure:
         comp.diffuse_roughness = float(const("Diffuse Roughness", 0.0))
     comp.anisotropy = anisotropy.read(node, ctx, "Anisotropic", "Anisotropic Rotation",
                                       "PRINCIPLED")
-    comp.thin_film = _thin_film(node, ctx, comp)
+    comp.thin_film = _thin_film(node, ctx)
     s = node_input(node, "Specular Tint")
     if s is not None and (s.is_linked or _tinted(s.default_value)):
         # the metal lobe's F82 tint, the specular layer's and the glass's F0 tint
@@ -54,18 +54,15 @@ def _principled(node, ctx) -> _Closure:
     return _Closure([(a, comp)], 1.0 - a, (1.0 - a,) * 3, _scale(emission, a))
 
 
-def _thin_film(node, ctx, comp):
+def _thin_film(node, ctx):
     """(thickness nm, IOR) of the Principled BSDF's Thin Film (Blender 4.2 and later), or
-    None. Cycles lays it on the specular layer, the metal and the glass; DRT on the first
-    two (engine/kernels/bsdf/thin_film.py), and says so for a glass."""
+    None: on the specular layer, the metal and the glass, as Cycles lays it
+    (engine/kernels/bsdf/thin_film.py)."""
     if node_input(node, "Thin Film Thickness") is None:
         return None
     thickness = float(_constant(node, "Thin Film Thickness", ctx, 0.0))
     if not thickness > 0.10000000149011612:   # Cycles' THINFILM_THICKNESS_CUTOFF, float32
         return None
-    if comp.transmission > 0.0:
-        ctx.issue(f"{node.name!r}: its thin film is rendered on its reflection and metal, "
-                  f"not on its transmission (glass) lobe")
     return thickness, max(float(_constant(node, "Thin Film IOR", ctx, 1.33)), 1e-5)
 
 

@@ -54,6 +54,7 @@ from . import beckmann as bk
 from . import fresnel
 from . import distribution as dist
 from . import microfacet as mf
+from .thin_film import glass_choice
 
 # Below this GGX alpha a rough interface is treated as smooth; |eta - 1| below
 # INDEX_MATCHED is no interface at all.
@@ -75,6 +76,23 @@ def canonical(oz, eta):
     return 1.0, eta
 
 
+@kernel(allocates=False)
+def pair_cosine(ox, oy, oz, ix, iy, iz, eta):
+    """(cos of wo to the half vector of the pair (wo, wi), eta_rel): the arguments of
+    the pair's Fresnel reflectance; the half vector wo + wi of a reflection, -(eta_rel
+    wi + wo) of a refraction, on wo's side."""
+    sign, eta_rel = canonical(oz, eta)
+    oz, iz = oz * sign, iz * sign
+    if iz > 0.0:
+        hx, hy, hz = ox + ix, oy + iy, oz + iz
+    else:
+        hx, hy, hz = -(eta_rel * ix + ox), -(eta_rel * iy + oy), -(eta_rel * iz + oz)
+    n = math.sqrt(hx * hx + hy * hy + hz * hz)
+    if not n > 0.0:
+        return 1.0, eta_rel
+    return min(abs(ox * hx + oy * hy + oz * hz) / n, 1.0), eta_rel
+
+
 @kernel
 def choice_probs(F, allow_reflect, allow_refract):
     """Probabilities of choosing reflection and refraction."""
@@ -86,13 +104,16 @@ def choice_probs(F, allow_reflect, allow_refract):
 # --- smooth interface ------------------------------------------------------------------
 
 @kernel
-def smooth_sample(ox, oy, oz, eta, u, allow_reflect, allow_refract):
+def smooth_sample(ox, oy, oz, eta, u, allow_reflect, allow_refract, film):
     """Delta reflection or refraction chosen by Fresnel (or forced by the allow flags):
     (wi_x, wi_y, wi_z, weight, refracted, valid, F); its pdf is a delta, F is the
-    Fresnel reflectance the weight holds (F or 1 - F)."""
+    Fresnel reflectance the weight holds (F or 1 - F): under a film (thin_film.
+    glass_choice; NO_FILM for none) the film's, averaged over the channels."""
     sign, eta_rel = canonical(oz, eta)
     cz = oz * sign
     F, cos_t, eta_t = fresnel.dielectric_full(cz, eta_rel)
+    if F < 1.0:
+        F = glass_choice(film, cz, eta_rel, F)
     pr, pt = choice_probs(F, allow_reflect, allow_refract)
     refr = u >= pr
     if refr:
@@ -204,9 +225,9 @@ def rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta, alpha, refract_only, walter, b
 
 @kernel
 def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, walter,
-              beckmann):
-    """pdf over wi (1/sr) of `rough_sample` with the same allow flags, also on Cycles'
-    pairs unless `walter` (see rough_eval_lobes)."""
+              beckmann, film):
+    """pdf over wi (1/sr) of `rough_sample` with the same allow flags and film, also on
+    Cycles' pairs unless `walter` (see rough_eval_lobes)."""
     a = mf.clamp_alpha(alpha)
     sign, eta_rel = canonical(oz, eta)
     oz = oz * sign
@@ -217,7 +238,10 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, 
         hx, hy, hz, ok = mf.half_vector(ox, oy, oz, ix, iy, iz)
         if not (ok and oz > 0.0):
             return 0.0
-        F_r = fresnel.dielectric(max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0), eta_rel)
+        cos_oh = max(mf.dot(ox, oy, oz, hx, hy, hz), 0.0)
+        F_r = fresnel.dielectric(cos_oh, eta_rel)
+        if F_r < 1.0:
+            F_r = glass_choice(film, cos_oh, eta_rel, F_r)
         pr, _ = choice_probs(F_r, allow_reflect, allow_refract)
         return pr * 0.25 * g1c * dist.D_of(hx, hy, hz, a, beckmann)
     # refraction: P(refract | h) D_wo(h) |dh/dwi|
@@ -226,6 +250,8 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, 
     if not usable:
         return 0.0
     F_t = fresnel.dielectric(cos_oh, eta_rel)
+    if F_t < 1.0:
+        F_t = glass_choice(film, cos_oh, eta_rel, F_t)
     _, pt = choice_probs(F_t, allow_reflect, allow_refract)
     den = s * s
     if not den > 0.0:
@@ -236,17 +262,20 @@ def rough_pdf(ox, oy, oz, ix, iy, iz, eta, alpha, allow_reflect, allow_refract, 
 
 @kernel
 def rough_sample(ox, oy, oz, eta, alpha, u_choice, u0, u1, allow_reflect, allow_refract,
-                 beckmann):
-    """Sample the rough interface: u_choice picks reflection or refraction, (u0, u1) the
-    visible normal. Returns (wi_x, wi_y, wi_z, refracted, valid); the weight and pdf of
-    the choice are left to the caller (the Principled mixture recomputes both)."""
+                 beckmann, film):
+    """Sample the rough interface: u_choice picks reflection or refraction (by the
+    Fresnel reflectance at the visible normal, a film's if `film` is not NO_FILM:
+    thin_film.glass_choice), (u0, u1) the visible normal. Returns (wi_x, wi_y, wi_z,
+    refracted, valid); the weight and pdf of the choice are left to the caller (the
+    Principled mixture recomputes both)."""
     a = mf.clamp_alpha(alpha)
     sign, eta_rel = canonical(oz, eta)
     oz = oz * sign
     hx, hy, hz = dist.sample_visible_normal_of(ox, oy, oz, a, u0, u1, beckmann)
     cos_oh = mf.dot(ox, oy, oz, hx, hy, hz)
     F, cos_t, eta_t = fresnel.dielectric_full(max(cos_oh, 0.0), eta_rel)
-    pr, pt = choice_probs(F, allow_reflect, allow_refract)
+    Fc = glass_choice(film, max(cos_oh, 0.0), eta_rel, F) if F < 1.0 else F
+    pr, pt = choice_probs(Fc, allow_reflect, allow_refract)
     refr = u_choice >= pr
     if refr:
         k = cos_oh / eta_t - cos_t

@@ -17,6 +17,7 @@ from . import blinn_phong as bp
 from . import dielectric as de
 from . import fresnel as fr
 from . import microfacet as mf
+from .thin_film import NO_FILM
 
 
 def _vec(a, n=None):
@@ -205,7 +206,7 @@ def _rough_pdf(wo, wi, eta, alpha, allow_r, allow_t, walter):
     out = np.empty(wo.shape[0])
     for k in range(wo.shape[0]):
         out[k] = de.rough_pdf(wo[k, 0], wo[k, 1], wo[k, 2], wi[k, 0], wi[k, 1], wi[k, 2],
-                              eta[k], alpha[k], allow_r, allow_t, walter, False)
+                              eta[k], alpha[k], allow_r, allow_t, walter, False, NO_FILM)
     return out
 
 
@@ -223,14 +224,14 @@ def _rough_sample(wo, eta, alpha, u_choice, u, allow_r, allow_t):
         ox, oy, oz = wo[k, 0], wo[k, 1], wo[k, 2]
         ix, iy, iz, refr[k], ok = de.rough_sample(ox, oy, oz, eta[k], alpha[k],
                                                   u_choice[k], u[k, 0], u[k, 1],
-                                                  allow_r, allow_t, False)
+                                                  allow_r, allow_t, False, NO_FILM)
         wi[k, 0], wi[k, 1], wi[k, 2] = ix, iy, iz
         if not ok:
             continue
         f_r, f_t, _ = de.rough_eval_lobes(ox, oy, oz, ix, iy, iz, eta[k], alpha[k], False,
                                           True, False)
         p = de.rough_pdf(ox, oy, oz, ix, iy, iz, eta[k], alpha[k], allow_r, allow_t, True,
-                         False)
+                         False, NO_FILM)
         if p > 0.0:
             valid[k] = True
             pdf[k] = p
@@ -247,7 +248,7 @@ def _smooth_sample(wo, eta, u):
     valid = np.empty(n, dtype=np.bool_)
     for k in range(n):
         wi[k, 0], wi[k, 1], wi[k, 2], w[k], refr[k], valid[k], _ = de.smooth_sample(
-            wo[k, 0], wo[k, 1], wo[k, 2], eta[k], u[k], True, True)
+            wo[k, 0], wo[k, 1], wo[k, 2], eta[k], u[k], True, True, NO_FILM)
     return wi, w, refr, valid
 
 

@@ -137,7 +137,7 @@ def setup_about(row, front_facing, wox, woy, woz, tables, state, dnx, dny, dnz):
     state[S_BECKMANN] = 1.0 if row[P_GLOSSY_MODEL] == GLOSSY_BECKMANN else 0.0
     state[S_METAL_CONST] = row[P_METAL_CONSTANT]
     state[S_METAL_F82] = 0.0
-    # a Thin Film on the specular layer and the metal (thin_film.py; not the glass)
+    # a Thin Film on the specular layer, the metal and the glass (thin_film.py)
     film = row[P_THIN_FILM] > thin_film.CUTOFF
     state[S_THIN_FILM] = row[P_THIN_FILM] if film else 0.0
     state[S_FILM_IOR] = max(row[P_THIN_FILM_IOR], 1e-5)
@@ -189,8 +189,9 @@ def setup_about(row, front_facing, wox, woy, woz, tables, state, dnx, dny, dnz):
     state[S_W_METAL] = m
     state[S_W_GLASS] = w_glass
     state[S_GLASS_TINTED] = 0.0
-    if w_glass > 0.0 and state[S_REFRACT_ONLY] == 0.0 and specular_tint.is_tinted(row):
-        specular_tint.glass_setup(row, eta_glass, state)
+    glass_f0 = film or specular_tint.is_tinted(row)      # per channel F_c (specular_tint)
+    if w_glass > 0.0 and state[S_REFRACT_ONLY] == 0.0 and glass_f0:
+        specular_tint.glass_setup(row, eta_glass, ior, state)
 
     # albedo-dependent weights at wo
     cos_o = min(max(woz, 0.0), 1.0)
@@ -305,7 +306,8 @@ def mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, q, allow_g, allow_t):
         p += q3 * dielectric.rough_pdf(wox, woy, woz, wix, wiy, wiz, state[S_ETA_GLASS],
                                        state[S_ALPHA], allow_g and state[S_REFRACT_ONLY] == 0.0,
                                        allow_t, state[S_WALTER] != 0.0,
-                                       state[S_BECKMANN] != 0.0)
+                                       state[S_BECKMANN] != 0.0,
+                                       specular_tint.glass_film(state))
     if qc > 0.0 or qs > 0.0 or qt > 0.0 or qhr > 0.0 or qht > 0.0 or qch > 0.0:
         p += layers.mixture_pdf(state, wox, woy, woz, wix, wiy, wiz, qc, qs, qt, qhr, qht,
                                 qch)
@@ -407,18 +409,21 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
             ok = ok and allow_t
         else:
             wix, wiy, wiz, ws, refr, ok, F = dielectric.smooth_sample(
-                wox, woy, woz, state[S_ETA_GLASS], u_re, allow_g, allow_t)
+                wox, woy, woz, state[S_ETA_GLASS], u_re, allow_g, allow_t,
+                specular_tint.glass_film(state))
         kind = TRANSMISSION if refr else GLOSSY
         if not ok:
             return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False
         w = ws * state[S_W_GLASS] / q_sel
         t = S_TINT if refr else S_GLASS_RTINT
         wr, wg, wb = state[t] * w, state[t + 1] * w, state[t + 2] * w
-        if state[S_GLASS_TINTED] != 0.0:        # Specular Tint: per channel F_c for F
+        if state[S_GLASS_TINTED] != 0.0:        # Specular Tint, Thin Film: F_c for F
             eta = state[S_ETA_GLASS]
-            wr *= specular_tint.glass_factor(state, 0, F, eta, not refr)
-            wg *= specular_tint.glass_factor(state, 1, F, eta, not refr)
-            wb *= specular_tint.glass_factor(state, 2, F, eta, not refr)
+            _, eta_rel = dielectric.canonical(woz, eta)
+            cos_o = min(abs(woz), 1.0)
+            wr *= specular_tint.glass_factor(state, 0, F, eta, not refr, cos_o, eta_rel)
+            wg *= specular_tint.glass_factor(state, 1, F, eta, not refr, cos_o, eta_rel)
+            wb *= specular_tint.glass_factor(state, 2, F, eta, not refr, cos_o, eta_rel)
         if state[S_LAYERED] != 0.0:
             s = layers.S_BASE_SCALE
             wr, wg, wb = wr * state[s], wg * state[s + 1], wb * state[s + 2]
@@ -426,7 +431,8 @@ def sample(state, wox, woy, woz, u_lobe, u1, u2, allow_d, allow_g, allow_t):
     else:
         wix, wiy, wiz, refr, ok = dielectric.rough_sample(
             wox, woy, woz, state[S_ETA_GLASS], state[S_ALPHA], u_re, u1, u2,
-            allow_g and state[S_REFRACT_ONLY] == 0.0, allow_t, state[S_BECKMANN] != 0.0)
+            allow_g and state[S_REFRACT_ONLY] == 0.0, allow_t, state[S_BECKMANN] != 0.0,
+            specular_tint.glass_film(state))
         kind = TRANSMISSION if refr else GLOSSY
     if not ok:
         return wix, wiy, wiz, 0.0, 0.0, 0.0, 0.0, kind, False, False

@@ -109,11 +109,13 @@ def base_glossy(state, wox, woy, woz, wix, wiy, wiz, see_g, see_t):
                                                state[S_WALTER] != 0.0,
                                                state[S_BECKMANN] != 0.0)
         k0 = k1 = k2 = 1.0
-        if state[S_GLASS_TINTED] != 0.0:        # Specular Tint: per channel F_c for F
+        if state[S_GLASS_TINTED] != 0.0:        # Specular Tint, Thin Film: F_c for F
             refl = f_r > 0.0
-            k0 = specular_tint.glass_factor(state, 0, F, state[S_ETA_GLASS], refl)
-            k1 = specular_tint.glass_factor(state, 1, F, state[S_ETA_GLASS], refl)
-            k2 = specular_tint.glass_factor(state, 2, F, state[S_ETA_GLASS], refl)
+            eta = state[S_ETA_GLASS]
+            cos_i, eta_rel = dielectric.pair_cosine(wox, woy, woz, wix, wiy, wiz, eta)
+            k0 = specular_tint.glass_factor(state, 0, F, eta, refl, cos_i, eta_rel)
+            k1 = specular_tint.glass_factor(state, 1, F, eta, refl, cos_i, eta_rel)
+            k2 = specular_tint.glass_factor(state, 2, F, eta, refl, cos_i, eta_rel)
         r, t = S_GLASS_RTINT, S_TINT
         fr += (f_r * state[r] + f_t * state[t]) * k0 * w_glass * state[S_MS_GLASS]
         fg += (f_r * state[r + 1] + f_t * state[t + 1]) * k1 * w_glass * state[S_MS_GLASS + 1]

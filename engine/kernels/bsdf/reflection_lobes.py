@@ -2,7 +2,8 @@
 state: the microfacet lobe (GGX or Beckmann, microfacet.py and beckmann.py, or the
 lecture's Blinn-Phong) and the metal lobe's Fresnel factor: Schlick's from F0
 (Principled), Cycles' F82-tint where a Specular Tint is set (fresnel.py), under a Thin
-Film (thin_film.py), or F0 itself at every angle (a Glossy BSDF). principled.py calls these; the state's slots: state.py."""
+Film (thin_film.py), or F0 itself at every angle (a Glossy BSDF). principled.py calls
+these; the state's slots: state.py."""
 from __future__ import annotations
 
 from ..jit import kernel

@@ -20,9 +20,9 @@ film's reflectance (thin_film.specular_layer, with the tint's F0 scaling), and t
 albedo the layer below sees is F_c at wo times the multiscatter factor, Cycles' estimate
 for a film (no table, no floor).
 
-The glass lobe (Principled's transmission) takes the same F_c, from F0 = F(1) of its
-IOR: its reflection carries F_c where the untinted lobe carries F, its refraction
-1 - F_c where it carries 1 - F (Cycles: reflectance F_c, transmittance (1 - F_c) times
+The glass lobe (Principled's transmission) takes the same F_c (a film's too), from
+F0 = F(1) of its IOR: its reflection carries F_c where the untinted lobe carries F, its
+refraction 1 - F_c where it carries 1 - F (Cycles: reflectance F_c, transmittance (1 - F_c) times
 the refraction tint). `glass_factor` is that ratio per channel at the pair's own F, so
 the dielectric kernels stay as they are; the reflect/refract choice keeps F (an
 importance choice; the weights carry the tint). Its multiscatter compensation stays
@@ -35,8 +35,8 @@ from . import fresnel
 from . import multiscatter as ms
 from . import thin_film
 from .params import P_SPEC_TINT
-from .state import (S_FILM_IOR, S_GLASS_F0, S_GLASS_TINTED, S_MS_E, S_SPEC_F0, S_SPEC_MS,
-                    S_SPEC_TINTED, S_THIN_FILM)
+from .state import (S_FILM_IOR, S_GLASS_F0, S_GLASS_IOR, S_GLASS_TINTED, S_MS_E, S_SPEC_F0,
+                    S_SPEC_MS, S_SPEC_TINTED, S_THIN_FILM)
 
 
 @kernel
@@ -99,20 +99,41 @@ def reflectance(state, c, cos_oh, eta_spec):
 
 
 @kernel
-def glass_setup(row, eta, state):
-    """The glass lobe's tinted F0 per channel (Cycles: F0(ior) x tint, saturated)."""
+def glass_setup(row, eta, ior, state):
+    """The glass lobe's tinted F0 per channel (Cycles: F0(ior) x tint, saturated); ior
+    its own (for a Thin Film on it)."""
     state[S_GLASS_TINTED] = 1.0
+    state[S_GLASS_IOR] = ior
     f0_real = fresnel.f0_from_ior(eta)
     for c in range(3):
         state[S_GLASS_F0 + c] = min(max(f0_real * row[P_SPEC_TINT + c], 0.0), 1.0)
 
 
 @kernel(allocates=False)
-def glass_factor(state, c, F, eta, reflected):
+def glass_factor(state, c, F, eta, reflected, cos_i, eta_rel):
     """F_c / F for a reflection, (1 - F_c) / (1 - F) for a refraction, at the pair's
-    Fresnel reflectance F (dielectric.rough_eval_lobes, smooth_sample)."""
+    Fresnel reflectance F (dielectric.rough_eval_lobes, smooth_sample), which it has at
+    cos_i of wo to the pair's half vector and the relative index eta_rel of that side.
+    Under a Thin Film F_c is the film's reflectance there (Cycles: the film's index
+    relative to the side the light comes from, 1 outside or the glass's inside), and F is
+    the film's average over the channels by which the choice was made
+    (thin_film.glass_choice)."""
     f0 = state[S_GLASS_F0 + c]
-    Fc = f0 + (1.0 - f0) * remap(F, fresnel.f0_from_ior(eta))
+    if state[S_THIN_FILM] > 0.0:
+        Fc = thin_film.glass(c, cos_i, state[S_THIN_FILM], state[S_FILM_IOR],
+                             state[S_GLASS_IOR], eta_rel, f0)
+    else:
+        Fc = f0 + (1.0 - f0) * remap(F, fresnel.f0_from_ior(eta))
     if reflected:
         return Fc / F if F > 0.0 else 0.0
     return (1.0 - Fc) / (1.0 - F) if F < 1.0 else 0.0
+
+
+@kernel(allocates=False)
+def glass_film(state):
+    """The glass lobe's film for dielectric.rough_sample, rough_pdf and smooth_sample
+    (thin_film.glass_choice): NO_FILM unless a Thin Film lies on it."""
+    if state[S_THIN_FILM] > 0.0 and state[S_GLASS_TINTED] != 0.0:
+        return (state[S_THIN_FILM], state[S_FILM_IOR], state[S_GLASS_IOR],
+                state[S_GLASS_F0], state[S_GLASS_F0 + 1], state[S_GLASS_F0 + 2])
+    return thin_film.NO_FILM

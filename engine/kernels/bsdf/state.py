@@ -51,4 +51,5 @@ S_TAN_C = layers.NSTATE + 39       # cos and sin of the tangent's angle in the l
 S_TAN_S = layers.NSTATE + 40
 S_THIN_FILM = layers.NSTATE + 41  # the thin film's thickness (nm; 0: none, thin_film.py)
 S_FILM_IOR = layers.NSTATE + 42    # ... its IOR
-NSTATE = layers.NSTATE + 43
+S_GLASS_IOR = layers.NSTATE + 43   # the glass lobe's IOR (a film on it: thin_film.py)
+NSTATE = layers.NSTATE + 44

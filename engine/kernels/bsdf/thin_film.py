@@ -1,4 +1,4 @@
-"""Thin-film interference on the Principled BSDF's specular layer and metal lobe, as
+"""Thin-film interference on the Principled BSDF's specular layer, metal and glass, as
 Cycles renders its Thin Film Thickness and IOR (Belcour and Barla 2017, "A Practical
 Extension to Microfacet Theory for the Modeling of Varying Iridescence"): a film of
 thickness d (nm) and index n_f between the air (n = 1) and the substrate. Its reflectance
@@ -16,10 +16,12 @@ of each term in closed form. The two polarisations are averaged and clamped to [
 Below 1 nm the film's index blends towards the air's (smoothstep in d), where the wave
 optics no longer hold.
 
-- dielectric substrate (the specular layer): R12, R23 and the phase signs from the
-  polarised dielectric Fresnel equations; then Specular Tint and Specular IOR Level scale
-  the result per channel by f0_c / F0 at the strength s = (1 - F) / (1 - F0), clamped
-  (Cycles' artistic F0 scaling, since F may fall below F0).
+- dielectric substrate (the specular layer, the glass): R12, R23 and the phase signs
+  from the polarised dielectric Fresnel equations; then Specular Tint and Specular IOR
+  Level scale the result per channel by f0_c / F0 at the strength s = (1 - F) / (1 -
+  F0), clamped (Cycles' artistic F0 scaling, since F may fall below F0). The glass
+  reflects F_c and refracts 1 - F_c (specular_tint.glass_factor), from either side: the
+  film's index is taken relative to the medium the light comes from, as in Cycles.
 - metal (F82-tint): n and k estimated from F0 and the F82 value (Gulbrandsen 2014,
   "Artist Friendly Metallic Fresnel"); R23 is the F82 model with F0 recomputed for n / n_f
   and k / n_f, its phase from the complex conductor Fresnel equations (Born and Wolf
@@ -188,3 +190,30 @@ def metal(c, cos_1, thickness, film_ior, f0, b):
     r_s = _airy(c, r12_s, r23, opd, -s12_s * s_re, -s12_s * s_im)
     r_p = _airy(c, r12_p, r23, opd, -s12_p * p_re, -s12_p * p_im)
     return min(max(0.5 * (r_s + r_p), 0.0), 1.0)
+
+
+NO_FILM = (0.0, 1.0, 1.0, 0.0, 0.0, 0.0)   # `glass_choice`'s film: none
+
+
+@kernel(allocates=False)
+def glass(c, cos_i, thickness, film_ior, glass_ior, eta_rel, f0_c):
+    """The film's F_c on a glass of index glass_ior, for light arriving at cos_i with
+    the relative index eta_rel of its side: the film's index relative to the medium the
+    light comes from (1 outside, the glass inside), as Cycles takes it."""
+    inside = (eta_rel < 1.0) == (glass_ior > 1.0)
+    nf = film_ior / (glass_ior if inside else 1.0)
+    return specular_layer(c, cos_i, thickness, nf, eta_rel, f0_c)
+
+
+@kernel(allocates=False)
+def glass_choice(film, cos_i, eta_rel, F):
+    """The reflectance by which a glass chooses between reflection and refraction: its
+    Fresnel F, or under a film (film = (thickness, film IOR, glass IOR, f0 per channel),
+    NO_FILM for none) the film's F_c averaged over the channels, as Cycles chooses; the
+    weights then carry F_c over it (specular_tint.glass_factor)."""
+    if not film[0] > 0.0:
+        return F
+    total = 0.0
+    for c in range(3):
+        total += glass(c, cos_i, film[0], film[1], film[2], eta_rel, film[3 + c])
+    return total / 3.0
