@@ -7,8 +7,8 @@ world of strength 0.4): the film's colours change with the angle across the sphe
 the lamp's highlight. The images are compared per colour channel, since a film moves
 colour more than brightness: each channel's mean within 1 % and its largest 8 x 8 block
 within 5 % of the channel's mean (8 % for the metals, below). Measured at 512 samples
-each (worst channel's mean, largest block): soap on black 0.02 % and 3.2 %, tinted plastic
-0.18 % and 2.6 %, oxidised copper 0.13 % and 6.2 %, tinted metal 0.18 % and 6.2 %. The
+each (worst channel's mean, largest block): soap on black 0.01 % and 3.2 %, tinted plastic
+0.05 % and 2.7 %, oxidised copper 0.13 % and 6.2 %, tinted metal 0.18 % and 6.2 %. The
 control, DRT without the film (as before, when DRT left the film out with a warning):
 37.7 % and 1073 %, 2.5 % and 83 %, 34.4 % and 861 %, 15.6 % and 384 %.
 
@@ -152,3 +152,53 @@ def test_thin_film_on_glass_changes_the_image_as_in_cycles(bpy_drt, case):
     assert off < MEAN_TOLERANCE, effect
     assert float(np.abs(effect["CYCLES"] - 1.0).max()) > 0.05     # the film shows
     assert block < 1.5 * own, (block, own)
+
+
+def _both_spheres(bpy):
+    """The copper under its film (left) and the clear bubble (right) in one scene."""
+    scene = _sphere_scene(bpy, CASES["oxidised_copper"])
+    copper = bpy.context.object
+    copper.location.x = -1.1
+    copper.scale = (0.9, 0.9, 0.9)
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.9, segments=48, ring_count=24,
+                                         location=(1.1, 0.0, 0.0))
+    bpy.ops.object.shade_smooth()
+    bpy.context.object.data.materials.append(GLASS_CASES["bubble"](bpy))
+    return scene
+
+
+def test_the_color_passes_carry_the_film(bpy_drt):
+    """Glossy and Transmission Color (the lobes' albedo at the first hit, Cycles' estimate:
+    a film's reflectance at the view, no table, times the closure weight's multiscatter
+    darkening) of a copper and a clear glass under films, against Cycles' passes at 128
+    samples: means within 0.002 and 8 x 8 blocks within 0.02 of Combined's mean. Measured:
+    +0.0001 and 0.0084 (Glossy), +0.0001 and 0.0061 (Transmission). With the film-free
+    Fresnel in the passes (before): the copper's Glossy Color 4.3 % above Cycles', the
+    bubble's 50 %; without the darkening, the copper's 1.2 %."""
+    import light_pass_scene
+    bpy = bpy_drt
+    if bpy.app.version < (5, 0, 0):
+        pytest.skip("the File Output node's API read here is Blender 5's")
+    names = ["Glossy Color", "Transmission Color"]
+
+    def build():
+        scene = _both_spheres(bpy)
+        scene.cycles.samples = scene.drt.samples = 128
+        scene.cycles.use_denoising = scene.cycles.use_adaptive_sampling = False
+        vl = scene.view_layers[0]
+        vl.use_pass_glossy_color = vl.use_pass_transmission_color = True
+        return scene
+    scene = build()
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    cycles = light_pass_scene.cycles_passes(bpy, scene, ["Image"] + names)
+    build()
+    drt = light_pass_scene.drt_passes(bpy, names)
+    scale = cycles["Image"].mean()
+    h, w, _ = cycles["Image"].shape
+    for name in names:
+        mean = (drt[name].mean() - cycles[name].mean()) / scale
+        d = (drt[name] - cycles[name])[:h // 8 * 8, :w // 8 * 8]
+        block = np.abs(d.reshape(h // 8, 8, w // 8, 8, 3).mean(axis=(1, 3))).max() / scale
+        print(f"{name}: mean {mean:+.4f}, worst block {block:.4f}")
+        assert abs(mean) < 0.002 and block < 0.02, (name, mean, block)

@@ -13,13 +13,14 @@ from __future__ import annotations
 
 import math
 
-from .bsdf import fresnel, layers
+from .bsdf import fresnel, layers, thin_film
 from .bsdf import principled as bsdf
 from .bsdf.principled import GLOSSY
 from .bsdf import microfacet as mf
-from .bsdf.state import (S_ALPHA, S_DIFFUSE, S_E_SPEC, S_ETA_GLASS, S_LAYERED, S_METAL_CONST,
-                         S_METAL_F0, S_MS_E, S_MS_METAL, S_REFRACT_ONLY, S_SSS, S_TINT,
-                         S_W_GLASS, S_W_METAL, S_W_SPEC)
+from .bsdf.state import (S_ALPHA, S_DIFFUSE, S_E_SPEC, S_ETA_GLASS, S_FILM_IOR, S_GLASS_F0,
+                         S_GLASS_IOR, S_GLASS_TINTED, S_LAYERED, S_METAL_B, S_METAL_CONST,
+                         S_METAL_F0, S_METAL_F82, S_MS_E, S_MS_METAL, S_REFRACT_ONLY, S_SSS,
+                         S_THIN_FILM, S_TINT, S_W_GLASS, S_W_METAL, S_W_SPEC)
 from .jit import kernel
 from .light_tally import DIFFUSE_CLASS, GLOSSY_CLASS, TRANSMISSION_CLASS, one_class, \
     surface_shares
@@ -123,7 +124,12 @@ def _channel_colours(state, woz, s, c):
     layered = state[S_LAYERED] != 0.0
     m = state[S_W_METAL]
     w_glass = state[S_W_GLASS]
+    film = state[S_THIN_FILM]
     F = fresnel.dielectric(cos_o, state[S_ETA_GLASS]) if w_glass > 0.0 else 0.0
+    if film > 0.0 and w_glass > 0.0 and state[S_GLASS_TINTED] != 0.0:
+        # a Thin Film: its reflectance at wo (Cycles' estimate for a film, no table)
+        F = thin_film.glass(c, cos_o, film, state[S_FILM_IOR], state[S_GLASS_IOR],
+                            state[S_ETA_GLASS], state[S_GLASS_F0 + c])
     refl = 0.0 if state[S_REFRACT_ONLY] != 0.0 else w_glass * F
     scale = state[layers.S_BASE_SCALE + c] if layered else 1.0
     d = state[S_DIFFUSE + c] + state[S_SSS + c]
@@ -137,7 +143,11 @@ def _channel_colours(state, woz, s, c):
         # a Principled Hair's: its weight times Cycles' albedo estimate, glossy
         hair_r += state[layers.S_CHIANG_W + c] * state[layers.S_CHIANG_ALBEDO + c]
     metal = 0.0
-    if m > 0.0:
+    if m > 0.0 and film > 0.0 and state[S_METAL_CONST] == 0.0:
+        b = state[S_METAL_B + c] if state[S_METAL_F82] != 0.0 else 0.0
+        metal = m * thin_film.metal(c, cos_o, film, state[S_FILM_IOR], state[S_METAL_F0 + c],
+                                    b) * state[S_MS_E] * state[S_MS_METAL + c]
+    elif m > 0.0:
         # the lobe's albedo: Fresnel over the lobe (a Glossy BSDF's is its colour) times
         # the single-scattering albedo E and the multiscatter factor (Cycles' estimate)
         f0 = state[S_METAL_F0 + c]

@@ -17,8 +17,8 @@ pay nothing (principle 3). The metal lobe's tint is F82-tint (fresnel.py).
 
 A Thin Film takes this module's per-channel path too (principled.setup): F_c is then the
 film's reflectance (thin_film.specular_layer, with the tint's F0 scaling), and the
-albedo the layer below sees is F_c at wo times the multiscatter factor, Cycles' estimate
-for a film (no table, no floor).
+albedo the layer below sees is F_c at wo (Cycles' estimate for a film: no table, no
+floor) times the closure weight's multiscatter darkening, E times the factor.
 
 The glass lobe (Principled's transmission) takes the same F_c (a film's too), from
 F0 = F(1) of its IOR: its reflection carries F_c where the untinted lobe carries F, its
@@ -78,7 +78,9 @@ def setup(row, multiscatter, cos_o, alpha, eta_spec, exact, tables, state):
         if state[S_THIN_FILM] > 0.0:
             film = thin_film.specular_layer(c, cos_o, state[S_THIN_FILM], state[S_FILM_IOR],
                                             eta_spec, f0)
-            albedo = max(albedo, film * factor)
+            # Cycles' closure weight carries the multiscatter darkening E (1 + Fms (1 -
+            # E) / E) (S_MS_E times the factor), its estimate the film's reflectance
+            albedo = max(albedo, film * state[S_MS_E] * factor)
             continue
         b = (1.0 - f0) / den
         floor = (f0 - b * f0_real) * e_white + b * exact
