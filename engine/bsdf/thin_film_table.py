@@ -51,11 +51,6 @@ _lock = threading.Lock()
 _table = None
 
 
-def opd_of_row(k) -> np.ndarray:
-    """The optical path difference (nm) of table row k."""
-    return np.asarray(k, np.float64) * (1000.0 * END_UM) / (2.0 * np.pi * (ROWS - 1))
-
-
 def xyz_table() -> np.ndarray:
     """(ROWS, 3) complex: the Fourier transform of the resampled XYZ CMFs."""
     from scipy.interpolate import CubicSpline

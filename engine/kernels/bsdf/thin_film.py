@@ -27,9 +27,10 @@ optics no longer hold.
   and k / n_f, its phase from the complex conductor Fresnel equations (Born and Wolf
   14.4.1).
 
-Only the Fresnel factor changes: the layering below the specular layer takes its
-reflectance at wo (Cycles' estimate for a film, no table), and the multiple-scattering
-compensation keeps the film-free average Fresnel, as in Cycles. The table is a constant
+Only the Fresnel factor changes: the layering below the specular layer and the Color
+passes take its reflectance at wo (Cycles' estimate for a film, no table) times the
+closure weight's multiscatter darkening, and the multiple-scattering compensation keeps
+the film-free average Fresnel, as in Cycles. The table is a constant
 of the compiled code (24 kB).
 """
 from __future__ import annotations
@@ -123,8 +124,8 @@ def over_dielectric(c, cos_1, thickness, film_ior, eta):
 @kernel(allocates=False)
 def specular_layer(c, cos_1, thickness, film_ior, eta, f0_c):
     """The specular layer's F_c with the film: `over_dielectric`, scaled towards f0_c / F0
-    (Specular Tint and Level; f0_c the layer's tinted F0 in channel c). `all_one` (every
-    channel totally reflected) is not scaled, as in Cycles."""
+    (Specular Tint and Level; f0_c the layer's tinted F0 in channel c). A channel totally
+    reflected (F = 1) is not scaled, which is what Cycles' all-channels test gives too."""
     F = over_dielectric(c, cos_1, thickness, film_ior, eta)
     f0_real = fresnel.f0_from_ior(eta)
     if f0_real > 1e-5 and F != 1.0:
