@@ -7,6 +7,7 @@ the light's point and the BSDF direction 2D), the hit rebuild, the Principled BS
 at the outgoing direction, next-event estimation (a light sample, the BSDF's value and pdf
 there) and the BSDF's sample for the next ray. Each piece is timed here on its own: a
 compiled loop calls it a million times, one thread, with inputs that change every call
+and the scene's tables by reference as the kernel passes them (engine/kernels/tuple_ref.py)
 (the scene's own materials, lamp and triangles; points inside the box; the render's
 sample count), best of five, less the same loop without the piece. The BSDF's value, pdf
 and sample are timed on states set up in advance. Their sum is set against the shading
@@ -31,6 +32,7 @@ from numba import njit  # noqa: E402
 from engine.kernels import lights as lt  # noqa: E402
 from engine.kernels.bsdf import principled as bsdf  # noqa: E402
 from engine.kernels.surface import rebuild_at_time  # noqa: E402
+from engine.kernels.tuple_ref import by_ref  # noqa: E402
 from engine.sampling import dimensions as D  # noqa: E402
 from engine.sampling.dispatch import sample_1d, sample_2d  # noqa: E402
 from engine.sampling.hashing import pixel_key  # noqa: E402
@@ -68,7 +70,8 @@ def _sampler(kind, spp, two, n):
 
 
 @njit
-def _rebuild(geometry, part, n):
+def _rebuild(geometry_tuple, part, n):
+    geometry = by_ref(geometry_tuple)          # as the shading kernel passes it
     acc = 0.0
     ntri = geometry[1].shape[0]
     for i in range(n):
@@ -87,8 +90,9 @@ STATES = 256        # BSDF states set up in advance for timing the value, pdf an
 
 
 @njit
-def _bsdf_setup(params, tables, part, n):
+def _bsdf_setup(params, tables_tuple, part, n):
     """part 0: the inputs alone; 1: the Principled BSDF's setup at wo."""
+    tables = by_ref(tables_tuple)
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
     acc = 0.0
@@ -139,7 +143,8 @@ def _bsdf_use(states, part, n):
 
 
 @njit
-def _light(lights, lo, hi, part, n):
+def _light(light_tuple, lo, hi, part, n):
+    lights = by_ref(light_tuple)
     acc = 0.0
     for i in range(n):
         u, v, w = (i * GOLDEN) % 1.0, (i * PLASTIC) % 1.0, (i * THIRD) % 1.0

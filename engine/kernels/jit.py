@@ -14,6 +14,7 @@ from numba import njit, types
 from numba.core import event
 
 from .kernel_cache import BORROWING, LOADS, EngineFunctionCache
+from .tuple_ref import TupleRef
 
 
 class Kernel:
@@ -168,25 +169,33 @@ def filter_address(py_func, plain) -> int:
     return _FILTERS[py_func][1]
 
 
-def holds_array(ty) -> bool:
-    """Whether a Numba type is, or is a tuple holding, an array."""
-    if isinstance(ty, types.ArrayCompatible):
+def holds_array(ty, kind=types.ArrayCompatible) -> bool:
+    """Whether a Numba type is, or is a tuple holding, an array (or a `kind`)."""
+    if isinstance(ty, kind):
         return True
     if isinstance(ty, types.BaseTuple):
-        return any(holds_array(t) for t in ty.types)
+        return any(holds_array(t, kind) for t in ty.types)
     return False
 
 
 class BorrowingCheck(event.Listener):
     """Refuses, as it compiles, a kernel without reference counting whose result holds
-    an array: its caller would release a reference the kernel never took."""
+    an array: its caller would release a reference the kernel never took; and any kernel
+    whose result holds a tuple_ref.TupleRef, which points into the kernel's own frame."""
 
     def on_start(self, ev):
         pass
 
     def on_end(self, ev):
         dispatcher = (ev.data or {}).get("dispatcher")
-        if dispatcher is None or dispatcher.targetoptions.get("_nrt") is not False:
+        if dispatcher is None:
+            return
+        made_here = dispatcher.py_func.__module__ == TupleRef.__module__   # by_ref's own
+        for sig, cres in list(dispatcher.overloads.items()):
+            if not made_here and holds_array(cres.signature.return_type, TupleRef):
+                raise TypeError(f"{dispatcher.py_func.__qualname__}{sig} returns a "
+                                "reference to a tuple in its own frame (tuple_ref.by_ref)")
+        if dispatcher.targetoptions.get("_nrt") is not False:
             return
         for sig, cres in list(dispatcher.overloads.items()):
             if holds_array(cres.signature.return_type):

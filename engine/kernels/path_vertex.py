@@ -48,6 +48,8 @@ from .found_light import background, escaped, lamps_in_front
 from . import light_tally as tl
 from .pass_shares import NO_SHARES, bounce_shares, light_shares, lobe_colours
 from .medium_vertex import scatter
+from .path_state import TracedScene
+from .tuple_ref import by_ref
 from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
                            TRANSMISSION_BIT, _INF, continues, ends_path, hit_weight,
                            holdout_share,
@@ -72,6 +74,21 @@ from ..nodes.shading import (bent_diffuse, may_emit, surface_normal,
 @kernel
 def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shadows, nexts,
           programs, volumes, het, sss):
+    """`shade_by_ref` with the records by reference (tuple_ref.py): the kernels a vertex
+    calls take the light table, the geometry, the path state, ... as one pointer each,
+    not as their arrays' hundreds of words. The arguments are `shade_by_ref`'s."""
+    s = scene
+    refs = by_ref(TracedScene(by_ref(s.geometry), s.params, s.emission, by_ref(s.textures),
+                              by_ref(s.tables), by_ref(s.lights), s.world, s.vol,
+                              s.het_count))
+    return shade_by_ref(depth, cfg, by_ref(paths), by_ref(tally), live, ro, rd, rt, hits,
+                        stopped, refs, by_ref(shadows), by_ref(nexts), by_ref(programs),
+                        by_ref(volumes), by_ref(het), by_ref(sss))
+
+
+@kernel
+def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shadows,
+                 nexts, programs, volumes, het, sss):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`
     (engine.accel.HitArrays: t, prim, inst, u, v per ray; prim -1 where missed); stopped:
     rays that ended at the transparent bounce limit. Writes the shadow rays to `shadows`

@@ -42,9 +42,11 @@ from .frame import dot, to_local, to_world
 from .jit import kernel
 from .lights.light_set import sample_lamp_at
 from .lights.pack import C_TYPE, LAMPS, T_ENV, T_ENV_MAP
+from .path_state import TracedScene
 from .path_weights import DIFFUSE_BIT, SHADOW_BIT, _add, holdout_share, uncovered
 from .surface import hit_uv, surface_at
 from .surface_hit import coat_frame, material_row, run_program, surface_emission
+from .tuple_ref import by_ref
 from ..nodes.context import N_HIT
 from ..nodes.differentials import cone_moves
 from ..nodes.interpreter import has_program
@@ -81,6 +83,20 @@ def mirror_row(row):
 @kernel
 def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shadows,
                   nexts, programs, volumes, het, sss):
+    """`whitted_by_ref` with the records by reference, as `path_vertex.shade` passes them
+    (tuple_ref.py). The arguments are `whitted_by_ref`'s."""
+    s = scene
+    refs = by_ref(TracedScene(by_ref(s.geometry), s.params, s.emission, by_ref(s.textures),
+                              by_ref(s.tables), by_ref(s.lights), s.world, s.vol,
+                              s.het_count))
+    return whitted_by_ref(depth, cfg, by_ref(paths), by_ref(tally), live, ro, rd, rt, hits,
+                          stopped, refs, by_ref(shadows), by_ref(nexts), by_ref(programs),
+                          volumes, het, sss)
+
+
+@kernel
+def whitted_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene,
+                   shadows, nexts, programs, volumes, het, sss):
     """Whitted's bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`.
     The arguments are `path_vertex.shade`'s (read its docstring); this kernel reads no
     roulette verdict, MIS state or volume (the paths' min_pdf, cont, prev_pdf, prev_pos;
