@@ -12,7 +12,8 @@ Cornell box's shading kernel, given its records by reference (path_vertex.shade)
 
 `by_ref(t)` in a kernel stores the tuple `t` once in the calling function's stack frame
 and gives a `TupleRef`, one pointer, that kernels index as they index the tuple:
-`ref[LAMPS]`, and `ref.beta` on a named tuple. The reference is borrowed from the frame
+`ref[LAMPS]`, and `ref.beta` on a named tuple (not unpacked: `a, b = ref` does not
+compile, so subsurface's `rays`, which is unpacked, stays a tuple). The reference is borrowed from the frame
 that made it: a kernel may pass it down to the kernels it calls, never return it or store
 it (`BorrowingCheck` in jit.py refuses a kernel that returns one), and the tuple's arrays
 must outlive it: wrap arguments and their members, which the caller holds for the call,
