@@ -7,9 +7,10 @@ the light's point and the BSDF direction 2D), the hit rebuild, the Principled BS
 at the outgoing direction, next-event estimation (a light sample, the BSDF's value and pdf
 there) and the BSDF's sample for the next ray. Each piece is timed here on its own: a
 compiled loop calls it a million times, one thread, with inputs that change every call
-and the scene's tables by reference as the kernel passes them (engine/kernels/tuple_ref.py)
 (the scene's own materials, lamp and triangles; points inside the box; the render's
-sample count), best of five, less the same loop without the piece. The BSDF's value, pdf
+sample count), best of five, less the same loop without the piece; the scene's
+tables are passed by reference, as the shading kernel passes them
+(engine/kernels/tuple_ref.py). The BSDF's value, pdf
 and sample are timed on states set up in advance. Their sum is set against the shading
 kernel's measured time per vertex, which also holds the MIS weights, the roulette, the
 ray queues and the path state.

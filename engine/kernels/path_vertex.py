@@ -83,7 +83,7 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                               s.het_count))
     return shade_by_ref(depth, cfg, by_ref(paths), by_ref(tally), live, ro, rd, rt, hits,
                         stopped, refs, by_ref(shadows), by_ref(nexts), by_ref(programs),
-                        by_ref(volumes), by_ref(het), sss)
+                        volumes, het, sss)
 
 
 @kernel

@@ -7,19 +7,20 @@ one of them copies about 200 words onto the stack and back, and a path vertex ma
 dozens of such calls. Measured on the Cornell box's area lamp (docs/vertex_costs.py),
 picking and sampling the one lamp cost 620 ns per call with the table passed as a
 tuple, 320 ns with it by reference, of which the sampling arithmetic is 110 ns; the
-Cornell box's shading kernel, given its records by reference (path_vertex.shade), renders
-2.3x faster (docs/benchmarks.md, section 1).
+Cornell box's shading per path vertex went from 1866 ns to 624 ns when
+path_vertex.shade began to pass its records by reference (docs/benchmarks.md,
+section 1, run before and after).
 
 `by_ref(t)` in a kernel stores the tuple `t` once in the calling function's stack frame
 and gives a `TupleRef`, one pointer, that kernels index as they index the tuple:
-`ref[LAMPS]`, and `ref.beta` on a named tuple (not unpacked: `a, b = ref` does not
-compile, so subsurface's `rays`, which is unpacked, stays a tuple). The reference is borrowed from the frame
-that made it: a kernel may pass it down to the kernels it calls, never return it or store
-it (`BorrowingCheck` in jit.py refuses a kernel that returns one), and the tuple's arrays
-must outlive it: wrap arguments and their members, which the caller holds for the call,
-not arrays the kernel allocates itself. Anything else passes
-through `by_ref` unchanged (None, an array), so a kernel wraps its arguments without
-asking what they are.
+`ref[LAMPS]`, and `ref.beta` on a named tuple. It cannot be unpacked (`a, b = ref` does
+not compile), so a tuple that a callee unpacks (subsurface's `rays`) stays a tuple. The
+reference is borrowed from the frame that made it: a kernel may pass it down to the
+kernels it calls, never return it or store it (`BorrowingCheck` in jit.py refuses a
+kernel that returns one), and the tuple's arrays must outlive it: wrap arguments and
+their members, which the caller holds for the call, not arrays the kernel allocates
+itself. Anything else passes through `by_ref` unchanged (None, an array), so a kernel
+wraps its arguments without asking what they are.
 
 Run as plain Python (NUMBA_DISABLE_JIT=1), `by_ref` returns the tuple itself.
 """
