@@ -65,6 +65,8 @@ class _Closure:
     mix: object = None     # (A, B, Fac Value): a Mix Shader whose Fac varies per hit; the
     #                        fields above are then its mixture at the Fac's average
     h_weight: float = 0.0                            # Holdout closure weight
+    plain_emission: bool = False   # some of its emission is an Emission shader's, which
+    #                                no coat or sheen dims (Material.emission_under_layers)
 
     def scaled(self, f, ctx):
         if self.alpha_texture is not None and f != 1.0:
@@ -73,13 +75,14 @@ class _Closure:
             return c.scaled(f, ctx)
         return _Closure([(w * f, c) for w, c in self.comps], self.t_weight * f,
                         _plain(np.asarray(self.t_color) * f), _scale(self.emission, f),
-                        self.alpha_texture, h_weight=self.h_weight * f)
+                        self.alpha_texture, h_weight=self.h_weight * f,
+                        plain_emission=self.plain_emission)
 
     def _alpha_to_constant(self):
         a = float(np.clip(self.alpha_texture.mean(), 0.0, 1.0))
         return _Closure([(w * a, c) for w, c in self.comps], self.t_weight + (1.0 - a),
                         _plain(np.asarray(self.t_color) + (1.0 - a)), self.emission,
-                        h_weight=self.h_weight * a)
+                        h_weight=self.h_weight * a, plain_emission=self.plain_emission)
 
     def is_emission_only(self):
         return (all(c is NULL_COMP for _, c in self.comps) and self.t_weight == 0
@@ -95,7 +98,8 @@ def _sum(a: _Closure, b: _Closure, ctx) -> _Closure:
     return _Closure(a.comps + b.comps, a.t_weight + b.t_weight,
                     _plain(np.asarray(a.t_color) + np.asarray(b.t_color)),
                     _lin([(1.0, a.emission), (1.0, b.emission)], ctx, "emission"),
-                    h_weight=a.h_weight + b.h_weight)
+                    h_weight=a.h_weight + b.h_weight,
+                    plain_emission=a.plain_emission or b.plain_emission)
 
 
 def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
@@ -153,6 +157,7 @@ def _reduce(cl: _Closure, ctx, name) -> "engine.Material":
     if p["thin_film"] is not None:
         m.thin_film_thickness, m.thin_film_ior = p["thin_film"]
     _set(m, "emission", emission)
+    m.emission_under_layers = not cl.plain_emission
     m.ior = float(p["ior"])
     m.transmission = float(p["transmission"])
     m.glossy_model = p["distribution"]

@@ -221,6 +221,13 @@ class MaterialTable:
         self.layered = ((self.coat_weight > 1e-5) | (self.sheen_weight > 1e-5)
                         | (self.translucent_color.max(1) > 0.0) | translucent_per_hit
                         | self.refraction_only | self.hair)
+        # the emission the coat and sheen dim (engine.kernels.bsdf.layered_emission)
+        under = np.array([bool(getattr(m, "emission_under_layers", True))
+                          for m in materials], bool)
+        emits = np.array([m.is_emissive() if hasattr(m, "is_emissive")
+                          else max(m.emission[:3]) > 0.0 for m in materials], bool)
+        self.emission_dimmed = under & emits & (
+            (self.coat_weight > 1e-5) | ((self.sheen_weight > 1e-5) & self.sheen_layered))
         for name in ("coat_weight", "coat_roughness", "coat_ior", "coat_tint", "sheen_weight",
                      "sheen_roughness", "sheen_tint", "translucent_color", "hair_reflection",
                      "hair_reflection_offset", "hair_reflection_roughness",

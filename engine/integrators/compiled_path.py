@@ -23,6 +23,8 @@ from ..accel import HitArrays
 from ..surface import or_empty
 from ..kernels import lights as klights
 from ..kernels.bsdf import principled as kbsdf
+from ..kernels.bsdf.layered_emission import dimming_rows
+from ..kernels.bsdf.params import P_EMISSION_DIM
 from ..bsdf.material_table import flatten_mixes
 from ..kernels.camera_rays import pack_camera
 from ..kernels.jit import Kernel
@@ -81,8 +83,11 @@ class CompiledPathIntegrator:
         self.skips_shadows = bool(((vis & visibility.SHADOW) == 0).any())
         self.any_transparent = mats.any_transparent
         self.tables = kbsdf.kernel_tables()
+        dim_rows = dimming_rows(self.params, self.tables)
+        dimming = ((self.params[surf.material, P_EMISSION_DIM], dim_rows)
+                   if len(dim_rows) else None)
         self.lights = klights.pack_lights(ctx.lights, surf.visibility, ctx.has_motion,
-                                          tree=s.light_tree)
+                                          tree=s.light_tree, dimming=dimming)
         self.world = np.ascontiguousarray(ctx.world_radiance, dtype=np.float64)
         # homogeneous volumes (engine.kernels.volume): the table, and the media the
         # camera is inside, where every path starts

@@ -31,7 +31,7 @@ from .jit import kernel
 from . import light_tally as tl
 from .light_tally import VOLUME_SHARES
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, keep_receiver,
-                           VOLUME, ends_path, nee_weight, power_heuristic,
+                           SPENT, VOLUME, ends_path, nee_weight, power_heuristic,
                            roulette)
 from .volume import EQUIANGULAR, distance_pdf, hg_phase, hg_sample, medium, volume_dim
 
@@ -84,7 +84,7 @@ def scatter(depth, cfg, paths, p, px, py, pz, dx, dy, dz, br, bg, bb, g, tally, 
         u_rr = sample_1d(kind, pkey[p], spp, index[p], base + D.ROULETTE)
         paths.cont[p] = roulette(u_rr, br, bg, bb)     # applied where the next ray arrives
     if ends_path(cfg, bounce[p] + 1, vbounce[p] + 1, VOLUME):
-        paths.cont[p] = 0.0
+        paths.cont[p] = SPENT
     if not (max(br, bg, bb) > 0.0 and pdf > 0.0):
         return ns, nn
     paths.beta[p, 0], paths.beta[p, 1], paths.beta[p, 2] = br, bg, bb     # phase / pdf = 1

@@ -35,6 +35,7 @@ from .bsdf.principled import SUBSURFACE, TRANSMISSION
 from ..sampling import dimensions as D
 from ..sampling.dispatch import sample_1d, sample_2d
 from . import lights as lt
+from .lights.pack import EMIT_DIM
 from .bsdf import principled as bsdf
 from .bsdf.joint_sample import sample_joint
 from .bsdf.state import S_ANY_SIDE, S_DIFFUSE_LABEL, S_WALTER
@@ -50,7 +51,7 @@ from .pass_shares import NO_SHARES, bounce_shares, light_shares, lobe_colours
 from .medium_vertex import scatter
 from .path_state import TracedScene
 from .tuple_ref import by_ref
-from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT,
+from .path_weights import (DIFFUSE_BIT, GLOSSY_BIT, ROULETTE_START, SHADOW_BIT, SPENT,
                            TRANSMISSION_BIT, _INF, continues, ends_path, hit_weight,
                            holdout_share,
                            keep_receiver, nee_weight, previous_receiver, roulette, uncovered)
@@ -209,7 +210,7 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
             nn_out = ray_queues.push_next(nexts, nn_out, p, px, py, pz, dx, dy, dz, prim,
                                           hit_inst[j])
             continue
-        if cont[p] == 0.0 and not may_emit(textures, emission, m):
+        if cont[p] <= 0.0 and not may_emit(textures, emission, m):
             continue                      # ended by the roulette, and nothing to find here
         uu, vv = hit_uv(corner_uvs, prim, hit_u[j], hit_v[j])
         programmed = programs is not None and has_program(programs, m)
@@ -244,8 +245,10 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
                 rx, ry, rz = nx, ny, nz
                 nx, ny, nz, bent = sx, sy, sz, True
         # 1c. emissive surfaces (two-sided), weighted against sampling that triangle
-        er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
-                                      programmed)
+        # (dimmed by a coat and sheen as Cycles' closures dim it: not on a spent path)
+        er, eg, eb = surface_emission(programs, textures, emission, params,
+                                      lights[EMIT_DIM], m, uu, vv, regs, programmed,
+                                      dx * s0x + dy * s0y + dz * s0z, cont[p] != SPENT)
         if er != 0.0 or eg != 0.0 or eb != 0.0:
             lpdf = lt.mesh_pdf(lights, prim, previous_receiver(prev_pos, p), px, py, pz,
                                path_time[p])
@@ -379,7 +382,7 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
             u_rr = sample_1d(kind, pkey[p], spp, index[p], base + D.ROULETTE)
             cont[p] = roulette(u_rr, br, bg, bb)
         if ends_path(cfg, b + 1, counts[p, skind] + 1, skind):
-            cont[p] = 0.0
+            cont[p] = SPENT
         if not max(br, bg, bb) > 0.0 or not (br < _INF and bg < _INF and bb < _INF):
             continue       # nothing left, or overflowed (or NaN): the path ends here
         beta[p, 0], beta[p, 1], beta[p, 2] = br, bg, bb

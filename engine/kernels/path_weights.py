@@ -108,6 +108,12 @@ def holdout_share(h, u_lobe, b, alpha, p, br, bg, bb):
 VOLUME = 3    # the kind of a scattering in a volume (0, 1, 2: the BSDF lobes' skind)
 
 
+# cont of a path whose last bounce used a budget up (ends_path): it ends at the vertex
+# its ray reaches, as with the roulette's 0, and gathers what it finds there as Cycles
+# gathers it on a path flagged to terminate (bsdf.layered_emission)
+SPENT = -1.0
+
+
 @kernel(allocates=False)
 def ends_path(cfg, bounces, kind_count, kind):
     """Whether the bounce that brings a path to `bounces` bounces, and its kind (0
@@ -117,7 +123,7 @@ def ends_path(cfg, bounces, kind_count, kind):
     bounces, and as many of each kind as its own limit + 1; the ray of the bounce that
     uses a budget up gathers only what it finds (emission and the world, weighted
     against the light sample of the vertex it left) and the path ends at the vertex it
-    reaches (cont 0, as the roulette ends paths)."""
+    reaches (cont SPENT, ended as by the roulette's 0)."""
     if bounces > cfg.max_bounces:
         return True
     if kind == 0:
@@ -145,10 +151,11 @@ def roulette(u, br, bg, bb):
 def continues(cont, p):
     """At path p's vertex, after the emission its ray found: the factor its throughput
     is divided by when it goes on (the survival probability of the roulette that let
-    the ray leave, 1 without one), or 0 when the roulette ended it. Resets the entry."""
+    the ray leave, 1 without one), or 0 when the roulette or a spent budget (SPENT)
+    ended it. Resets the entry."""
     q = cont[p]
     cont[p] = 1.0
-    return q
+    return q if q > 0.0 else 0.0
 
 
 @kernel(allocates=False)

@@ -42,7 +42,7 @@ from . import light_tally as tl
 from .light_tally import DIFFUSE_SHARES
 from ..sampling.hashing import stream_uniform
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, keep_receiver,
-                           ends_path, nee_weight, roulette)
+                           SPENT, ends_path, nee_weight, roulette)
 from .subsurface import MAX_BOUNCES, object_of, walk, walk_radius
 from .subsurface_disk import find_exit
 from ..embree.rays import new_ray_record
@@ -201,7 +201,7 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, front, px
     if b + 1 >= ROULETTE_START:
         cont[p] = roulette(stream_uniform(key, EXIT_STEP, 5), tr, tg, tb)
     if ends_path(cfg, b + 1, counts[p, 0] + 1, 0):
-        cont[p] = 0.0
+        cont[p] = SPENT
     if not (tr < math.inf and tg < math.inf and tb < math.inf):
         return ns, nn
     pdf = iz * INV_PI

@@ -5,9 +5,11 @@ row. `programs` is None in a scene without shader programs (engine.nodes.shading
 Numba then compiles these without that code."""
 from __future__ import annotations
 
+from .bsdf.layered_emission import LAYERS, TINT, dimmed
 from .bsdf.params import (P_ANISO_KIND, P_ANISO_ROT, P_BASE, P_BUMP_CORRECTION,
-                          P_CHIANG_COLOR, P_CHIANG_MELANIN, P_COAT_N, P_COAT_WEIGHT, P_HAIR,
-                          P_LAYERS, P_METALLIC, P_ROUGHNESS, P_TANGENT, P_TRANSLUCENT)
+                          P_CHIANG_COLOR, P_CHIANG_MELANIN, P_COAT_N, P_COAT_WEIGHT,
+                          P_EMISSION_DIM, P_HAIR, P_LAYERS, P_METALLIC, P_ROUGHNESS,
+                          P_TANGENT, P_TRANSLUCENT)
 from .frame import to_local
 from .jit import kernel
 from .textures import apply_to_row, emission_at
@@ -41,12 +43,20 @@ def run_program(programs, params, geometry, counts, path_info, p, m, prim, inst,
 
 
 @kernel(allocates=False)
-def surface_emission(programs, textures, emission, m, uu, vv, regs, programmed):
+def surface_emission(programs, textures, emission, params, dims, m, uu, vv, regs,
+                     programmed, cos, layered):
     """Material m's emitted radiance at the hit: its (textured) emission, or what its
-    program (run by `run_program` when `programmed`) says."""
+    program (run by `run_program` when `programmed`) says, as its coat and sheen dim it
+    seen at cosine cos to the surface's normal (bsdf.layered_emission; dims: the light
+    table's L[EMIT_DIM]): by their albedos and the coat's tint where `layered`, else by
+    the tint alone (on a path whose budget is spent)."""
     er, eg, eb = emission_at(textures, emission, m, uu, vv)
     if programs is not None and programmed:
         er, eg, eb = program_emission(programs, m, regs, er, eg, eb)
+    row = params[m, P_EMISSION_DIM]
+    if row >= 0.0 and (er != 0.0 or eg != 0.0 or eb != 0.0):
+        er, eg, eb = dimmed(dims, int(row), LAYERS if layered else TINT, cos, er, eg,
+                            eb)
     return er, eg, eb
 
 

@@ -41,7 +41,7 @@ from .bsdf.params import (P_ANISO_KIND, P_COAT_ROUGHNESS, P_FILTER_ALPHA, P_HAIR
 from .frame import dot, to_local, to_world
 from .jit import kernel
 from .lights.light_set import sample_lamp_at
-from .lights.pack import C_TYPE, LAMPS, T_ENV, T_ENV_MAP
+from .lights.pack import C_TYPE, EMIT_DIM, LAMPS, T_ENV, T_ENV_MAP
 from .path_state import TracedScene
 from .path_weights import DIFFUSE_BIT, SHADOW_BIT, _add, holdout_share, uncovered
 from .surface import hit_uv, surface_at
@@ -180,8 +180,9 @@ def whitted_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sc
         holed, u_lobe = holdout_share(params[ms, P_HOLDOUT], u_lobe, b, alpha, p, br, bg, bb)
         if holed:
             continue                      # a Holdout's share: a hole, or no light
-        er, eg, eb = surface_emission(programs, textures, emission, m, uu, vv, regs,
-                                      programmed)
+        er, eg, eb = surface_emission(programs, textures, emission, params,
+                                      lights[EMIT_DIM], m, uu, vv, regs, programmed,
+                                      dx * n0x + dy * n0y + dz * n0z, True)
         _add(tally.L, p, br * er, bg * eg, bb * eb, clamp_hit)
         wox, woy, woz = to_local(-dx, -dy, -dz, nx, ny, nz)
         material_row(params, textures, programs, ms, uu, vv, regs, programmed, row)

@@ -154,6 +154,11 @@ class Material:
     #                                       its emissive triangles: 'NONE', 'FRONT', 'BACK'
     #                                       or 'FRONT_BACK' (Material > Settings >
     #                                       Emission Sampling; engine.mesh_lights)
+    emission_under_layers: bool = True   # the emission lies under the coat and sheen,
+    #                                      which dim it at the angle it is seen from (a
+    #                                      Principled BSDF's, as in Cycles' svm/closure.h;
+    #                                      engine.kernels.bsdf.layered_emission); False:
+    #                                      an Emission shader's, which nothing dims
     holdout: bool = False                # a Holdout shader: a hole in the alpha where the
     #                                      camera sees it, black to every other ray
     holdout_weight: float = 0.0          # a Holdout shader's share of the opaque part (a

@@ -216,7 +216,8 @@ def _glass(node, ctx, refraction=False) -> _Closure:
 def _emission(node, ctx) -> _Closure:
     color = _input(node, "Color", ctx, True, WHITE)
     strength = _constant(node, "Strength", ctx, 1.0)
-    return _Closure([(1.0, NULL_COMP)], emission=_scale(color, strength))
+    return _Closure([(1.0, NULL_COMP)], emission=_scale(color, strength),
+                    plain_emission=True)
 
 
 def _transparent(node, ctx) -> _Closure:
@@ -234,7 +235,8 @@ def _add(a: _Closure, b: _Closure, ctx) -> _Closure:
         emit, other = (a, b) if a.is_emission_only() else (b, a)
         return _Closure(other.comps, other.t_weight, other.t_color,
                         _lin([(1.0, emit.emission), (1.0, other.emission)], ctx,
-                             "emission"), other.alpha_texture, h_weight=other.h_weight)
+                             "emission"), other.alpha_texture, h_weight=other.h_weight,
+                        plain_emission=emit.plain_emission or other.plain_emission)
     return _sum(a, b, ctx)
 
 

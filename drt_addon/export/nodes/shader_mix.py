@@ -88,4 +88,5 @@ def _plastic(a: _Closure, b: _Closure, ior, fac, ctx):
     comp = replace(ca, spec=0.5, ior=float(ior), roughness=cb.roughness,
                    distribution=cb.distribution)
     return _Closure([(1.0, comp)], 0.0, BLACK,
-                    _lin([(1.0 - fac, a.emission), (fac, b.emission)], ctx, "emission"))
+                    _lin([(1.0 - fac, a.emission), (fac, b.emission)], ctx, "emission"),
+                    plain_emission=a.plain_emission or b.plain_emission)

@@ -95,7 +95,9 @@ P_COAT_N = 101           # per hit, 3 columns: the coat's normal in the shading 
 #                          frame: Cycles' coat keeps it); 0: the frame's
 P_THIN_FILM = 104        # Thin Film Thickness (nm; at most thin_film.CUTOFF: none)
 P_THIN_FILM_IOR = 105    # Thin Film IOR
-NPARAM = 106
+P_EMISSION_DIM = 106     # the row of L[EMIT_DIM] that dims its emission (a Principled's
+#                          under its coat and sheen: layered_emission.py), or -1: none
+NPARAM = 107
 
 GLOSSY_GGX = 0
 GLOSSY_BLINN_PHONG = 1
@@ -142,6 +144,8 @@ def pack_materials(table) -> np.ndarray:
     rows[:, P_SETS_NORMAL] = table.sets_normal
     rows[:, P_HOLDOUT] = table.holdout_weight
     rows[:, P_LAYERS] = table.layered
+    dimmed = np.asarray(getattr(table, "emission_dimmed", np.zeros(m, bool)), bool)
+    rows[:, P_EMISSION_DIM] = np.where(dimmed, np.cumsum(dimmed) - 1, -1)
     rows[:, P_SSS_WEIGHT] = table.subsurface_weight
     rows[:, P_SSS_RADIUS:P_SSS_RADIUS + 3] = table.subsurface_radius
     rows[:, P_SSS_ANISOTROPY] = table.subsurface_anisotropy

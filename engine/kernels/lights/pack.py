@@ -52,6 +52,12 @@ every scene):
   as with Cycles' Light Tree off or a single entry):
   L[TREE_NODES]  float64 (n_nodes, tree_build.N_NODE), L[TREE_SLOTS] int64 (n_slots,),
   L[TREE_EMIT]   float64 (n_entries, tree_build.N_EMIT).
+  Emission that a Principled's coat and sheen dim (engine.kernels.bsdf.layered_emission;
+  both empty when no material's is):
+  L[TRI_DIM]     int64 (n_tri,): the row of L[EMIT_DIM] that dims triangle j's radiance,
+                 or -1.
+  L[EMIT_DIM]    float64 (n_rows, 2, layered_emission.N_COS, 3): the rows (a material's
+                 P_EMISSION_DIM names its row).
 """
 from __future__ import annotations
 
@@ -93,6 +99,8 @@ SLICE_OF = 23
 TREE_NODES = 24
 TREE_SLOTS = 25
 TREE_EMIT = 26
+TRI_DIM = 27
+EMIT_DIM = 28
 
 # ---------------------------------------------------------------- L[ENV_MAP] fields
 M_HAS = 0           # 1: the world is an environment map
@@ -219,7 +227,8 @@ def _f64(a, shape):
     return np.array(np.asarray(a, dtype=np.float64).reshape(shape), order="C", copy=True)
 
 
-def pack_lights(light_set, tri_visibility=None, timed=True, tree=True) -> tuple:
+def pack_lights(light_set, tri_visibility=None, timed=True, tree=True,
+                dimming=None) -> tuple:
     """The LightSet as the kernels' tuple L (fields: this module's docstring).
     tri_visibility: the visibility mask of every global triangle (Surfaces.visibility),
     or None when every triangle is seen by every ray.
@@ -227,7 +236,9 @@ def pack_lights(light_set, tri_visibility=None, timed=True, tree=True) -> tuple:
     L[LAMP_SLICES] (see the module docstring); with `timed` False (a render that samples
     no time: the shutter is closed) it is its middle slice alone, as TimeSlicedLight
     without a time. `tree`: pick lights with the light tree (Cycles' default), else by
-    LightSet.select_pdf (Cycles' distribution without the tree)."""
+    LightSet.select_pdf (Cycles' distribution without the tree). `dimming`: (the row
+    of dimming_rows of every global triangle, or -1; those rows), or None: nothing
+    dims the triangles' emission (see the module docstring, L[TRI_DIM])."""
     models = light_set.models
     lamps = np.zeros((len(models), N_COLUMNS))
     slice_of = np.zeros((len(models), 2), dtype=np.int64)
@@ -282,9 +293,25 @@ def pack_lights(light_set, tri_visibility=None, timed=True, tree=True) -> tuple:
         # light (below a surface that does not transmit), which a closure whose sampling
         # and evaluation differ (the Hair BSDF's) sees in its MIS weights
         from .tree_build import tree_arrays
-        return L + tree_arrays(L, models)
-    from .tree_build import N_EMIT, N_NODE
-    return L + (np.zeros((0, N_NODE)), np.zeros(0, np.int64), np.zeros((0, N_EMIT)))
+        L = L + tree_arrays(L, models)
+    else:
+        from .tree_build import N_EMIT, N_NODE
+        L = L + (np.zeros((0, N_NODE)), np.zeros(0, np.int64), np.zeros((0, N_EMIT)))
+    return L + _dimming(dimming, tri[5])
+
+
+def _dimming(dimming, tri_prim) -> tuple:
+    """(L[TRI_DIM], L[EMIT_DIM]) of `dimming` (pack_lights) for the triangles of global
+    ids tri_prim: both empty when no triangle's emission is dimmed."""
+    from ..bsdf.layered_emission import N_COS
+    empty = (np.zeros(0, np.int64), np.zeros((0, 2, N_COS, 3)))
+    if dimming is None or len(tri_prim) == 0:
+        return empty
+    per_prim, rows = dimming
+    tri_dim = np.asarray(per_prim, np.int64)[tri_prim]
+    if not (tri_dim >= 0).any():
+        return empty
+    return np.ascontiguousarray(tri_dim), _f64(rows, (-1, 2, N_COS, 3))
 
 
 def _pack_map(world) -> tuple:

@@ -13,8 +13,10 @@ import math
 
 from ..frame import unit
 from ..jit import kernel
-from .pack import (NEE_BACK_OFF, NEE_FRONT_OFF, TRI_AREA, TRI_E1, TRI_E2, TRI_ENTRY,
-                   TRI_NORMAL, TRI_PRIM, TRI_RADIANCE, TRI_V0, TRI_VISIBILITY)
+from ..bsdf.layered_emission import TINT, dimmed
+from .pack import (EMIT_DIM, NEE_BACK_OFF, NEE_FRONT_OFF, TRI_AREA, TRI_DIM, TRI_E1,
+                   TRI_E2, TRI_ENTRY, TRI_NORMAL, TRI_PRIM, TRI_RADIANCE, TRI_V0,
+                   TRI_VISIBILITY)
 from .spherical_triangle import sample_direction, solid_angle
 
 
@@ -84,7 +86,8 @@ def sample_triangle(L, j, px, py, pz, u0, u1):
     """A point of triangle entry j seen from p (pick probability NOT included), as
     Cycles samples it: uniform in the solid angle it subtends when it is near
     (`_corners_from`; Arvo's map, spherical_triangle.py), else uniform in area (Heitz's
-    map): (wix, wiy, wiz, dist, r, g, b, pdf, prim, margin), pdf in solid angle, prim
+    map): (wix, wiy, wiz, dist, r, g, b, pdf, prim, margin), (r, g, b) its radiance
+    towards p (a coat's tint dims it: bsdf.layered_emission), pdf in solid angle, prim
     the triangle's global id, which the shadow ray towards the point names
     (engine.embree.self_hits) so that it does not meet the light itself, as Cycles'
     shadow rays name ls->prim, and margin how far short of the point it stops (REACH)."""
@@ -126,8 +129,12 @@ def sample_triangle(L, j, px, py, pz, u0, u1):
     if not pdf > 0.0:
         return wx, wy, wz, dist, 0.0, 0.0, 0.0, 0.0, L[TRI_PRIM][j], 0.0
     rad = L[TRI_RADIANCE]
+    r, g, b = rad[j, 0], rad[j, 1], rad[j, 2]
+    dim = L[TRI_DIM]
+    if dim.shape[0] > 0 and dim[j] >= 0:      # under a tinted coat, at the angle seen
+        r, g, b = dimmed(L[EMIT_DIM], dim[j], TINT, cos_l, r, g, b)
     margin = REACH * max(abs(qx), abs(qy), abs(qz)) / cos_l
-    return wx, wy, wz, dist, rad[j, 0], rad[j, 1], rad[j, 2], pdf, L[TRI_PRIM][j], margin
+    return wx, wy, wz, dist, r, g, b, pdf, L[TRI_PRIM][j], margin
 
 
 @kernel(allocates=False)
