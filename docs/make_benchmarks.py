@@ -226,17 +226,20 @@ def main():
                   f"| off | {r['static']:.2f} |", f"| on | {r['blur']:.2f} |", ""]
         done("5")
     if "6" not in skip:
-        from adaptive_benchmark import measure, table
+        from adaptive_benchmark import UNEVEN, measure, table, targets as adaptive_targets
         rows = []
         chosen = [b for b in args.adaptive_scenes.split(",") if b] or ADAPTIVE_SCENES
         for blend in chosen:
             for sampler in ("jittered", "sobol"):
-                rows.append(measure(os.path.join(SAMPLES, blend), long_side=32 if q else 96,
+                path = blend if blend == UNEVEN else os.path.join(SAMPLES, blend)
+                rows.append(measure(path, long_side=32 if q else 96,
                                     ref_spp=256 if q else 2048, sampler=sampler,
                                     ladder=(4, 16, 64) if q else (16, 64, 256)))
                 print(blend, sampler, rows[-1]["metrics"], flush=True)
         lines += table(rows) if chosen == ADAPTIVE_SCENES else \
             _join_rows(saved["6"]["lines"], table(rows), chosen)
+        targets += adaptive_targets(rows) if chosen == ADAPTIVE_SCENES else \
+            saved["6"]["targets"]
         done("6")
     if "7" not in skip:      # the convergence studies (cached in ~/.cache/drt/converge)
         import make_convergence_docs as studies
@@ -268,7 +271,8 @@ def main():
 
 ADAPTIVE_SCENES = ("cornell_box.blend", "metals.blend", "glass.blend",
                    "glossy_dielectric.blend", "dof.blend", "motion_cube.blend",
-                   "hdri_world.blend", "fog_room.blend", "product_shot.blend")
+                   "hdri_world.blend", "fog_room.blend", "product_shot.blend",
+                   "uneven noise (tests/test_adaptive_sampling.py)")
 SECTIONS_JSON = os.path.join(DOCS, "benchmarks.json")
 
 
