@@ -157,7 +157,8 @@ def table(rows) -> list:
                    f"{ab['time_saving']:.2f}x |")
     return out + ["", "Under adaptive sampling the jittered sampler stratifies a pixel's "
                   "first Min Samples on their own and later samples in generations that "
-                  "double (52, 52, 104, 208, ...): a pixel that stops early holds whole "
+                  "double (64, 64, 128, 256, ... at threshold 0.01): a pixel that stops "
+                  "early holds whole "
                   "stratified sets, as a uniform render of that many samples does (with "
                   "strata over all of Samples, as before, it held a random subset of 1024 "
                   "strata, and adaptive sampling lost to uniform on every sample scene: "
