@@ -56,7 +56,9 @@ def uneven(long_side: int):
     """(engine Scene, DRT's default settings) of the scene whose noise is uneven that
     tests/test_adaptive_sampling.py renders: the Cornell box seen from further back in
     a grey world, the world noise-free, the box's indirect light noisy."""
-    sys.path.insert(0, os.path.join(ROOT, "tests"))
+    tests = os.path.join(ROOT, "tests")
+    if tests not in sys.path:
+        sys.path.insert(0, tests)
     from engine import RenderSettings
     from test_adaptive_sampling import uneven_scene
     return uneven_scene(long_side), RenderSettings()
@@ -116,6 +118,7 @@ def targets(rows) -> list:
     (what Cycles' stopping rule aims at), on every scene, and where noise is uneven."""
     if not rows:
         return []
+
     def saving(r):
         return r["metrics"]["display MSE"]["time_saving"]
     worst = min(rows, key=saving)
