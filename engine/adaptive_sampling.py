@@ -2,7 +2,7 @@
 estimate is under a noise threshold.
 
 The error of a pixel is measured on two films: the mean I of all its samples and the mean
-A of its odd-indexed samples (engine.film keeps both). With stratified or quasi-Monte Carlo
+A of half of them, Cycles' class A (engine.film keeps both). With stratified or quasi-Monte Carlo
 samples the spread of single samples overstates the error of their mean; I - A does not,
 since both halves are estimates of the same integral from the same kind of point set.
 Cycles' per-pixel error (after Dammertz et al., "A hierarchical automatic stopping
@@ -13,8 +13,10 @@ condition for Monte Carlo global illumination", 2.1) is
 with s(x) = sqrt(x) below 1 and x above (bright pixels need less relative precision), and
 a pixel has converged when error < 5 x threshold (Cycles scales the user's threshold by 5).
 Converged pixels next to unconverged ones are kept alive (a 3x3 box spread, as Cycles'
-two filter passes), so noise does not end in hard seams. Checks happen every `step`
-samples once a pixel has `min_samples`.
+two filter passes), so noise does not end in hard seams. Checks happen as Cycles' render
+scheduler makes them: first after (min_samples + 1) | (step - 1) + 1 samples (80 for Min
+Samples 64 and step 16: the first sample count past min_samples that ends a step), then
+every `step` samples.
 
 Automatic values, as Cycles: threshold 0 means max(0.001, 1 / samples); min samples 0
 means max(4, ceil(16 / threshold^0.3)) (threshold 0.01: 64 samples).
@@ -50,37 +52,44 @@ class AdaptiveSampling:
             least = max(4, math.ceil(16.0 / threshold ** 0.3))
         return cls(threshold=float(threshold), min_samples=int(least))
 
-    def pixel_error(self, film: Film) -> np.ndarray:
-        """(n,) Cycles' relative error estimate per pixel (flat order); inf for pixels
-        without samples in both halves."""
-        diff = np.abs(film.half_difference()).sum(axis=1)
-        intensity = film.sum.sum(axis=1) / np.maximum(film.count, 1)
+    def first_check(self) -> int:
+        """Samples before the first convergence check (Cycles' AdaptiveSampling::
+        align_samples: the first filter follows 0-based sample (min + 1) | (step - 1))."""
+        return ((self.min_samples + 1) | (self.step - 1)) + 1
+
+    def pixel_error(self, film: Film, pixels=None) -> np.ndarray:
+        """Cycles' relative error estimate of each pixel (flat order) or of `pixels` (flat
+        indices); inf for pixels without samples in both halves."""
+        sel = slice(None) if pixels is None else pixels
+        diff = np.abs(film.half_difference(pixels)).sum(axis=1)
+        count, half = film.count[sel], film.count_half[sel]
+        intensity = film.sum[sel].sum(axis=1) / np.maximum(count, 1)
         scale = np.where(intensity < 1.0, np.sqrt(np.maximum(intensity, 0.0)), intensity)
         err = diff / (1e-4 + scale)
-        has_halves = (film.count_odd > 0) & (film.count_odd < film.count)
-        return np.where(has_halves, err, np.inf)
+        return np.where((half > 0) & (half < count), err, np.inf)
 
     def active(self, film: Film) -> np.ndarray:
         """(n,) bool: pixels that still take samples (not converged, or next to one that
-        is not)."""
+        is not), every pixel checked."""
         unconverged = ~(self.pixel_error(film) < 5.0 * self.threshold)
         return spread(unconverged.reshape(film.height, film.width)).reshape(-1)
 
-    def passes(self, total: int, first_passes, active_count, paths_per_pass: int):
-        """Sample ranges (relative to the render's first sample) for an adaptive render,
-        yielded one by one: `first_passes` up to min_samples, then a multiple of `step`
-        samples per pass, so each pass ends where convergence is checked. When few pixels
-        are left the passes get longer (up to about `paths_per_pass` paths), so that the
-        per-pass cost of launching kernels does not dominate: a pixel then takes at most
-        that many samples past its convergence check."""
-        head = min(self.min_samples, total)
+    def check(self, film: Film, sampled: np.ndarray, unconverged: np.ndarray) -> np.ndarray:
+        """The pixels (flat indices) that go on after a pass over `sampled`: only theirs is
+        checked again, as Cycles checks (a pixel that took no samples keeps its state), and
+        `unconverged` (n,) bool is updated in place; so a check costs in proportion to the
+        pixels still sampling, not the frame. Equal to np.flatnonzero(active(film))."""
+        unconverged[sampled] = ~(self.pixel_error(film, sampled) < 5.0 * self.threshold)
+        return np.flatnonzero(spread(unconverged.reshape(film.height, film.width)))
+
+    def passes(self, total: int, first_passes):
+        """Sample ranges (relative to the render's first sample) for an adaptive render:
+        `first_passes` up to the first check, then `step` samples a pass, each ending
+        where Cycles checks convergence."""
+        head = min(self.first_check(), total)
         yield from first_passes(head)
-        done = head
-        while done < total:
-            wanted = -(-paths_per_pass // max(active_count(), 1))   # samples per pixel
-            b = min(done + self.step * max(1, -(-wanted // self.step)), total)
-            yield done, b
-            done = b
+        for a in range(head, total, self.step):
+            yield a, min(a + self.step, total)
 
 
 def spread(mask: np.ndarray) -> np.ndarray:

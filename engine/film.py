@@ -8,11 +8,13 @@ importance sampling every sample counts in exactly one pixel with weight one, so
 films rendered from disjoint sample ranges merge by addition into exactly the film of
 the whole range, variance estimate included.
 
-It also keeps the sum of the odd-indexed samples alone (and their count): a second film
-of every other sample, as Cycles keeps for adaptive sampling. The difference between the
-whole mean and that half's mean estimates the error of the pixel honestly even for
-stratified and quasi-Monte Carlo samples, whose sum of squares overstates it
-(engine.adaptive_sampling).
+It also keeps the sum of half of the samples alone (and their count): a second film of
+Cycles' class A, the samples s whose popcount(s & 0xaaaaaaaa) is odd (two of every four
+consecutive indices; Christensen, Kensler and Kilpatrick, "Progressive Multi-Jittered
+Sample Sequences", 10.2.1: each half of a progressive sequence is itself well spread), as
+Cycles keeps for adaptive sampling. The difference between the whole mean and that
+half's mean estimates the error of the pixel honestly even for stratified and
+quasi-Monte Carlo samples, whose sum of squares overstates it (engine.adaptive_sampling).
 
 With `extra` channels it also sums, per pixel, that many more RGB values of each sample
 (the light passes and light groups of engine.light_passes).
@@ -35,23 +37,36 @@ def _accumulate_extra(pixel, extra, extra_sum):
 
 
 @kernel
+def in_half(s):
+    """1 if sample index s is in the half film (Cycles' class A: popcount(s &
+    0xaaaaaaaa) odd, the parity folded down to bit 0), else 0."""
+    x = s & 0xAAAAAAAA
+    x ^= x >> 16
+    x ^= x >> 8
+    x ^= x >> 4
+    x ^= x >> 2
+    x ^= x >> 1
+    return x & 1
+
+
+@kernel
 def _accumulate(pixel, index, radiance, alpha, count, total, total_sq, alpha_sum,
-                count_odd, total_odd):
+                count_half, total_half):
     """Add each sample to its pixel's statistics (alpha empty: coverage 1); samples of
-    odd index also to the half film."""
+    class A also to the half film."""
     has_alpha = alpha.shape[0] > 0
     for i in range(pixel.shape[0]):
         p = pixel[i]
-        odd = index[i] & 1
+        half = in_half(index[i])
         count[p] += 1
-        count_odd[p] += odd
+        count_half[p] += half
         alpha_sum[p] += alpha[i] if has_alpha else 1.0
         for c in range(3):
             v = radiance[i, c]
             total[p, c] += v
             total_sq[p, c] += v * v
-            if odd:
-                total_odd[p, c] += v
+            if half:
+                total_half[p, c] += v
 
 
 class Film:
@@ -63,8 +78,8 @@ class Film:
         self.sum = np.zeros((n, 3), dtype=np.float64)
         self.sum_sq = np.zeros((n, 3), dtype=np.float64)
         self.alpha_sum = np.zeros(n, dtype=np.float64)
-        self.count_odd = np.zeros(n, dtype=np.int64)
-        self.sum_odd = np.zeros((n, 3), dtype=np.float64)
+        self.count_half = np.zeros(n, dtype=np.int64)
+        self.sum_half = np.zeros((n, 3), dtype=np.float64)
 
     def add(self, pixel: np.ndarray, radiance: np.ndarray, alpha: np.ndarray | None = None,
             *, index: np.ndarray, extra: np.ndarray | None = None) -> None:
@@ -79,13 +94,13 @@ class Film:
         _accumulate(pixel, index, np.ascontiguousarray(radiance, dtype=np.float64),
                     np.zeros(0) if alpha is None else np.ascontiguousarray(alpha, np.float64),
                     self.count, self.sum, self.sum_sq, self.alpha_sum,
-                    self.count_odd, self.sum_odd)
+                    self.count_half, self.sum_half)
         if self.extra_sum.shape[1]:
             if extra is None or extra.shape != (len(pixel),) + self.extra_sum.shape[1:]:
                 raise ValueError("this film keeps extra channels: one row of them per sample")
             _accumulate_extra(pixel, np.ascontiguousarray(extra, np.float64), self.extra_sum)
 
-    STATISTICS = ("count", "sum", "sum_sq", "alpha_sum", "count_odd", "sum_odd",
+    STATISTICS = ("count", "sum", "sum_sq", "alpha_sum", "count_half", "sum_half",
                   "extra_sum")
 
     def statistics(self) -> dict:
@@ -119,16 +134,18 @@ class Film:
         it (background samples add no radiance), as Blender expects."""
         return (self.alpha_sum / np.maximum(self.count, 1)).reshape(self.height, self.width)
 
-    def half_difference(self) -> np.ndarray:
-        """(n, 3) mean of all samples minus mean of the odd-indexed ones, per pixel (flat
-        order); 0 where a pixel has no odd or no even sample. Its square estimates the
-        variance of the pixel mean (with n/2 samples in each half, E[(I - A)^2] =
-        sigma^2 / n), whatever the sampler's stratification."""
-        c = self.count[:, None].astype(np.float64)
-        co = self.count_odd[:, None].astype(np.float64)
+    def half_difference(self, pixels=None) -> np.ndarray:
+        """(n, 3) mean of all samples minus mean of the half film's, per pixel (flat
+        order), or of `pixels` (flat indices) alone; 0 where a pixel has no sample in one
+        of the halves. Its square estimates the variance of the pixel mean (with n/2
+        samples in each half, E[(I - A)^2] = sigma^2 / n), whatever the sampler's
+        stratification."""
+        sel = slice(None) if pixels is None else pixels
+        c = self.count[sel][:, None].astype(np.float64)
+        co = self.count_half[sel][:, None].astype(np.float64)
         ok = (co > 0) & (co < c)
         with np.errstate(divide="ignore", invalid="ignore"):
-            d = self.sum / c - self.sum_odd / co
+            d = self.sum[sel] / c - self.sum_half[sel] / co
         return np.where(ok, d, 0.0)
 
     def variance_of_mean(self) -> np.ndarray:

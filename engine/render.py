@@ -63,7 +63,7 @@ class RenderContext:
         self.sampler = make_sampler(settings.sampler, settings.seed, settings.samples)
         adaptive = AdaptiveSampling.from_settings(settings)
         if adaptive is not None:
-            self.sampler.follow_stops(adaptive.min_samples, adaptive.step)
+            self.sampler.follow_stops(adaptive.first_check(), adaptive.step)
         self.has_motion = scene.has_motion()
         self.materials = MaterialTable(scene.materials)
         # instanced meshes stay instanced unless they emit or bound a volume
@@ -292,8 +292,8 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
     stop = threading.Event()
     adaptive = AdaptiveSampling.from_settings(settings)
     active = np.arange(n_pixels)
-    passes = adaptive.passes(total, plan_passes, lambda: len(active), 8192 * threads) \
-        if adaptive else plan_passes(total)
+    unconverged = np.ones(n_pixels, dtype=bool)
+    passes = adaptive.passes(total, plan_passes) if adaptive else plan_passes(total)
 
     running = [0]
     abandoned = threading.Event()
@@ -380,8 +380,8 @@ def render(scene: Scene, settings: RenderSettings, *, sample_start: int = 0,
                     break
                 if not stop.is_set():
                     stats.samples_done = b - sample_start
-                if adaptive is not None and stats.samples_done >= adaptive.min_samples:
-                    active = np.flatnonzero(adaptive.active(film))
+                if adaptive is not None and stats.samples_done >= adaptive.first_check():
+                    active = adaptive.check(film, active, unconverged)
                     stats.active_pixels = len(active)
                 if progress is not None:
                     fraction = stats.samples_done / total

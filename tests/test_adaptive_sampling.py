@@ -47,13 +47,24 @@ def test_cycles_automatic_values():
     assert AdaptiveSampling.from_settings(RenderSettings()) is None
 
 
+@pytest.mark.parametrize("least, first", [(64, 80), (52, 64), (4, 16), (16, 32), (79, 96)])
+def test_the_first_check_is_cycles(least, first):
+    """Cycles' scheduler filters first after 0-based sample (min + 1) | (step - 1)."""
+    a = AdaptiveSampling(threshold=0.01, min_samples=least)
+    assert a.first_check() == first
+    passes = list(a.passes(1024, lambda n: [(0, n)]))
+    assert passes[0] == (0, first) and passes[1] == (first, first + 16)
+    assert all(b - a == 16 for a, b in passes[1:-1]) and passes[-1][1] == 1024
+
+
 def test_pixel_error_is_cycles_formula():
     film = Film(3, 1)
-    # pixel 0: samples 0.2, 0.6 (index 0, 1) in red; 0.1, 0.1 in green and blue
+    # pixel 0: samples 0.2, 0.6 (index 1 in class B, 2 in class A: the half film) in red;
+    # 0.1, 0.1 in green and blue
     film.add(np.zeros(2, int), np.array([[0.2, 0.1, 0.1], [0.6, 0.1, 0.1]]),
-             index=np.array([0, 1]))
+             index=np.array([1, 2]))
     # pixel 1: bright (intensity over 1): samples 3 and 5 in every channel
-    film.add(np.ones(2, int), np.array([[3.0] * 3, [5.0] * 3]), index=np.array([0, 1]))
+    film.add(np.ones(2, int), np.array([[3.0] * 3, [5.0] * 3]), index=np.array([1, 2]))
     # pixel 2: one sample only (no halves): not converged
     film.add(np.full(1, 2), np.array([[1.0, 1.0, 1.0]]), index=np.array([0]))
     err = AdaptiveSampling(threshold=0.01, min_samples=4).pixel_error(film)
@@ -61,6 +72,27 @@ def test_pixel_error_is_cycles_formula():
     assert err[0] == pytest.approx(abs(0.4 - 0.6) / (1e-4 + np.sqrt(i0)))
     assert err[1] == pytest.approx(3 * abs(4.0 - 5.0) / (1e-4 + 12.0))
     assert np.isinf(err[2])
+
+
+def test_a_check_of_the_sampled_pixels_equals_one_of_every_pixel():
+    """Checking only the pixels a pass sampled (the others keep their state, as in
+    Cycles) gives the active set that checking every pixel gives, pass after pass."""
+    rng = np.random.default_rng(5)
+    h, w = 12, 16
+    film = Film(w, h)
+    noise = np.where(rng.random(h * w) < 0.3, 0.8, 0.02)        # some pixels noisy
+    a = AdaptiveSampling(threshold=0.01, min_samples=16)
+    unconverged = np.ones(h * w, bool)
+    active, start = np.arange(h * w), 0
+    for k in (16, 16, 16, 16):
+        pix = np.repeat(active, k)
+        index = np.tile(np.arange(start, start + k), len(active))
+        film.add(pix, 0.5 + noise[pix, None] * rng.standard_normal((len(pix), 3)), index=index)
+        start += k
+        np.testing.assert_array_equal(a.pixel_error(film, active), a.pixel_error(film)[active])
+        active = a.check(film, active, unconverged)
+        np.testing.assert_array_equal(active, np.flatnonzero(a.active(film)))
+    assert 0 < len(active) < h * w
 
 
 def test_unconverged_pixels_keep_their_neighbours_alive():
@@ -100,7 +132,9 @@ def test_adaptive_sampling_reaches_the_error_of_uniform_with_fewer_samples():
     per_pixel = sum(st.pixel_samples for _, st in runs) / 2 / (32 * 32)
     assert per_pixel < 200
     film = runs[0][0]
-    assert film.count.min() == 52               # min samples for 0.02: ceil(16 / 0.02^0.3)
+    # min samples for 0.02: ceil(16 / 0.02^0.3) = 52; Cycles' first check after
+    # (52 + 1) | 15 + 1 = 64 samples
+    assert film.count.min() == 64
     assert film.count.max() > 500
     assert runs[0][1].active_pixels < 32 * 32
     uniform = [render(scene, RenderSettings(seed=s, samples=int(round(per_pixel))))[0]

@@ -6,6 +6,25 @@ from engine.film import Film
 from engine_scenes import cornell_box
 
 
+def _cycles_class_a(s: int) -> bool:
+    """Cycles' sample_is_class_A (kernel/sample/pattern.h), in plain Python."""
+    return bin(s & 0xAAAAAAAA).count("1") % 2 == 1
+
+
+def test_the_half_film_holds_cycles_class_a():
+    """Sample s goes to the half film exactly when Cycles puts it in class A: two of
+    every four consecutive indices, and half of any aligned power-of-two run of 4 or
+    more."""
+    film = Film(1, 1)
+    n = 4096
+    values = np.random.default_rng(3).random((n, 3))
+    film.add(np.zeros(n, int), values, index=np.arange(n))
+    chosen = np.array([_cycles_class_a(s) for s in range(n)])
+    assert film.count_half[0] == chosen.sum() == n // 2
+    np.testing.assert_allclose(film.sum_half[0], values[chosen].sum(axis=0), rtol=1e-12)
+    assert all(chosen[k:k + 4].sum() == 2 for k in range(0, n, 4))
+
+
 def test_split_sample_ranges_merge_into_the_whole_render():
     scene = cornell_box(24, 24)
     settings = RenderSettings(samples=8, seed=11, chunk_paths=1024)
@@ -16,10 +35,10 @@ def test_split_sample_ranges_merge_into_the_whole_render():
     assert np.array_equal(merged.count, whole.count)
     np.testing.assert_allclose(merged.sum, whole.sum, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(merged.sum_sq, whole.sum_sq, rtol=1e-12, atol=1e-12)
-    # the half film of odd samples (adaptive sampling's error estimate) merges too
-    assert np.array_equal(merged.count_odd, whole.count_odd)
-    assert np.array_equal(whole.count_odd, np.full(24 * 24, 4))
-    np.testing.assert_allclose(merged.sum_odd, whole.sum_odd, rtol=1e-12, atol=1e-12)
+    # the half film (adaptive sampling's error estimate) merges too
+    assert np.array_equal(merged.count_half, whole.count_half)
+    assert np.array_equal(whole.count_half, np.full(24 * 24, 4))
+    np.testing.assert_allclose(merged.sum_half, whole.sum_half, rtol=1e-12, atol=1e-12)
     np.testing.assert_allclose(merged.variance_of_mean(), whole.variance_of_mean(),
                                rtol=1e-9, atol=1e-12)
 
@@ -80,4 +99,4 @@ def test_film_statistics_rebuild_the_film_in_another_process():
     copy = Film.from_statistics(3, 2, {k: v.copy() for k, v in film.statistics().items()})
     for name in Film.STATISTICS:
         assert np.array_equal(getattr(copy, name), getattr(film, name)), name
-    assert copy.count_odd.sum() == 25
+    assert copy.count_half.sum() == sum(_cycles_class_a(s) for s in range(50))
