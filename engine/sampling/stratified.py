@@ -14,10 +14,11 @@ any N, not only squares.
 Sample indices past N start a fresh, independently permuted generation of N, so
 progressive rendering can ask for more samples without breaking anything.
 
-Adaptive sampling stops a pixel after min_samples + k * step samples. A pixel stopped at
-52 of 1024 would hold a random subset of 1024 strata, little better than random samples;
+Adaptive sampling stops a pixel at one of Cycles' checks: the first after `first` samples
+(80 for Min Samples 64), then every `step` (engine.adaptive_sampling). A pixel stopped at
+80 of 1024 would hold a random subset of 1024 strata, little better than random samples;
 so under adaptive sampling the generations grow with the pixel instead: the first holds
-min_samples samples, and each later one as many as all before it (52, 52, 104, 208, ...).
+the `first` samples, and each later one as many as all before it (80, 80, 160, 320, ...).
 A pixel that stops holds whole stratified generations and part of one more, at most half
 of its samples; one that runs on is stratified in ever larger sets. (`pattern(first,
 doubling)` packs this into the one integer the kernels pass around as `spp`.)
