@@ -9,6 +9,8 @@ crashes is a row of the table, not the end of the run.
 
     .venv/bin/python docs/public_files.py --source github:OWNER/REPO@COMMIT FILE.blend ...
     .venv/bin/python docs/public_files.py --source -     # the page again, no render
+    .venv/bin/python docs/public_files.py --kinds --source ... FILE.blend ...   # what the
+                                        # measured files hold (docs/blend_kinds.py), no render
 
 Rows are kept in docs/public_files.json by file name and source, and docs/public_files.md
 is written from all of them; a run on some files updates their rows. The files are not
@@ -133,19 +135,32 @@ CAUSES = {
 }
 
 
+def kinds_one(path: str) -> list:
+    """What `path` holds (blend_kinds), without rendering it."""
+    sys.path[:0] = [ROOT, DOCS]
+    import bpy
+
+    import drt_addon
+    from blend_kinds import kinds
+    drt_addon.register()
+    bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
+    return kinds(bpy.context.scene)
+
+
 def measure_one(path: str) -> dict:
     """Render `path` with both engines in this process; the row of the table."""
-    sys.path[:0] = [ROOT, os.path.join(ROOT, "tests")]
+    sys.path[:0] = [ROOT, os.path.join(ROOT, "tests"), DOCS]
     import bpy
     import numpy as np
 
     import drt_addon
+    from blend_kinds import kinds
     from conftest import render_current, use_engine
     from drt_addon import render_engine
     from test_artist_scenes_vs_cycles import _block_mad
     from test_multiscatter_vs_cycles import compare
     drt_addon.register()
-    images, seconds, warnings = {}, {}, []
+    images, seconds, warnings, held = {}, {}, [], []
     for engine, spp in (("DRT", DRT_SAMPLES), ("CYCLES", CYCLES_SAMPLES),
                         ("CYCLES64", DRT_SAMPLES)):
         bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
@@ -160,6 +175,7 @@ def measure_one(path: str) -> dict:
         seconds[engine] = time.perf_counter() - start
         if engine == "DRT":
             warnings = [w[:200] for w in render_engine.last_render.get("warnings", [])]
+            held = kinds(scene)
     h, w = images["DRT"].shape[:2]
     drt, cycles, cycles64 = (images[e][:h - h % 8, :w - w % 8]          # 8 x 8 blocks
                              for e in ("DRT", "CYCLES", "CYCLES64"))
@@ -167,7 +183,7 @@ def measure_one(path: str) -> dict:
     return {"means": [float(m) for m in means], "block": float(block),
             "cycles_block": float(compare(cycles64, cycles)[1]),
             "block_mad": float(_block_mad(drt, cycles)), "size": list(drt.shape[:2]),
-            "seconds": seconds, "warnings": warnings,
+            "seconds": seconds, "warnings": warnings, "kinds": held,
             "nonfinite": int((~np.isfinite(drt)).sum())}
 
 
@@ -228,6 +244,7 @@ def write_page(rows: dict) -> None:
              f"own worst block\" is Cycles at {DRT_SAMPLES} samples (another seed) against "
              f"Cycles at {CYCLES_SAMPLES}: the noise that the block measure holds at DRT's "
              "sample count, where small bright emitters are seen directly.", ""]
+    lines += _kinds_table(rows)
     total = matched = noise = 0
     for source, items in by_source.items():
         lines += [f"## {source}", "",
@@ -247,17 +264,55 @@ def write_page(rows: dict) -> None:
         f.write("\n".join(lines))
 
 
+def _kinds_table(rows: dict) -> list:
+    """Markdown: for each of issue 27's kinds of content (docs/blend_kinds.py), the files
+    that hold it and how many of them match."""
+    sys.path.insert(0, DOCS)
+    from blend_kinds import KINDS
+    out = ["## What the files hold", "",
+           "Each file's content in the words of issue 27 (`docs/blend_kinds.py` inspects "
+           "the scene as it renders; files rendered before it existed have no entry).", "",
+           "| kind | files | match | within the noise | the files that do not match |",
+           "|---|---|---|---|---|"]
+    for kind in KINDS:
+        held = [m for m in rows.values() if kind in m.get("kinds", [])]
+        missing = ", ".join(sorted(m["file"] for m in held if not _matches(m)))
+        out.append(f"| {kind} | {len(held)} | {sum(map(_matches, held))} | "
+                   f"{sum(_within_noise(m) and not _matches(m) for m in held)} | {missing} |")
+    unknown = sum("kinds" not in m for m in rows.values())
+    return out + ["", f"{unknown} of {len(rows)} files have not been inspected.", ""]
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("files", nargs="*")
     ap.add_argument("--source", required=True,
                     help="where the files come from, e.g. github:owner/repo@commit")
     ap.add_argument("--one", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--kinds", action="store_true",
+                    help="only say what the (already measured) files hold; no render")
     args = ap.parse_args()
     if args.one:
-        print("ROW " + json.dumps(measure_one(args.files[0])), flush=True)
+        found = kinds_one(args.files[0]) if args.kinds else measure_one(args.files[0])
+        print("ROW " + json.dumps(found), flush=True)
         return 0
     rows = json.load(open(TABLE)) if os.path.exists(TABLE) else {}
+    if args.kinds:
+        for path in args.files:
+            key = f"{args.source} {os.path.basename(path)}"
+            done = subprocess.run([sys.executable, __file__, "--one", "--kinds", "--source",
+                                   args.source, path], capture_output=True, text=True,
+                                  cwd=ROOT)
+            found = [line[4:] for line in done.stdout.splitlines() if line.startswith("ROW ")]
+            if key in rows and found:
+                rows[key]["kinds"] = json.loads(found[-1])
+                print(key, rows[key]["kinds"], flush=True)
+            else:
+                print(key, "not inspected" if key in rows else "not measured yet", flush=True)
+        with open(TABLE, "w") as f:
+            json.dump(rows, f, indent=1, sort_keys=True)
+        write_page(rows)
+        return 0
     if not args.files:                      # the page again from the measured rows
         write_page(rows)
         return 0
