@@ -112,11 +112,20 @@ def main():
     ap.add_argument("--skip", default="", help="comma-separated sections to skip (1..10)")
     ap.add_argument("--only", default="", help="comma-separated sections to run (1..10); the "
                     "others keep their last measured figures (docs/benchmarks.json)")
+    ap.add_argument("--section6-page", action="store_true",
+                    help="write section 6 again from its last measured rows (no render)")
     args = ap.parse_args()
     skip = set(args.skip.split(",")) - {""}
     if args.only:
         skip |= set(map(str, range(1, 11))) - set(args.only.split(","))
     saved = _load_sections()
+    if args.section6_page:
+        from adaptive_benchmark import table, targets as adaptive_targets
+        rows = saved["6"]["rows"]
+        saved["6"].update(lines=table(rows), targets=adaptive_targets(rows))
+        _save_sections(saved)
+        _write_page(saved)
+        return
     q = args.quick
     cores = os.cpu_count() or 1
     base = f"{platform.machine()}, {cores} cores, Python {platform.python_version()}"
@@ -226,21 +235,27 @@ def main():
                   f"| off | {r['static']:.2f} |", f"| on | {r['blur']:.2f} |", ""]
         done("5")
     if "6" not in skip:
-        from adaptive_benchmark import UNEVEN, measure, table, targets as adaptive_targets
+        from adaptive_benchmark import (UNEVEN, measure, measure_cycles, table,
+                                        targets as adaptive_targets)
         rows = []
         chosen = [b for b in args.adaptive_scenes.split(",") if b] or ADAPTIVE_SCENES
+        size = dict(long_side=32 if q else 96, ref_spp=256 if q else 2048,
+                    ladder=(4, 16, 64) if q else (16, 64, 256))
         for blend in chosen:
+            path = blend if blend == UNEVEN else os.path.join(SAMPLES, blend)
             for sampler in ("jittered", "sobol"):
-                path = blend if blend == UNEVEN else os.path.join(SAMPLES, blend)
-                rows.append(measure(path, long_side=32 if q else 96,
-                                    ref_spp=256 if q else 2048, sampler=sampler,
-                                    ladder=(4, 16, 64) if q else (16, 64, 256)))
+                rows.append(measure(path, sampler=sampler, **size))
                 print(blend, sampler, rows[-1]["metrics"], flush=True)
+            rows.append(measure_cycles(path, **size))
+            print(blend, "Cycles", rows[-1]["metrics"], flush=True)
         lines += table(rows) if chosen == ADAPTIVE_SCENES else \
             _join_rows(saved["6"]["lines"], table(rows), chosen)
         targets += adaptive_targets(rows) if chosen == ADAPTIVE_SCENES else \
             saved["6"]["targets"]
         done("6")
+        if chosen == ADAPTIVE_SCENES:
+            saved["6"]["rows"] = rows            # its page again: --section6-page
+            _save_sections(saved)
     if "7" not in skip:      # the convergence studies (cached in ~/.cache/drt/converge)
         import make_convergence_docs as studies
         lines += studies.benchmark_section(studies.main(["cornell_box"] if q else []))
@@ -272,7 +287,7 @@ def main():
 ADAPTIVE_SCENES = ("cornell_box.blend", "metals.blend", "glass.blend",
                    "glossy_dielectric.blend", "dof.blend", "motion_cube.blend",
                    "hdri_world.blend", "fog_room.blend", "product_shot.blend",
-                   "uneven noise (tests/test_adaptive_sampling.py)")
+                   "cornell_box.blend from afar")      # adaptive_benchmark.UNEVEN
 SECTIONS_JSON = os.path.join(DOCS, "benchmarks.json")
 
 
