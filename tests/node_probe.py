@@ -18,6 +18,7 @@ import math
 import numpy as np
 
 from conftest import render_current, use_engine
+from figures import AGAINST_CYCLES, record
 
 TILE = 16                  # pixels per tile
 
@@ -162,11 +163,15 @@ def drt_against_cycles(bpy, scene, drt_samples, cycles_samples=None):
     return image_errors(render(bpy, scene, "DRT", drt_samples), cycles)
 
 
-def image_errors(drt, cycles):
-    """(|mean ratio - 1|, largest 8 x 8 block difference over the image mean)."""
+def image_errors(drt, cycles, what=AGAINST_CYCLES):
+    """(|mean ratio - 1|, largest 8 x 8 block difference over the image mean), recorded
+    for the docs (figures.record) as `what`."""
     h, w, _ = cycles.shape
     d = (drt - cycles).mean(axis=2).reshape(h // 8, 8, w // 8, 8).mean(axis=(1, 3))
-    return abs(drt.mean() / cycles.mean() - 1.0), float(np.abs(d).max() / cycles.mean())
+    mean = abs(float(drt.mean()) / float(cycles.mean()) - 1.0)
+    block = float(np.abs(d).max() / cycles.mean())
+    record(what, mean=mean, block=block)
+    return mean, block
 
 
 def new_scene(bpy, size=64):

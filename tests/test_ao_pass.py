@@ -22,6 +22,7 @@ from engine.ambient_occlusion import AmbientOcclusion
 from engine.aov import first_hit_passes
 from engine.scene import Camera, Material, Scene, World
 from engine_scenes import look_at, quad
+from figures import AGAINST_CYCLES, record
 
 W, H = 32, 24
 
@@ -116,5 +117,7 @@ def test_ao_pass_matches_cycles(bpy_drt):
     mean = out["DRT", 0.5].mean() - cycles.mean()
     print(f"AO vs Cycles: mean {mean:+.4f}, worst block {np.abs(diff).max():.4f}; "
           f"control (twice the distance): worst block {np.abs(control).max():.4f}")
+    record(AGAINST_CYCLES + " (AO, of its full 1)", mean=abs(mean), block=np.abs(diff).max())
+    record("control: twice the distance (AO, of its full 1)", block=np.abs(control).max())
     assert abs(mean) < 0.005 and np.abs(diff).max() < 0.03
     assert np.abs(control).max() > 0.1

@@ -69,7 +69,8 @@ def _matches_and_flat_does_not(bpy, scene, nt, socket, what):
     print(f"{what}: mean {mean:.2%}, largest block {block:.2%}")
     for link in list(socket.links):
         nt.links.remove(link)
-    flat_mean, flat_block = image_errors(node_probe.render(bpy, scene, "DRT", 64), cycles)
+    flat_mean, flat_block = image_errors(node_probe.render(bpy, scene, "DRT", 64), cycles,
+                                          "control: the bump unlinked")
     print(f"flat: mean {flat_mean:.2%}, largest block {flat_block:.2%}")
     assert mean < 0.015 and block < 0.03, (mean, block)
     assert flat_block > 0.1, flat_block
@@ -148,7 +149,8 @@ def test_bent_sphere_without_bump_map_correction_matches_cycles(bpy_drt, kind,
     drt = node_probe.render(bpy, scene, "DRT", SPHERE_SAMPLES)
     mean, block = image_errors(drt, cycles)
     mat.cycles.use_bump_map_correction = True
-    corrected = image_errors(node_probe.render(bpy, scene, "DRT", SPHERE_SAMPLES), cycles)
+    corrected = image_errors(node_probe.render(bpy, scene, "DRT", SPHERE_SAMPLES), cycles,
+                             "control: with bump map correction")
     print(f"{kind} sphere, no correction: mean {mean:.2%}, largest block {block:.2%}; "
           f"corrected: mean {corrected[0]:.2%}, largest block {corrected[1]:.2%}")
     assert mean < 0.01 and block < 0.03, (mean, block)
@@ -215,7 +217,8 @@ def test_light_path_depths_lit_match_cycles(bpy_drt):
     for out in path.outputs:
         for link in list(out.links):
             nt.links.remove(link)
-    unlinked = image_errors(node_probe.render(bpy, scene, "DRT", 16), cycles)[1]
+    unlinked = image_errors(node_probe.render(bpy, scene, "DRT", 16), cycles,
+                            "control: the depths unlinked")[1]
     print(f"depths unlinked: largest block {unlinked:.2%}")
     assert mean < 0.02 and block < 0.05, (mean, block)
     assert unlinked > 0.1, unlinked

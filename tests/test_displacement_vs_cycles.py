@@ -99,7 +99,8 @@ def test_displacement_matches_cycles(bpy_drt, method, coordinates, vector, flat,
     drt = node_probe.render(bpy, scene, "DRT", SAMPLES)
     mean, block = image_errors(drt, cycles)
     mat.displacement_method = "BUMP"
-    control = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles)
+    control = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles,
+                           "control: Bump Only")
     print(f"{method} {coordinates or 'Generated'}{' vector' if vector else ''}"
           f"{' flat' if flat else ''}: mean "
           f"{mean:.2%}, largest block {block:.2%}; as Bump Only: mean {control[0]:.2%}, "
@@ -177,7 +178,8 @@ def test_adaptive_subdivision_matches_cycles(bpy_drt):
     drt = node_probe.render(bpy, scene, "DRT", SAMPLES)
     mean, block = image_errors(drt, cycles)
     mod.use_adaptive_subdivision = False
-    control = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles)
+    control = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles,
+                           "control: the render levels, not diced")
     print(f"adaptive subdivision: mean {mean:.2%}, largest block {block:.2%}; at the "
           f"render levels: mean {control[0]:.2%}, largest block {control[1]:.2%}")
     assert mean < 0.01 and block < 0.03, (mean, block)
@@ -398,13 +400,15 @@ def test_the_displacements_bump_is_the_normal_the_surface_nodes_read(bpy_drt, me
     _surface_normal_readout(bpy, mat)
     cycles = node_probe.render(bpy, scene, "CYCLES", 32)
     drt = node_probe.render(bpy, scene, "DRT", 32)
-    errors = [image_errors(drt[..., k:k + 1], cycles[..., k:k + 1]) for k in range(3)]
+    errors = [image_errors(drt[..., k:k + 1], cycles[..., k:k + 1],
+                           f"DRT against Cycles, {'RGB'[k]}") for k in range(3)]
     nt = mat.node_tree
     for link in list(nt.nodes["Material Output"].inputs["Displacement"].links):
         nt.links.remove(link)
     mat.displacement_method = "BUMP"
     flat = node_probe.render(bpy, scene, "CYCLES", 32)
-    control = max(image_errors(flat[..., k:k + 1], cycles[..., k:k + 1])[1]
+    control = max(image_errors(flat[..., k:k + 1], cycles[..., k:k + 1],
+                               f"control: Cycles without the displacement, {'RGB'[k]}")[1]
                   for k in range(3))
     print(f"{method}: per channel (mean, block) "
           + ", ".join(f"({m:.2%}, {b:.2%})" for m, b in errors)

@@ -117,7 +117,7 @@ def test_emitters_left_out_of_light_sampling_match_cycles(bpy_drt):
     control = float(sampled[..., 2][faces].mean() - cycles[..., 2][faces].mean())
     print(f"mean {mean:.2%}, largest block {block:.2%}; {faces.sum()} face pixels: "
           f"{inside:.6f}; sampled: {control:.6f}, largest block "
-          f"{image_errors(sampled, cycles)[1]:.2%}")
+          f"{image_errors(sampled, cycles, 'control: both light-sampled')[1]:.2%}")
     assert faces.sum() > 500
     assert mean < 0.01 and block < 0.03, (mean, block)
     assert abs(inside) < 2e-3, inside

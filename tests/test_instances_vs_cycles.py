@@ -107,7 +107,8 @@ def test_scattered_instances_match_cycles(bpy_drt):
     print(f"scattered instances: mean {mean:.2%}, largest block {block:.2%}")
     for link in list(bsdf.inputs["Base Color"].links):       # the control
         nt.links.remove(link)
-    one_mean, one_block = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles)
+    one_mean, one_block = image_errors(node_probe.render(bpy, scene, "DRT", SAMPLES), cycles,
+                                       "control: one colour for all places")
     print(f"one colour for all places: mean {one_mean:.2%}, largest block {one_block:.2%}")
     assert mean < 0.015 and block < 0.04, (mean, block)
     assert one_block > 0.10, (one_mean, one_block)

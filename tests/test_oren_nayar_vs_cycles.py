@@ -64,7 +64,8 @@ def test_rough_diffuse_surfaces_match_cycles(bpy_drt):
     drt = node_probe.render(bpy, scene, "DRT", DRT_SAMPLES)
     mean, block = image_errors(drt, cycles)
     _set_roughness(bpy, 0.0)
-    control = image_errors(node_probe.render(bpy, scene, "DRT", DRT_SAMPLES), cycles)
+    control = image_errors(node_probe.render(bpy, scene, "DRT", DRT_SAMPLES), cycles,
+                           "control: Lambert (roughness 0)")
     print(f"diffuse roughness: mean {mean:.2%}, largest block {block:.2%}; Lambert: mean "
           f"{control[0]:.2%}, largest block {control[1]:.2%}")
     assert mean < 0.01 and block < 0.03, (mean, block)

@@ -61,13 +61,14 @@ def test_coarse_sphere_terminator_matches_cycles(bpy_drt, light):
     mean, block = image_errors(drt, cycles)
     sphere.shadow_terminator_geometry_offset = 0.0
     drt_flat = node_probe.render(bpy, scene, "DRT", SAMPLES)
-    flat = image_errors(drt_flat, cycles)
+    flat = image_errors(drt_flat, cycles, "control: Geometry Offset 0 in DRT")
     print(f"{light}: mean {mean:.2%}, largest block {block:.2%}; from the flat triangles: "
           f"mean {flat[0]:.2%}, largest block {flat[1]:.2%}")
     assert mean < 0.01 and block < 0.03, (mean, block)
     assert flat[1] > 0.04, flat
     if light == "sun":
-        both = image_errors(drt_flat, node_probe.render(bpy, scene, "CYCLES", SAMPLES))
+        both = image_errors(drt_flat, node_probe.render(bpy, scene, "CYCLES", SAMPLES),
+                            "DRT against Cycles, both at Geometry Offset 0")
         print(f"both at offset 0: mean {both[0]:.2%}, largest block {both[1]:.2%}")
         assert both[0] < 0.01 and both[1] < 0.03, both
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from figures import AGAINST_CYCLES, record
 from node_probe import new_material, render
 from test_anisotropic_vs_cycles import _sphere_scene
 
@@ -78,14 +79,16 @@ GLASS_CASES = {
 }
 
 
-def channel_errors(drt, cycles):
+def channel_errors(drt, cycles, what=AGAINST_CYCLES):
     """(largest |channel mean ratio - 1|, largest 8 x 8 block difference of a channel
-    over that channel's mean)."""
+    over that channel's mean), recorded for the docs as `what`."""
     h, w, _ = cycles.shape
     means = drt.mean(axis=(0, 1)) / cycles.mean(axis=(0, 1)) - 1.0
     d = (drt - cycles).reshape(h // 8, 8, w // 8, 8, 3).mean(axis=(1, 3))
     block = np.abs(d).max(axis=(0, 1)) / cycles.mean(axis=(0, 1))
-    return float(np.abs(means).max()), float(block.max())
+    worst = float(np.abs(means).max()), float(block.max())
+    record(what + " (worst channel)", mean=worst[0], block=worst[1])
+    return worst
 
 
 @pytest.mark.parametrize("case", sorted(CASES))
@@ -98,7 +101,8 @@ def test_thin_film_matches_cycles(bpy_drt, case):
     # the control: the film left out
     for mat in bpy.data.materials:
         mat.node_tree.nodes["Principled BSDF"].inputs["Thin Film Thickness"].default_value = 0.0
-    c_mean, c_block = channel_errors(render(bpy, scene, "DRT", 64)[..., :3], cycles)
+    c_mean, c_block = channel_errors(render(bpy, scene, "DRT", 64)[..., :3], cycles,
+                                     "control: the film left out")
     print(f"{case} without the film (control): worst channel mean {c_mean:.2%}, "
           f"largest block {c_block:.2%}")
     bound = METAL_BLOCK_TOLERANCE if case in ("oxidised_copper", "tinted_metal") else \
@@ -145,7 +149,9 @@ def test_thin_film_on_glass_changes_the_image_as_in_cycles(bpy_drt, case):
     effect = {e: means[e, film] / means[e, 0.0] for e in ("CYCLES", "DRT")}
     off = float(np.abs(effect["DRT"] / effect["CYCLES"] - 1.0).max())
     _, block = channel_errors(images["DRT", film], images["CYCLES", film])
-    _, own = channel_errors(cycles_again, images["CYCLES", film])
+    _, own = channel_errors(cycles_again, images["CYCLES", film],
+                            "Cycles against itself (another seed)")
+    record("the film's effect on each channel's mean, DRT's over Cycles'", mean=off)
     print(f"{case}: the film's effect, DRT {np.round(effect['DRT'] - 1, 4)}, Cycles "
           f"{np.round(effect['CYCLES'] - 1, 4)} (off by {off:.2%}); largest block "
           f"{block:.2%}, Cycles' own {own:.2%}")
