@@ -134,6 +134,14 @@ CAUSES = {
         "without the brightest 0.1 % of pixels +8.6 %; not examined yet (the noise "
         "groups' vector-to-float conversions and the Generated coordinates inside a "
         "volume are candidates)",
+    "github:mpett/blends@1e67d3ab9f5730c96c69858f6254a341e80405dc neon.blend":
+        "a neon text (Emission added to a Principled BSDF, mixed by Layer Weight) lighting "
+        "a brick wall with true displacement (its colour image missing in both: pink). "
+        "DRT is about half as bright over the whole lit wall: at 160 px (DRT 16 samples, "
+        "Cycles 64, 2026-12-02) each of 4 x 4 regions of the lit middle holds 0.49 to "
+        "0.63 of Cycles' light, the unlit top and bottom black in both. The wall's "
+        "material links a Mix Shader into the Principled BSDF's Roughness (an invalid "
+        "link both engines ignore). Not examined yet",
     "mellowmallow.blend":
         "its marshmallows are a soft body at frame 131 with no cache: every vertex NaN in "
         "both engines; the green is the 1 kW lamp seen in a glass-and-translucent jar, "
