@@ -138,8 +138,8 @@ CAUSES = {
         "a neon text (Emission added to a Principled BSDF, mixed by Layer Weight) lighting "
         "a brick wall with true displacement (its colour image missing in both: pink). "
         "DRT is about half as bright over the whole lit wall: at 160 px (DRT 16 samples, "
-        "Cycles 64, 2026-12-02) each of 4 x 4 regions of the lit middle holds 0.49 to "
-        "0.63 of Cycles' light, the unlit top and bottom black in both. The wall's "
+        "Cycles 64, 2026-12-02) each of the 8 regions (of 4 x 4) of the lit middle holds 0.48 to "
+        "0.65 of Cycles' light, the unlit top and bottom black in both. The wall's "
         "material links a Mix Shader into the Principled BSDF's Roughness (an invalid "
         "link both engines ignore). Not examined yet",
     "mellowmallow.blend":
