@@ -11,7 +11,7 @@ from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _Layers, _sum
 from ..material_params import TOL, _is_tex, _lin, _scale
 from .links import _link
 from .shader_inputs import _constant, _input
-from .shader_mix import _mix_factor, _plastic, lifted_mix
+from .shader_mix import _mix_factor, _plastic, lifted_mix, per_hit_emission
 from . import anisotropy, hair, metallic, subsurface
 
 
@@ -215,7 +215,7 @@ def _glass(node, ctx, refraction=False) -> _Closure:
 
 def _emission(node, ctx) -> _Closure:
     color = _input(node, "Color", ctx, True, WHITE)
-    strength = _constant(node, "Strength", ctx, 1.0)
+    strength = _input(node, "Strength", ctx, False, 1.0)      # per hit where it varies
     return _Closure([(1.0, NULL_COMP)], emission=_scale(color, strength),
                     plain_emission=True)
 
@@ -299,6 +299,7 @@ def _closure(socket, ctx, depth=0) -> _Closure:
                                                 y.scaled(fac, ctx), ctx), a, b)
         # per hit: export_material makes a Material of each side
         mixed = _sum(a.scaled(1.0 - fac, ctx), b.scaled(fac, ctx), ctx)
+        mixed.emission = per_hit_emission(a, b, varying, ctx)
         mixed.mix = (a, b, varying)
         return mixed
     if kind == "ShaderNodeAddShader":

@@ -11,7 +11,7 @@ import numpy as np
 
 from ...engine_link import engine
 from ..closures import BLACK, NULL_COMP, WHITE, _Closure
-from ..material_params import _lin, _mean, _same
+from ..material_params import NodeParam, _lin, _mean, _same, _scale, cv
 from .links import _link
 from .shader_inputs import _constant
 
@@ -48,6 +48,19 @@ def _mix_factor(node, ctx):
     if folded is not None:
         return float(np.clip(folded, 0.0, 1.0)), None, None
     return float(np.clip(ctx.nodes.mean(value), 0.0, 1.0)), None, value
+
+
+def per_hit_emission(a: _Closure, b: _Closure, fac, ctx):
+    """The emission of a Mix Shader whose Fac varies per hit (the program value `fac`):
+    Cycles weighs both shaders' emissions at the hit by 1 - Fac and Fac, the Fac clamped
+    to [0, 1] (svm_node_mix_closure), so a hit sees that sum, not the mix at the Fac's
+    average (which is what the rest of the mixed closure set holds)."""
+    nodes = ctx.nodes
+    f = NodeParam(nodes.emit(cv.CV_MATH, "float", [fac, nodes.const(1.0), nodes.const(0.0),
+                                                   cv.MATH_OPS.index("MULTIPLY_ADD"), 1]),
+                  nodes)
+    return _lin([(1.0, _scale(a.emission, f.scaled(-1.0, add=1.0))),
+                 (1.0, _scale(b.emission, f))], ctx, "emission")
 
 
 def lifted_mix(combine, a, b):
