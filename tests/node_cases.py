@@ -471,8 +471,26 @@ def _mapping(kind):
     return build
 
 
+def _normal_node(output):
+    """The Normal node: its own direction (unnormalised here, as a dragged widget may
+    leave it) or its Dot with the tile's object coordinates (normalised by the node)."""
+    def build(nt, p):
+        n = p.node(nt, "ShaderNodeNormal")
+        n.outputs["Normal"].default_value = (0.3, -0.5, 0.8)
+        nt.links.new(p.coords(nt).outputs["Object"], n.inputs["Normal"])
+        if output == "Dot":
+            return shown(nt, p, n.outputs["Dot"], 0.4)
+        show = p.node(nt, "ShaderNodeVectorMath", operation="MULTIPLY_ADD")
+        nt.links.new(n.outputs["Normal"], show.inputs[0])
+        show.inputs[1].default_value = (0.4, 0.4, 0.4)
+        show.inputs[2].default_value = (0.5, 0.5, 0.5)
+        return show.outputs[0]
+    return build
+
+
 VECTOR = [(f"vmath_{o.lower()}", _vector_math(o)) for o in VECTOR_OPS] + [
-    (f"mapping_{k.lower()}", _mapping(k)) for k in ("POINT", "TEXTURE", "VECTOR", "NORMAL")]
+    (f"mapping_{k.lower()}", _mapping(k)) for k in ("POINT", "TEXTURE", "VECTOR", "NORMAL")] + [
+    ("normal_direction", _normal_node("Normal")), ("normal_dot", _normal_node("Dot"))]
 
 FAMILIES = {"input": (INPUT, "plane"), "input_spheres": (INPUT_SPHERES, "sphere"),
             "texture": (TEXTURE, "plane"), "color": (COLOR, "plane"),

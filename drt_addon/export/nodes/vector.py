@@ -1,9 +1,10 @@
 """Vector nodes to program operations (engine.nodes.vector_nodes, engine.nodes.bump):
-Vector Math, Mapping, Normal Map (tangent space, from the tangents of the mesh's UV map)
-and Bump."""
+Vector Math, Mapping, Normal, Normal Map (tangent space, from the tangents of the mesh's
+UV map) and Bump."""
 from __future__ import annotations
 
 import importlib
+import math
 
 from ...engine_link import engine
 from .errors import Unsupported
@@ -38,6 +39,23 @@ def _mapping(c, node, out):
     return c.emit(VE.VEC_MAPPING, "vector", [c.input(node, "Vector", "vector"), location,
                                              c.input(node, "Rotation", "vector"),
                                              c.input(node, "Scale", "vector"), kind])
+
+
+def _normal(c, node, out):
+    """Cycles' Normal node (svm_node_normal): its own direction (the sphere widget, kept
+    as its Normal output's value), normalised, and the dot product of that direction with
+    the normalised Normal input."""
+    d = [float(x) for x in node.outputs["Normal"].default_value]
+    length = math.sqrt(sum(x * x for x in d))
+    direction = c.const(tuple(x / length for x in d) if length > 0.0 else (0.0, 0.0, 0.0),
+                        "vector")
+    if out.identifier == "Normal":
+        return direction
+    n = c.input(node, "Normal", "vector")
+    one = c.const(1.0)
+    unit = c.emit(VE.VEC_MATH, "vector", [n, n, n, one, VE.VECTOR_OPS.index("NORMALIZE")])
+    return c.emit(VE.VEC_MATH_VALUE, "float", [direction, unit, unit, one,
+                                               VE.VECTOR_OPS.index("DOT_PRODUCT")])
 
 
 def _normal_map(c, node, out):
@@ -78,6 +96,7 @@ def _bump(c, node, out):
 TRANSLATORS = {
     "ShaderNodeBump": _bump,
     "ShaderNodeNormalMap": _normal_map,
+    "ShaderNodeNormal": _normal,
     "ShaderNodeVectorMath": _vector_math,
     "ShaderNodeMapping": _mapping,
 }
