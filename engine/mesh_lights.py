@@ -77,13 +77,19 @@ SIDES = {"NONE": 0, "FRONT": FRONT, "BACK": BACK, "FRONT_BACK": FRONT | BACK}
 
 
 class EmissiveTriangles:
-    def __init__(self, v0, v1, v2, radiance, prim_ids, n_prims_total: int, sides=None):
-        """sides: FRONT, BACK or both (the default) per triangle, the sides sampled."""
+    def __init__(self, v0, v1, v2, radiance, prim_ids, n_prims_total: int, sides=None,
+                 shaded=None):
+        """sides: FRONT, BACK or both (the default) per triangle, the sides sampled.
+        shaded: per triangle, 0, or its material's index + 1 where its emission varies
+        over the surface: `radiance` is then an estimate (its average), and a light
+        sample evaluates the material where it lands (engine.kernels.shaded_emitter)."""
         v0, v1, v2 = (np.asarray(v, dtype=np.float64).reshape(-1, 3) for v in (v0, v1, v2))
         radiance = np.asarray(radiance, dtype=np.float64).reshape(-1, 3)
         prim_ids = np.asarray(prim_ids, dtype=np.int64).reshape(-1)
         sides = (np.full(len(prim_ids), FRONT | BACK, np.int64) if sides is None
                  else np.asarray(sides, np.int64).reshape(-1))
+        shaded = (np.zeros(len(prim_ids), np.int64) if shaded is None
+                  else np.asarray(shaded, np.int64).reshape(-1))
         e1, e2 = v1 - v0, v2 - v0
         cr = np.cross(e1, e2)
         norm = np.linalg.norm(cr, axis=1)
@@ -97,22 +103,27 @@ class EmissiveTriangles:
         self.power = power[keep]
         self.prim = prim_ids[keep]
         self.sides = sides[keep]
-        # (copies sampled on other sides stay apart)
+        self.shaded = shaded[keep]
+        # (copies sampled on other sides, or of other varying emissions, stay apart)
         first, copy_of = _coincident_copies(v0[keep], v1[keep], v2[keep],
-                                              np.column_stack([self.radiance, self.sides]))
+                                              np.column_stack([self.radiance, self.sides,
+                                                               self.shaded]))
         self.entry = np.full(max(int(n_prims_total), 1), -1, dtype=np.int64)
         self.entry[self.prim] = copy_of
         for name in ("v0", "e1", "e2", "normal", "area", "radiance", "power", "prim",
-                     "sides"):
+                     "sides", "shaded"):
             setattr(self, name, getattr(self, name)[first])
 
     @classmethod
-    def from_scene(cls, scene, accel, emission=None, only=None) -> "EmissiveTriangles":
+    def from_scene(cls, scene, accel, emission=None, only=None,
+                   shaded=None) -> "EmissiveTriangles":
         """The emissive triangles of `scene`, with the global ids of `accel`
         (engine.accel.Accelerator: static triangles first, ids 0..len(accel.triangles)-1).
         `emission`: (materials, 3) radiance table, by default the materials' `emission`;
         the renderer passes the one its integrator adds at hits, so both agree. `only`:
-        a flag per global triangle, the ones that may be lights (None: all)."""
+        a flag per global triangle, the ones that may be lights (None: all). `shaded`: a
+        flag per material whose emission varies over the surface (`emission` then holds
+        its average, an estimate)."""
         tri = accel.triangles
         if not len(tri) or not scene.materials:
             return cls(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
@@ -137,8 +148,12 @@ class EmissiveTriangles:
         sides[:len(scene.materials)] = [
             SIDES.get(getattr(m, "emission_sampling", "FRONT_BACK"), FRONT | BACK)
             for m in scene.materials][:len(emission)]
+        varies = np.zeros(len(emission), np.int64)
+        if shaded is not None:
+            flags = np.asarray(shaded, bool)[:len(emission)]
+            varies[:len(flags)] = np.where(flags, np.arange(len(flags)) + 1, 0)
         return cls(p[t[:, 0]], p[t[:, 1]], p[t[:, 2]], emission[mat[emissive]], emissive,
-                   len(tri), sides[mat[emissive]])
+                   len(tri), sides[mat[emissive]], varies[mat[emissive]])
 
     def __len__(self):
         return len(self.area)

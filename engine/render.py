@@ -67,14 +67,15 @@ class RenderContext:
         self.has_motion = scene.has_motion()
         self.materials = MaterialTable(scene.materials)
         # instanced meshes stay instanced unless they emit or bound a volume
-        meshes = instancing.resolve(scene.meshes,
-                                    _instanceable(scene.materials, self.materials.emission))
+        meshes = instancing.resolve(
+            scene.meshes, _instanceable(scene.materials, self.materials.emission_estimate))
         self.accel = Accelerator(meshes, threads=1, time_enabled=self.has_motion,
                                  curves=scene.curves)
         self.surfaces = SurfaceBuilder(self.accel, [getattr(m, "holdout", False)
                                                     for m in scene.materials])
-        self._light(scene, EmissiveTriangles.from_scene(scene, self.accel,
-                                                        self.materials.emission))
+        self._light(scene, EmissiveTriangles.from_scene(
+            scene, self.accel, self.materials.emission_estimate,
+            shaded=self.materials.emission_shaded))
         self.integrator = make_integrator(settings.integrator, self)
         self.catcher = self._catcher_run()
         # A camera that does not move gets its rays from one compiled kernel.

@@ -14,12 +14,11 @@ average on 70 % of it, a dark Principled between) and a smooth tube whose emissi
 panel's Emission Strength grows with its height (an Emission's Strength was read as its
 average before, with a warning).
 
-Measured (256 samples each; mean, largest 8 x 8 block): 0.00 %, 1.91 %; the panel's
-Strength at its average 0.98 %, 389 %; and its Fac at its average too 1.16 %, 536 %;
-before the fix 2.14 %, 536 %. At 1024 samples the tube's block stays 2.2 % darker than
-Cycles': it is smooth-shaded, and light from the panel arriving under a face's plane
-but above its smooth normal is found by Cycles' next-event estimation only, which DRT
-does not do for emission that varies per hit (engine.bsdf.material_table)."""
+Measured (256 samples each; mean, largest 8 x 8 block): 0.10 %, 1.07 %; the panel's
+Strength at its average 0.88 %, 389 %; and its Fac at its average too 1.06 %, 536 %;
+before the fix 2.14 %, 536 %. With the fix but the panel and tube found by BSDF rays
+alone (before engine.kernels.shaded_emitter light-sampled them) 0.00 %, 1.91 %, the
+tube's block 2.2 % dark even at 1024 samples: see the second test."""
 from __future__ import annotations
 
 import math
@@ -28,6 +27,7 @@ import node_probe
 from node_probe import image_errors, new_material, new_scene
 
 SAMPLES = 256
+TUBE_SAMPLES = 1024      # the tube alone: a 1 % difference, read over its pixels
 PANEL_STRENGTH = 6.0     # the panel's average Emission Strength
 STRIPE_SHARE = 0.7       # the panel's average Fac (the Color Ramp's white and its ramps)
 
@@ -124,3 +124,32 @@ def test_per_hit_mix_emission_matches_cycles(bpy_drt):
           f"{flat[0]:.2%}, {flat[1]:.2%}; and Fac: {control[0]:.2%}, {control[1]:.2%}")
     assert mean < 0.01 and block < 0.03, (mean, block)
     assert flat[1] > 0.1 and control[1] > 0.1, (flat, control)
+
+
+def test_varying_emission_is_light_sampled_as_cycles_samples_it(bpy_drt):
+    """The tube alone in a black world: its grey Principled side is lit by nothing but
+    the tube itself, through its smooth normals, from faces whose planes it lies behind:
+    light that only next-event estimation finds (BSDF rays below a face's geometric
+    normal are refused, in both engines). Cycles light-samples the tube, evaluating its
+    Layer Weight at each sampled point, and so must DRT (engine.kernels.shaded_emitter);
+    the control is DRT with the tube's Emission Sampling at None (what DRT did before
+    for an emission that varies per hit: BSDF rays alone), which falls short.
+    Measured (1024 samples each, the tube's 154 bright pixels): DRT / Cycles 0.9999;
+    control 0.9893."""
+    bpy = bpy_drt
+    scene = _neon_scene(bpy)
+    scene.world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+    for name in ("Plane", "Plane.001"):
+        bpy.data.objects[name].hide_render = True
+    cycles = node_probe.render(bpy, scene, "CYCLES", TUBE_SAMPLES)[..., :3]
+    drt = node_probe.render(bpy, scene, "DRT", TUBE_SAMPLES)[..., :3]
+    bpy.data.materials["tube"].cycles.emission_sampling = "NONE"
+    control = node_probe.render(bpy, scene, "DRT", TUBE_SAMPLES)[..., :3]
+    tube = cycles[..., 2] > 0.3
+    ratio = float(drt[tube].mean() / cycles[tube].mean())
+    unsampled = float(control[tube].mean() / cycles[tube].mean())
+    print(f"{tube.sum()} tube pixels: DRT / Cycles {ratio:.4f}; not light-sampled "
+          f"{unsampled:.4f}")
+    assert tube.sum() > 80
+    assert abs(ratio - 1.0) < 0.004, ratio
+    assert unsampled < 0.995, unsampled

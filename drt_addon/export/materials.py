@@ -93,7 +93,7 @@ from typing import Optional
 
 from ..engine_link import engine
 from .closures import _Comp, _reduce, program_outputs
-from .emission_sampling import emission_sampling
+from .emission_sampling import emission_sampling, surface_estimate
 from .errors import Reporter
 from .images import image_cache
 from .nodes import NodeCompiler
@@ -244,7 +244,24 @@ def export_material(mat, reporter: Reporter, grids=None,
                       key=(name, "material"))
     result.pass_index = int(getattr(mat, "pass_index", 0))     # the Material Index pass
     result.emission_sampling = emission_sampling(mat)    # Material > Settings
+    _estimate_varying_emission(result, mat)
     return result
+
+
+def _estimate_varying_emission(result, mat):
+    """An emission that varies per hit keeps its average as its plain value, which light
+    sampling weighs its triangles by (engine.kernels.shaded_emitter). Where that average
+    is black though the program emits (a Layer Weight's Facing, which the average cannot
+    see, having no view), it takes Cycles' own estimate of the tree instead (a linked
+    input counts 1), as Cycles' light tree weighs such a mesh."""
+    outputs = getattr(getattr(result, "shader", None), "outputs", None) or {}
+    if "emission" not in outputs or max(result.emission[:3]) > 0.0:
+        return
+    try:
+        estimate, _ = surface_estimate(mat)
+    except Exception:            # a tree the estimate cannot walk
+        estimate = [1.0, 1.0, 1.0]
+    result.emission = tuple(max(float(x), 0.0) for x in estimate[:3])
 
 
 class _DefaultVolume:

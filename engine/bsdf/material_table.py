@@ -49,10 +49,11 @@ class MaterialTable:
     albedo AOV). What a hit sees comes from `lookup(name, index, uv)`, which evaluates the
     parameter's texture (engine.textures) at the hit's UV where the material has one.
 
-    `emission` is the table emissive-triangle light sampling uses (engine.mesh_lights):
-    it is zero for materials whose emission is textured, because a light entry has one
-    radiance per triangle. Those surfaces are still found by BSDF-sampled rays, with MIS
-    weight 1 (their light pdf is 0), which is unbiased, only noisier.
+    `emission` is the constant emission a hit reads: zero for materials whose emission
+    varies over the surface (a texture or a program says it per hit). Light sampling
+    (engine.mesh_lights) reads `emission_estimate`, which holds those materials'
+    average instead, and `emission_shaded`, which names them: their light samples
+    evaluate the material where they land (engine.kernels.shaded_emitter).
     """
 
     PARAMS = ("base_color", "metallic", "roughness", "emission", "alpha")
@@ -153,6 +154,9 @@ class MaterialTable:
             _require_finite(materials, name, arr)
         self.emission_textured = self.textured.get("emission", np.zeros(len(materials), bool))
         self.emission = np.where(self.emission_textured[:, None], 0.0, emission)
+        self.emission_shaded = self.emission_textured & (emission.max(axis=1) > 0.0)
+        self.emission_estimate = np.where(self.emission_shaded[:, None],
+                                          np.maximum(emission, 0.0), self.emission)
         self.any_emission = bool((self.emission > 0).any() or self.emission_textured.any())
         alpha_tex = self.textured.get("alpha", np.zeros(len(materials), bool))
         # Materials that may let rays through (stochastic transparency in the integrators)

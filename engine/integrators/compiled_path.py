@@ -22,6 +22,7 @@ from .. import light_passes, visibility
 from ..accel import HitArrays
 from ..surface import or_empty
 from ..kernels import lights as klights
+from ..kernels.lights.pack import EMISSION_SHADED, TRI_VISIBILITY
 from ..kernels.bsdf import principled as kbsdf
 from ..kernels.bsdf.layered_emission import dimming_rows
 from ..kernels.bsdf.params import P_EMISSION_DIM
@@ -111,9 +112,13 @@ class CompiledPathIntegrator:
         # casts itself (engine.kernels.subsurface)
         rays = ctx.accel.kernel_rays() if mats.any_subsurface else None
         self.subsurface = rays is not None
+        # emissive triangles whose emission varies over them: their light samples run
+        # their material (engine.kernels.shaded_emitter)
+        shaded = bool((self.lights[TRI_VISIBILITY] & EMISSION_SHADED).any())
         self.features = (self.textures if programmed else None,
                          self.vol if self.has_volumes else None,
-                         self.vol if self.heterogeneous else None, rays)
+                         self.vol if self.heterogeneous else None, rays,
+                         self.emission if shaded else None)
         self.start_stack = (camera_stack(ctx, self.vol, surf.material) if self.has_volumes
                             else np.full(STACK, -1, np.int32))
         # the scene as the vertex kernels read it

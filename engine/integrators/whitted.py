@@ -17,7 +17,7 @@ class WhittedIntegrator(CompiledPathIntegrator):
         self._lamp_rays = lamp_rays(self.lights)
         # subsurface scattering is its diffuse lobe here: no walk, so no scene for rays
         # cast in the kernel (and no second compile of it for that argument)
-        self.features = self.features[:3] + (None,)
+        self.features = self.features[:3] + (None,) + self.features[4:]
 
     @property
     def shadow_rays_per_path(self) -> int:

@@ -26,7 +26,7 @@ NO_SEGMENT_MIS = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 @kernel
 def along_ray(depth, cfg, paths, p, tally, lights, vol, het, textures, geometry, shadows,
               ns_out, ox, oy, oz, dx, dy, dz, t_geom, br, bg, bb, clamp_hit, vhit, regs,
-              het_count):
+              het_count, emitters):
     """Path p's ray (o, d) through its media up to t_geom, with throughput b; `het`:
     the scene has heterogeneous media. Returns (vmode, scattered, t_end, throughput
     after the segment, the segment for the lamps found (NO_SEGMENT's layout), the phase
@@ -71,7 +71,7 @@ def along_ray(depth, cfg, paths, p, tally, lights, vol, het, textures, geometry,
             ns_out = equiangular_light(
                 depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_geom, b0r / cont[p],
                 b0g / cont[p], b0b / cont[p], (wcr, wcg, wcb), method, tally, lights, vol,
-                shadows, ns_out)
+                shadows, ns_out, emitters)
     tl.found(tally, p, b, er, eg, eb, clamp_hit, False, -1)    # a medium's: no group
     return (vmode, scattered, t_end, br, bg, bb,
             (str_, stg, stb, wcr, wcg, wcb, mfr, mfg, mfb), g_phase, segment_mis, ns_out)

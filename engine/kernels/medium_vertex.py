@@ -28,6 +28,7 @@ from . import equiangular as eq
 from . import lights as lt
 from . import ray_queues
 from .jit import kernel
+from .shaded_emitter import radiance as emitter_radiance
 from . import light_tally as tl
 from .light_tally import VOLUME_SHARES
 from .path_weights import (DIFFUSE_BIT, ROULETTE_START, SHADOW_BIT, keep_receiver,
@@ -39,7 +40,7 @@ from .volume import EQUIANGULAR, distance_pdf, hg_phase, hg_sample, medium, volu
 
 @kernel(allocates=False)
 def scatter(depth, cfg, paths, p, px, py, pz, dx, dy, dz, br, bg, bb, g, tally, lights, vol,
-            shadows, ns, nexts, nn, segment):
+            shadows, ns, nexts, nn, segment, emitters):
     """Path p of `paths` (path_state.PathState; throughput b, after the segment's weight)
     scattered at
     point x moving along d, by a Henyey-Greenstein phase function of anisotropy g. Writes
@@ -59,6 +60,10 @@ def scatter(depth, cfg, paths, p, px, py, pz, dx, dy, dz, br, bg, bb, g, tally, 
         u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
         k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, lprim, margin = lt.sample(
             lights, recv, u_pick, u1, u2, time)
+        if lpdf > 0.0:     # an emission that varies over its triangle: there
+            lr, lg, lb = emitter_radiance(emitters, lights, lprim, paths.counts,
+                                          (paths.used, paths.cone), p, bounce[p], px, py, pz,
+                                          wx, wy, wz, dist, time, lr, lg, lb)
         seen = lt.entry_visibility(lights, k)
         if lpdf > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0:
             ph = hg_phase(g, dx * wx + dy * wy + dz * wz)
@@ -125,7 +130,7 @@ def distance_weight(lights, k, recv, time, dx, dy, dz, segment):
 
 @kernel(allocates=False)
 def equiangular_light(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, br, bg, bb,
-                      channels, method, tally, lights, vol, shadows, ns):
+                      channels, method, tally, lights, vol, shadows, ns, emitters):
     """The equiangular half of a homogeneous segment's direct light: path p (throughput
     b before the segment, roulette applied) travels o + t d, t in [0, t_max], through its
     medium, whose distance sampling picked the channels with weights `channels` (RGB),
@@ -160,6 +165,10 @@ def equiangular_light(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, br, b
     u1, u2 = sample_2d(kind, pkey[p], spp, index[p], volume_dim(depth, 4))
     wx, wy, wz, dist, lr, lg, lb, ppoint, delta, lprim, margin = lt.sample_entry(
         lights, k, px, py, pz, u1, u2, time)
+    if ppoint > 0.0:
+        lr, lg, lb = emitter_radiance(emitters, lights, lprim, paths.counts,
+                                      (paths.used, paths.cone), p, bounce[p], px, py, pz, wx,
+                                      wy, wz, dist, time, lr, lg, lb)
     seen = lt.entry_visibility(lights, k)
     if not (ppoint > 0.0 and max(lr, lg, lb) > 0.0 and (seen & DIFFUSE_BIT) != 0):
         return ns

@@ -63,6 +63,7 @@ from .bsdf.params import P_ANISO_KIND, P_BUMP_CORRECTION, P_HAIR, P_HOLDOUT, P_S
 from .surface import hit_uv, surface_at
 from .terminator import shadow_origin
 from .surface_hit import coat_frame, material_row, run_program, surface_emission
+from .shaded_emitter import EmitterShading, radiance as emitter_radiance
 from .subsurface import walk_key
 from .subsurface_vertex import scatter_below
 from ..nodes.context import N_HIT
@@ -74,7 +75,7 @@ from ..nodes.shading import (bent_diffuse, may_emit, surface_normal,
 
 @kernel
 def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shadows, nexts,
-          programs, volumes, het, sss):
+          programs, volumes, het, sss, shaded):
     """`shade_by_ref` with the records by reference (tuple_ref.py): the kernels a vertex
     calls take the light table, the geometry, the path state, ... as one pointer each,
     not as their arrays' hundreds of words. The arguments are `shade_by_ref`'s."""
@@ -84,12 +85,12 @@ def shade(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shad
                               s.het_count))
     return shade_by_ref(depth, cfg, by_ref(paths), by_ref(tally), live, ro, rd, rt, hits,
                         stopped, refs, by_ref(shadows), by_ref(nexts), by_ref(programs),
-                        volumes, het, sss)
+                        volumes, het, sss, shaded)
 
 
 @kernel
 def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shadows,
-                 nexts, programs, volumes, het, sss):
+                 nexts, programs, volumes, het, sss, shaded):
     """One bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`
     (engine.accel.HitArrays: t, prim, inst, u, v per ray; prim -1 where missed); stopped:
     rays that ended at the transparent bounce limit. Writes the shadow rays to `shadows`
@@ -107,7 +108,7 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
     added, and what it reaches beyond is weighted by its transmittance. A hit on a
     volume's boundary surface is crossed without a bounce.
 
-    programs, volumes, het, sss: what the scene uses, each None when it does not (Numba then
+    programs, volumes, het, sss, shaded: what the scene uses, each None when it does not (Numba then
     compiles this kernel without that code, and never compiles what only it calls: a
     scene without node programs and volumes compiles in about half the time, benchmarks
     section 10). programs: the
@@ -115,7 +116,9 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
     when the scene has media; het: the same when one of them is heterogeneous; sss: the
     scene for rays cast inside a kernel (engine.kernels.subsurface.local_hit) when a
     material scatters below its surface: a sampled subsurface lobe then walks there
-    (engine.kernels.subsurface_vertex), queueing one more shadow ray for its exit."""
+    (engine.kernels.subsurface_vertex), queueing one more shadow ray for its exit;
+    shaded: the emission table when a light entry's emission varies over its triangle,
+    which a light sample then evaluates there (engine.kernels.shaded_emitter)."""
     pkey, index, beta, counts = paths.key, paths.index, paths.beta, paths.counts
     bounce, ray_bits, min_pdf = paths.bounce, paths.ray_bits, paths.min_pdf
     cont, prev_pdf, prev_pos, path_time = paths.cont, paths.prev_pdf, paths.prev_pos, \
@@ -138,6 +141,11 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
     row = np.empty(params.shape[1])
     hit_row = np.zeros(N_HIT)
     regs = np.zeros(max(textures[NREGS][0], 1))
+    if shaded is None:
+        emitters = None
+    else:        # the emitters' programs write buffers of their own
+        emitters = EmitterShading(programs, params, geometry, textures, emission,
+                                  np.zeros(N_HIT), np.zeros(max(textures[NREGS][0], 1)))
     ns_out, nn_out = 0, 0
     base = D.FIRST_BOUNCE + depth * D.PER_BOUNCE
     # what shadow rays' origins read (terminator), taken out of the tuple once
@@ -166,7 +174,8 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
             vmode, scattered, t_end, br, bg, bb, seg, g_phase, segment_mis, ns_out = \
                 along_ray(depth, cfg, paths, p, tally, lights, vol, het is not None and
                           het_scene, textures, geometry, shadows, ns_out, ox, oy, oz, dx,
-                          dy, dz, t_geom, br, bg, bb, clamp_hit, vhit, regs, het_count)
+                          dy, dz, t_geom, br, bg, bb, clamp_hit, vhit, regs, het_count,
+                          emitters)
         # 1a. area and sphere lamps in front of the geometry
         lamps_in_front(tally, lights, paths, p, b, ox, oy, oz, dx, dy, dz, t_end,
                        (vmode,) + seg,
@@ -179,7 +188,8 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
             cone_moves(path_info[1], p, t_end)
             ns_out, nn_out = scatter(depth, cfg, paths, p, ox + dx * t_end, oy + dy * t_end,
                                      oz + dz * t_end, dx, dy, dz, br, bg, bb, g_phase, tally,
-                                     lights, vol, shadows, ns_out, nexts, nn_out, segment_mis)
+                                     lights, vol, shadows, ns_out, nexts, nn_out, segment_mis,
+                                     emitters)
             continue
         # 1b. escaped rays: the world and sun discs (or, for camera rays on a transparent
         # film, no colour and the coverage left)
@@ -293,6 +303,10 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
             u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
             k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, lprim, margin = lt.sample(
                 lights, recv, u_pick, u1, u2, path_time[p])
+            if lpdf > 0.0:     # an emission that varies over its triangle: there
+                lr, lg, lb = emitter_radiance(emitters, lights, lprim, counts, path_info, p,
+                                              b, px, py, pz, wx, wy, wz, dist, path_time[p],
+                                              lr, lg, lb)
             lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
             # a uniform world, which Cycles never samples (its escaping rays find it):
             # refraction towards it on Walter's pairs, as those rays see it
@@ -353,7 +367,8 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
                     cfg, walk_key(pkey[p], index[p], depth), p, paths, sss,
                     geometry, row, prim, hit_inst[j], front, px, py, pz, gx, gy, gz, nx,
                     ny, nz, dx, dy, dz, u1, u2, br * wr, bg * wg, bb * wb, tally, lights,
-                    shadows, ns_out, nexts, nn_out, programs, params, hit_row, regs)
+                    shadows, ns_out, nexts, nn_out, programs, params, hit_row, regs,
+                    emitters)
             continue
         wx, wy, wz = to_world(ix, iy, iz, nx, ny, nz)
         if bent and ad and not sdelta and spdf > 0.0:

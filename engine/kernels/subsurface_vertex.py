@@ -38,6 +38,7 @@ from .bsdf.params import (P_BASE, P_ROUGHNESS, P_SETS_NORMAL, P_SSS_ALPHA,
                           SSS_BURLEY, SSS_SKIN)
 from .frame import dot, to_local, to_world
 from .jit import kernel
+from .shaded_emitter import radiance as emitter_radiance
 from . import light_tally as tl
 from .light_tally import DIFFUSE_SHARES
 from ..sampling.hashing import stream_uniform
@@ -104,7 +105,8 @@ def walk_params(row):
 @kernel(allocates=False)
 def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, front, px, py, pz,
                   gx, gy, gz, nx, ny, nz, dx, dy, dz, u1, u2, br, bg, bb, tally,
-                  lights, shadows, ns, nexts, nn, programs, params, hit_row, regs):
+                  lights, shadows, ns, nexts, nn, programs, params, hit_row, regs,
+                  emitters):
     """Path p (throughput b, the lobe's weight included) enters the surface it hit at p
     (triangle prim of instance inst, from outside where front; geometric normal g and
     shading normal n facing the ray along d), walks from p, its first ray naming prim
@@ -165,6 +167,9 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, front, px
         k, lx, ly, lz, dist, lr, lg, lb, lpdf, delta, lprim, margin = lt.sample(
             lights, recv, stream_uniform(key, EXIT_STEP, 0),
             stream_uniform(key, EXIT_STEP, 1), stream_uniform(key, EXIT_STEP, 2), time)
+        if lpdf > 0.0:     # an emission that varies over its triangle: there
+            lr, lg, lb = emitter_radiance(emitters, lights, lprim, counts, path_info, p, b,
+                                          qx, qy, qz, lx, ly, lz, dist, time, lr, lg, lb)
         seen = lt.entry_visibility(lights, k)
         # (Cycles' bump shadowing where the normal is bent: path_vertex's bent_diffuse)
         cosine = dot(lx, ly, lz, mx, my, mz) * bump_shadowing(n0x, n0y, n0z, mx, my, mz,

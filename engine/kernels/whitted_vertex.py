@@ -82,7 +82,7 @@ def mirror_row(row):
 
 @kernel
 def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene, shadows,
-                  nexts, programs, volumes, het, sss):
+                  nexts, programs, volumes, het, sss, shaded):
     """`whitted_by_ref` with the records by reference, as `path_vertex.shade` passes them
     (tuple_ref.py). The arguments are `whitted_by_ref`'s."""
     s = scene
@@ -91,12 +91,12 @@ def shade_whitted(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sce
                               s.het_count))
     return whitted_by_ref(depth, cfg, by_ref(paths), by_ref(tally), live, ro, rd, rt, hits,
                           stopped, refs, by_ref(shadows), by_ref(nexts), by_ref(programs),
-                          volumes, het, sss)
+                          volumes, het, sss, shaded)
 
 
 @kernel
 def whitted_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scene,
-                   shadows, nexts, programs, volumes, het, sss):
+                   shadows, nexts, programs, volumes, het, sss, shaded):
     """Whitted's bounce for the live paths `live` whose rays (ro, rd, rt) hit `hits`.
     The arguments are `path_vertex.shade`'s (read its docstring); this kernel reads no
     roulette verdict, MIS state or volume (the paths' min_pdf, cont, prev_pdf, prev_pos;

@@ -27,7 +27,7 @@ every scene):
                  object's engine.visibility mask; all 31 when not given), and above them
                  the sides next-event estimation leaves out (NEE_FRONT_OFF,
                  NEE_BACK_OFF: engine.mesh_lights, Material > Settings > Emission
-                 Sampling).
+                 Sampling), and EMISSION_SHADED where its emission varies over it.
   The environment map (`engine.environment_map.EnvironmentMap`, whether or not it is
   bright enough to be a light; empty arrays and M_HAS = 0 without one):
   L[ENV_MAP]     float64 (N_MAP,): the M_* fields below (flags, |det|, strength, matrix
@@ -86,6 +86,8 @@ ENV = 12
 TRI_VISIBILITY = 13
 NEE_FRONT_OFF = 32  # bits of L[TRI_VISIBILITY] above the ray kinds (engine.visibility):
 NEE_BACK_OFF = 64   # the side of the triangle (its normal's, the other) not sampled
+EMISSION_SHADED = 128   # its radiance an estimate: the sample runs its material
+#                         (engine.kernels.shaded_emitter)
 ENV_MAP = 14
 ENV_PIXELS = 15
 ENV_TEXTURE = 16
@@ -286,6 +288,9 @@ def pack_lights(light_set, tri_visibility=None, timed=True, tree=True,
         sides = np.asarray(sides, np.int64)
         vis |= (np.where(sides & FRONT, 0, NEE_FRONT_OFF)
                 | np.where(sides & BACK, 0, NEE_BACK_OFF))
+    shaded = getattr(mesh, "shaded", None) if n_tri else None
+    if shaded is not None:
+        vis |= np.where(np.asarray(shaded) != 0, EMISSION_SHADED, 0)
     L = ((lamps, select_pdf, cdf, suns) + tri + (env, vis) + _pack_map(light_set.world)
          + (guide_table(cdf, guide_cells(len(cdf))), slices, slice_of))
     if tree and len(select_pdf) > 0:
