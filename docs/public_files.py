@@ -135,13 +135,16 @@ CAUSES = {
         "groups' vector-to-float conversions and the Generated coordinates inside a "
         "volume are candidates)",
     "github:mpett/blends@1e67d3ab9f5730c96c69858f6254a341e80405dc neon.blend":
-        "a neon text (Emission added to a Principled BSDF, mixed by Layer Weight) lighting "
-        "a brick wall with true displacement (its colour image missing in both: pink). "
-        "DRT is about half as bright over the whole lit wall: at 160 px (DRT 16 samples, "
-        "Cycles 64, 2026-12-02) each of the 8 regions (of 4 x 4) of the lit middle holds 0.48 to "
-        "0.65 of Cycles' light, the unlit top and bottom black in both. The wall's "
-        "material links a Mix Shader into the Principled BSDF's Roughness (an invalid "
-        "link both engines ignore). Not examined yet",
+        "a neon text (Mix Shader: its Fac a constant Color Ramp of a Gradient; a black "
+        "Principled, and an Emission coloured by Layer Weight > Facing plus a blue Glossy) "
+        "lighting a brick wall with true displacement (its images missing in both: pink). "
+        "It was -45 % (2026-12-02): DRT emitted a per-hit Mix at its Fac's average (the "
+        "letters at 0.50 of Cycles' light), and left the neon to BSDF rays (the wall a "
+        "field of fireflies); both fixed the same day (tests/test_mixed_emission_vs_cycles"
+        ".py). The means now match; the worst block is a tube's open end at a letter's "
+        "hook, 2 pixels brighter in DRT (3.0 against 1.9), not examined. At 200 px "
+        "against Cycles at 512 samples the worst block is DRT 17.5 % at 64 samples, "
+        "8.0 % at 256, Cycles' own 16.8 % at 64: noise of the thin bright tubes",
     "mellowmallow.blend":
         "its marshmallows are a soft body at frame 131 with no cache: every vertex NaN in "
         "both engines; the green is the 1 kW lamp seen in a glass-and-translucent jar, "
