@@ -120,12 +120,12 @@ def test_cancel_during_a_compile_returns_without_waiting_for_it(monkeypatch):
 
 
 def test_shade_is_compiled_without_what_the_scene_lacks():
-    """Principle 3 for the compiler: a scene without node programs, volumes and
-    subsurface scattering gets a `shade` whose last four arguments are None, so Numba
-    compiles none of that code (nor the interpreter, the media's tracking and scattering
-    and the random walk, which only it calls); a scene with a world volume gets the
-    volume table in its place, one with a subsurface material the scene for the walk's
-    rays."""
+    """Principle 3 for the compiler: a scene without node programs, volumes, subsurface
+    scattering and emitters whose emission varies over them gets a `shade` whose last
+    five arguments are None, so Numba compiles none of that code (nor the interpreter,
+    the media's tracking and scattering, the random walk and the emitters' evaluation at
+    light samples, which only it calls); a scene with a world volume gets the volume
+    table in its place, one with a subsurface material the scene for the walk's rays."""
     from dataclasses import replace
 
     from numba.core import types
@@ -135,25 +135,25 @@ def test_shade_is_compiled_without_what_the_scene_lacks():
     plain = cornell_box(8, 8)
     ctx = render_module.RenderContext(plain, settings)
     render_module.render(plain, settings, context=ctx)
-    assert ctx.integrator.features == (None, None, None, None)
+    assert ctx.integrator.features == (None, None, None, None, None)
     ctx.close()
     foggy = cornell_box(8, 8)
     foggy.world = replace(foggy.world, volume=Volume(scattering=(0.1, 0.1, 0.1)))
     ctx = render_module.RenderContext(foggy, settings)
     render_module.render(foggy, settings, context=ctx)
-    programs, volumes, het, sss = ctx.integrator.features
-    assert programs is None and het is None and sss is None
+    programs, volumes, het, sss, shaded = ctx.integrator.features
+    assert programs is None and het is None and sss is None and shaded is None
     assert volumes is ctx.integrator.vol
     ctx.close()
     waxy = cornell_box(8, 8)
     waxy.materials[0] = replace(waxy.materials[0], subsurface_weight=1.0)
     ctx = render_module.RenderContext(waxy, settings)
     assert ctx.integrator.features[:3] == (None, None, None)
-    assert ctx.integrator.features[3] is not None
+    assert ctx.integrator.features[3] is not None and ctx.integrator.features[4] is None
     ctx.close()
-    last4 = [tuple(type(t) for t in sig[-4:]) for sig in shade.signatures]
-    assert (types.NoneType,) * 4 in last4
-    assert any(t[0] is types.NoneType and t[1] is not types.NoneType for t in last4)
+    last5 = [tuple(type(t) for t in sig[-5:]) for sig in shade.signatures]
+    assert (types.NoneType,) * 5 in last5
+    assert any(t[0] is types.NoneType and t[1] is not types.NoneType for t in last5)
 
 
 def test_the_batch_renderers_bar_says_compiling_then_counts_samples(capsys):
