@@ -8,7 +8,7 @@ import numpy as np
 
 from ...blender_compat import node_input
 from ..closures import BLACK, NULL_COMP, WHITE, _Closure, _Comp, _Layers, _sum
-from ..material_params import TOL, _is_tex, _lin, _scale
+from ..material_params import TOL, NodeParam, _is_tex, _lin, _scale
 from .links import _link
 from .shader_inputs import _constant, _input
 from .shader_mix import _mix_factor, _plastic, lifted_mix, per_hit_emission
@@ -240,12 +240,26 @@ def _add(a: _Closure, b: _Closure, ctx) -> _Closure:
     return _sum(a, b, ctx)
 
 
+def _converted_emission(socket, out, ctx) -> _Closure:
+    """A value linked into a shader socket, which Cycles turns into an Emission of
+    strength 1 (ShaderGraph::connect's automatic conversion): a float feeds its Strength
+    (its colour white), anything else its Color."""
+    kind = "float" if out.type in ("VALUE", "INT", "BOOLEAN") else "color"
+    value = ctx.nodes.socket(socket, kind)
+    folded = ctx.nodes.fold(value)
+    param = folded if folded is not None else NodeParam(value, ctx.nodes)
+    emission = _scale(WHITE, param) if kind == "float" else param
+    return _Closure([(1.0, NULL_COMP)], emission=emission, plain_emission=True)
+
+
 def _closure(socket, ctx, depth=0) -> _Closure:
     """The closure feeding a shader socket."""
     found = _link(socket)
     if found is None:
         return _Closure([(1.0, NULL_COMP)])       # no closure: black
     node = found[0]
+    if found[1].type != "SHADER":
+        return _converted_emission(socket, found[1], ctx)
     # a tree is read node by node along every path to the output: shared sub-trees are
     # read again for each path, so a long chain of shaders feeding both inputs of the
     # next Mix would take 2^length reads; past MAX_SHADER_READS the rest is cut off
