@@ -38,7 +38,8 @@ TESTS = ["tests/test_anisotropic_vs_cycles.py", "tests/test_coat_normal_vs_cycle
          "tests/test_instances_vs_cycles.py", "tests/test_light_distribution_vs_cycles.py",
          "tests/test_bounce_budget_vs_cycles.py", "tests/test_caustics_switches_vs_cycles.py",
          "tests/test_shadow_ray_glass_vs_cycles.py", "tests/test_lights_vs_cycles.py",
-         "tests/test_displacement_vs_cycles.py", "tests/test_ao_pass.py"]
+         "tests/test_displacement_vs_cycles.py", "tests/test_ao_pass.py",
+         "tests/test_mixed_emission_vs_cycles.py"]
 
 
 def run_tests(tests) -> dict:

@@ -5,7 +5,10 @@ with the Fac's probability, and its emission is the mix at the hit's own Fac
 (export/nodes/shader_mix.per_hit_emission); before that it was the mix at the Fac's
 average over the surface, which is what a public neon sign (mpett/blends neon.blend:
 Mix(Fac = a constant Color Ramp of a Gradient Texture; Principled, Emission + Glossy))
-showed: its letters at half their brightness (0.50 of Cycles' light over them).
+showed: its letters at half their brightness (0.50 of Cycles' light over them). The
+other two tests: such emission is light-sampled as Cycles samples it, evaluated where a
+sample lands (engine.kernels.shaded_emitter), and a value linked straight into a shader
+socket emits (Cycles' automatic conversion to an Emission).
 
 The scene, as an artist builds a neon sign: a striped panel (Mix Fac = a Color Ramp,
 white - black - white, of a Gradient Texture of Generated coordinates: Emission on
