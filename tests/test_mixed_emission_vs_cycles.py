@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 
 import node_probe
+from figures import AGAINST_CYCLES, record
 from node_probe import image_errors, new_material, new_scene
 
 SAMPLES = 256
@@ -153,6 +154,8 @@ def test_varying_emission_is_light_sampled_as_cycles_samples_it(bpy_drt):
     unsampled = float(control[tube].mean() / cycles[tube].mean())
     print(f"{tube.sum()} tube pixels: DRT / Cycles {ratio:.4f}; not light-sampled "
           f"{unsampled:.4f}")
+    record(AGAINST_CYCLES, tube_ratio=ratio)
+    record("control: not light-sampled", tube_ratio=unsampled)
     assert tube.sum() > 80
     assert abs(ratio - 1.0) < 0.004, ratio
     assert unsampled < 0.995, unsampled
