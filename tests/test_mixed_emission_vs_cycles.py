@@ -12,8 +12,8 @@ socket emits (Cycles' automatic conversion to an Emission).
 
 The scene, as an artist builds a neon sign: a striped panel (Mix Fac = a Color Ramp,
 white - black - white, of a Gradient Texture of Generated coordinates: Emission on
-average on 70 % of it, a dark Principled between) and a smooth tube whose emission follows Layer Weight > Facing
-(brighter towards its silhouette), over a grey floor they light, in a dim world. The
+average on 70 % of it, a dark Principled between) and a smooth tube whose emission
+follows Layer Weight > Facing (brighter towards its silhouette), over a grey floor they light, in a dim world. The
 panel's Emission Strength grows with its height (an Emission's Strength was read as its
 average before, with a warning).
 

@@ -16,8 +16,9 @@ class WhittedIntegrator(CompiledPathIntegrator):
         super().__init__(ctx)
         self._lamp_rays = lamp_rays(self.lights)
         # subsurface scattering is its diffuse lobe here: no walk, so no scene for rays
-        # cast in the kernel (and no second compile of it for that argument)
-        self.features = self.features[:3] + (None,) + self.features[4:]
+        # cast in the kernel (and no second compile of it for that argument); its lamps
+        # alone are sampled, so no emitter is evaluated at a light sample either
+        self.features = self.features[:3] + (None, None)
 
     @property
     def shadow_rays_per_path(self) -> int:

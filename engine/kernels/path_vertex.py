@@ -108,10 +108,10 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
     added, and what it reaches beyond is weighted by its transmittance. A hit on a
     volume's boundary surface is crossed without a bounce.
 
-    programs, volumes, het, sss, shaded: what the scene uses, each None when it does not (Numba then
-    compiles this kernel without that code, and never compiles what only it calls: a
-    scene without node programs and volumes compiles in about half the time, benchmarks
-    section 10). programs: the
+    programs, volumes, het, sss, shaded: what the scene uses, each None when it does not
+    (Numba then compiles this kernel without that code, and never compiles what only it
+    calls: a scene without node programs and volumes compiles in about half the time,
+    benchmarks section 10). programs: the
     shading tables when a material has a shader program; volumes: the volume table
     when the scene has media; het: the same when one of them is heterogeneous; sss: the
     scene for rays cast inside a kernel (engine.kernels.subsurface.local_hit) when a
@@ -303,10 +303,6 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
             u1, u2 = sample_2d(kind, pkey[p], spp, index[p], base + D.LIGHT_POINT)
             k, wx, wy, wz, dist, lr, lg, lb, lpdf, delta, lprim, margin = lt.sample(
                 lights, recv, u_pick, u1, u2, path_time[p])
-            if lpdf > 0.0:     # an emission that varies over its triangle: there
-                lr, lg, lb = emitter_radiance(emitters, lights, lprim, counts, path_info, p,
-                                              b, px, py, pz, wx, wy, wz, dist, path_time[p],
-                                              lr, lg, lb)
             lx, ly, lz = to_local(wx, wy, wz, nx, ny, nz)
             # a uniform world, which Cycles never samples (its escaping rays find it):
             # refraction towards it on Walter's pairs, as those rays see it
@@ -318,6 +314,12 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
             fr, fg, fb, cosine = lit_bsdf(state, bent, wox, woy, woz, lx, ly, lz, see_d,
                                           see_g, see_t, s0x, s0y, s0z, nx, ny, nz, rx, ry,
                                           rz, wx, wy, wz, correct)
+            if lpdf > 0.0 and max(fr, fg, fb) > 0.0:
+                # an emission that varies over its triangle: what it sends from there (its
+                # program runs only for a sample the lobes take)
+                lr, lg, lb = emitter_radiance(emitters, lights, lprim, counts, path_info, p,
+                                              b, px, py, pz, wx, wy, wz, dist, path_time[p],
+                                              lr, lg, lb)
             # as in Cycles, the lobes alone decide (on the shading normals): a light
             # under the triangle's own plane but above its smooth normal lights it, its
             # shadow ray leaving from the curved surface the normals describe
