@@ -150,6 +150,21 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
         scene.collection.objects.link(spot)
         fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled", {"Density": 0.08})
         cube(bpy, scene, "Fog", *fog_box, fog)
+    elif case == "noise_lamps":
+        # point lamps inside fog in blobs (a heterogeneous volume), the area lamp dimmed
+        # to a fill: the light is scattered mostly close to the lamps
+        lamp.data.energy = 20.0
+        for name, loc, power, colour in (("Warm", (0.8, 0.3, 1.2), 150.0, (1.0, 0.5, 0.2)),
+                                         ("Cool", (-1.2, 1.4, 1.8), 100.0, (0.2, 0.5, 1.0))):
+            point = bpy.data.objects.new(name, bpy.data.lights.new(name, "POINT"))
+            point.data.energy = power
+            point.data.color = colour
+            point.data.shadow_soft_size = 0.05
+            point.location = loc
+            scene.collection.objects.link(point)
+        fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled", {})
+        noise_density(bpy, fog, "Principled Volume")
+        cube(bpy, scene, "Fog", *fog_box, fog)
     elif case == "camera_inside":
         fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled", {"Density": 0.15})
         cube(bpy, scene, "Fog", (-5.0, -8.0, -0.5), (5.0, 5.0, 5.0), fog)
@@ -159,4 +174,4 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
 
 
 CASES = ("scatter", "tinted", "multiple", "noise", "absorption_glass", "clear_glass",
-         "emission", "world", "camera_inside", "beam")
+         "emission", "world", "camera_inside", "beam", "noise_lamps")

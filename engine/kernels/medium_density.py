@@ -23,8 +23,11 @@ extinction is mu everywhere, and sample tentative collisions at rate mu:
   null collision, after which tracking goes on. Passing the segment's end keeps f.
 - a shadow ray's transmittance (ratio tracking): the product over the collisions of
   1 - sigma_t,c(x) / mu.
+- a point sampled on the segment by another strategy (equiangularly towards a lamp):
+  ratio tracking's transmittance to it, and the density with which tracking would have
+  scattered there, for the MIS weights of the two (`equiangular_point`).
 
-Both are unbiased for any mu > 0: where the density exceeds mu, sigma_n is negative and
+All are unbiased for any mu > 0: where the density exceeds mu, sigma_n is negative and
 so are the weights, which costs variance, never bias. The bound only decides the
 noise and the number of program runs (about mu times the length). The majorant is a
 row's V_MAJ, or where the row has one, its majorant grid's cell along the ray
@@ -48,7 +51,7 @@ from ..nodes.shading import OUT_VOL_EM, OUT_VOL_SA, OUT_VOL_SS
 from ..sampling.hashing import chain, stream_key, stream_uniform
 from .jit import kernel
 from .majorant_grid import RES, cell_majorant, has_grid
-from .volume import V_G, V_HET, V_MAJ, V_OBJ, medium
+from .volume import V_G, V_HET, V_MAJ, V_OBJ, V_SS, medium
 
 MAX_STEPS = 1024           # collisions per segment (Cycles' VOLUME_MAX_STEPS)
 ADVANCE_LIMIT = 4 * RES + 8  # cells one free flight may cross
@@ -72,6 +75,23 @@ def heterogeneous_in(vol, stacks, p):
         if m < 0:
             return False
         if vol[m, V_HET] != 0.0:
+            return True
+    return False
+
+
+@kernel(allocates=False)
+def scatters_in(vol, stacks, p, T):
+    """Whether path p's medium can scatter: a homogeneous row with a scattering
+    coefficient, or a heterogeneous row whose program has a scattering output."""
+    outs = T[OUTS]
+    for k in range(stacks.shape[1]):
+        m = stacks[p, k]
+        if m < 0:
+            return False
+        if vol[m, V_HET] != 0.0:
+            if outs[m, OUT_VOL_SS] >= 0:
+                return True
+        elif vol[m, V_SS] + vol[m, V_SS + 1] + vol[m, V_SS + 2] > 0.0:
             return True
     return False
 
@@ -185,50 +205,118 @@ def shadow_keys(pkey, index, sh_path, depth):
 
 @kernel(allocates=False)
 def tracked_segment(vol, stacks, p, T, objects, camera, ox, oy, oz, dx, dy, dz, t, t_mark,
-                    br, bg, bb, ray, depth, key, hit, regs, count):
+                    t_eq, br, bg, bb, ray, depth, key, hit, regs, count):
     """Path p (throughput b) travels distance t (inf: to infinity) from o along d through
     its heterogeneous medium (see the module's docstring).
 
     Returns (scattered, t_end, throughput factor f RGB, f at distance t_mark RGB (0 when
     the path scattered before it), emitted radiance RGB (times b), g at the
-    scattering)."""
+    scattering, the scattering's density for MIS (0: none), `eq`).
+
+    `eq` serves a point sampled at t_eq in [0, t] by equiangular sampling (t_eq < 0:
+    none): (f RGB, prod(1 - P_s), mu(t_eq)) of a tracking that took every collision
+    before t_eq as null, or zeros when tracking ended before. Where the path scatters
+    before t_eq, tracking goes on to t_eq as ratio tracking (the collisions' places do
+    not depend on what was decided at them), as Cycles does. `equiangular_point` takes
+    it from there."""
     maj = T[MAJORANTS]
     mu_fixed, row = majorant_parts(vol, stacks, p, maj)
     fr = fg = fb = 1.0
     mr = mg = mb = 0.0
     marked = False
     Er = Eg = Eb = 0.0
+    p_null = 1.0                         # the product of the null collisions' 1 - P_s
+    eq = (0.0, 0.0, 0.0, 0.0, 0.0)
+    eq_due = t_eq >= 0.0
     if not (mu_fixed > 0.0 or row >= 0):
-        return False, t, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0
+        return (False, t, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                (1.0, 1.0, 1.0, 1.0, 0.0))
+    # the scattering, once sampled: (t_end, f RGB, g, density)
+    scattered = passed = False
+    out = (t, 0.0, 0.0, 0.0, 0.0, 0.0)
     s = 0.0
     for step in range(MAX_STEPS):
         tau = -math.log(max(1.0 - stream_uniform(key, step, 0), 1e-300))
         s, mu, passed = advance(maj, row, mu_fixed, ox, oy, oz, dx, dy, dz, s, t, tau)
-        if not marked and s >= t_mark:
+        if not marked and s >= t_mark and not scattered:
             mr, mg, mb, marked = fr, fg, fb, True
-        if passed:
-            return False, t, fr, fg, fb, mr, mg, mb, Er, Eg, Eb, 0.0
+        if eq_due and s >= t_eq:
+            eq = (fr, fg, fb, p_null, majorant_at(maj, row, mu_fixed, ox, oy, oz, dx, dy,
+                                                  dz, t_eq))
+            eq_due = False
+        if passed or (scattered and not eq_due):
+            break
         sar, sag, sab, ssr, ssg, ssb, g, er, eg, eb = point_medium(
             vol, stacks, p, T, objects, camera, ox + dx * s, oy + dy * s, oz + dz * s,
             dx, dy, dz, ray, depth, hit, regs, count)
-        Er += br * fr * er / mu
-        Eg += bg * fg * eg / mu
-        Eb += bb * fb * eb / mu
+        if not scattered:
+            Er += br * fr * er / mu
+            Eg += bg * fg * eg / mu
+            Eb += bb * fb * eb / mu
         nr, ng, nb = mu - sar - ssr, mu - sag - ssg, mu - sab - ssb
-        wr, wg, wb = abs(br * fr), abs(bg * fg), abs(bb * fb)
-        num = wr * ssr + wg * ssg + wb * ssb
-        den = num + wr * abs(nr) + wg * abs(ng) + wb * abs(nb)
-        if not den > 0.0:
+        ps = scatter_probability(br * fr, bg * fg, bb * fb, ssr, ssg, ssb, nr, ng, nb)
+        if not ps >= 0.0:
             break                        # nothing left to carry: absorbed
-        ps = num / den
-        if stream_uniform(key, step, 1) < ps:
+        if not scattered and stream_uniform(key, step, 1) < ps:
             k = 1.0 / (mu * ps)
-            return (True, s, fr * ssr * k, fg * ssg * k, fb * ssb * k, mr, mg, mb,
-                    Er, Eg, Eb, g)
+            scattered = True
+            out = (s, fr * ssr * k, fg * ssg * k, fb * ssb * k, g, p_null * mu * ps)
+        # a null collision (after the path scattered: for the equiangular point only)
         k = 1.0 / (mu * (1.0 - ps))
         fr, fg, fb = fr * nr * k, fg * ng * k, fb * nb * k
+        p_null *= 1.0 - ps
+    if scattered:
+        t_end, sfr, sfg, sfb, g, density = out
+        return True, t_end, sfr, sfg, sfb, mr, mg, mb, Er, Eg, Eb, g, density, eq
+    if passed:
+        return False, t, fr, fg, fb, mr, mg, mb, Er, Eg, Eb, 0.0, 0.0, eq
     # absorbed (or past MAX_STEPS): nothing goes on
-    return False, t, 0.0, 0.0, 0.0, mr, mg, mb, Er, Eg, Eb, 0.0
+    return False, t, 0.0, 0.0, 0.0, mr, mg, mb, Er, Eg, Eb, 0.0, 0.0, eq
+
+
+@kernel(allocates=False)
+def majorant_at(maj, row, mu_fixed, ox, oy, oz, dx, dy, dz, s):
+    """The majorant at distance s along the ray."""
+    if row < 0:
+        return mu_fixed
+    return mu_fixed + cell_majorant(maj, row, ox, oy, oz, dx, dy, dz, s)[0]
+
+
+@kernel(allocates=False)
+def scatter_probability(wr, wg, wb, ssr, ssg, ssb, nr, ng, nb):
+    """P_s of a collision (the module's docstring), the channels weighted by the
+    throughput w; -1 when nothing is left to carry (every weighted channel absorbed)."""
+    wr, wg, wb = abs(wr), abs(wg), abs(wb)
+    num = wr * ssr + wg * ssg + wb * ssb
+    den = num + wr * abs(nr) + wg * abs(ng) + wb * abs(nb)
+    return num / den if den > 0.0 else -1.0
+
+
+@kernel(allocates=False)
+def equiangular_point(vol, stacks, p, T, objects, camera, ox, oy, oz, dx, dy, dz, t, br,
+                      bg, bb, eq, ray, depth, hit, regs, count):
+    """The medium at a point sampled equiangularly at distance t along path p's ray
+    (throughput b at its origin), from `tracked_segment`'s `eq`: the ratio-tracking
+    estimate of the transmittance to t (RGB: f prod(1 - P_s) = prod sigma_n / mu), the
+    scattering coefficient (RGB) and anisotropy there, and the density with which the
+    tracking would have scattered the path at t after the same null collisions (0:
+    never), for the MIS weights of the two strategies.
+
+    That density is the path-space density of null-scattering tracking (Miller et al.
+    2019, "A null-scattering path integral formulation of light transport", as Cycles
+    weighs its equiangular samples in heterogeneous volumes): prod(1 - P_s) over the
+    null collisions before t, times mu(t) P_s(t). The factors the two strategies share
+    (the exponential steps between collisions) cancel in the weights and are left out."""
+    fr, fg, fb, p_null, mu = eq
+    if not mu > 0.0:
+        return 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    sar, sag, sab, ssr, ssg, ssb, g, _, _, _ = point_medium(
+        vol, stacks, p, T, objects, camera, ox + dx * t, oy + dy * t, oz + dz * t,
+        dx, dy, dz, ray, depth, hit, regs, count)
+    ps = scatter_probability(br * fr, bg * fg, bb * fb, ssr, ssg, ssb, mu - sar - ssr,
+                             mu - sag - ssg, mu - sab - ssb)
+    return (fr * p_null, fg * p_null, fb * p_null, ssr, ssg, ssb, g,
+            p_null * mu * ps if ps > 0.0 else 0.0)
 
 
 @kernel(allocates=False)

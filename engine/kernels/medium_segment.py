@@ -1,7 +1,7 @@
 """The medium along a ray, before whatever the ray reaches: the first stage of a path
 vertex (`path_vertex.shade`) for a ray that travels inside a volume. The segment adds the
 medium's emission, weighs the throughput by its transmittance and may scatter the path
-(then `medium_vertex.scatter` shades that point); through a homogeneous medium sampled
+(then `medium_vertex.scatter` shades that point); through a medium sampled
 equiangularly it also queues that strategy's light sample (`medium_vertex.
 equiangular_light`). A heterogeneous medium is tracked by null scattering
 (`medium_density.tracked_segment`)."""
@@ -11,8 +11,9 @@ from ..sampling.dispatch import sample_1d
 from . import lights as lt
 from . import light_tally as tl
 from .jit import kernel
-from .medium_density import heterogeneous_in, path_key, tracked_segment
-from .medium_vertex import equiangular_light
+from .medium_density import (equiangular_point, heterogeneous_in, path_key, scatters_in,
+                             tracked_segment)
+from .medium_vertex import equiangular_light, equiangular_pick, equiangular_shade
 from .path_weights import _INF
 from .volume import (DISTANCE, distance_pdf, medium, sample_method, segment, volume_dim)
 
@@ -48,10 +49,29 @@ def along_ray(depth, cfg, paths, p, tally, lights, vol, het, textures, geometry,
         if n_lights > 0:
             t_lamp = lt.hit_lamps(lights, ox, oy, oz, dx, dy, dz, t_geom, bits, time)[0]
         vmode = 3
-        scattered, t_end, fr, fg, fb, mfr, mfg, mfb, er, eg, eb, g_phase = \
+        method = sample_method(vol, stacks, p)
+        k_eq, by_segment, t_eq, pe = -1, 0.0, -1.0, 0.0
+        if (method != DISTANCE and n_lights > 0 and cont[p] > 0.0
+                and scatters_in(vol, stacks, p, textures)):
+            k_eq, by_segment, t_eq, pe = equiangular_pick(depth, cfg, paths, p, ox, oy, oz,
+                                                          dx, dy, dz, t_geom, lights)
+        scattered, t_end, fr, fg, fb, mfr, mfg, mfb, er, eg, eb, g_phase, pd, eq = \
             tracked_segment(vol, stacks, p, textures, geometry[9], geometry[12], ox, oy,
-                            oz, dx, dy, dz, t_geom, t_lamp, br, bg, bb, bits, b,
+                            oz, dx, dy, dz, t_geom, t_lamp, t_eq, br, bg, bb, bits, b,
                             path_key(pkey[p], index[p], depth), vhit, regs, het_count)
+        if scattered and method != DISTANCE:
+            segment_mis = (ox, oy, oz, t_geom, t_end, pd, float(method))
+        if k_eq >= 0:
+            # the segment's direct light at an equiangular distance, its transmittance
+            # from the same tracking (the roulette verdict on this ray applies)
+            br0, bg0, bb0 = b0r / cont[p], b0g / cont[p], b0b / cont[p]
+            trr, trg, trb, ssr, ssg, ssb, g_eq, pd_eq = equiangular_point(
+                vol, stacks, p, textures, geometry[9], geometry[12], ox, oy, oz, dx, dy, dz,
+                t_eq, br0, bg0, bb0, eq, bits, b, vhit, regs, het_count)
+            ns_out = equiangular_shade(
+                depth, cfg, paths, p, ox + dx * t_eq, oy + dy * t_eq, oz + dz * t_eq, dx,
+                dy, dz, k_eq, by_segment, pe, pd_eq, br0 * trr * ssr, bg0 * trg * ssg,
+                bb0 * trb * ssb, g_eq, method, tally, lights, shadows, ns_out, emitters)
         br, bg, bb = br * fr, bg * fg, bb * fb
     else:
         vmode, scattered, t_end, br, bg, bb, str_, stg, stb, wcr, wcg, wcb, er, eg, eb = \

@@ -17,7 +17,9 @@ scatters or not: one more shadow ray). The scattering picks its light for its po
 segment (the tree's segment form, lights/tree_segment.py, as Cycles does), before it
 knows its point. The weights are the power heuristic of the two strategies' densities
 of the pair (light, distance); a sun or the world, which has no position, is the
-distance strategy's alone. Heterogeneous segments use the distance strategy alone."""
+distance strategy's alone. A heterogeneous segment is tracked (medium_density): its
+equiangular point's transmittance by ratio tracking, and the two strategies' densities
+are those of null-scattering paths (medium_density.tracked_point), as in Cycles."""
 from __future__ import annotations
 
 import math
@@ -129,39 +131,67 @@ def distance_weight(lights, k, recv, time, dx, dy, dz, segment):
 
 
 @kernel(allocates=False)
+def equiangular_pick(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, lights):
+    """The equiangular strategy's sample on path p's segment o + t d, t in [0, t_max]:
+    a light picked for the whole segment (before any point on it is known) and a
+    distance sampled towards its position. Returns (entry k, its pick probability, t,
+    the distance's density); k = -1: none (no light, or one without a position)."""
+    pkey, index, time = paths.key, paths.index, paths.time[p]
+    kind, spp = cfg.sampler, cfg.spp
+    if lt.n_entries(lights) == 0:
+        return -1, 0.0, -1.0, 0.0
+    u_pick = sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 2))
+    k, by_segment = lt.pick_entry(lights, lt.segment_receiver(ox, oy, oz, dx, dy, dz,
+                                                              t_max), u_pick, time)
+    if k < 0:
+        return -1, 0.0, -1.0, 0.0
+    has, cx, cy, cz = lt.entry_center(lights, k, time)
+    if not has:
+        return -1, 0.0, -1.0, 0.0
+    t, pe = eq.sample(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_max,
+                      sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 3)))
+    if not pe > 0.0:
+        return -1, 0.0, -1.0, 0.0
+    return k, by_segment, t, pe
+
+
+@kernel(allocates=False)
 def equiangular_light(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, br, bg, bb,
                       channels, method, tally, lights, vol, shadows, ns, emitters):
     """The equiangular half of a homogeneous segment's direct light: path p (throughput
     b before the segment, roulette applied) travels o + t d, t in [0, t_max], through its
     medium, whose distance sampling picked the channels with weights `channels` (RGB),
-    with Volume Sampling Method `method` (EQUIANGULAR or MULTIPLE_IMPORTANCE). Picks a
-    light for the segment (before any point on it is known), samples a distance towards
-    its position and a point on it from there, and queues the shadow ray (returned count
-    ns). Its weight against phase sampling takes the light's pick probability for that
-    point, as a scattering there would pick it."""
-    pkey, index, time, bounce = paths.key, paths.index, paths.time[p], paths.bounce
-    stacks = paths.stacks
-    kind, spp = cfg.sampler, cfg.spp
-    mode = cfg.mis_mode
-    if lt.n_entries(lights) == 0:
-        return ns
-    u_pick = sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 2))
-    k, by_segment = lt.pick_entry(lights, lt.segment_receiver(ox, oy, oz, dx, dy, dz,
-                                                              t_max), u_pick, time)
+    with Volume Sampling Method `method` (EQUIANGULAR or MULTIPLE_IMPORTANCE): the
+    transmittance and the distance density in closed form. Returns the shadow count."""
+    k, by_segment, t, pe = equiangular_pick(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz,
+                                            t_max, lights)
     if k < 0:
         return ns
-    has, cx, cy, cz = lt.entry_center(lights, k, time)
-    if not has:
-        return ns
-    t, pe = eq.sample(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_max,
-                      sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 3)))
-    if not pe > 0.0:
-        return ns
-    sar, sag, sab, ssr, ssg, ssb, g, _, _, _ = medium(vol, stacks, p)
+    sar, sag, sab, ssr, ssg, ssb, g, _, _, _ = medium(vol, paths.stacks, p)
     str_, stg, stb = sar + ssr, sag + ssg, sab + ssb
     wr, wg, wb = channels
-    pd = distance_pdf(str_, stg, stb, wr, wg, wb, t)
-    px, py, pz = ox + dx * t, oy + dy * t, oz + dz * t
+    return equiangular_shade(
+        depth, cfg, paths, p, ox + dx * t, oy + dy * t, oz + dz * t, dx, dy, dz, k,
+        by_segment, pe, distance_pdf(str_, stg, stb, wr, wg, wb, t),
+        br * ssr * math.exp(-str_ * t), bg * ssg * math.exp(-stg * t),
+        bb * ssb * math.exp(-stb * t), g, method, tally, lights, shadows, ns, emitters)
+
+
+@kernel(allocates=False)
+def equiangular_shade(depth, cfg, paths, p, px, py, pz, dx, dy, dz, k, by_segment, pe, pd,
+                      sr, sg, sb, g, method, tally, lights, shadows, ns, emitters):
+    """The light sample of the equiangular strategy at its point x (`equiangular_pick`'s
+    entry k, picked with probability by_segment, at a distance of density pe; pd: the
+    distance strategy's density there) of path p moving along d, where the path's
+    throughput times the transmittance to x times the scattering coefficient is s (RGB)
+    and the phase function's anisotropy g. Samples a point on the light from x and
+    queues the shadow ray (returned count ns). Its weight against phase sampling takes
+    the light's pick probability for x, as a scattering there would pick it."""
+    pkey, index, time, bounce = paths.key, paths.index, paths.time[p], paths.bounce
+    kind, spp = cfg.sampler, cfg.spp
+    mode = cfg.mis_mode
+    if not max(sr, sg, sb) > 0.0:
+        return ns
     u1, u2 = sample_2d(kind, pkey[p], spp, index[p], volume_dim(depth, 4))
     wx, wy, wz, dist, lr, lg, lb, ppoint, delta, lprim, margin = lt.sample_entry(
         lights, k, px, py, pz, u1, u2, time)
@@ -179,9 +209,7 @@ def equiangular_light(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, br, b
     w_t = 1.0 if method == EQUIANGULAR else power_heuristic(pe * by_segment, pd * select)
     w = (nee_weight(mode, ppoint * select, ph, delta)
          / (ppoint * by_segment) * ph * w_t / pe)
-    cr = br * ssr * math.exp(-str_ * t) * lr * w
-    cg = bg * ssg * math.exp(-stg * t) * lg * w
-    cb = bb * ssb * math.exp(-stb * t) * lb * w
+    cr, cg, cb = sr * lr * w, sg * lg * w, sb * lb * w
     if not seen & SHADOW_BIT:
         clamp = cfg.clamp_direct if bounce[p] == 0 else cfg.clamp_indirect
         tl.lit(tally, p, bounce[p], cr, cg, cb, clamp, VOLUME_SHARES, tl.entry_group(tally, k))
@@ -189,6 +217,6 @@ def equiangular_light(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, br, b
     sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz, dist,
                                              margin, cfg.scene_radius)
     ns = ray_queues.push(shadows, ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr, cg,
-                         cb, stacks, -1, -1, lprim)
+                         cb, paths.stacks, -1, -1, lprim)
     tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))
     return ns
