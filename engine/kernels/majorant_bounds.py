@@ -9,10 +9,19 @@ Volume object's), at the centre of the largest voxel of each grid whose trilinea
 support reaches into each cell: a program that grows with its grids peaks at such a
 centre, which jittered points of a sparse smoke miss. V_MAJ is the largest of them all
 (MU_FLOOR when every sample is zero); a cell's majorant is MAJORANT_SCALE times the
-largest in the cell, and at least majorant_grid.FLOOR of V_MAJ."""
+largest in the cell and its 26 neighbours, and at least majorant_grid.FLOOR of V_MAJ.
+
+The neighbours count because samples miss peaks: a thresholded noise (a Color Ramp
+with a narrow step on Density) has peaks between one cell's 8 points that a
+neighbour's points find. Where the density exceeds a cell's majorant the trackers'
+weights turn negative (unbiased, but fireflies and black pixels): in a public file of
+textured fog lit by lamps inside it (docs/public_files.md, space.blend) the cells alone
+left DRT's image 20 to 40 % above Cycles' at 128 samples, speckled; with their
+neighbours, within 1.2 % and clean (2026-12-03)."""
 from __future__ import annotations
 
 import numpy as np
+from scipy.ndimage import maximum_filter
 
 from ..nodes.context import N_HIT, O_TO_WORLD
 from ..nodes.pack import GRIDS, MAJORANTS, NREGS, OPS, PROG, VOXELS
@@ -103,6 +112,12 @@ def cell_peaks(T, m, objects, obj, lo, hi) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(points), np.concatenate(cells)
 
 
+def with_neighbours(cell_top):
+    """Each cell's value (RES^3, the grid's order) raised to the largest of its 3 x 3 x 3
+    neighbourhood."""
+    return maximum_filter(cell_top.reshape(RES, RES, RES), size=3, mode="nearest").ravel()
+
+
 def bound_majorants(vol, T, tri_material, tri_object, objects, triangles, camera,
                     grids=True):
     """Fill V_OBJ and V_MAJ of the heterogeneous rows of `vol` and their majorant grids
@@ -132,6 +147,7 @@ def bound_majorants(vol, T, tri_material, tri_object, objects, triangles, camera
         if len(peaks):
             np.maximum.at(cell_top, peak_cells,
                           point_values(vol, m, T, objects, camera, peaks))
+        cell_top = with_neighbours(cell_top)
         top = float(cell_top.max())
         vol[m, V_MAJ] = max(MAJORANT_SCALE * top, MU_FLOOR)
         if grids and m < maj.shape[0]:

@@ -12,10 +12,10 @@ zeros (no grid) for a material without a heterogeneous volume:
   MG_CELLS + ((i RES) + j) RES + k   cell (i, j, k)'s majorant
 
 A cell's majorant is MAJORANT_SCALE times the largest extinction or emission channel of
-the row's program found in it: at 2 x 2 x 2 jittered points of the cell, and at the
-centre of the largest voxel of each grid the program reads whose trilinear support
-reaches into the cell (a program that grows with its grids peaks at such a centre);
-never below FLOOR of the row's global majorant. The estimators stay unbiased for any
+the row's program found in it or in its 26 neighbours (majorant_bounds): at 2 x 2 x 2
+jittered points of each cell, and at the centre of the largest voxel of each grid the
+program reads whose trilinear support reaches into the cell (a program that grows with
+its grids peaks at such a centre); never below FLOOR of the row's global majorant. The estimators stay unbiased for any
 majorant above 0 (medium_density's docstring): the grid only moves where the
 collisions are taken.
 
