@@ -133,6 +133,33 @@ CAUSES = {
         "(fireflies and black pixels, unbiased but far from converged); cells now take "
         "their neighbours' samples too, and the fog's direct light is also sampled "
         "equiangularly towards the lamps (volumes.md)",
+    "github:Ibrahim71Reza/Blender_Projects@6dcffbc8e494f4969d6c81d96f20d6a294823118 "
+    "Water.blend":
+        "water under an area lamp whose node tree patterns its colour (two Wave Textures "
+        "through Color Ramps and a Mix: moving caustics) and whose Spread is 2 degrees: "
+        "DRT reads neither yet (both named in its report) and emits the lamp's own colour "
+        "over the whole hemisphere, so the scene is lit many times brighter than "
+        "Cycles' narrow patterned beam. Light node trees that vary and area Spread are "
+        "issue 27's, not built yet",
+    "github:Dime98/blender@f27344744f68fa6b995d29754bac5b01774b3fe6 smoke.blend":
+        "a world volume (Volume Scatter on the World Output) lit by a spot lamp, the file "
+        "set to write a movie (the measuring script now sets still images first): DRT "
+        "+51/+44/+38 %; not examined yet",
+    "github:io7m/com.io7m.visual.engineer_sleep@9c75b2ee39efcb418a1f25654220ef68ba8268b9 "
+    "bedroom.blend":
+        "both engines render it black (the means are 0 / 0): nothing to compare",
+    "github:jalilzod/BLENDER30DAYS_challenge@485530b816f287d349506c6f55c7e40e06d675fc "
+    "Shelf.blend":
+        "the file has no camera: neither engine renders it (DRT's error is Blender's)",
+    "github:nmeo7/blender-projects@70c203bd19146e92145648e19c096923b870139a "
+    "wallpaper.blend":
+        "a world volume (Volume Scatter on the World Output) lit by one lamp: blue "
+        "+8.0 % (red +0.5 %); not examined yet",
+    "github:Rpittrer/BlenderProjects@4301db0eca6933b0567e7f105ef5ed14fcc2ac98 "
+    "illenium.blend":
+        "twelve lamps, spots among them, and a world node program: the means match "
+        "(within 0.15 %), the worst block is 46 % against Cycles' own 24 %; not "
+        "examined yet",
     "github:mpett/blends@1e67d3ab9f5730c96c69858f6254a341e80405dc neon.blend":
         "a neon text (Mix Shader: its Fac a constant Color Ramp of a Gradient; a black "
         "Principled, and an Emission coloured by Layer Weight > Facing plus a blue Glossy) "

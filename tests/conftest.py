@@ -106,10 +106,18 @@ def cached_render(cache, bpy, path, engine, samples, setup=None, tag="") -> np.n
     return cache[key]
 
 
+def _still_images(settings):
+    """A file whose output is a movie (Blender 5's media type VIDEO offers only FFMPEG)
+    is set to write still images, so that OpenEXR can be picked."""
+    if getattr(settings, "media_type", "IMAGE") != "IMAGE":
+        settings.media_type = "IMAGE"
+
+
 def read_render_result(bpy, scene) -> np.ndarray:
     """Blender's Render Result as Blender writes it: scene-linear OpenEXR, read back as
     float64 (h, w, 3), row 0 at the top."""
     settings = scene.render.image_settings
+    _still_images(settings)
     settings.file_format = "OPEN_EXR"
     settings.color_depth = "32"
     with tempfile.TemporaryDirectory() as d:
@@ -121,6 +129,7 @@ def read_render_result(bpy, scene) -> np.ndarray:
 def read_render_rgba(bpy, scene) -> np.ndarray:
     """Blender's Render Result with its alpha, as (h * w, 4) float64 (bottom-up rows)."""
     settings = scene.render.image_settings
+    _still_images(settings)
     settings.file_format, settings.color_depth, settings.color_mode = "OPEN_EXR", "32", "RGBA"
     with tempfile.TemporaryDirectory() as d:
         path = os.path.join(d, "rgba.exr")
