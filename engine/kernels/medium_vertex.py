@@ -7,19 +7,21 @@ sampled from the phase function. As in Cycles a volume scattering counts as a bo
 is seen by lamps as a diffuse ray, and the scattering that uses up the volume (or the
 total) bounce budget ends the path where its ray arrives (path_weights.ends_path).
 
-The direct light of a homogeneous segment is estimated twice, and the two combined by
-multiple importance sampling over the distance (Cycles' "Multiple Importance" volume
-sampling): at the distance-sampled scattering (`scatter`, when the path scatters), and
-at a distance sampled equiangularly towards the picked light's position
-(`equiangular_light`, for every segment through a scattering medium, whether the path
-scatters or not: one more shadow ray). The scattering picks its light for its point
+The direct light of a segment is estimated twice, and the two combined by multiple
+importance sampling over the distance (Cycles' "Multiple Importance" volume sampling):
+at the distance-sampled scattering (`scatter`, when the path scatters), and at a
+distance sampled equiangularly towards the picked light's position (`equiangular_pick`
+and `equiangular_shade`, for every segment through a scattering medium, whether the
+path scatters or not: one more shadow ray). The scattering picks its light for its point
 (the light tree, lights/tree.py); the equiangular strategy picks one for the whole
 segment (the tree's segment form, lights/tree_segment.py, as Cycles does), before it
 knows its point. The weights are the power heuristic of the two strategies' densities
 of the pair (light, distance); a sun or the world, which has no position, is the
-distance strategy's alone. A heterogeneous segment is tracked (medium_density): its
-equiangular point's transmittance by ratio tracking, and the two strategies' densities
-are those of null-scattering paths (medium_density.tracked_point), as in Cycles."""
+distance strategy's alone. A homogeneous segment has both in closed form
+(`equiangular_light`). A heterogeneous one is tracked (medium_density.tracked_segment):
+its equiangular point's transmittance by ratio tracking, and the two strategies'
+densities are those of null-scattering paths (medium_density.equiangular_point), as
+in Cycles."""
 from __future__ import annotations
 
 import math
