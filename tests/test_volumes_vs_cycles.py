@@ -4,8 +4,9 @@ per kind of volume: fog in a box (Principled Volume, a volume-only material), ti
 forward-scattering fog (Color, Absorption Color, Anisotropy), multiple scattering
 (Volume Scatter, 4 volume bounces), fog in blobs (a Noise Texture through a Color Ramp
 on Density: a heterogeneous volume), the same fog lit by two point lamps inside it, an
-emitting volume, a world volume, the camera inside the fog, and coloured glass (a Glass
-BSDF with Volume Absorption inside).
+emitting volume, a world volume, a world volume lit by a spot beam beyond the camera's
+clip end (rays that reach it go on through the world's volume, as in Cycles), the camera
+inside the fog, and coloured glass (a Glass BSDF with Volume Absorption inside).
 
 Checks (tests/test_multiscatter_vs_cycles.py's `compare`): image means within 1 % per
 channel and every 8 x 8 block within 3 % of the image mean. Controls show each check
@@ -76,7 +77,8 @@ def _check(case, drt, cycles):
 
 
 @pytest.mark.parametrize("case", ["scatter", "tinted", "multiple", "noise", "noise_lamps",
-                                  "emission", "world", "camera_inside", "beam"])
+                                  "emission", "world", "camera_inside", "beam",
+                                  "clipped_world"])
 def test_volume_matches_cycles(bpy_drt, case):
     assert _check(case, *_pair(bpy_drt, case))
 

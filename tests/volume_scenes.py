@@ -165,6 +165,25 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
         fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled", {})
         noise_density(bpy, fog, "Principled Volume")
         cube(bpy, scene, "Fog", *fog_box, fog)
+    elif case == "clipped_world":
+        # thin fog filling the world under a grey sky, a spot beam crossing the view far
+        # beyond the camera's clip end (as smoke.blend, a public file): rays that reach
+        # the clip end go on through the world's volume (Cycles ends a missed ray's
+        # volume segment at infinity), so the sky behind the fog is not seen
+        lamp.data.energy = 50.0
+        nt = scene.world.node_tree
+        nt.nodes["Background"].inputs["Color"].default_value = (0.3, 0.3, 0.3, 1.0)
+        nt.nodes["Background"].inputs["Strength"].default_value = 1.0
+        v = nt.nodes.new("ShaderNodeVolumeScatter")
+        v.inputs["Density"].default_value = 0.02
+        nt.links.new(v.outputs[0], nt.nodes["World Output"].inputs["Volume"])
+        spot = bpy.data.objects.new("Spot", bpy.data.lights.new("Spot", "SPOT"))
+        spot.data.energy = 200000.0
+        spot.data.spot_size = math.radians(35.0)
+        spot.location = (-14.0, 30.0, 12.0)
+        spot.rotation_euler = (math.radians(-35.0), math.radians(-30.0), 0.0)
+        scene.collection.objects.link(spot)
+        cam.data.clip_end = 9.0
     elif case == "camera_inside":
         fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled", {"Density": 0.15})
         cube(bpy, scene, "Fog", (-5.0, -8.0, -0.5), (5.0, 5.0, 5.0), fog)
@@ -174,4 +193,4 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
 
 
 CASES = ("scatter", "tinted", "multiple", "noise", "absorption_glass", "clear_glass",
-         "emission", "world", "camera_inside", "beam", "noise_lamps")
+         "emission", "world", "camera_inside", "beam", "noise_lamps", "clipped_world")

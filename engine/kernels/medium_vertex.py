@@ -32,6 +32,7 @@ from . import equiangular as eq
 from . import lights as lt
 from . import ray_queues
 from .jit import kernel
+from .lights.lit_segment import lit_range
 from .shaded_emitter import radiance as emitter_radiance
 from . import light_tally as tl
 from .light_tally import VOLUME_SHARES
@@ -125,18 +126,21 @@ def distance_weight(lights, k, recv, time, dx, dy, dz, segment):
                                                               t_max), time)
     if not by_segment > 0.0:
         return 1.0
+    t_lo, t_hi = lit_range(lights, k, ox, oy, oz, dx, dy, dz, 0.0, t_max, time)
+    pe = eq.pdf(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_lo, t_hi, t)
+    if not pe > 0.0:
+        return 1.0                     # where the equiangular strategy never samples
     if int(method) == EQUIANGULAR:
         return 0.0
-    return power_heuristic(pd * lt.select_pdf(lights, k, recv, time),
-                           eq.pdf(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_max, t)
-                           * by_segment)
+    return power_heuristic(pd * lt.select_pdf(lights, k, recv, time), pe * by_segment)
 
 
 @kernel(allocates=False)
 def equiangular_pick(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, lights):
     """The equiangular strategy's sample on path p's segment o + t d, t in [0, t_max]:
     a light picked for the whole segment (before any point on it is known) and a
-    distance sampled towards its position. Returns (entry k, its pick probability, t,
+    distance sampled towards its position, on the part of the segment it can light
+    (lights/lit_segment.py). Returns (entry k, its pick probability, t,
     the distance's density); k = -1: none (no light, or one without a position)."""
     pkey, index, time = paths.key, paths.index, paths.time[p]
     kind, spp = cfg.sampler, cfg.spp
@@ -150,7 +154,8 @@ def equiangular_pick(depth, cfg, paths, p, ox, oy, oz, dx, dy, dz, t_max, lights
     has, cx, cy, cz = lt.entry_center(lights, k, time)
     if not has:
         return -1, 0.0, -1.0, 0.0
-    t, pe = eq.sample(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_max,
+    t_lo, t_hi = lit_range(lights, k, ox, oy, oz, dx, dy, dz, 0.0, t_max, time)
+    t, pe = eq.sample(ox, oy, oz, dx, dy, dz, cx, cy, cz, t_lo, t_hi,
                       sample_1d(kind, pkey[p], spp, index[p], volume_dim(depth, 3)))
     if not pe > 0.0:
         return -1, 0.0, -1.0, 0.0

@@ -171,13 +171,17 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
         g_phase = 0.0
         segment_mis = NO_SEGMENT_MIS             # no equiangular counterpart
         if volumes is not None and in_medium(stacks, p):
+            # A ray that reaches nothing goes on through its media to infinity, also past
+            # the camera's clip end (Cycles ends a missed ray's volume segment at
+            # FLT_MAX); lamps are still found only up to the ray's own end.
             vmode, scattered, t_end, br, bg, bb, seg, g_phase, segment_mis, ns_out = \
                 along_ray(depth, cfg, paths, p, tally, lights, vol, het is not None and
                           het_scene, textures, geometry, shadows, ns_out, ox, oy, oz, dx,
-                          dy, dz, t_geom, br, bg, bb, clamp_hit, vhit, regs, het_count,
-                          emitters)
+                          dy, dz, t_geom if hit else _INF, br, bg, bb, clamp_hit, vhit,
+                          regs, het_count, emitters)
         # 1a. area and sphere lamps in front of the geometry
-        lamps_in_front(tally, lights, paths, p, b, ox, oy, oz, dx, dy, dz, t_end,
+        lamps_in_front(tally, lights, paths, p, b, ox, oy, oz, dx, dy, dz,
+                       min(t_end, t_geom),
                        (vmode,) + seg,
                        vol.shape[0] > 0, mode, b0r, b0g, b0b, clamp_hit)
         if volumes is not None and scattered:
