@@ -64,7 +64,9 @@ CASES = {
                      "grey sky, a spot lamp's beam (200 kW, 35 degrees) crossing the view "
                      "far beyond the camera's clip end (9 m): a ray that reaches the clip "
                      "end goes on through the world's volume to infinity, as in Cycles, "
-                     "so the sky is not seen through the fog and the beam beyond is. "
+                     "so the sky is not seen through the fog and the beam beyond is. A "
+                     "sun (3 W/m2) gives no light at all through such a volume, in "
+                     "either engine. "
                      "Before 2026-12-03 DRT ended the volume at the clip end (smoke.blend, "
                      "a public file, was +51 % too bright).",
 }
@@ -226,9 +228,15 @@ def main(argv=None):
                          f"{100 * block:.1f} % | {ds:.1f} | {cs:.1f} |")
             sections += [f"## {case}", "", text, "", f"![{case}](images/{name})", ""]
     lines += [""] + sections + [
+        "## A volume that fills the world", "",
+        "A volume on the World Output fills all space, so, as in Cycles, no sun and no "
+        "world light reaches anything through it (their shadow rays are endless), and "
+        "the sky is not seen through it, also past the camera's clip end (the clipped_world "
+        "case); Blender warns that such a volume might need to be converted to an "
+        "object. Lamps with a position light it. Before 2026-12-03 DRT let sun and world "
+        "light through four scene radii of it, and camera rays saw the sky through what "
+        "lay beyond the clip end.", "",
         "## Known differences", "",
-        "- A world volume attenuates sun and world shadow rays over four scene radii "
-        "(Cycles: to infinity).",
         "- Phase functions other than Henyey-Greenstein are not rendered (warned); an "
         "Anisotropy that varies in space takes its average, and so does a world volume "
         "that varies (warned).",

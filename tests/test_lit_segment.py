@@ -13,6 +13,10 @@ equiangular sampling draws its distances from, and how far a ray's medium reache
   FLT_MAX): an absorbing world hides the sky whatever the clip end, and an emitting one
   shines E / sigma_t. Before, DRT ended camera rays' volume at the clip end and saw
   the sky through the rest (smoke.blend, a public file: +51 %).
+- Shadow rays towards a sun or the world are endless too: through a volume that fills
+  the world no sun light arrives (Cycles renders such a floor black; DRT let four scene
+  radii of fog attenuate it, 0.81 of the light at density 0.01), while a lamp with a
+  position lights the floor through exp(-sigma_t d) of it.
 """
 from __future__ import annotations
 
@@ -27,7 +31,7 @@ from engine.kernels import equiangular as eq
 from engine.kernels.lights import pack_lights
 from engine.kernels.lights.lit_segment import cone_range, lit_range
 from engine.lights import LightSet
-from engine.scene.lights import AreaLight, PointLight
+from engine.scene.lights import AreaLight, PointLight, SunLight
 from engine_scenes import look_at, quad
 
 
@@ -182,3 +186,29 @@ def test_missed_rays_go_on_through_the_world_volume_past_the_clip_end(clip_end):
     image = _world_fog(glowing, clip_end)
     np.testing.assert_allclose(image, np.broadcast_to((10.0, 5.0, 2.5), image.shape),
                                rtol=1e-9)
+
+
+def _floor_under(light, volume):
+    """A grey floor seen from 2 m above, lit by `light`, in a world filled by `volume`
+    (black sky): the image mean."""
+    cam = Camera(look_at((0.0, 0.0, 2.0), (0.0, 0.0, 0.0), up=(0.0, 1.0, 0.0)), lens=50.0)
+    floor = quad((0.0, 0.0, 0.0), (4.0, 0.0, 0.0), (0.0, 4.0, 0.0), material=0)
+    scene = Scene(cam, 8, 8, [floor], [Material("grey", (0.5, 0.5, 0.5))], [light],
+                  World((0.0, 0.0, 0.0), volume=volume))
+    film, stats = render(scene, RenderSettings(samples=16, seed=2))
+    assert stats.nonfinite_samples == 0
+    return float(film.mean().mean())
+
+
+def test_no_sun_light_passes_a_volume_that_fills_the_world():
+    sun = SunLight((0.0, 0.0, -1.0), (3.0, 3.0, 3.0))
+    fog = Volume(absorption=(0.01, 0.01, 0.01))
+    clear = _floor_under(sun, None)
+    assert clear > 0.1                                  # the control: lit without fog
+    assert _floor_under(sun, fog) == 0.0
+    # a lamp with a position lights the floor through the fog between them: exp(-0.2 x
+    # (2 m from the camera + 1 m from the lamp)) straight down, less aslant (the floor
+    # seen is within 0.72 m of the middle)
+    lamp = PointLight((0.0, 0.0, 1.0), (100.0, 100.0, 100.0))
+    ratio = _floor_under(lamp, Volume(absorption=(0.2, 0.2, 0.2))) / _floor_under(lamp, None)
+    assert math.exp(-0.2 * 3.5) < ratio < math.exp(-0.2 * 3.0)

@@ -137,7 +137,7 @@ def test_after_a_diffuse_bounce_burley_is_a_diffuse_lobe():
     from engine.kernels.path_config import PathConfig
     from engine.kernels.prepare_closures import prepare_closures
 
-    cfg = PathConfig(0, 1, 12, 4, 4, 12, 0, 0.0, 10.0, 0, 100.0, False, 1.0, True, True)
+    cfg = PathConfig(0, 1, 12, 4, 4, 12, 0, 0.0, 10.0, 0, False, 1.0, True, True)
     tables = kernel_tables()
     base = np.zeros(NPARAM)
     base[P_BASE:P_BASE + 3] = (0.8, 0.5, 0.3)

@@ -204,3 +204,22 @@ def test_volume_sampling_method_is_the_files(bpy_drt):
     assert fog_eq.volume.sampling == "EQUIANGULAR"
     vol = pack_volumes([fog, fog_eq], world_fog)
     assert list(vol[:, V_METHOD]) == [MULTIPLE_IMPORTANCE, EQUIANGULAR, DISTANCE]
+
+
+def test_a_sun_in_a_world_volume_is_named_in_the_report(bpy_drt):
+    """The exporter: a world volume that absorbs or scatters hides the sun lamps (their
+    light never arrives, in Cycles as in DRT): the report names them once; a world
+    volume without a sun, or a sun without one, says nothing of it."""
+    from drt_addon.export import export_scene
+    from drt_addon.export.errors import Reporter
+    warned = {}
+    for case in ("clipped_world", "world", "scatter"):
+        scene = volume_scenes.build(bpy_drt, case, SIZE)
+        if case == "scatter":
+            sun = bpy_drt.data.objects.new("Sun", bpy_drt.data.lights.new("Sun", "SUN"))
+            scene.collection.objects.link(sun)
+        rep = Reporter()
+        export_scene(bpy_drt.context.evaluated_depsgraph_get(), rep)
+        warned[case] = [w for w in rep.warnings if "sun lamp" in w]
+    assert len(warned["clipped_world"]) == 1 and "Sun" in warned["clipped_world"][0]
+    assert warned["world"] == [] and warned["scatter"] == []

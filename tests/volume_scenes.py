@@ -169,7 +169,8 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
         # thin fog filling the world under a grey sky, a spot beam crossing the view far
         # beyond the camera's clip end (as smoke.blend, a public file): rays that reach
         # the clip end go on through the world's volume (Cycles ends a missed ray's
-        # volume segment at infinity), so the sky behind the fog is not seen
+        # volume segment at infinity), so the sky behind the fog is not seen, nor does
+        # its light or a sun's reach anything
         lamp.data.energy = 50.0
         nt = scene.world.node_tree
         nt.nodes["Background"].inputs["Color"].default_value = (0.3, 0.3, 0.3, 1.0)
@@ -183,6 +184,11 @@ def build(bpy, case, size=(WIDTH, HEIGHT)):
         spot.location = (-14.0, 30.0, 12.0)
         spot.rotation_euler = (math.radians(-35.0), math.radians(-30.0), 0.0)
         scene.collection.objects.link(spot)
+        # and a sun, which gives no light at all through a volume that fills the world
+        sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", "SUN"))
+        sun.data.energy = 3.0
+        sun.rotation_euler = (math.radians(30.0), 0.0, math.radians(20.0))
+        scene.collection.objects.link(sun)
         cam.data.clip_end = 9.0
     elif case == "camera_inside":
         fog = volume_material(bpy, "Fog", "ShaderNodeVolumePrincipled", {"Density": 0.15})

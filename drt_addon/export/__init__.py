@@ -21,7 +21,7 @@ from .mesh import GEOMETRY_TYPES, MeshCache, instance_mesh, uv_request
 from .motion import MotionExport, read_settings
 from .object_info import object_info, object_values, random_id
 from .volume_objects import density_scale, domain, read_volume
-from .volumes import is_heterogeneous, world_volume
+from .volumes import is_heterogeneous, suns_blocked_message, world_volume
 from .world import export_world
 
 __all__ = ["BLACK_IMAGE", "ExportError", "RenderRegion", "Reporter", "export_scene",
@@ -260,6 +260,9 @@ def _export_scene(depsgraph, reporter, size, region, stats, tracker,
     if world_id is not None:
         world.volume = world_volume(world_id, reporter)
         world.lightgroup = _lightgroup(world_id)
+        blocked = suns_blocked_message(world.volume, lights)
+        if blocked:
+            reporter.warn(blocked, key="suns in a world volume")
     shutter = None
     if tracker is not None:
         shutter = tracker.finish(meshes, camera, lights)

@@ -342,3 +342,19 @@ def world_volume(world, reporter) -> "engine.Volume | None":
     v = export_volume(out.inputs.get("Volume"), ctx)
     ctx.report(reporter)
     return v
+
+
+def suns_blocked_message(volume, lights) -> str:
+    """What to tell the artist when a volume on the World Output, which fills all space,
+    hides the sun lamps: their light never arrives through it (their shadow rays are
+    endless), as in Cycles; "" when it does not (no such volume, one that only emits, or
+    no sun)."""
+    if volume is None or not (any(v > 0 for v in volume.absorption)
+                              or any(v > 0 for v in volume.scattering)):
+        return ""
+    suns = [light.name for light in lights if isinstance(light, engine.SunLight)]
+    if not suns:
+        return ""
+    return (f"the world's volume fills all space, so sun lamp(s) {', '.join(suns)} and "
+            "the world's light give no light through it, as in Cycles; to light fog "
+            "with a sun, put the fog in a volume object (a large cube)")

@@ -66,7 +66,7 @@ class CompiledPathIntegrator:
             else np.zeros(0)
         self.transparent_limit = s.transparent_bounces
         self._mode = "mis"
-        self.cfg = path_config(ctx.sampler, s, ctx.scene_radius, ctx.scene.film_transparent)
+        self.cfg = path_config(ctx.sampler, s, ctx.scene.film_transparent)
         self.geometry = surf.geometry(self.camera)
         self.params = kbsdf.pack_materials(mats)
         self.emission = np.ascontiguousarray(mats.emission, dtype=np.float64)

@@ -82,7 +82,7 @@ def scatter(depth, cfg, paths, p, px, py, pz, dx, dy, dz, br, bg, bb, g, tally, 
                        tl.entry_group(tally, k))
             else:
                 sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz,
-                                                         dist, margin, cfg.scene_radius)
+                                                         dist, margin)
                 ns = ray_queues.push(shadows, ns, p, bounce[p], px, py, pz, sdx, sdy, sdz,
                                      far, cr, cg, cb, paths.stacks, -1, -1, lprim)
                 tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))
@@ -222,7 +222,7 @@ def equiangular_shade(depth, cfg, paths, p, px, py, pz, dx, dy, dz, k, by_segmen
         tl.lit(tally, p, bounce[p], cr, cg, cb, clamp, VOLUME_SHARES, tl.entry_group(tally, k))
         return ns
     sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz, dist,
-                                             margin, cfg.scene_radius)
+                                             margin)
     ns = ray_queues.push(shadows, ns, p, bounce[p], px, py, pz, sdx, sdy, sdz, far, cr, cg,
                          cb, paths.stacks, -1, -1, lprim)
     tl.queued(tally, ns - 1, p, bounce[p], VOLUME_SHARES, tl.entry_group(tally, k))

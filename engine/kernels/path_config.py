@@ -19,14 +19,13 @@ class PathConfig(NamedTuple):
     clamp_indirect: float       # Clamping > Indirect Light (0: off)
     mis_mode: int               # path_weights' MIS (the power heuristic), LIGHT_ONLY or
     #                             BSDF_ONLY
-    scene_radius: float         # where lights at infinity stand (shadow rays' length)
     film_transparent: bool      # Film > Transparent: escaped camera rays leave alpha
     filter_glossy: float        # Light Paths > Filter Glossy (0: off)
     caustics_reflective: bool   # Light Paths > Caustics > Reflective
     caustics_refractive: bool   # ... Refractive
 
 
-def path_config(sampler, settings, scene_radius: float, film_transparent: bool,
+def path_config(sampler, settings, film_transparent: bool,
                 mis_mode: int = MIS) -> PathConfig:
     """The record of a render (engine.settings.RenderSettings), every field of one type."""
     s = settings
@@ -34,5 +33,5 @@ def path_config(sampler, settings, scene_radius: float, film_transparent: bool,
                       int(s.diffuse_bounces), int(s.glossy_bounces),
                       int(s.transmission_bounces), int(s.volume_bounces),
                       float(s.clamp_direct), float(s.clamp_indirect), int(mis_mode),
-                      float(scene_radius), bool(film_transparent), float(s.filter_glossy),
+                      bool(film_transparent), float(s.filter_glossy),
                       bool(s.caustics_reflective), bool(s.caustics_refractive))

@@ -135,7 +135,6 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
     film_transparent = cfg.film_transparent and alpha.shape[0] > 0
     kind, spp = cfg.sampler, cfg.spp
     clamp_direct, clamp_indirect, mode = cfg.clamp_direct, cfg.clamp_indirect, cfg.mis_mode
-    scene_radius = cfg.scene_radius
     n_lights = lt.n_entries(lights)
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
@@ -332,7 +331,7 @@ def shade_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, scen
                     positions, corners, corner_normals, cutoff, objects, prim, hit_inst[j],
                     hit_u[j], hit_v[j], px, py, pz, gx, gy, gz, s0x, s0y, s0z, wx, wy, wz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, px, py, pz, wx, wy,
-                                                         wz, dist, margin, scene_radius)
+                                                         wz, dist, margin)
                 bpdf = bsdf.pdf_seen(state, wox, woy, woz, lx, ly, lz, ad, ag, at,
                                      see_d, see_g, see_t)
                 shares = NO_SHARES

@@ -15,12 +15,13 @@ from .jit import kernel
 
 
 @kernel(allocates=False)
-def towards(sox, soy, soz, px, py, pz, wx, wy, wz, dist, margin, scene_radius):
+def towards(sox, soy, soz, px, py, pz, wx, wy, wz, dist, margin):
     """Direction and length of the shadow ray from origin so (for the shading point p)
-    towards direction w for `dist` (inf: a sun or the world): to the sampled point,
-    stopping `margin` short of it (a point on an emissive triangle, which the ray also
-    names: push's light_prim, Cycles' ls->prim), or a relative 2e-5 short where margin
-    is 0 (a lamp's)."""
+    towards direction w for `dist` (inf: a sun or the world, and the ray is endless, so
+    a volume that fills the world lets nothing through, as in Cycles): to the sampled
+    point, stopping `margin` short of it (a point on an emissive triangle, which the ray
+    also names: push's light_prim, Cycles' ls->prim), or a relative 2e-5 short where
+    margin is 0 (a lamp's)."""
     sdx, sdy, sdz = wx, wy, wz
     if math.isfinite(dist):
         tx = px + wx * dist - sox
@@ -31,7 +32,7 @@ def towards(sox, soy, soz, px, py, pz, wx, wy, wz, dist, margin, scene_radius):
             sdx, sdy, sdz = tx / seg, ty / seg, tz / seg
         far = seg - margin if margin > 0.0 else seg * (1.0 - 2e-5)
     else:
-        far = scene_radius * 4.0
+        far = math.inf
     return sdx, sdy, sdz, max(far, 0.0)
 
 

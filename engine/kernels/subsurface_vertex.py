@@ -187,8 +187,7 @@ def scatter_below(cfg, key, p, paths, rays, geometry, row, prim, inst, front, px
                     geometry[0], geometry[1], geometry[4], geometry[13], geometry[9], prim2,
                     inst2, u, v, qx, qy, qz, hx, hy, hz, n0x, n0y, n0z, lx, ly, lz)
                 sdx, sdy, sdz, far = ray_queues.towards(sox, soy, soz, qx, qy, qz, lx, ly,
-                                                         lz, dist, margin,
-                                                         cfg.scene_radius)
+                                                         lz, dist, margin)
                 ns = ray_queues.push(shadows, ns, p, b, sox, soy, soz, sdx, sdy, sdz, far, cr,
                                      cg, cb, stacks, own, inst2, lprim)
                 tl.queued(tally, ns - 1, p, b, DIFFUSE_SHARES, tl.entry_group(tally, k))

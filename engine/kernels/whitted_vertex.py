@@ -116,7 +116,6 @@ def whitted_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sc
     kind, spp = cfg.sampler, cfg.spp
     max_bounces = cfg.max_bounces
     clamp_direct, clamp_indirect = cfg.clamp_direct, cfg.clamp_indirect
-    scene_radius = cfg.scene_radius
     lamps = lights[LAMPS]
     state = np.empty(bsdf.NSTATE)
     row = np.empty(params.shape[1])
@@ -228,7 +227,7 @@ def whitted_by_ref(depth, cfg, paths, tally, live, ro, rd, rt, hits, stopped, sc
                 _add(tally.L, p, cr, cg, cb, clamp)
                 continue
             sdx, sdy, sdz, far = ray_queues.towards(px, py, pz, px, py, pz, wx, wy, wz,
-                                                     dist, 0.0, scene_radius)
+                                                     dist, 0.0)
             ns_out = ray_queues.push(shadows, ns_out, p, b, px, py, pz, sdx, sdy, sdz, far,
                                      cr, cg, cb, stacks, prim, hit_inst[j])
         # 3. one ray of Whitted's tree: mirror reflection or refraction
