@@ -142,9 +142,13 @@ CAUSES = {
         "Cycles' narrow patterned beam. Light node trees that vary and area Spread are "
         "issue 27's, not built yet",
     "github:Dime98/blender@f27344744f68fa6b995d29754bac5b01774b3fe6 smoke.blend":
-        "a world volume (Volume Scatter on the World Output) lit by a spot lamp, the file "
-        "set to write a movie (the measuring script now sets still images first): DRT "
-        "+51/+44/+38 %; not examined yet",
+        "a world volume (Volume Scatter on the World Output) lit by a 70 kW spot lamp, the "
+        "camera's clip end at 100 m: DRT was +51/+44/+38 % because its camera rays ended "
+        "the volume at the clip end and saw the sky through the rest, where Cycles goes "
+        "on through the volume to infinity; with that (2026-12-03) the sky was a field of "
+        "noise (equiangular distances drawn along an endless ray, mostly outside the "
+        "spot's cone), and drawn inside the cone, as Cycles draws them, it is as smooth "
+        "as Cycles'. tests/volume_scenes.py's clipped_world case is this file's setting",
     "github:io7m/com.io7m.visual.engineer_sleep@9c75b2ee39efcb418a1f25654220ef68ba8268b9 "
     "bedroom.blend":
         "both engines render it black (the means are 0 / 0): nothing to compare",
@@ -153,8 +157,11 @@ CAUSES = {
         "the file has no camera: neither engine renders it (DRT's error is Blender's)",
     "github:nmeo7/blender-projects@70c203bd19146e92145648e19c096923b870139a "
     "wallpaper.blend":
-        "a world volume (Volume Scatter on the World Output) lit by one lamp: blue "
-        "+8.0 % (red +0.5 %); not examined yet",
+        "a world volume (Volume Scatter on the World Output) under a sun and a Noise "
+        "Texture sky: blue was +8.0 % because DRT let the sun and the sky light the scene "
+        "through four scene radii of the volume, where Cycles' shadow rays towards them "
+        "are endless and none of their light arrives; since 2026-12-03 DRT does the same "
+        "and names the sun in its report: the means within 0.3 %, within the noise",
     "github:Rpittrer/BlenderProjects@4301db0eca6933b0567e7f105ef5ed14fcc2ac98 "
     "illenium.blend":
         "twelve lamps, spots among them, and a world node program: the means match "
