@@ -39,7 +39,7 @@ TESTS = ["tests/test_anisotropic_vs_cycles.py", "tests/test_coat_normal_vs_cycle
          "tests/test_bounce_budget_vs_cycles.py", "tests/test_caustics_switches_vs_cycles.py",
          "tests/test_shadow_ray_glass_vs_cycles.py", "tests/test_lights_vs_cycles.py",
          "tests/test_displacement_vs_cycles.py", "tests/test_ao_pass.py",
-         "tests/test_mixed_emission_vs_cycles.py"]
+         "tests/test_mixed_emission_vs_cycles.py", "tests/test_area_spread_vs_cycles.py"]
 
 
 def run_tests(tests) -> dict:

@@ -10,7 +10,10 @@ Units (Blender's, checked against Cycles 5.0, see ../shared/notes/blender-facts.
 - Sun: strength is irradiance (W/m^2) at normal incidence; with an angular diameter a > 0
   it is a uniform cone of half-angle a/2 and radiance E / (pi sin^2(a/2)).
 - Area: one-sided along the light's -Z, radiance S / (pi A) with A the world-space area
-  (pi/4 x size product for disks and ellipses); `normalize` off drops the 1/A.
+  (pi/4 x size product for disks and ellipses); `normalize` off drops the 1/A. A Spread
+  below 180 degrees (half angle h) weighs the radiance leaving at angle a from the
+  normal by Cycles' soft-box grid, max(tan h - tan a, 0) / (tan h - h) (3 / h^3 for h
+  <= 0.05), which keeps the lamp's power (kernels/lights/area.py).
 - Emissive triangles (engine.mesh_lights): radiance = the material's emission, two-sided.
 
 Every light model has its parameters (what engine.kernels.lights.pack puts in a row) and
@@ -130,9 +133,27 @@ class AreaLightModel:
         self.lx, self.ly = lx, ly
         self.zh = np.cross(self.xh, self.yh)
         self.corner = self.center - self.ax - self.ay
+        self.tan_half_spread, self.normalize_spread = spread_parameters(light.spread)
 
     def power(self, scene_radius):
         return luminance(self.radiance) * np.pi * self.area
+
+
+MIN_HALF_SPREAD = 1e-4     # radians: a Spread of 0 (Cycles: a single direction) is this
+
+
+def spread_parameters(spread) -> tuple:
+    """(tan h, normalisation) of an area lamp's Spread (full angle, radians; h the half
+    angle), as Cycles computes them; (0, 0) for a lamp that emits over the hemisphere.
+    The normalisation keeps the power: the integral of cos(a) (tan h - tan a) over the
+    cone of half angle h is pi (tan h - h)."""
+    spread = float(spread) if np.isfinite(spread) else np.pi
+    half = 0.5 * min(max(spread, 0.0), np.pi)
+    if half >= 0.5 * np.pi - 1e-6:
+        return 0.0, 0.0
+    half = max(half, MIN_HALF_SPREAD)
+    tan_h = float(np.tan(half))
+    return tan_h, (1.0 / (tan_h - half) if half > 0.05 else 3.0 / half ** 3)
 
 
 class TimeSlicedLight:

@@ -111,6 +111,21 @@ def scene(name):
                             (6, 6, 6), "RECTANGLE", 1.0, 0.5),           # parallelogram
                   AreaLight(matrix((0.2, 0.0, 3.0), (1, 0, 0), np.pi, (-1, 1, 1)),
                             (7, 7, 7), "SQUARE", 0.9, normalize=False)]  # mirrored
+    elif name == "spread":
+        # area lamps whose Spread narrows their emission (full angles, radians): sampled
+        # in the part of the lamp that can light the point (kernels/lights/area.py)
+        lights = [AreaLight(matrix((0, 0, 2), (1, 0, 0), np.pi, (1.5, 0.7, 1)),
+                            (20, 18, 16), "SQUARE", 0.7, spread=1.0),
+                  AreaLight(matrix((1, -1, 1.5), (1, 1, 0), 2.6, (1, 2, 1)),
+                            (9, 9, 9), "RECTANGLE", 1.2, 0.4, spread=0.17),
+                  AreaLight(matrix((-1, 0.5, 2.2), (0.3, 1, 0.2), 2.9, (0.5, 0.5, 0.5)),
+                            (5, 6, 7), "DISK", 0.5, spread=0.5),
+                  AreaLight(matrix((0.5, 1.5, 1.8), (1, 0, 0.4), 3.0, (1.3, 0.6, 1)),
+                            (8, 4, 2), "ELLIPSE", 0.8, 0.3, spread=0.09),
+                  AreaLight(matrix((-1.2, -1.0, 1.0), (0, 1, 0), 2.8, (1, 1, 1), shear=0.4),
+                            (6, 6, 6), "RECTANGLE", 1.0, 0.5, spread=0.7),
+                  AreaLight(matrix((0.2, 0.0, 3.0), (1, 0, 0), np.pi, (1, 1, 1)),
+                            (7, 7, 7), "SQUARE", 2.0, spread=0.0)]      # the least spread
     elif name == "world":
         lights = [PointLight((0.3, -0.2, 1.5), (10, 8, 6))]
     elif name == "triangles":
@@ -126,7 +141,7 @@ def scene(name):
                             "DISK", 1e-6)]
     elif name == "all":
         lights = (scene("point")[0] + scene("sphere")[0] + scene("disc")[0]
-                  + scene("sun")[0] + scene("area")[0])
+                  + scene("sun")[0] + scene("area")[0] + scene("spread")[0])
     elif name == "empty":
         lights = []
     else:
@@ -144,8 +159,8 @@ def scene(name):
     return lights, mesh, world, 5.0, np.array(anchors)
 
 
-SCENES = ["point", "sphere", "disc", "sun", "area", "world", "triangles", "tiny", "all",
-          "empty"]
+SCENES = ["point", "sphere", "disc", "sun", "area", "spread", "world", "triangles", "tiny",
+          "all", "empty"]
 
 
 def light_set(name):

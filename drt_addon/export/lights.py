@@ -113,13 +113,9 @@ def export_light(obj, matrix_world, reporter: Reporter):
             reporter.warn(f"DRT: area light {obj.name!r} has zero size; it is skipped, as "
                           "Cycles does", key=(obj.name, "zero size"))
             return None
-        spread = float(getattr(light, "spread", math.pi))
-        if spread < math.pi - 1e-6:
-            reporter.warn(f"DRT: area light {obj.name!r} has a spread of "
-                          f"{math.degrees(spread):.0f} degrees; DRT emits over the full "
-                          "hemisphere (180 degrees)", key=(obj.name, "spread"))
         return engine.AreaLight(m, strength, shape=light.shape, size_x=float(light.size),
                                 size_y=float(light.size_y), normalize=_normalize(light),
+                                spread=float(getattr(light, "spread", math.pi)),
                                 visible_camera=bool(vis & visibility.CAMERA),
                                 name=obj.name, visibility=vis)
     reporter.warn(f"DRT: light {obj.name!r} of type {light.type} is not supported; skipped")

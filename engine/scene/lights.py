@@ -2,6 +2,8 @@
 sphere lights), `SunLight` and `AreaLight`."""
 from __future__ import annotations
 
+import math
+
 from dataclasses import dataclass
 from typing import Optional
 
@@ -53,13 +55,16 @@ class AreaLight:
 
     matrix: 4x4 light-to-world transform (scale allowed), shape one of 'SQUARE',
     'RECTANGLE', 'DISK', 'ELLIPSE'; size_x/size_y in local units; strength RGB watts;
-    normalize as Blender's `normalize` (radiance divided by the area when True)."""
+    normalize as Blender's `normalize` (radiance divided by the area when True); spread
+    the full angle (radians) of the cone each point emits into, Blender's Spread (pi:
+    the whole hemisphere)."""
     matrix: np.ndarray
     strength: tuple
     shape: str = "SQUARE"
     size_x: float = 1.0
     size_y: float = 1.0
     normalize: bool = True
+    spread: float = math.pi
     visible_camera: bool = True
     name: str = "area"
     visibility: int = 31           # the ray kinds that see it (engine.visibility)

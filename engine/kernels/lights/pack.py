@@ -161,7 +161,10 @@ C_ZH = 65           # 3: xh cross yh
 C_CORNER = 68       # 3: center - ax - ay
 # world
 C_ENV_PDF = 71
-N_COLUMNS = 72
+# area, continued
+C_TAN_SPREAD = 72   # tan of half the Spread (0: the whole hemisphere)
+C_NORM_SPREAD = 73  # the Spread's normalisation (engine.lights.spread_parameters)
+N_COLUMNS = 74
 
 
 def _put(row, col, values):
@@ -213,6 +216,8 @@ def _lamp_row(model) -> np.ndarray:
         _put(row, C_YH, model.yh)
         _put(row, C_ZH, model.zh)
         _put(row, C_CORNER, model.corner)
+        row[C_TAN_SPREAD] = model.tan_half_spread
+        row[C_NORM_SPREAD] = model.normalize_spread
     elif isinstance(model, EnvironmentLightModel):
         row[C_TYPE] = T_ENV
         _put(row, C_RAD, model.radiance)

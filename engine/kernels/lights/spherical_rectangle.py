@@ -57,8 +57,9 @@ def _times(ar, ai, br, bi):
 
 
 @kernel(allocates=False)
-def spherical_rectangle(lamps, k, px, py, pz):
-    """The rectangle of lamp k seen from p, in its local frame:
+def spherical_rectangle(lamps, k, px, py, pz, s_lo, s_hi, t_lo, t_hi):
+    """The part [s_lo, s_hi] x [t_lo, t_hi] of lamp k's rectangle (its (s, t)
+    coordinates, [-1, 1] over the whole lamp) seen from p, in its local frame:
     (x0, x1, y0, y1, z_signed, z, cos k, sin k, solid_angle), k the map's starting
     angle."""
     dx = lamps[k, C_CORNER] - px
@@ -68,8 +69,10 @@ def spherical_rectangle(lamps, k, px, py, pz):
     y0 = dx * lamps[k, C_YH] + dy * lamps[k, C_YH + 1] + dz * lamps[k, C_YH + 2]
     zs = dx * lamps[k, C_ZH] + dy * lamps[k, C_ZH + 1] + dz * lamps[k, C_ZH + 2]
     z = abs(zs)
-    x1 = x0 + lamps[k, C_LX]
-    y1 = y0 + lamps[k, C_LY]
+    x1 = x0 + 0.5 * (s_hi + 1.0) * lamps[k, C_LX]
+    y1 = y0 + 0.5 * (t_hi + 1.0) * lamps[k, C_LY]
+    x0 = x0 + 0.5 * (s_lo + 1.0) * lamps[k, C_LX]
+    y0 = y0 + 0.5 * (t_lo + 1.0) * lamps[k, C_LY]
     z2 = z * z
     c0r, c0i = _corner(x1, y0, z, z2, 1.0)
     c1r, c1i = _corner(x1, y1, z, z2, -1.0)

@@ -29,8 +29,8 @@ import numpy as np
 from ..jit import kernel
 from .pack import (C_AREA, C_AX, C_AXIS, C_AY, C_CENTER, C_COS_HALF, C_INTENSITY,
                    C_IS_SPOT, C_IRRADIANCE, C_NORMAL, C_ONE_MINUS, C_POS, C_RAD, C_RADIUS,
-                   C_TO_LIGHT, C_TYPE, LAMP_SLICES, LAMPS, SLICE_OF, T_AREA, T_DISC,
-                   T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA, TRI_AREA, TRI_E1, TRI_E2,
+                   C_TAN_SPREAD, C_TO_LIGHT, C_TYPE, LAMP_SLICES, LAMPS, SLICE_OF, T_AREA,
+                   T_DISC, T_POINT, T_SPHERE, T_SUN, T_SUN_DELTA, TRI_AREA, TRI_E1, TRI_E2,
                    TRI_NORMAL, TRI_RADIANCE, TRI_V0, TRI_VISIBILITY, NEE_BACK_OFF,
                    NEE_FRONT_OFF)
 from .tree_cone import EMPTY, box_measure, measure, merge
@@ -120,7 +120,9 @@ def _lamp_measure(L, k, models, e):
         e[E_MAX:E_MAX + 3] = corners.max(axis=0)
         e[E_CENTROID:E_CENTROID + 3] = row[C_CENTER:C_CENTER + 3]
         e[E_ENERGY] = np.abs(row[C_RAD:C_RAD + 3]).mean() * row[C_AREA]
-        e[E_THETA_O], e[E_THETA_E] = _slices_cone(rows, C_NORMAL, -1.0, PI / 2, e)
+        # a Spread narrows each point's emission to its half angle (Cycles' theta_e)
+        spread = math.atan(row[C_TAN_SPREAD]) if row[C_TAN_SPREAD] != 0.0 else PI / 2
+        e[E_THETA_O], e[E_THETA_E] = _slices_cone(rows, C_NORMAL, -1.0, spread, e)
         return False
     if kind in (T_SUN, T_SUN_DELTA):
         half = 0.0 if kind == T_SUN_DELTA else 2.0 * math.asin(math.sqrt(
