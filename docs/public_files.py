@@ -137,10 +137,11 @@ CAUSES = {
     "Water.blend":
         "water under an area lamp whose node tree patterns its colour (two Wave Textures "
         "through Color Ramps and a Mix: moving caustics) and whose Spread is 2 degrees: "
-        "DRT reads neither yet (both named in its report) and emits the lamp's own colour "
-        "over the whole hemisphere, so the scene is lit many times brighter than "
-        "Cycles' narrow patterned beam. Light node trees that vary and area Spread are "
-        "issue 27's, not built yet",
+        "since 2026-12-03 DRT renders the Spread (its beam is as narrow as Cycles'), but "
+        "not yet a light node tree that varies (named in its report): it emits the "
+        "lamp's own white over the whole lamp where Cycles' Wave Textures let through "
+        "thin bright streaks, so the scene is lit many times brighter. Light node trees "
+        "that vary are issue 27's, not built yet",
     "github:Dime98/blender@f27344744f68fa6b995d29754bac5b01774b3fe6 smoke.blend":
         "a world volume (Volume Scatter on the World Output) lit by a 70 kW spot lamp, the "
         "camera's clip end at 100 m: DRT was +51/+44/+38 % because its camera rays ended "
