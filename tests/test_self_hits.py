@@ -38,10 +38,11 @@ def test_a_ray_names_its_triangle_and_meets_a_coincident_face_at_distance_zero(c
     named = coincident.intersect(o, up, np.full(2, np.inf), skip=np.array([[0, -1], [-1, -1]]))
     assert named.prim[0] in (2, 3) and named.t[0] == 0.0
     assert named.prim[1] in (0, 2, 3) and named.t[1] == 0.0
-    # leaving the copy as well: the ceiling, at its exact distance
+    # leaving the copy as well: the ceiling, at its distance to two float32 ulps (how
+    # Embree divides depends on the CPU: 1.0 on some, 0.99999994 on a 2-core EPYC)
     acc = Accelerator([quad(), quad(1.0, name="ceiling")], threads=1)
     h = acc.intersect(o[:1], up[:1], np.full(1, np.inf), skip=np.array([[0, -1]]))
-    assert h.prim[0] in (2, 3) and h.t[0] == 1.0
+    assert h.prim[0] in (2, 3) and abs(h.t[0] - 1.0) <= 2 * np.finfo(np.float32).eps
     acc.close()
 
 

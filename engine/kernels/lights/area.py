@@ -34,10 +34,10 @@ def _uses_solid_angle(lamps, k, z, omega):
 
 @kernel(allocates=False)
 def spread_factor(lamps, k, wx, wy, wz):
-    """The Spread's weight of the light lamp k sends back along the unit direction w
-    (from a receiver towards the lamp): max(tan h - tan a, 0) times the normalisation,
-    a the angle between -w's reverse and the lamp's emitting normal; 1 without a
-    Spread."""
+    """The Spread's weight of the light lamp k sends to a receiver that sees it along
+    the unit direction w: max(tan h - tan a, 0) times the normalisation, a the angle
+    between the light's way out (-w) and the lamp's axis (-Z, so cos a = w . Z); 1
+    without a Spread."""
     tan_h = lamps[k, C_TAN_SPREAD]
     if tan_h == 0.0:
         return 1.0
