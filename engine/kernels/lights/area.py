@@ -66,20 +66,25 @@ def spread_window(lamps, k, px, py, pz):
     r = z * lamps[k, C_TAN_SPREAD]
     # the foot, relative to the centre: -(v - z n)
     qx, qy, qz = z * nx - vx, z * ny - vy, z * nz - vz
-    lo_s = hi_s = lo_t = hi_t = 0.0
-    for axis in range(2):
-        ix, iy, iz = (lamps[k, C_INV + 3 * axis], lamps[k, C_INV + 3 * axis + 1],
-                      lamps[k, C_INV + 3 * axis + 2])
-        centre = qx * ix + qy * iy + qz * iz
-        dn = ix * nx + iy * ny + iz * nz            # the row, in the lamp's plane
-        px_, py_, pz_ = ix - dn * nx, iy - dn * ny, iz - dn * nz
-        half = r * math.sqrt(px_ * px_ + py_ * py_ + pz_ * pz_)
-        lo, hi = max(centre - half, -1.0), min(centre + half, 1.0)
-        if axis == 0:
-            lo_s, hi_s = lo, hi
-        else:
-            lo_t, hi_t = lo, hi
-    return lo_s, hi_s, lo_t, hi_t
+    s_lo, s_hi = _window_side(lamps, k, 0, qx, qy, qz, nx, ny, nz, r)
+    t_lo, t_hi = _window_side(lamps, k, 1, qx, qy, qz, nx, ny, nz, r)
+    return s_lo, s_hi, t_lo, t_hi
+
+
+@kernel(allocates=False)
+def _window_side(lamps, k, axis, qx, qy, qz, nx, ny, nz, r):
+    """The range of lamp k's coordinate `axis` (0: s, 1: t) over the disc of radius r
+    about the in-plane point q (relative to the centre), clipped to [-1, 1]: the
+    coordinate is q . row of the inverse frame, so the disc spans r times the row's
+    length in the lamp's plane either side."""
+    ix = lamps[k, C_INV + 3 * axis]
+    iy = lamps[k, C_INV + 3 * axis + 1]
+    iz = lamps[k, C_INV + 3 * axis + 2]
+    centre = qx * ix + qy * iy + qz * iz
+    dn = ix * nx + iy * ny + iz * nz
+    ux, uy, uz = ix - dn * nx, iy - dn * ny, iz - dn * nz
+    half = r * math.sqrt(ux * ux + uy * uy + uz * uz)
+    return max(centre - half, -1.0), min(centre + half, 1.0)
 
 
 @kernel(allocates=False)
@@ -138,6 +143,14 @@ def sample_area(lamps, k, px, py, pz, u0, u1):
 
 
 @kernel(allocates=False)
+def _lamp_coords(lamps, k, qx, qy, qz):
+    """(s, t): the in-plane offset q from lamp k's centre in its coordinates ([-1, 1]^2
+    over its parallelogram, the unit disc for the round shapes)."""
+    return (qx * lamps[k, C_INV] + qy * lamps[k, C_INV + 1] + qz * lamps[k, C_INV + 2],
+            qx * lamps[k, C_INV + 3] + qy * lamps[k, C_INV + 4] + qz * lamps[k, C_INV + 5])
+
+
+@kernel(allocates=False)
 def intersect_area(lamps, k, ox, oy, oz, dx, dy, dz):
     """Where one ray meets area lamp k: (t or inf, r, g, b); only the emitting
     side (rays travelling along the light's +Z) hits."""
@@ -154,8 +167,7 @@ def intersect_area(lamps, k, ox, oy, oz, dx, dy, dz):
     qx = ox + dx * tq - cx
     qy = oy + dy * tq - cy
     qz = oz + dz * tq - cz
-    s = qx * lamps[k, C_INV] + qy * lamps[k, C_INV + 1] + qz * lamps[k, C_INV + 2]
-    u = qx * lamps[k, C_INV + 3] + qy * lamps[k, C_INV + 4] + qz * lamps[k, C_INV + 5]
+    s, u = _lamp_coords(lamps, k, qx, qy, qz)
     if lamps[k, C_ROUND] != 0.0:
         inside = s * s + u * u <= 1.0
     else:
@@ -184,8 +196,7 @@ def pdf_area(lamps, k, px, py, pz, wix, wiy, wiz, t):
         qx = px + wix * t - lamps[k, C_CENTER]
         qy = py + wiy * t - lamps[k, C_CENTER + 1]
         qz = pz + wiz * t - lamps[k, C_CENTER + 2]
-        s = qx * lamps[k, C_INV] + qy * lamps[k, C_INV + 1] + qz * lamps[k, C_INV + 2]
-        u = qx * lamps[k, C_INV + 3] + qy * lamps[k, C_INV + 4] + qz * lamps[k, C_INV + 5]
+        s, u = _lamp_coords(lamps, k, qx, qy, qz)
         if not (s_lo <= s <= s_hi and t_lo <= u <= t_hi):
             return 0.0                   # outside the window: never sampled from p
         area = _window_area(lamps, k, s_lo, s_hi, t_lo, t_hi)
